@@ -1,0 +1,239 @@
+"""The checks: one Pinocchio quantity against its closed form, on many states.
+
+Error measure
+-------------
+Every comparison is made in diagonally scaled coordinates z_i = √S_i·θ_i, with
+S_i the model's inertia scale of coordinate i (``diagonal_scale``), so that a
+cart in kg and a rod in kg·m² are judged on one footing and raw κ(M), which
+mostly reflects units, does not inflate tolerances.  In these coordinates
+M̃ = S^{-½} M S^{-½} has entries of order one, forces scale by S^{-½} and
+accelerations by S^{½}.
+
+For each state the check computes the error e, a *scale* s (the size of the
+terms that produced the quantity, including cancellation and, for inverses and
+accelerations, the conditioning ‖M̃⁻¹‖) and passes when
+
+    e ≤ K·ε·(1 + |θ|max)·s + a,
+
+where ε is machine epsilon, K the check's named constant, (1 + |θ|max) the
+growth of rounding in angles as large as |θ| (cos(θ + 2πk) is only as exact as
+θ is), and a the known model-form allowance (zero unless the URDF lies outside
+the seed's family, see ``pendverify.robot``).  Reported: e/s and the tolerance
+(K·ε·(1 + |θ|max) + a/s) at the worst state, the state with the largest
+e / tolerance.
+
+How Ṁ is obtained (skew check): from Pinocchio's analytic RNEA derivatives with
+gravity off, Ṁ e_j = ∂τ/∂q(q, 0, e_j)·q̇, which does not use its Coriolis matrix.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from pendverify.analytic import ClosedFormModel
+from pendverify.robot import PinocchioSystem
+from pendverify.sampling import State
+
+EPS = float(np.finfo(float).eps)
+
+
+@dataclass(frozen=True)
+class Sample:
+    error: float
+    scale: float
+    allowance: float = 0.0
+    note: str = ""
+
+
+@dataclass(frozen=True)
+class Check:
+    name: str
+    pinocchio: str
+    closed_form: str
+    K: float
+    evaluate: Callable[[ClosedFormModel, PinocchioSystem, State], Sample]
+
+
+@dataclass
+class CheckResult:
+    """The evidence of one check on one model: errors, tolerance, where it was worst."""
+
+    model: str
+    check: str
+    description: str
+    max_error: float
+    tolerance: float
+    max_abs_error: float
+    samples: int
+    seed: int
+    worst_state: dict
+    passed: bool
+    notes: list[str] = field(default_factory=list)
+
+    def as_dict(self) -> dict:
+        return dict(self.__dict__)
+
+
+# --- scaled-coordinate helpers ------------------------------------------------------------
+def _weights(model, q):
+    return 1.0 / np.sqrt(model.diagonal_scale(q))
+
+
+def _scaled_matrix(A, w):
+    return A * np.outer(w, w)
+
+
+def _angular_rate(model, v) -> float:
+    return float(np.max(np.abs(v[np.array(model.angular)]), initial=0.0))
+
+
+def _norm2(A) -> float:
+    return float(np.linalg.norm(A, 2))
+
+
+def _force_scale(model, state, w) -> float:
+    """Size of the generalized forces acting, in scaled units (sum of |terms|)."""
+    rate = _angular_rate(model, state.v)
+    zdot = state.v / w
+    coriolis = rate * np.sum(np.abs(zdot))
+    gravity = np.max(w * model.gravity_scale())
+    applied = w * (
+        np.abs(model.input_matrix()) @ np.abs(state.u)
+        + np.abs(model.disturbance_matrix()) @ np.abs(state.w)
+        + np.abs(model.damping_matrix()) @ np.abs(state.v)
+    )
+    return float(coriolis + gravity + np.max(applied, initial=0.0))
+
+
+def _allowance(system) -> np.ndarray:
+    a = system.geometry.gravity_allowance
+    return np.zeros(system.model.nv) if a is None else a
+
+
+# --- the checks ---------------------------------------------------------------------------
+def _crba(model, system, s):
+    w = _weights(model, s.q)
+    err = np.max(np.abs(_scaled_matrix(system.mass_matrix(s.q) - model.mass_matrix(s.q), w)))
+    return Sample(err, 1.0)
+
+
+def _rnea(model, system, s):
+    w = _weights(model, s.q)
+    err = np.max(w * np.abs(system.bias(s.q, s.v) - model.bias(s.q, s.v)))
+    zdot = s.v / w
+    scale = _angular_rate(model, s.v) * np.sum(np.abs(zdot)) + np.max(w * model.gravity_scale())
+    return Sample(err, scale, float(np.max(w * _allowance(system))))
+
+
+def _gravity(model, system, s):
+    w = _weights(model, s.q)
+    err = np.max(w * np.abs(system.gravity(s.q) - model.gravity(s.q)))
+    return Sample(err, float(np.max(w * model.gravity_scale())), float(np.max(w * _allowance(system))))
+
+
+def _coriolis(model, system, s):
+    w = _weights(model, s.q)
+    diff = system.coriolis_matrix(s.q, s.v) - model.coriolis_matrix(s.q, s.v)
+    return Sample(np.max(np.abs(_scaled_matrix(diff, w))), max(_angular_rate(model, s.v), 1.0))
+
+
+def _skew(model, system, s):
+    w = _weights(model, s.q)
+    N = system.mass_matrix_derivative(s.q, s.v) - 2 * model.coriolis_matrix(s.q, s.v)
+    return Sample(np.max(np.abs(_scaled_matrix(N + N.T, w))), max(_angular_rate(model, s.v), 1.0))
+
+
+def _det(model, system, s):
+    scale = float(np.prod(model.diagonal_scale(s.q)))
+    closed, lu = model.det_mass_matrix(s.q), system.det_mass_matrix(s.q)
+    if not (closed > 0 and lu > 0):
+        return Sample(np.inf, scale, note=f"det M not positive: closed form {closed:.3g}, LU {lu:.3g}")
+    return Sample(abs(closed - lu), scale)
+
+
+def _minverse(model, system, s):
+    sqrt_s = 1.0 / _weights(model, s.q)
+    diff = system.inverse_mass_matrix(s.q) - model.inverse_mass_matrix(s.q)
+    Minv_scaled = _scaled_matrix(model.inverse_mass_matrix(s.q), sqrt_s)
+    return Sample(np.max(np.abs(_scaled_matrix(diff, sqrt_s))), _norm2(Minv_scaled) ** 2)
+
+
+def _aba(model, system, s):
+    w = _weights(model, s.q)
+    tau = model.input_matrix() @ s.u + model.disturbance_matrix() @ s.w - model.damping_matrix() @ s.v
+    a_pin = system.acceleration(s.q, s.v, tau)
+    a_hand = model.acceleration(s.q, s.v, s.u, s.w)
+    Minv_norm = _norm2(_scaled_matrix(model.inverse_mass_matrix(s.q), 1.0 / w))
+    M_norm = _norm2(_scaled_matrix(model.mass_matrix(s.q), w))
+    scale = Minv_norm * (_force_scale(model, s, w) + M_norm * np.max(np.abs(a_pin / w)))
+    allowance = float(np.max(Minv_norm * np.max(w * _allowance(system))))
+    return Sample(np.max(np.abs((a_pin - a_hand) / w)), scale, allowance)
+
+
+def _energy(model, system, s):
+    w = _weights(model, s.q)
+    zero = np.zeros(model.nv)
+    kinetic = abs(system.kinetic_energy(s.q, s.v) - model.kinetic_energy(s.q, s.v))
+    # potential energies agree up to a constant: compare differences from θ = 0
+    dv_pin = system.potential_energy(s.q) - system.potential_energy(zero)
+    dv_hand = model.potential_energy(s.q) - model.potential_energy(zero)
+    kinetic_scale = 0.5 * float(np.sum((s.v / w) ** 2)) * _norm2(_scaled_matrix(model.mass_matrix(s.q), w))
+    potential_scale = float(np.max(model.gravity_scale()))
+    allowance = 2 * float(np.sum(_allowance(system)))  # |ΔV| ≤ m g |offset| at both ends
+    return Sample(kinetic + abs(dv_pin - dv_hand), kinetic_scale + potential_scale, allowance)
+
+
+CHECKS: tuple[Check, ...] = (
+    Check("crba", "crba (symmetrised)", "M(q)", 8, _crba),
+    Check("rnea", "rnea(q, q̇, 0)", "C(q,q̇)·q̇ + H(q), friction removed", 16, _rnea),
+    Check("gravity", "computeGeneralizedGravity", "H(q)", 16, _gravity),
+    Check("coriolis", "computeCoriolisMatrix", "C(q,q̇) without friction", 16, _coriolis),
+    Check("skew", "Ṁ (RNEA derivatives) − 2C", "skew-symmetric", 16, _skew),
+    Check("det", "det(crba) by LU", "closed-form det M(q) > 0", 16, _det),
+    Check("minverse", "computeMinverse", "M(q)⁻¹ (closed form)", 16, _minverse),
+    Check("aba", "aba(q, q̇, Bu + Ww − Dq̇)", "closed-form q̈ (f + g·u, M⁻¹f)", 16, _aba),
+    Check("energy", "kinetic + potential energy", "½q̇ᵀMq̇, V(q) − V(0)", 16, _energy),
+)
+CHECK_NAMES = tuple(c.name for c in CHECKS)
+
+
+def run_check(check: Check, label: str, model, system, states, seed: int) -> CheckResult:
+    """Evaluate one check on every state and keep the evidence of the worst one."""
+    worst_ratio, worst = -1.0, None
+    max_abs = 0.0
+    notes: list[str] = []
+    for state in states:
+        sample = check.evaluate(model, system, state)
+        if sample.note and len(notes) < 3:
+            notes.append(f"{state.label}: {sample.note}")
+        angle = float(np.max(np.abs(state.q[np.array(model.angular)]), initial=0.0))
+        rel_tol = check.K * EPS * (1.0 + angle) + sample.allowance / sample.scale
+        rel_err = sample.error / sample.scale
+        ratio = rel_err / rel_tol if np.isfinite(rel_err) else np.inf
+        if np.isnan(rel_err):
+            ratio = np.inf
+            notes.append(f"{state.label}: NaN")
+        max_abs = max(max_abs, float(sample.error))
+        if ratio > worst_ratio:
+            worst_ratio, worst = ratio, (state, rel_err, rel_tol)
+    state, rel_err, rel_tol = worst
+    return CheckResult(
+        model=label,
+        check=check.name,
+        description=f"{check.pinocchio} vs {check.closed_form}",
+        max_error=float(rel_err),
+        tolerance=float(rel_tol),
+        max_abs_error=max_abs,
+        samples=len(states),
+        seed=seed,
+        worst_state=state.as_dict(),
+        passed=bool(worst_ratio <= 1.0),
+        notes=notes,
+    )
+
+
+def run_checks(label, model, system, states, seed, names=CHECK_NAMES) -> list[CheckResult]:
+    return [run_check(c, label, model, system, states, seed) for c in CHECKS if c.name in names]

@@ -1,0 +1,90 @@
+"""The verification report: one table for people, one JSON document for machines."""
+
+from __future__ import annotations
+
+import json
+import platform
+from dataclasses import dataclass, field
+
+import numpy as np
+import pinocchio
+
+from pendverify import __version__
+from pendverify.checks import CheckResult
+
+
+@dataclass
+class Report:
+    seed: int
+    states: dict[str, int]
+    results: list[CheckResult]
+    notes: dict[str, list[str]] = field(default_factory=dict)
+    sources: dict[str, str] = field(default_factory=dict)
+    elapsed_s: float = 0.0
+
+    @property
+    def passed(self) -> bool:
+        return all(r.passed for r in self.results)
+
+    def failures(self) -> list[CheckResult]:
+        return [r for r in self.results if not r.passed]
+
+    def as_dict(self) -> dict:
+        return {
+            "pendverify": __version__,
+            "pinocchio": pinocchio.__version__,
+            "numpy": np.__version__,
+            "python": platform.python_version(),
+            "seed": self.seed,
+            "states": self.states,
+            "elapsed_s": round(self.elapsed_s, 3),
+            "passed": self.passed,
+            "sources": self.sources,
+            "notes": self.notes,
+            "results": [r.as_dict() for r in self.results],
+        }
+
+    def to_json(self) -> str:
+        return json.dumps(self.as_dict(), indent=2, ensure_ascii=False) + "\n"
+
+
+def _state_text(state: dict) -> str:
+    q = ", ".join(f"{x:.3g}" for x in state["q"])
+    return f"{state['label']} q=({q})"
+
+
+def format_table(report: Report) -> str:
+    header = ("model", "check", "error", "tolerance", "worst state", "result")
+    rows = [
+        (
+            r.model,
+            r.check,
+            f"{r.max_error:.2e}",
+            f"{r.tolerance:.2e}",
+            _state_text(r.worst_state),
+            "pass" if r.passed else "FAIL",
+        )
+        for r in report.results
+    ]
+    widths = [max(len(h), *(len(row[i]) for row in rows)) for i, h in enumerate(header)]
+    line = "  ".join(h.ljust(w) for h, w in zip(header, widths, strict=True))
+    out = [line, "-" * len(line)]
+    out += ["  ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)).rstrip() for row in rows]
+    out.append("")
+    out.append(
+        "error and tolerance are relative, in diagonally scaled coordinates: "
+        "tolerance = K·ε·(1 + |θ|max) (+ model-form allowance)."
+    )
+    for model, notes in report.notes.items():
+        for note in notes:
+            out.append(f"note [{model}]: {note}")
+    for r in report.failures():
+        for note in r.notes:
+            out.append(f"fail [{r.model} {r.check}]: {note}")
+    total = sum(report.states.values())
+    verdict = "all checks pass" if report.passed else f"{len(report.failures())} check(s) FAIL"
+    out.append(
+        f"{len(report.results)} checks on {len(report.states)} model(s), {total} states "
+        f"(seed {report.seed}), {report.elapsed_s:.2f} s: {verdict}"
+    )
+    return "\n".join(out)

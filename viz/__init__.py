@@ -1,0 +1,1 @@
+"""Visualisation: Meshcat scenes and review pages (see the render issue)."""
