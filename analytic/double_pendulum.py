@@ -43,6 +43,7 @@ import numpy as np
 
 from pendverify.analytic.interface import ClosedFormModel
 from pendverify.analytic.params import ParameterSet, quantity
+from pendverify.errors import ParameterError
 
 
 @dataclasses.dataclass(frozen=True)
@@ -62,6 +63,22 @@ class DoublePendulumParams(ParameterSet):
     b1: float = quantity("damping", "viscous friction of joint 1 in [N·m·s/rad]")
     b2: float = quantity("damping", "viscous friction of joint 2 in [N·m·s/rad]")
     g: float = quantity("gravity", "gravitational acceleration in [m/s²]")
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        # det M = I2 (I1 + m1 r1² + m2 l1²) + m2 r2² (I1 + m1 r1²) ≥ det M(θ) for all θ
+        if (
+            self.I2 * (self.I1 + self.m1 * self.r1**2 + self.m2 * self.l1**2)
+            + self.m2 * self.r2**2 * (self.I1 + self.m1 * self.r1**2)
+            <= 0
+        ):
+            raise ParameterError(
+                f"<{self.model} parameters>",
+                "I2" if self.I2 == 0 and self.r2 == 0 else "I1",
+                0.0,
+                "M(θ) is singular: link 2 needs inertia about joint 2 (I2 > 0 or r2 > 0), "
+                "and with I2 = 0 link 1 needs some too (I1 > 0 or r1 > 0)",
+            )
 
 
 class DoublePendulum(ClosedFormModel):

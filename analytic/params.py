@@ -59,14 +59,15 @@ def quantity(kind: str, doc: str) -> Any:
     return dataclasses.field(metadata={"kind": kind, "doc": doc})
 
 
-def _rule_text(name: str, kind: str) -> str:
+def _rule_text(kind: str) -> str:
     comparison, unit = _RULES[kind]
-    return f"a {kind} must be a finite number {comparison} (in {unit})"
+    article = "an" if kind[0] in "aeiou" else "a"
+    return f"{article} {kind} must be a finite number {comparison} (in {unit})"
 
 
 def check_value(source: str, key: str, value: object, kind: str) -> float:
     """Return ``value`` as a float, or raise a ParameterError naming the rule."""
-    rule = _rule_text(key, kind)
+    rule = _rule_text(kind)
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ParameterError(source, key, value, rule + f"; got a {type(value).__name__}")
     x = float(value)
@@ -115,7 +116,10 @@ class ParameterSet:
             if f.name not in data:
                 raise ParameterError(source, prefix + f.name, None, f"missing key ({f.metadata['doc']})")
             values[f.name] = check_value(source, prefix + f.name, data[f.name], f.metadata["kind"])
-        return cls(**values)
+        try:
+            return cls(**values)
+        except ParameterError as exc:  # a rule across fields: name the file
+            raise ParameterError(source, prefix + exc.key, exc.value, exc.rule) from None
 
     def as_dict(self) -> dict[str, float]:
         return dataclasses.asdict(self)

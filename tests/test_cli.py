@@ -1,0 +1,77 @@
+"""The command line, called as ``main([...])``: table, JSON, exit codes, errors."""
+
+from __future__ import annotations
+
+import json
+
+from pendverify.checks import CHECK_NAMES
+from pendverify.cli import main
+from pendverify.erd import double_pendulum_urdfs
+
+from .conftest import default_params
+
+JSON_FIELDS = {"model", "check", "max_error", "tolerance", "samples", "worst_state", "passed", "seed"}
+
+
+def test_default_check_passes_and_writes_json(tmp_path, capsys):
+    out_json = tmp_path / "sub" / "report.json"
+    assert main(["check", "--samples", "50", "--json", str(out_json)]) == 0
+    out = capsys.readouterr().out
+    assert "all checks pass" in out
+    for label in ("double_pendulum", "cart_double_pendulum", "erd:double_pendulum_simple"):
+        assert label in out
+    report = json.loads(out_json.read_text())
+    assert report["passed"] is True
+    assert report["seed"] == 20260301
+    models = {r["model"] for r in report["results"]}
+    assert {"double_pendulum", "cart_double_pendulum", "erd:double_pendulum"} <= models
+    for r in report["results"]:
+        assert JSON_FIELDS <= set(r)
+        assert r["max_error"] <= r["tolerance"]
+    assert {r["check"] for r in report["results"]} == set(CHECK_NAMES)
+    assert not list(out_json.parent.glob(".*.tmp")), "temporary file left behind"
+
+
+def test_model_urdf_extracts_parameters(capsys):
+    urdf = str(double_pendulum_urdfs()["double_pendulum_simple"])
+    assert main(["check", "--model", "double_pendulum", "--urdf", urdf, "--samples", "20"]) == 0
+    assert "parameters read off the URDF" in capsys.readouterr().out
+
+
+def test_params_alone_checks_the_generated_urdf(tmp_path, capsys):
+    path = tmp_path / "mine.toml"
+    path.write_text(default_params("cart_double_pendulum").replace(m=3.0).to_toml())
+    assert main(["check", "--params", str(path), "--samples", "20"]) == 0
+    assert "cart_double_pendulum:mine" in capsys.readouterr().out
+
+
+def test_cart_urdf_alone_needs_params(capsys):
+    from importlib.resources import files
+
+    urdf = str(files("pendverify.urdf") / "cart_double_pendulum.urdf")
+    assert main(["check", "--model", "cart_double_pendulum", "--urdf", urdf]) == 2
+    assert "give --params" in capsys.readouterr().err
+
+
+def test_not_a_planar_chain_is_exit_2(capsys):
+    from importlib.resources import files
+
+    urdf = str(files("pendverify.urdf") / "cart_double_pendulum.urdf")
+    assert main(["check", "--model", "double_pendulum", "--urdf", urdf]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("pendverify: error: ")
+    assert "expected a chain of joints revolute → revolute, found prismatic → revolute → revolute" in err
+
+
+def test_unknown_model_is_exit_2(capsys):
+    assert main(["check", "--model", "triple", "--urdf", "x.urdf"]) == 2
+    assert "unknown model 'triple'; known: double_pendulum, cart_double_pendulum" in capsys.readouterr().err
+
+
+def test_bad_parameter_file_is_exit_2(tmp_path, capsys):
+    path = tmp_path / "neg.toml"
+    path.write_text(
+        default_params("double_pendulum").replace(b1=0.0).to_toml().replace("b1 = 0.0", "b1 = -1.0")
+    )
+    assert main(["check", "--params", str(path)]) == 2
+    assert f"{path}: key 'parameters.b1' = -1.0: a damping must be" in capsys.readouterr().err
