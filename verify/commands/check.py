@@ -1,0 +1,52 @@
+"""``pendverify check``: Pinocchio against the closed forms, one table."""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+from pendverify.commands import non_negative_int
+
+
+def register(sub) -> None:
+    p = sub.add_parser("check", help="compare Pinocchio with the hand-derived closed forms")
+    p.add_argument("--model", help="double_pendulum or cart_double_pendulum")
+    p.add_argument("--urdf", help="a URDF to check (with --model, or with --params)")
+    p.add_argument("--params", help="a parameter file (TOML) giving the closed form")
+    p.add_argument("--samples", type=non_negative_int, default=None, help="random states per model")
+    p.add_argument("--seed", type=non_negative_int, default=None, help="seed of the state sampler")
+    p.add_argument("--json", help="also write the report as JSON to this path")
+    p.add_argument("--no-erd", dest="erd", action="store_false", help="skip example-robot-data's URDFs")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from pendverify.atomic import write_atomic
+    from pendverify.checks import run_checks
+    from pendverify.report import Report, format_table
+    from pendverify.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED, sample_states
+    from pendverify.targets import default_target, erd_targets, user_target
+
+    samples = DEFAULT_RANDOM_STATES if args.samples is None else args.samples
+    seed = DEFAULT_SEED if args.seed is None else args.seed
+    if args.urdf or args.params:
+        targets = [user_target(args.model, args.urdf, args.params)]
+    else:
+        names = [args.model] if args.model else ["double_pendulum", "cart_double_pendulum"]
+        targets = [default_target(name) for name in names]
+        if args.erd and (args.model in (None, "double_pendulum")):
+            targets += erd_targets()
+    report = Report(seed=seed, states={}, results=[])
+    for target in targets:
+        states = sample_states(target.model, samples, seed)
+        report.states[target.label] = len(states)
+        report.sources[target.label] = target.source
+        if target.notes:
+            report.notes[target.label] = target.notes
+        report.results += run_checks(target.label, target.model, target.system, states, seed)
+    report.elapsed_s = time.perf_counter() - args.started
+    print(format_table(report))
+    if args.json:
+        write_atomic(args.json, report.to_json())
+        print(f"report written to {args.json}")
+    return 0 if report.passed else 1
