@@ -78,25 +78,25 @@ class CheckResult:
 
 
 # --- scaled-coordinate helpers ------------------------------------------------------------
-def _weights(model, q):
+def weights(model, q):
     return 1.0 / np.sqrt(model.diagonal_scale(q))
 
 
-def _scaled_matrix(A, w):
+def scaled_matrix(A, w):
     return A * np.outer(w, w)
 
 
-def _angular_rate(model, v) -> float:
+def angular_rate(model, v) -> float:
     return float(np.max(np.abs(v[np.array(model.angular)]), initial=0.0))
 
 
-def _norm2(A) -> float:
+def norm2(A) -> float:
     return float(np.linalg.norm(A, 2))
 
 
 def _force_scale(model, state, w) -> float:
     """Size of the generalized forces acting, in scaled units (sum of |terms|)."""
-    rate = _angular_rate(model, state.v)
+    rate = angular_rate(model, state.v)
     zdot = state.v / w
     coriolis = rate * np.sum(np.abs(zdot))
     gravity = np.max(w * model.gravity_scale())
@@ -115,35 +115,35 @@ def _allowance(system) -> np.ndarray:
 
 # --- the checks ---------------------------------------------------------------------------
 def _crba(model, system, s):
-    w = _weights(model, s.q)
-    err = np.max(np.abs(_scaled_matrix(system.mass_matrix(s.q) - model.mass_matrix(s.q), w)))
+    w = weights(model, s.q)
+    err = np.max(np.abs(scaled_matrix(system.mass_matrix(s.q) - model.mass_matrix(s.q), w)))
     return Sample(err, 1.0)
 
 
 def _rnea(model, system, s):
-    w = _weights(model, s.q)
+    w = weights(model, s.q)
     err = np.max(w * np.abs(system.bias(s.q, s.v) - model.bias(s.q, s.v)))
     zdot = s.v / w
-    scale = _angular_rate(model, s.v) * np.sum(np.abs(zdot)) + np.max(w * model.gravity_scale())
+    scale = angular_rate(model, s.v) * np.sum(np.abs(zdot)) + np.max(w * model.gravity_scale())
     return Sample(err, scale, float(np.max(w * _allowance(system))))
 
 
 def _gravity(model, system, s):
-    w = _weights(model, s.q)
+    w = weights(model, s.q)
     err = np.max(w * np.abs(system.gravity(s.q) - model.gravity(s.q)))
     return Sample(err, float(np.max(w * model.gravity_scale())), float(np.max(w * _allowance(system))))
 
 
 def _coriolis(model, system, s):
-    w = _weights(model, s.q)
+    w = weights(model, s.q)
     diff = system.coriolis_matrix(s.q, s.v) - model.coriolis_matrix(s.q, s.v)
-    return Sample(np.max(np.abs(_scaled_matrix(diff, w))), max(_angular_rate(model, s.v), 1.0))
+    return Sample(np.max(np.abs(scaled_matrix(diff, w))), max(angular_rate(model, s.v), 1.0))
 
 
 def _skew(model, system, s):
-    w = _weights(model, s.q)
+    w = weights(model, s.q)
     N = system.mass_matrix_derivative(s.q, s.v) - 2 * model.coriolis_matrix(s.q, s.v)
-    return Sample(np.max(np.abs(_scaled_matrix(N + N.T, w))), max(_angular_rate(model, s.v), 1.0))
+    return Sample(np.max(np.abs(scaled_matrix(N + N.T, w))), max(angular_rate(model, s.v), 1.0))
 
 
 def _det(model, system, s):
@@ -155,32 +155,32 @@ def _det(model, system, s):
 
 
 def _minverse(model, system, s):
-    sqrt_s = 1.0 / _weights(model, s.q)
+    sqrt_s = 1.0 / weights(model, s.q)
     diff = system.inverse_mass_matrix(s.q) - model.inverse_mass_matrix(s.q)
-    Minv_scaled = _scaled_matrix(model.inverse_mass_matrix(s.q), sqrt_s)
-    return Sample(np.max(np.abs(_scaled_matrix(diff, sqrt_s))), _norm2(Minv_scaled) ** 2)
+    Minv_scaled = scaled_matrix(model.inverse_mass_matrix(s.q), sqrt_s)
+    return Sample(np.max(np.abs(scaled_matrix(diff, sqrt_s))), norm2(Minv_scaled) ** 2)
 
 
 def _aba(model, system, s):
-    w = _weights(model, s.q)
+    w = weights(model, s.q)
     tau = model.input_matrix() @ s.u + model.disturbance_matrix() @ s.w - model.damping_matrix() @ s.v
     a_pin = system.acceleration(s.q, s.v, tau)
     a_hand = model.acceleration(s.q, s.v, s.u, s.w)
-    Minv_norm = _norm2(_scaled_matrix(model.inverse_mass_matrix(s.q), 1.0 / w))
-    M_norm = _norm2(_scaled_matrix(model.mass_matrix(s.q), w))
+    Minv_norm = norm2(scaled_matrix(model.inverse_mass_matrix(s.q), 1.0 / w))
+    M_norm = norm2(scaled_matrix(model.mass_matrix(s.q), w))
     scale = Minv_norm * (_force_scale(model, s, w) + M_norm * np.max(np.abs(a_pin / w)))
     allowance = float(np.max(Minv_norm * np.max(w * _allowance(system))))
     return Sample(np.max(np.abs((a_pin - a_hand) / w)), scale, allowance)
 
 
 def _energy(model, system, s):
-    w = _weights(model, s.q)
+    w = weights(model, s.q)
     zero = np.zeros(model.nv)
     kinetic = abs(system.kinetic_energy(s.q, s.v) - model.kinetic_energy(s.q, s.v))
     # potential energies agree up to a constant: compare differences from θ = 0
     dv_pin = system.potential_energy(s.q) - system.potential_energy(zero)
     dv_hand = model.potential_energy(s.q) - model.potential_energy(zero)
-    kinetic_scale = 0.5 * float(np.sum((s.v / w) ** 2)) * _norm2(_scaled_matrix(model.mass_matrix(s.q), w))
+    kinetic_scale = 0.5 * float(np.sum((s.v / w) ** 2)) * norm2(scaled_matrix(model.mass_matrix(s.q), w))
     potential_scale = float(np.max(model.gravity_scale()))
     allowance = 2 * float(np.sum(_allowance(system)))  # |ΔV| ≤ m g |offset| at both ends
     return Sample(kinetic + abs(dv_pin - dv_hand), kinetic_scale + potential_scale, allowance)
