@@ -61,6 +61,9 @@ class Dynamics:
         return np.concatenate([v, a, [v @ tau_in, -(v @ tau_diss)]])
 
     def energy(self, q, v) -> float:
+        """E = T + V of the system being integrated: Pinocchio's under ABA, the hand model's otherwise."""
+        if self.engine == "aba":
+            return self.system.kinetic_energy(q, v) + self.system.potential_energy(q)
         return self.model.kinetic_energy(q, v) + self.model.potential_energy(q)
 
     def inputs(self, t, q, v) -> tuple[np.ndarray, np.ndarray]:
@@ -69,15 +72,20 @@ class Dynamics:
         return u, w
 
 
-def build_dynamics(scene: Scene, engine: str | None = None) -> Dynamics:
-    """Model, engine and force terms for a scene; LQR gains are computed here."""
+def build_dynamics(scene: Scene, engine: str | None = None, urdf: str | None = None) -> Dynamics:
+    """Model, engine and force terms for a scene; LQR gains are computed here.
+
+    ``urdf`` (text or path) replaces the URDF the project writes for the scene's
+    parameter set, e.g. to simulate a user's URDF that is being certified.
+    """
     engine = engine or scene.engine
     g = scene.gravity if scene.gravity is not None else 0.0
     params = scene.params.replace(g=g)
     model = MODELS[scene.model](params)
     system = None
     if engine in ("aba", "both"):
-        system = PinocchioSystem.from_urdf(scene.model, urdf_for(params), g, f"<URDF of {scene.name}>")
+        source = f"<URDF of {scene.name}>" if urdf is None else None
+        system = PinocchioSystem.from_urdf(scene.model, urdf or urdf_for(params), g, source)
     terms = ["inertia M(q)q̈", "Coriolis/centrifugal C(q,q̇)q̇"]
     terms.append(f"gravity H(q), g = {g:g} m/s²" if scene.gravity is not None else "gravity: off (H = 0)")
 

@@ -135,9 +135,9 @@ def _engine_comparison(dyn: Dynamics, steps_t, steps_x) -> InvariantResult:
     )
 
 
-def simulate(scene: Scene, engine: str | None = None) -> Run:
+def simulate(scene: Scene, engine: str | None = None, urdf: str | None = None) -> Run:
     engine = engine or scene.engine
-    dyn = build_dynamics(scene, engine)
+    dyn = build_dynamics(scene, engine, urdf)
     x0 = np.concatenate([scene.q0, scene.v0, [0.0, 0.0]])
     n_samples = int(np.floor(scene.duration * scene.sample_rate + 1e-9)) + 1
     sample_times = np.arange(n_samples) / scene.sample_rate
