@@ -83,6 +83,15 @@ class CoordinateMap:
         return self._T_inv @ Minv_q @ self._T_inv.T
 
     @property
+    def amplification(self) -> float:
+        """cond₂(T)²: how much the congruence Tᵀ·A·T can magnify rounding done in joint coordinates.
+
+        1 for maps that only shift or flip angles; ((1 + √5)/2)⁴ ≈ 6.85 for the
+        cart's relative second joint.
+        """
+        return float(np.linalg.cond(self.T)) ** 2
+
+    @property
     def det_factor(self) -> float:
         """det M_θ / det M_q = det(T)²."""
         return float(np.linalg.det(self.T)) ** 2

@@ -21,6 +21,8 @@ class Report:
     notes: dict[str, list[str]] = field(default_factory=dict)
     sources: dict[str, str] = field(default_factory=dict)
     elapsed_s: float = 0.0
+    #: Known traps that explain a target's failures (``pendverify.diagnose``), in words.
+    diagnoses: dict[str, list[str]] = field(default_factory=dict)
 
     @property
     def passed(self) -> bool:
@@ -41,6 +43,7 @@ class Report:
             "passed": self.passed,
             "sources": self.sources,
             "notes": self.notes,
+            "diagnoses": self.diagnoses,
             "results": [r.as_dict() for r in self.results],
         }
 
@@ -73,7 +76,7 @@ def format_table(report: Report) -> str:
     out.append("")
     out.append(
         "error and tolerance are relative, in diagonally scaled coordinates: "
-        "tolerance = K·ε·(1 + |θ|max) (+ model-form allowance)."
+        "tolerance = K·ε·(1 + |θ|max)·cond(T)² (+ model-form allowance)."
     )
     for model, notes in report.notes.items():
         for note in notes:
@@ -81,6 +84,9 @@ def format_table(report: Report) -> str:
     for r in report.failures():
         for note in r.notes:
             out.append(f"fail [{r.model} {r.check}]: {note}")
+    for model, sentences in report.diagnoses.items():
+        for sentence in sentences:
+            out.append(f"diagnosis [{model}]: {sentence}")
     total = sum(report.states.values())
     verdict = "all checks pass" if report.passed else f"{len(report.failures())} check(s) FAIL"
     out.append(

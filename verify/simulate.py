@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from pendverify import __version__
-from pendverify.checks import EPS, angular_rate, norm2, scaled_matrix, weights
+from pendverify.checks import EPS, norm2, rate_scale, scaled_matrix, weights
 from pendverify.dynamics import Dynamics, build_dynamics
 from pendverify.integrate import Integration, integrate
 from pendverify.invariants import InvariantResult, adaptive_bound, energy_scale, evaluate, richardson_bound
@@ -118,7 +118,7 @@ def _engine_comparison(dyn: Dynamics, steps_t, steps_x) -> InvariantResult:
         w = weights(model, q)
         Minv = norm2(scaled_matrix(model.inverse_mass_matrix(q), 1 / w))
         M = norm2(scaled_matrix(model.mass_matrix(q), w))
-        forces = angular_rate(model, v) * np.sum(np.abs(v / w)) + np.max(w * model.gravity_scale())
+        forces = rate_scale(model, q, v) * np.sum(np.abs(v / w)) + np.max(w * model.gravity_scale())
         forces += np.max(w * (np.abs(tau_in) + np.abs(tau_diss)))
         scale = Minv * (forces + M * np.max(np.abs(a_pin / w)))
         err = np.max(np.abs((a_pin - a_cf) / w)) / scale
