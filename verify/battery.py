@@ -1,0 +1,149 @@
+"""The full battery a parameter set must pass before it is certified.
+
+1. every core check (``pendverify.checks``) on a large seeded sample of states;
+2. the stress cases that apply to these parameters (``stress_items``);
+3. one simulation invariant per effect: a short run with gravity alone
+   (energy drift), with damping (dissipation balance, energy never rises),
+   with actuation (work–energy balance) and, for the cart, with a seeded noise
+   disturbance (work–energy balance).
+
+The battery runs on the URDF being certified, whether the project wrote it or
+the user brought it.  Everything is deterministic in (parameters, URDF, seed,
+settings), so ``recheck`` can run it again and compare figures.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from pendverify.analytic import MODELS, ParameterSet
+from pendverify.checks import run_checks
+from pendverify.robot import PinocchioSystem
+from pendverify.sampling import sample_states
+
+
+@dataclass(frozen=True)
+class BatterySettings:
+    samples: int = 2000  # random states for the core checks
+    seed: int = 20260301
+    sim_duration: float = 2.0  # s, per effect
+    sim_rtol: float = 1e-10
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+@dataclass(frozen=True)
+class BatteryItem:
+    name: str
+    kind: str  # check | stress | invariant
+    max_error: float
+    tolerance: float
+    samples: int
+    seed: int
+    passed: bool
+    detail: str = ""
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+    @property
+    def margin(self) -> float:
+        """error / tolerance: below 1 passes."""
+        return self.max_error / self.tolerance if self.tolerance > 0 else float("inf")
+
+
+def check_items(model, system, settings: BatterySettings) -> list[BatteryItem]:
+    states = sample_states(model, settings.samples, settings.seed)
+    return [
+        BatteryItem(
+            f"check:{r.check}",
+            "check",
+            r.max_error,
+            r.tolerance,
+            r.samples,
+            r.seed,
+            r.passed,
+            r.worst_state["label"],
+        )
+        for r in run_checks(model.name, model, system, states, settings.seed)
+    ]
+
+
+def _effect_scenes(model_name: str, params: ParameterSet, settings: BatterySettings) -> dict[str, dict]:
+    """One short scene per effect, as scene documents (see pendverify.scene)."""
+    if model_name == "double_pendulum":
+        q0, v0 = [0.4, 1.1], [0.5, -0.5]
+        actuation = {"type": "sine", "amplitude": [1.0, 0.4], "frequency": 0.7}
+        disturbance = None
+    else:
+        q0, v0 = [0.0, 0.15, -0.1], [0.1, 0.0, 0.2]
+        actuation = {"type": "sine", "amplitude": [2.0], "frequency": 0.5}
+        disturbance = {"type": "noise", "std": [0.5, 0.05, 0.05], "bandwidth": 4.0, "seed": settings.seed}
+    base = {
+        "model": model_name,
+        "parameters": params.as_dict(),
+        "initial": {"q": q0, "v": v0},
+        "time": {"duration": settings.sim_duration, "sample_rate": 50.0},
+        "integrator": {"method": "DOP853", "rtol": settings.sim_rtol, "atol": settings.sim_rtol},
+    }
+    scenes = {
+        "gravity": {"gravity": True},
+        "damping": {"gravity": True, "damping": [max(d, 0.05) for d in _damping(model_name, params)]},
+        "actuation": {"gravity": True, "actuation": actuation},
+    }
+    if disturbance:
+        scenes["disturbance"] = {"gravity": True, "disturbance": disturbance}
+    return {name: {**base, "name": f"battery:{name}", "effects": effects} for name, effects in scenes.items()}
+
+
+def _damping(model_name: str, params: ParameterSet) -> list[float]:
+    return list(np.diag(MODELS[model_name](params).damping_matrix()))
+
+
+def invariant_items(model_name, params, urdf: str, settings: BatterySettings) -> list[BatteryItem]:
+    from pendverify.scene import parse_scene
+    from pendverify.simulate import simulate
+
+    items = []
+    for effect, doc in _effect_scenes(model_name, params, settings).items():
+        run = simulate(parse_scene(doc, f"<battery {effect}>"), "aba", urdf)
+        steps = len(run.integration.steps_t) - 1
+        for inv in run.invariants:
+            items.append(
+                BatteryItem(
+                    f"invariant:{effect}:{inv.name.split(' ')[0]}"
+                    + (":no-increase" if inv.name.startswith("energy never") else ""),
+                    "invariant",
+                    inv.error,
+                    inv.tolerance,
+                    steps,
+                    settings.seed,
+                    inv.passed,
+                    inv.name,
+                )
+            )
+    return items
+
+
+def stress_items(model_name, params, urdf: str, settings: BatterySettings) -> list[BatteryItem]:
+    """The stress cases that apply to these parameters (see pendverify.stress)."""
+    try:
+        from pendverify.stress import battery_cases
+    except ImportError:  # the stress suite is optional until it lands
+        return []
+    return [BatteryItem(**case) for case in battery_cases(model_name, params, urdf, settings.seed)]
+
+
+def run_battery(
+    model_name: str, params: ParameterSet, urdf: str, settings: BatterySettings
+) -> list[BatteryItem]:
+    model = MODELS[model_name](params)
+    system = PinocchioSystem.from_urdf(model_name, urdf, params.g, f"<URDF being certified: {model_name}>")
+    return (
+        check_items(model, system, settings)
+        + stress_items(model_name, params, urdf, settings)
+        + invariant_items(model_name, params, urdf, settings)
+    )
