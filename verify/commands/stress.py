@@ -1,0 +1,183 @@
+"""``pendverify stress``: the catalogue of hard cases, one table, exit 1 on any failure.
+
+Prints, per case, the achieved relative error next to the tolerance used, κ(M)
+raw and after diagonal scaling, and the verdict; then the simulation
+invariants, the notes (refusals, warnings, failures), the near-singular trust
+study against 50-digit mpmath, and the time taken.  ``--json`` writes the same
+evidence atomically.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import platform
+import time
+
+from pendverify.commands import non_negative_int
+
+
+def register(sub) -> None:
+    p = sub.add_parser("stress", help="run the catalogue of numerically hard cases")
+    p.add_argument("--quick", action="store_true", help="fewer states and shorter horizons (same cases)")
+    p.add_argument("--case", action="append", metavar="NAME", help="run only this case (repeatable)")
+    p.add_argument("--seed", type=non_negative_int, default=None, help="seed of the state sampler")
+    p.add_argument("--json", help="also write the report as JSON to this path")
+    p.set_defaults(func=run)
+
+
+def _num(x, fmt=".2e") -> str:
+    return "-" if x is None else format(x, fmt)
+
+
+def format_table(report) -> str:
+    header = ("case", "quantity", "error", "tolerance", "κ(M)", "κ̃(M)", "result")
+    rows = [
+        (
+            r.case,
+            r.quantity,
+            _num(r.error),
+            _num(r.tolerance),
+            _num(r.kappa_raw, ".1e"),
+            _num(r.kappa_scaled, ".1e"),
+            r.verdict,
+        )
+        for r in report.results
+    ]
+    widths = [max(len(h), *(len(row[i]) for row in rows)) for i, h in enumerate(header)]
+    line = "  ".join(h.ljust(w) for h, w in zip(header, widths, strict=True))
+    out = [line, "-" * len(line)]
+    out += ["  ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)).rstrip() for row in rows]
+    out.append("")
+    out.append(
+        "error and tolerance are relative, in diagonally scaled coordinates; κ̃(M) is κ(M) after "
+        "diagonal scaling (worst over the case's states)."
+    )
+    invariants = [r for r in report.results if r.invariant]
+    if invariants:
+        out.append("")
+        out.append("invariants:")
+        out += [f"  {r.case}: {r.invariant}" for r in invariants]
+    notes = [r for r in report.results if r.note]
+    if notes:
+        out.append("")
+        out.append("notes:")
+        out += [f"  {'FAIL ' if not r.passed else ''}{r.case}: {r.note}" for r in notes]
+    return "\n".join(out)
+
+
+def format_study(study) -> str:
+    from pendverify.near_singular import REFUSE_REL, StudyRow
+
+    labels = {
+        "det_closed_form": "det closed",
+        "det_lu": "det LU",
+        "accel_closed_form": "q̈ closed",
+        "accel_aba": "q̈ ABA",
+        "minv_closed_form": "M⁻¹ closed",
+        "minv_pinocchio": "M⁻¹ Pinocchio",
+    }
+    header = ("m1 [kg]", "κ̃(M)", "guard", *labels.values())
+    rows = []
+    for m1 in sorted({r.m1 for r in study.rows}, reverse=True):
+        group = [r for r in study.rows if r.m1 == m1]
+        order = ("ok", "warn", "refuse")
+        guard = max((r.level for r in group), key=order.index)
+        worst = [max(getattr(r, q) for r in group) for q in StudyRow.QUANTITIES]
+        kappa = max(r.kappa_scaled for r in group)
+        rows.append((f"{m1:.0e}", f"{kappa:.1e}", guard, *(f"{e:.1e}" for e in worst)))
+    widths = [max(len(h), *(len(row[i]) for row in rows)) for i, h in enumerate(header)]
+    out = [
+        "near-singular cart, m1 → 0 at θ1 = θ2 (θ1 = 0 and 0.7, and θ2 = θ1 + 1e-12): relative error "
+        "against 50-digit mpmath, worst over the states",
+        "  ".join(h.ljust(w) for h, w in zip(header, widths, strict=True)),
+    ]
+    out.append("-" * len(out[-1]))
+    out += ["  ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)).rstrip() for row in rows]
+    per = ", ".join(f"{labels[q]} ≥ {m:.0e}" for q, m in study.limit_per_quantity.items())
+    out.append(f"trusted to {REFUSE_REL:g} down to m1 [kg]: {per}")
+    out.append(
+        f"measured trust limit (every quantity): m1 ≥ {study.measured_limit:.0e} kg; "
+        f"the guard accepts m1 ≥ {study.accepted_limit:.0e} kg and refuses below; {study.zero_mass_note}, "
+        f"{'refused' if study.zero_mass_refused else 'NOT refused'}"
+    )
+    return "\n".join(out)
+
+
+def report_dict(report) -> dict:
+    import dataclasses
+
+    import numpy as np
+    import pinocchio
+
+    from pendverify import __version__
+
+    study = None
+    if report.study is not None:
+        s = report.study
+        study = {
+            "measured_limit_kg": s.measured_limit,
+            "accepted_limit_kg": s.accepted_limit,
+            "limit_per_quantity_kg": s.limit_per_quantity,
+            "zero_mass": s.zero_mass_note,
+            "zero_mass_refused": s.zero_mass_refused,
+            "violations": s.violations,
+            "rows": [dataclasses.asdict(r) for r in s.rows],
+        }
+    return {
+        "pendverify": __version__,
+        "pinocchio": pinocchio.__version__,
+        "numpy": np.__version__,
+        "python": platform.python_version(),
+        "seed": report.seed,
+        "settings": dataclasses.asdict(report.settings),
+        "elapsed_s": round(report.elapsed_s, 3),
+        "passed": report.passed,
+        "results": [r.as_dict() for r in report.results],
+        "near_singular": study,
+    }
+
+
+def _finite_json(value):
+    """JSON has no inf or NaN: write them as strings."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return str(value)
+    if isinstance(value, dict):
+        return {k: _finite_json(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_finite_json(v) for v in value]
+    return value
+
+
+def run(args: argparse.Namespace) -> int:
+    from pendverify.atomic import write_atomic
+    from pendverify.errors import UnknownNameError
+    from pendverify.stress import CASE_NAMES, FULL, QUICK, SEED, run_catalogue
+
+    for name in args.case or ():
+        if name not in CASE_NAMES:
+            raise UnknownNameError("stress case", name, CASE_NAMES)
+    seed = SEED if args.seed is None else args.seed
+    report = run_catalogue(QUICK if args.quick else FULL, names=args.case, seed=seed)
+    print(format_table(report))
+    if report.study is not None:
+        print()
+        print(format_study(report.study))
+    elapsed = time.perf_counter() - args.started
+    failures = [r for r in report.results if not r.passed]
+    verdict = "all cases pass" if not failures else f"{len(failures)} case(s) FAIL"
+    print()
+    print(
+        f"{len(report.results)} stress cases ({'quick' if args.quick else 'full'}, seed {seed}), "
+        f"{elapsed:.1f} s: {verdict}"
+    )
+    if args.json:
+        document = report_dict(report)
+        document["elapsed_s"] = round(elapsed, 3)
+        write_atomic(
+            args.json,
+            json.dumps(_finite_json(document), indent=2, ensure_ascii=False, allow_nan=False) + "\n",
+        )
+        print(f"report written to {args.json}")
+    return 0 if not failures else 1
