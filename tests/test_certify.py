@@ -179,3 +179,23 @@ def test_bad_sweep_is_a_clear_error(tmp_path, capsys):
         f"{sweep}: key 'ranges.mass' = [0.5, 2.0]: unknown parameter; double_pendulum has m1"
         in capsys.readouterr().err
     )
+
+
+def test_near_singular_set_is_not_certified(tmp_path, capsys):
+    params = tmp_path / "fragile.toml"
+    params.write_text(default_params("cart_double_pendulum").replace(m1=1e-12).to_toml("fragile"))
+    out = tmp_path / "out"
+    assert main(["certify", str(params), "-o", str(out), *FAST]) == 1
+    text = capsys.readouterr().out
+    assert "NOT certified" in text and "stress:conditioning" in text
+    assert not (out / "fragile.cert.json").exists()
+
+
+def test_battery_covers_stress_cases(certified):
+    names = {c["name"] for c in json.loads(certified.read_text())["checks"] if c["kind"] == "stress"}
+    assert names == {
+        "stress:large-angles",
+        "stress:high-speeds",
+        "stress:zero-gravity",
+        "stress:conditioning",
+    }

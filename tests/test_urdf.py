@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -103,3 +104,23 @@ def test_reversed_axis_and_offset_are_read_off_the_geometry():
     model = DoublePendulum(params)
     results = run_checks("turned", model, system, sample_states(model, 40, SEED), SEED)
     assert all(r.passed for r in results), [(r.check, r.max_error) for r in results if not r.passed]
+
+
+@pytest.mark.parametrize(
+    ("call", "key"),
+    [
+        (lambda s: s.mass_matrix([0.1, float("nan")]), "q[1]"),
+        (lambda s: s.bias([0.1, 0.2], [float("inf"), 0.0]), "v[0]"),
+        (lambda s: s.acceleration([0.1, 0.2], [0.0, 0.0], [0.0, float("nan")]), "tau[1]"),
+    ],
+)
+def test_non_finite_states_are_refused_not_propagated(call, key):
+    from pendverify.errors import InputError
+
+    system = PinocchioSystem.from_urdf(
+        "double_pendulum", urdf_for(default_params("double_pendulum")), 9.81, "dp.urdf"
+    )
+    with pytest.raises(
+        InputError, match=rf"dp\.urdf: key '{re.escape(key)}' = .*: a state entry must be a finite number"
+    ):
+        call(system)

@@ -1,7 +1,9 @@
 """The full battery a parameter set must pass before it is certified.
 
 1. every core check (``pendverify.checks``) on a large seeded sample of states;
-2. the stress cases that apply to these parameters (``stress_items``);
+2. the stress cases that apply to any set, run on these parameters: large
+   angles, high speeds, zero gravity, and the conditioning guard (a set whose
+   M is too near singular to compare is refused, not certified);
 3. one simulation invariant per effect: a short run with gravity alone
    (energy drift), with damping (dissipation balance, energy never rises),
    with actuation (work–energy balance) and, for the cart, with a seeded noise
@@ -20,6 +22,7 @@ import numpy as np
 
 from pendverify.analytic import MODELS, ParameterSet
 from pendverify.checks import run_checks
+from pendverify.errors import PendverifyError
 from pendverify.robot import PinocchioSystem
 from pendverify.sampling import sample_states
 
@@ -109,7 +112,16 @@ def invariant_items(model_name, params, urdf: str, settings: BatterySettings) ->
 
     items = []
     for effect, doc in _effect_scenes(model_name, params, settings).items():
-        run = simulate(parse_scene(doc, f"<battery {effect}>"), "aba", urdf)
+        try:
+            run = simulate(parse_scene(doc, f"<battery {effect}>"), "aba", urdf)
+        except (PendverifyError, RuntimeError, FloatingPointError) as exc:
+            # a run that diverges or dies is a failed item, not a crash of the battery
+            items.append(
+                BatteryItem(
+                    f"invariant:{effect}", "invariant", np.inf, 0.0, 0, settings.seed, False, str(exc)
+                )
+            )
+            continue
         steps = len(run.integration.steps_t) - 1
         for inv in run.invariants:
             items.append(
@@ -128,13 +140,40 @@ def invariant_items(model_name, params, urdf: str, settings: BatterySettings) ->
     return items
 
 
-def stress_items(model_name, params, urdf: str, settings: BatterySettings) -> list[BatteryItem]:
-    """The stress cases that apply to these parameters (see pendverify.stress)."""
-    try:
-        from pendverify.stress import battery_cases
-    except ImportError:  # the stress suite is optional until it lands
-        return []
-    return [BatteryItem(**case) for case in battery_cases(model_name, params, urdf, settings.seed)]
+def stress_items(model_name, params, settings: BatterySettings) -> list[BatteryItem]:
+    """The stress cases that apply to any parameter set, run on this one.
+
+    Large angles (|θ| ≈ 1e6 rad, with the θ + 2πk invariance), high speeds
+    (|q̇| ≤ 1e3), zero gravity, and the conditioning guard of
+    ``pendverify.near_singular`` over the sampled states: a set whose
+    comparisons would need refusing (near-singular M) is not certified.
+    """
+    from pendverify import stress
+
+    ctx = stress.Context(stress.FULL, settings.seed)
+    cases = [
+        stress.large_angle_case("large angles", lambda: params),
+        stress.high_speed_case("high speeds", lambda: params),
+        stress.checks_case("zero gravity", "gravity", lambda: params.replace(g=0.0)),
+        stress.checks_case("conditioning", "conditioning", lambda: params),
+    ]
+    items = []
+    for case in cases:
+        r = stress.run_case(case, ctx)
+        passed = r.passed and r.refused == 0 and r.level != "refuse"
+        items.append(
+            BatteryItem(
+                f"stress:{case.name.replace(' ', '-')}",
+                "stress",
+                float(r.error or 0.0),
+                float(r.tolerance or 1.0),
+                ctx.settings.random_states,
+                settings.seed,
+                bool(passed),
+                r.verdict + (f"; {r.invariant}" if r.invariant else "") + (f"; {r.note}" if r.note else ""),
+            )
+        )
+    return items
 
 
 def run_battery(
@@ -144,6 +183,6 @@ def run_battery(
     system = PinocchioSystem.from_urdf(model_name, urdf, params.g, f"<URDF being certified: {model_name}>")
     return (
         check_items(model, system, settings)
-        + stress_items(model_name, params, urdf, settings)
+        + stress_items(model_name, params, settings)
         + invariant_items(model_name, params, urdf, settings)
     )

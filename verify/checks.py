@@ -227,8 +227,12 @@ def run_check(check: Check, label: str, model, system, states, seed: int) -> Che
         if sample.note and len(notes) < 3:
             notes.append(f"{state.label}: {sample.note}")
         angle = float(np.max(np.abs(state.q[np.array(model.angular)]), initial=0.0))
-        rel_tol = check.K * EPS * (1.0 + angle) * amplification + sample.allowance / sample.scale
-        rel_err = sample.error / sample.scale
+        if sample.scale > 0:
+            rel_tol = check.K * EPS * (1.0 + angle) * amplification + sample.allowance / sample.scale
+            rel_err = sample.error / sample.scale
+        else:  # nothing acts (at rest with g = 0): any error at all is a failure
+            rel_tol = check.K * EPS * (1.0 + angle) * amplification
+            rel_err = 0.0 if sample.error == 0 else np.inf
         ratio = rel_err / rel_tol if np.isfinite(rel_err) else np.inf
         if np.isnan(rel_err):
             ratio = np.inf

@@ -84,8 +84,9 @@ def build_dynamics(scene: Scene, engine: str | None = None, urdf: str | None = N
     model = MODELS[scene.model](params)
     system = None
     if engine in ("aba", "both"):
-        source = f"<URDF of {scene.name}>" if urdf is None else None
-        system = PinocchioSystem.from_urdf(scene.model, urdf or urdf_for(params), g, source)
+        system = PinocchioSystem.from_urdf(
+            scene.model, urdf or urdf_for(params), g, f"<URDF of {scene.name}>"
+        )
     terms = ["inertia M(q)q̈", "Coriolis/centrifugal C(q,q̇)q̇"]
     terms.append(f"gravity H(q), g = {g:g} m/s²" if scene.gravity is not None else "gravity: off (H = 0)")
 

@@ -32,6 +32,7 @@ import pinocchio as pin
 from pendverify.analytic import DoublePendulumParams, ParameterSet
 from pendverify.coordinates import CoordinateMap
 from pendverify.errors import ParameterError, UrdfShapeError
+from pendverify.validate import finite_state
 
 PARALLEL_TOL = 1e-9  # |sin| of the angle between axes that count as parallel
 DEFAULT_G = 9.81  # m/s², Pinocchio's default, used when a URDF alone is given
@@ -261,8 +262,14 @@ class PinocchioSystem:
         return cls(model, geometry, DEFAULT_G if g is None else g, source)
 
     def _qv(self, theta, theta_dot=None):
-        q = self.cmap.configuration(theta)
-        v = self.cmap.velocity(theta_dot) if theta_dot is not None else np.zeros(self.model.nv)
+        # Pinocchio turns a NaN angle into NaN results without a word: refuse it here.
+        n = self.model.nv
+        q = self.cmap.configuration(finite_state("q", theta, n, self.source))
+        v = (
+            np.zeros(n)
+            if theta_dot is None
+            else self.cmap.velocity(finite_state("v", theta_dot, n, self.source))
+        )
         return q, v
 
     @staticmethod
@@ -316,7 +323,8 @@ class PinocchioSystem:
     def acceleration(self, theta, theta_dot, tau_theta) -> np.ndarray:
         """q̈ by ABA for a generalized force given in the model's coordinates."""
         q, v = self._qv(theta, theta_dot)
-        a = pin.aba(self.model, self.data, q, v, self.cmap.force_to_joints(tau_theta))
+        tau = self.cmap.force_to_joints(finite_state("tau", tau_theta, self.model.nv, self.source))
+        a = pin.aba(self.model, self.data, q, v, tau)
         return self.cmap.acceleration_to_model(a)
 
     def kinetic_energy(self, theta, theta_dot) -> float:
