@@ -44,16 +44,21 @@ used verbatim.  The seed gives no C matrix: the Christoffel form of M is
 
 and H = ∂V/∂y = (0, −g (m1+m2) l1 sin θ1, −g m2 l2 sin θ2) with
 V = g (m1 l1 cos θ1 + m2 (l1 cos θ1 + l2 cos θ2)), so that f = −C ẏ − H − D ẏ + B u + w.
+
+Lagrangian (for ``pendverify sympy``): the seed's K and P verbatim, the Rayleigh
+function R = ½ (d1 q̇² + d2 θ̇1² + d3 θ̇2²) and the input power
+P_in = (u + w1) q̇ + w2 θ̇1 + w3 θ̇2.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
+from typing import ClassVar
 
 import numpy as np
 
-from pendverify.analytic.interface import ClosedFormModel
+from pendverify.analytic.interface import STANDARD_CLOSED_FORMS, ClosedForm, ClosedFormModel, Energies
 from pendverify.analytic.params import ParameterSet, quantity
 
 
@@ -81,10 +86,22 @@ class CartDoublePendulum(ClosedFormModel):
     angular = (False, True, True)
     inputs = ("u",)
     disturbances = ("w1", "w2", "w3")
+    # The seed's own right-hand side f is a closed form too.
+    closed_forms: ClassVar[dict[str, ClosedForm]] = {
+        **STANDARD_CLOSED_FORMS,
+        "f": ClosedForm("qvuw", "-C*v - H - D*v + B*u + W*w"),
+    }
+
+    @classmethod
+    def urdf_geometry(cls, pin_model, source, g):
+        """Read the map (absolute angles from upright) off the URDF (``pendverify.robot``)."""
+        from pendverify.robot import cart_double_pendulum_geometry
+
+        return cart_double_pendulum_geometry(pin_model, source)
 
     def mass_matrix(self, y):
         p = self.params
-        c1, c2, c12 = math.cos(y[1]), math.cos(y[2]), math.cos(y[1] - y[2])
+        c1, c2, c12 = self.math.cos(y[1]), self.math.cos(y[2]), self.math.cos(y[1] - y[2])
         m12 = p.m1 + p.m2
         return np.array(
             [
@@ -96,7 +113,7 @@ class CartDoublePendulum(ClosedFormModel):
 
     def coriolis_matrix(self, y, yd):
         p = self.params
-        s1, s2, s12 = math.sin(y[1]), math.sin(y[2]), math.sin(y[1] - y[2])
+        s1, s2, s12 = self.math.sin(y[1]), self.math.sin(y[2]), self.math.sin(y[1] - y[2])
         k = p.l1 * p.l2 * p.m2
         return np.array(
             [
@@ -109,7 +126,7 @@ class CartDoublePendulum(ClosedFormModel):
     def gravity(self, y):
         p = self.params
         return np.array(
-            [0.0, -p.g * (p.m1 + p.m2) * p.l1 * math.sin(y[1]), -p.g * p.m2 * p.l2 * math.sin(y[2])]
+            [0.0, -p.g * (p.m1 + p.m2) * p.l1 * self.math.sin(y[1]), -p.g * p.m2 * p.l2 * self.math.sin(y[2])]
         )
 
     def gravity_scale(self):
@@ -118,7 +135,7 @@ class CartDoublePendulum(ClosedFormModel):
 
     def potential_energy(self, y):
         p = self.params
-        return p.g * ((p.m1 + p.m2) * p.l1 * math.cos(y[1]) + p.m2 * p.l2 * math.cos(y[2]))
+        return p.g * ((p.m1 + p.m2) * p.l1 * self.math.cos(y[1]) + p.m2 * p.l2 * self.math.cos(y[2]))
 
     def damping_matrix(self):
         p = self.params
@@ -133,7 +150,7 @@ class CartDoublePendulum(ClosedFormModel):
     def f(self, y, yd, u, w):
         """The seed's right-hand side f(y, ẏ, u, w) of M(y) ÿ = f, verbatim."""
         p = self.params
-        s1, s2, s12 = math.sin(y[1]), math.sin(y[2]), math.sin(y[1] - y[2])
+        s1, s2, s12 = self.math.sin(y[1]), self.math.sin(y[2]), self.math.sin(y[1] - y[2])
         return (
             np.array(
                 [
@@ -149,7 +166,7 @@ class CartDoublePendulum(ClosedFormModel):
 
     def det_mass_matrix(self, y):
         p = self.params
-        s1sq, s12sq = math.sin(y[1]) ** 2, math.sin(y[1] - y[2]) ** 2
+        s1sq, s12sq = self.math.sin(y[1]) ** 2, self.math.sin(y[1] - y[2]) ** 2
         return (
             p.l1**2 * p.l2**2 * p.m2 * (p.m * p.m1 + p.m1**2 * s1sq + p.m1 * p.m2 * s1sq + p.m * p.m2 * s12sq)
         )
@@ -172,6 +189,25 @@ class CartDoublePendulum(ClosedFormModel):
 
     def acceleration(self, q, v, u, w):
         return self.state_derivative(np.concatenate([q, v]), u, w)[3:]
+
+    def energies(self, y, yd, u, w):
+        p, cos, sin = self.params, self.math.cos, self.math.sin
+        qd, t1, t2 = yd
+        kinetic = (
+            p.m * qd**2
+            + p.m1 * ((qd + p.l1 * t1 * cos(y[1])) ** 2 + (p.l1 * t1 * sin(y[1])) ** 2)
+            + p.m2
+            * (
+                (qd + p.l1 * t1 * cos(y[1]) + p.l2 * t2 * cos(y[2])) ** 2
+                + (p.l1 * t1 * sin(y[1]) + p.l2 * t2 * sin(y[2])) ** 2
+            )
+        ) / 2
+        return Energies(
+            kinetic=kinetic,
+            potential=p.g * (p.m1 * p.l1 * cos(y[1]) + p.m2 * (p.l1 * cos(y[1]) + p.l2 * cos(y[2]))),
+            dissipation=(p.d1 * qd**2 + p.d2 * t1**2 + p.d3 * t2**2) / 2,
+            power=(u[0] + w[0]) * qd + w[1] * t1 + w[2] * t2,
+        )
 
     def special_states(self):
         pi = math.pi

@@ -32,16 +32,23 @@ The seed cites an appendix that is not included.  Its constants are taken as
 seed's C carries the friction on its diagonal; ``coriolis_matrix`` returns it
 without, ``seed_coriolis_matrix`` with.  V(q) = g (m1 r1 + m2 l1) sin θ1 +
 g m2 r2 sin(θ1 + θ2), so H = ∂V/∂q.
+
+Lagrangian (for ``pendverify sympy``): the centres of mass sit at
+c1 = r1 (cos θ1, sin θ1) and c2 = l1 (cos θ1, sin θ1) + r2 (cos(θ1+θ2), sin(θ1+θ2)), so
+
+    T = ½ m1 |ċ1|² + ½ I1 θ̇1² + ½ m2 |ċ2|² + ½ I2 (θ̇1 + θ̇2)²,
+    V = g (m1 c1,y + m2 c2,y),   R = ½ (b1 θ̇1² + b2 θ̇2²),   P = τ1 θ̇1 + τ2 θ̇2.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
+from typing import ClassVar
 
 import numpy as np
 
-from pendverify.analytic.interface import ClosedFormModel
+from pendverify.analytic.interface import STANDARD_CLOSED_FORMS, ClosedForm, ClosedFormModel, Energies
 from pendverify.analytic.params import ParameterSet, quantity
 from pendverify.errors import ParameterError
 
@@ -87,6 +94,18 @@ class DoublePendulum(ClosedFormModel):
     coordinates = ("theta1", "theta2")
     angular = (True, True)
     inputs = ("tau1", "tau2")
+    # The seed writes C with the friction on its diagonal: that is the formula to mutate.
+    closed_forms: ClassVar[dict[str, ClosedForm]] = {
+        **{k: f for k, f in STANDARD_CLOSED_FORMS.items() if k != "coriolis_matrix"},
+        "seed_coriolis_matrix": ClosedForm("qv", "C + D"),
+    }
+
+    @classmethod
+    def urdf_geometry(cls, pin_model, source, g):
+        """Read the map, the offsets and the seed's parameters off the URDF (``pendverify.robot``)."""
+        from pendverify.robot import double_pendulum_geometry
+
+        return double_pendulum_geometry(pin_model, source, g)
 
     # --- the appendix constants ------------------------------------------------------
     @property
@@ -107,13 +126,13 @@ class DoublePendulum(ClosedFormModel):
     # --- the seed's matrices -----------------------------------------------------------
     def mass_matrix(self, q):
         a, b, d = self.alpha, self.beta, self.delta
-        c2 = math.cos(q[1])
+        c2 = self.math.cos(q[1])
         return np.array([[a + 2 * b * c2, d + b * c2], [d + b * c2, d]])
 
     def seed_coriolis_matrix(self, q, v):
         """C exactly as the seed prints it: friction b1, b2 on the diagonal."""
         b, p = self.beta, self.params
-        s2 = math.sin(q[1])
+        s2 = self.math.sin(q[1])
         return np.array(
             [
                 [-b * s2 * v[1] + p.b1, -b * s2 * (v[0] + v[1])],
@@ -122,11 +141,12 @@ class DoublePendulum(ClosedFormModel):
         )
 
     def coriolis_matrix(self, q, v):
+        # the seed's own C, less its friction; the checks' scales include |D| for this subtraction
         return self.seed_coriolis_matrix(q, v) - self.damping_matrix()
 
     def gravity(self, q):
         p = self.params
-        c1, c12 = math.cos(q[0]), math.cos(q[0] + q[1])
+        c1, c12 = self.math.cos(q[0]), self.math.cos(q[0] + q[1])
         return np.array(
             [
                 p.m1 * p.g * p.r1 * c1 + p.m2 * p.g * (p.l1 * c1 + p.r2 * c12),
@@ -140,7 +160,9 @@ class DoublePendulum(ClosedFormModel):
 
     def potential_energy(self, q):
         p = self.params
-        return p.g * ((p.m1 * p.r1 + p.m2 * p.l1) * math.sin(q[0]) + p.m2 * p.r2 * math.sin(q[0] + q[1]))
+        return p.g * (
+            (p.m1 * p.r1 + p.m2 * p.l1) * self.math.sin(q[0]) + p.m2 * p.r2 * self.math.sin(q[0] + q[1])
+        )
 
     def damping_matrix(self):
         return np.diag([self.params.b1, self.params.b2])
@@ -150,11 +172,11 @@ class DoublePendulum(ClosedFormModel):
 
     def det_mass_matrix(self, q):
         a, b, d = self.alpha, self.beta, self.delta
-        return a * d - d * d - (b * math.cos(q[1])) ** 2
+        return a * d - d * d - (b * self.math.cos(q[1])) ** 2
 
     def inverse_mass_matrix(self, q):
         a, b, d = self.alpha, self.beta, self.delta
-        c2 = math.cos(q[1])
+        c2 = self.math.cos(q[1])
         adj = np.array([[d, -(d + b * c2)], [-(d + b * c2), a + 2 * b * c2]])
         return adj / self.det_mass_matrix(q)
 
@@ -176,6 +198,28 @@ class DoublePendulum(ClosedFormModel):
     def diagonal_scale(self, q):
         # M11 = α + 2β cos θ2 can cancel; scale by its terms' magnitudes.
         return np.array([self.alpha + 2 * abs(self.beta), self.delta])
+
+    def energies(self, q, v, u, w):
+        p, cos, sin = self.params, self.math.cos, self.math.sin
+        omega1, omega12 = v[0], v[0] + v[1]  # absolute angular rates of the links
+        c1_dot = (-p.r1 * sin(q[0]) * omega1, p.r1 * cos(q[0]) * omega1)
+        c2_dot = (
+            -p.l1 * sin(q[0]) * omega1 - p.r2 * sin(q[0] + q[1]) * omega12,
+            p.l1 * cos(q[0]) * omega1 + p.r2 * cos(q[0] + q[1]) * omega12,
+        )
+        kinetic = (
+            p.m1 * (c1_dot[0] ** 2 + c1_dot[1] ** 2) / 2
+            + p.I1 * omega1**2 / 2
+            + p.m2 * (c2_dot[0] ** 2 + c2_dot[1] ** 2) / 2
+            + p.I2 * omega12**2 / 2
+        )
+        height1, height2 = p.r1 * sin(q[0]), p.l1 * sin(q[0]) + p.r2 * sin(q[0] + q[1])
+        return Energies(
+            kinetic=kinetic,
+            potential=p.g * (p.m1 * height1 + p.m2 * height2),
+            dissipation=(p.b1 * v[0] ** 2 + p.b2 * v[1] ** 2) / 2,
+            power=u[0] * v[0] + u[1] * v[1],
+        )
 
     def special_states(self):
         half_pi = math.pi / 2

@@ -108,6 +108,20 @@ def norm2(A) -> float:
     return float(np.linalg.norm(A, 2))
 
 
+def position_lever(model, q) -> float:
+    """max |x_i|/ℓ_i over linear coordinates, with ℓ_i the radius of gyration of ``rate_scale``.
+
+    Pinocchio expresses spatial inertias and velocities in the world frame, so a
+    cart far from the origin carries lever arms |x| into its intermediate terms:
+    inverses grow like (x/ℓ)², Coriolis terms like x/ℓ, and cancel in the result.
+    """
+    angular = np.array(model.angular)
+    if not (np.any(~angular) and np.any(angular)):
+        return 0.0
+    S = model.diagonal_scale(q)
+    return float(np.max(np.abs(q[~angular]) / np.sqrt(np.min(S[angular]) / S[~angular])))
+
+
 def _force_scale(model, state, w) -> float:
     """Size of the generalized forces acting, in scaled units (sum of |terms|)."""
     rate = rate_scale(model, state.q, state.v)
@@ -134,11 +148,18 @@ def _crba(model, system, s):
     return Sample(err, 1.0)
 
 
+def _damping_rate(model, w) -> float:
+    """max |D̃| in 1/s: a hand C written with friction inside (C + D, as seed 000) rounds at this size."""
+    return float(np.max(np.abs(scaled_matrix(model.damping_matrix(), w)), initial=0.0))
+
+
 def _rnea(model, system, s):
     w = weights(model, s.q)
     err = np.max(w * np.abs(system.bias(s.q, s.v) - model.bias(s.q, s.v)))
     zdot = s.v / w
-    scale = rate_scale(model, s.q, s.v) * np.sum(np.abs(zdot)) + np.max(w * model.gravity_scale())
+    scale = (rate_scale(model, s.q, s.v) + _damping_rate(model, w)) * np.sum(np.abs(zdot)) + np.max(
+        w * model.gravity_scale()
+    )
     return Sample(err, scale, float(np.max(w * _allowance(system))))
 
 
@@ -151,13 +172,15 @@ def _gravity(model, system, s):
 def _coriolis(model, system, s):
     w = weights(model, s.q)
     diff = system.coriolis_matrix(s.q, s.v) - model.coriolis_matrix(s.q, s.v)
-    return Sample(np.max(np.abs(scaled_matrix(diff, w))), max(rate_scale(model, s.q, s.v), 1.0))
+    rates = max(rate_scale(model, s.q, s.v) + _damping_rate(model, w), 1.0)
+    return Sample(np.max(np.abs(scaled_matrix(diff, w))), rates * (1.0 + position_lever(model, s.q)))
 
 
 def _skew(model, system, s):
     w = weights(model, s.q)
     N = system.mass_matrix_derivative(s.q, s.v) - 2 * model.coriolis_matrix(s.q, s.v)
-    return Sample(np.max(np.abs(scaled_matrix(N + N.T, w))), max(rate_scale(model, s.q, s.v), 1.0))
+    rates = max(rate_scale(model, s.q, s.v) + _damping_rate(model, w), 1.0)
+    return Sample(np.max(np.abs(scaled_matrix(N + N.T, w))), rates)
 
 
 def _det(model, system, s):
@@ -174,7 +197,8 @@ def _minverse(model, system, s):
     Minv_scaled = scaled_matrix(model.inverse_mass_matrix(s.q), sqrt_s)
     M_scaled = scaled_matrix(model.mass_matrix(s.q), 1.0 / sqrt_s)
     # δ(M⁻¹) = −M⁻¹ δM M⁻¹ with |δM̃| ~ ε‖M̃‖
-    return Sample(np.max(np.abs(scaled_matrix(diff, sqrt_s))), norm2(Minv_scaled) ** 2 * norm2(M_scaled))
+    scale = norm2(Minv_scaled) ** 2 * norm2(M_scaled) * (1.0 + position_lever(model, s.q) ** 2)
+    return Sample(np.max(np.abs(scaled_matrix(diff, sqrt_s))), scale)
 
 
 def _aba(model, system, s):

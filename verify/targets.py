@@ -4,7 +4,12 @@
 * example-robot-data's double-pendulum URDFs against the seed-000 closed form
   with parameters read off the URDF itself;
 * a user's URDF against a user's parameter set, or (double pendulum) against
-  the parameters read off that URDF.
+  the parameters read off that URDF;
+* a user's own model file (``--analytic``, ``pendverify.plugin``) against a URDF.
+
+Built-in and plug-in models take one path: the URDF is loaded, the model class's
+``urdf_geometry`` hook gives the coordinate map (the seeds read it off the
+geometry, a plug-in declares it), and ``model_target`` pairs the two.
 """
 
 from __future__ import annotations
@@ -14,10 +19,16 @@ from importlib.resources import files
 from pathlib import Path
 
 from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
-from pendverify.analytic.params import default_parameter_file, load_parameter_file
+from pendverify.analytic.params import (
+    default_parameter_file,
+    load_parameter_file,
+    parse_parameter_document,
+    read_toml,
+)
 from pendverify.erd import double_pendulum_urdfs
-from pendverify.errors import PendverifyError, UnknownNameError
-from pendverify.robot import PinocchioSystem, load_model
+from pendverify.errors import ParameterError, PendverifyError, UnknownNameError
+from pendverify.plugin import load_model_class
+from pendverify.robot import DEFAULT_G, PinocchioSystem, load_model
 from pendverify.urdf_writer import urdf_for
 
 PARAMETER_MATCH_RTOL = 1e-9
@@ -32,6 +43,27 @@ class Target:
     notes: list[str] = field(default_factory=list)
 
 
+MATRIX_C_CHECKS = ("coriolis", "skew")
+
+
+def applicable_checks(model: ClosedFormModel | type[ClosedFormModel]) -> tuple[str, ...]:
+    """The checks a model can take: those comparing the matrix C need a model that has one."""
+    from pendverify.checks import CHECK_NAMES
+
+    if model.has_coriolis_matrix:
+        return CHECK_NAMES
+    return tuple(c for c in CHECK_NAMES if c not in MATRIX_C_CHECKS)
+
+
+def skipped_checks_note(cls: type[ClosedFormModel]) -> list[str]:
+    if cls.has_coriolis_matrix:
+        return []
+    return [
+        f"{', '.join(MATRIX_C_CHECKS)} not run: {cls.__name__} gives the force C·q̇ "
+        "(coriolis_force), not a matrix C; C·q̇ is checked by rnea and aba"
+    ]
+
+
 def committed_urdf(model: str) -> Path:
     return Path(str(files("pendverify.urdf") / f"{model}.urdf"))
 
@@ -42,18 +74,26 @@ def _model_class(name: str):
     return MODELS[name]
 
 
+def system_for(cls: type[ClosedFormModel], urdf, g: float | None = None, source: str | None = None):
+    """A URDF (path or XML text) in Pinocchio, seen in ``cls``'s coordinates via its ``urdf_geometry``."""
+    pin_model, source = load_model(urdf, source)
+    geometry = cls.urdf_geometry(pin_model, source, g)
+    return PinocchioSystem(pin_model, geometry, DEFAULT_G if g is None else g, source)
+
+
 def default_target(model_name: str) -> Target:
     _, _, params = load_parameter_file(default_parameter_file(model_name))
     path = committed_urdf(model_name)
-    system = PinocchioSystem.from_urdf(model_name, path, params.g)
-    return Target(model_name, _model_class(model_name)(params), system, str(path))
+    cls = _model_class(model_name)
+    return Target(model_name, cls(params), system_for(cls, path, params.g), str(path))
 
 
 def erd_targets() -> list[Target]:
     targets = []
+    cls = _model_class("double_pendulum")
     for stem, path in double_pendulum_urdfs().items():
-        system = PinocchioSystem.from_urdf("double_pendulum", path)
-        model = _model_class("double_pendulum")(system.geometry.params)
+        system = system_for(cls, path)
+        model = cls(system.geometry.params)
         targets.append(Target(f"erd:{stem}", model, system, str(path), list(system.geometry.notes)))
     return targets
 
@@ -71,6 +111,31 @@ def parameter_differences(urdf_params: ParameterSet, given: ParameterSet) -> lis
     return notes
 
 
+def model_target(cls: type[ClosedFormModel], urdf: str, params: ParameterSet | None) -> Target:
+    """A model class, a URDF file and (unless the URDF fixes them) its parameters: built-in or plug-in."""
+    g = getattr(params, "g", None)
+    system = system_for(cls, urdf, g)
+    notes = list(system.geometry.notes)
+    read = system.geometry.params
+    if params is None:
+        if read is None:
+            raise PendverifyError(
+                f"{urdf}: give --params: a {cls.name} URDF alone does not fix the closed form"
+            )
+        params = read if isinstance(read, cls.params_type) else cls.params_type(**read.as_dict())
+        notes.append("parameters read off the URDF")
+    elif read is not None:
+        notes += parameter_differences(read, params)
+    notes += skipped_checks_note(cls)
+    if not hasattr(params, "g"):
+        notes.append(f"the parameter set has no g: Pinocchio's gravity is {DEFAULT_G} m/s²")
+    try:
+        model = cls(params)
+    except Exception as exc:
+        raise PendverifyError(f"{cls.name}: building the model failed: {type(exc).__name__}: {exc}") from None
+    return Target(f"{cls.name}:{Path(urdf).stem}", model, system, system.source, notes)
+
+
 def user_target(model_name: str | None, urdf: str | None, params_file: str | None) -> Target:
     """A target from the CLI's --model / --urdf / --params."""
     params = None
@@ -84,20 +149,28 @@ def user_target(model_name: str | None, urdf: str | None, params_file: str | Non
     cls = _model_class(model_name)
     if urdf is None:
         # the URDF of this parameter set, as the project writes it
-        system = PinocchioSystem.from_urdf(model_name, urdf_for(params), params.g, f"<URDF of {params_file}>")
+        system = system_for(cls, urdf_for(params), params.g, f"<URDF of {params_file}>")
         return Target(f"{model_name}:{Path(params_file).stem}", cls(params), system, system.source)
-    pin_model, source = load_model(urdf)
-    del pin_model  # parsed once here for a clear early error
-    g = params.g if params is not None else None
-    system = PinocchioSystem.from_urdf(model_name, urdf, g, source)
-    notes = list(system.geometry.notes)
-    if params is None:
-        if system.geometry.params is None:
-            raise PendverifyError(
-                f"{urdf}: give --params: a {model_name} URDF alone does not fix the closed form"
-            )
-        params = system.geometry.params
-        notes.append("parameters read off the URDF")
-    elif system.geometry.params is not None:
-        notes += parameter_differences(system.geometry.params, params)
-    return Target(f"{model_name}:{Path(urdf).stem}", cls(params), system, source, notes)
+    return model_target(cls, urdf, params)
+
+
+def plugin_parameters(cls: type[ClosedFormModel], model_file: str, params_file: str) -> ParameterSet:
+    """A parameter file for a plug-in: its ``model`` key must be the plug-in's name."""
+    data = read_toml(Path(params_file))
+    if data.get("model") != cls.name:
+        raise ParameterError(
+            params_file,
+            "model",
+            data.get("model"),
+            f"must be {cls.name!r}, the model defined in {model_file}",
+        )
+    return parse_parameter_document(data, params_file, {cls.name: cls.params_type})[2]
+
+
+def plugin_target(model_file: str, urdf: str | None, params_file: str | None) -> Target:
+    """A target from the CLI's --analytic / --urdf / --params."""
+    cls = load_model_class(model_file)
+    if urdf is None:
+        raise PendverifyError(f"{model_file}: give --urdf: the URDF to verify {cls.name} against")
+    params = plugin_parameters(cls, model_file, params_file) if params_file else None
+    return model_target(cls, urdf, params)

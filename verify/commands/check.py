@@ -11,6 +11,12 @@ from pendverify.commands import non_negative_int
 def register(sub) -> None:
     p = sub.add_parser("check", help="compare Pinocchio with the hand-derived closed forms")
     p.add_argument("--model", help="double_pendulum or cart_double_pendulum")
+    p.add_argument(
+        "--analytic",
+        metavar="FILE",
+        help="your own closed-form model: a Python file defining one ClosedFormModel subclass "
+        "(see examples/cart_pole.py); needs --urdf",
+    )
     p.add_argument("--urdf", help="a URDF to check (with --model, or with --params)")
     p.add_argument("--params", help="a parameter file (TOML) giving the closed form")
     p.add_argument("--samples", type=non_negative_int, default=None, help="random states per model")
@@ -23,13 +29,21 @@ def register(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     from pendverify.atomic import write_atomic
     from pendverify.checks import run_checks
+    from pendverify.diagnose import diagnose
+    from pendverify.errors import PendverifyError
     from pendverify.report import Report, format_table
     from pendverify.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED, sample_states
-    from pendverify.targets import default_target, erd_targets, user_target
+    from pendverify.targets import applicable_checks, default_target, erd_targets, plugin_target, user_target
 
     samples = DEFAULT_RANDOM_STATES if args.samples is None else args.samples
     seed = DEFAULT_SEED if args.seed is None else args.seed
-    if args.urdf or args.params:
+    if args.analytic:
+        if args.model:
+            raise PendverifyError(
+                "give either --model (a built-in model) or --analytic (a model file), not both"
+            )
+        targets = [plugin_target(args.analytic, args.urdf, args.params)]
+    elif args.urdf or args.params:
         targets = [user_target(args.model, args.urdf, args.params)]
     else:
         names = [args.model] if args.model else ["double_pendulum", "cart_double_pendulum"]
@@ -43,7 +57,12 @@ def run(args: argparse.Namespace) -> int:
         report.sources[target.label] = target.source
         if target.notes:
             report.notes[target.label] = target.notes
-        report.results += run_checks(target.label, target.model, target.system, states, seed)
+        names = applicable_checks(target.model)
+        results = run_checks(target.label, target.model, target.system, states, seed, names)
+        diagnoses = diagnose(target.model, target.system, results)
+        if diagnoses:
+            report.diagnoses[target.label] = diagnoses
+        report.results += results
     report.elapsed_s = time.perf_counter() - args.started
     print(format_table(report))
     if args.json:

@@ -1,0 +1,184 @@
+"""SymPy as a third opinion: both seeds equal their Lagrangian derivation, planted errors do not.
+
+The key case is a wrong assumption shared by the hand model and the URDF: the
+numerical checks cannot see it (both sides agree), the derivation from the
+energies written from the stated conventions does.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import sympy as sp
+
+from pendverify.analytic import MODELS, CartDoublePendulum, DoublePendulum
+from pendverify.analytic.interface import Energies
+from pendverify.checks import run_checks
+from pendverify.cli import main
+from pendverify.errors import PendverifyError
+from pendverify.lagrange import derive
+from pendverify.sampling import sample_states
+from pendverify.symbolic import SymbolicModel, is_zero
+from pendverify.sympy_check import DIFFERS, EQUAL, SKIPPED, WARNING, compare
+from pendverify.targets import system_for
+from pendverify.urdf_writer import urdf_for
+
+from .conftest import SEED, default_params
+
+
+@pytest.mark.parametrize("cls", list(MODELS.values()), ids=list(MODELS))
+def test_seed_closed_forms_equal_their_lagrangian(cls):
+    report = compare(cls)
+    assert report.passed
+    statuses = {c.method: c.status for c in report.comparisons}
+    expected_skips = {"acceleration"} if cls is CartDoublePendulum else set()  # np.linalg.solve
+    assert {m for m, s in statuses.items() if s == SKIPPED} == expected_skips
+    assert all(s in (EQUAL, SKIPPED) for s in statuses.values()), statuses
+    # term by term: every entry of every closed form was compared
+    assert sum(c.entries for c in report.comparisons) == (31 if cls is DoublePendulum else 58)
+    extra = "seed_coriolis_matrix" if cls is DoublePendulum else "f"
+    assert statuses[extra] == EQUAL
+
+
+def test_derivation_gives_the_textbook_quantities():
+    sm = SymbolicModel.of(DoublePendulum)
+    lag = derive(sm)
+    p = sm.parameters
+    t2 = sm.symbols["q"][1]
+    beta = p["m2"] * p["l1"] * p["r2"]
+    assert is_zero(lag.M[1, 1] - (p["I2"] + p["m2"] * p["r2"] ** 2), sm.angles)
+    assert is_zero(lag.M[0, 1] - (p["I2"] + p["m2"] * p["r2"] ** 2 + beta * sp.cos(t2)), sm.angles)
+    assert lag.D == sp.diag(p["b1"], p["b2"]) and lag.B == sp.eye(2) and lag.W.shape == (2, 0)
+
+
+# --- a wrong assumption shared by the URDF and the hand model ---------------------------------
+class PivotInertia(DoublePendulum):
+    """Treats I1, I2 as inertias about the joints: the parallel-axis m·r² terms are left out."""
+
+    @property
+    def alpha(self):
+        p = self.params
+        return p.I1 + p.I2 + p.m2 * p.l1**2
+
+    @property
+    def delta(self):
+        return self.params.I2
+
+
+def test_shared_wrong_assumption_passes_numerically_but_not_symbolically():
+    params = default_params("double_pendulum").replace(I1=0.09, I2=0.06)
+    # the URDF written under the same belief: its centre-of-mass inertia is I − m·r²
+    urdf_params = params.replace(
+        I1=params.I1 - params.m1 * params.r1**2, I2=params.I2 - params.m2 * params.r2**2
+    )
+    model = PivotInertia(params)
+    system = system_for(DoublePendulum, urdf_for(urdf_params), params.g)
+    results = run_checks("pivot", model, system, sample_states(model, 40, SEED), SEED)
+    assert all(r.passed for r in results), [r.check for r in results if not r.passed]
+
+    report = compare(PivotInertia)
+    assert not report.passed
+    mass = next(c for c in report.comparisons if c.method == "mass_matrix")
+    assert mass.status == DIFFERS
+    assert any("M[1,1]: -m2*r2**2" in d for d in mass.differences), mass.differences
+    assert any("M[0,0]: -m1*r1**2 - m2*r2**2" in d for d in mass.differences), mass.differences
+
+
+# --- Coriolis factorisations ------------------------------------------------------------------
+class NotChristoffel(DoublePendulum):
+    """Same C·q̇ as the seed, but −β sin θ2 θ̇1·θ̇2 moved from column 2 to column 1 of row 1."""
+
+    def seed_coriolis_matrix(self, q, v):
+        b, s = self.beta, self.math.sin(q[1])
+        return np.array([[-2 * b * s * v[1] + self.params.b1, -b * s * v[1]], [b * s * v[0], self.params.b2]])
+
+
+class SkewShifted(CartDoublePendulum):
+    """C + c·[q̇]×: same C·q̇ (q̇ × q̇ = 0) and Ṁ − 2C still skew, yet not the Christoffel C."""
+
+    def coriolis_matrix(self, y, yd):
+        c = self.params.m1
+        cross = np.array([[0, -yd[2], yd[1]], [yd[2], 0, -yd[0]], [-yd[1], yd[0], 0]])
+        return super().coriolis_matrix(y, yd) + c * cross
+
+
+@pytest.mark.parametrize(
+    ("cls", "verdict"),
+    [
+        (NotChristoffel, "Ṁ − 2C is not skew: only C·q̇ is right"),
+        (SkewShifted, "Ṁ − 2C is skew: a Christoffel-consistent factorisation"),
+    ],
+)
+def test_other_coriolis_factorisations_are_warnings(cls, verdict):
+    report = compare(cls)
+    coriolis = next(c for c in report.comparisons if c.method == "coriolis_matrix")
+    assert coriolis.status == WARNING
+    assert verdict in coriolis.note
+    assert report.passed  # a warning, not a failure
+
+
+class WrongSign(CartDoublePendulum):
+    def coriolis_matrix(self, y, yd):
+        C = super().coriolis_matrix(y, yd)
+        C[0, 2] = -C[0, 2]
+        return C
+
+
+def test_wrong_coriolis_term_differs():
+    report = compare(WrongSign)
+    coriolis = next(c for c in report.comparisons if c.method == "coriolis_matrix")
+    assert coriolis.status == DIFFERS and not report.passed
+    assert coriolis.differences == ["C[0,2]: 2*dtheta2*l2*m2*sin(theta2)"]
+
+
+# --- the zero test and the derivation's guards ------------------------------------------------
+def test_zero_test_decides_trigonometric_identities():
+    a, b, x = sp.symbols("a b x", real=True)
+    angles = (a, b)
+    assert is_zero(sp.sin(a) ** 2 + sp.cos(a) ** 2 - 1, angles)
+    assert is_zero(sp.cos(a - b) - sp.cos(a) * sp.cos(b) - sp.sin(a) * sp.sin(b), angles)
+    assert is_zero(
+        (sp.sin(a) ** 4 - sp.cos(a) ** 4) / (1 + x**2) - (1 - 2 * sp.cos(a) ** 2) / (1 + x**2), angles
+    )
+    assert not is_zero(sp.cos(a + b) - sp.cos(a - b), angles)
+    assert not is_zero(sp.sin(a) * sp.Rational(1001, 1000) - sp.sin(a), angles)
+    assert not is_zero(sp.sin(sp.Rational(1001, 1000) * a) - sp.sin(a), angles)  # outside the class: probe
+    assert is_zero(sp.sqrt(x**2 + 1) ** 2 - x**2 - 1, angles)
+
+
+class LinearKinetic(DoublePendulum):
+    def energies(self, q, v, u, w):
+        e = super().energies(q, v, u, w)
+        return Energies(e.kinetic + self.params.m1 * v[0], e.potential, e.dissipation, e.power)
+
+
+class NoEnergies(DoublePendulum):
+    def energies(self, q, v, u, w):
+        return None
+
+
+class NumericTrig(DoublePendulum):
+    def gravity(self, q):
+        return np.array([math.cos(q[0]), 0.0])
+
+
+@pytest.mark.parametrize(
+    ("cls", "message"),
+    [
+        (LinearKinetic, "the kinetic energy is not a quadratic form"),
+        (NoEnergies, "defines no energies(q, v, u, w)"),
+        (NumericTrig, "NumericTrig.gravity cannot be read by SymPy"),
+    ],
+)
+def test_models_sympy_cannot_use_are_named_errors(cls, message):
+    with pytest.raises(PendverifyError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        compare(cls)
+
+
+def test_sympy_command(capsys):
+    assert main(["sympy", "--model", "cart_double_pendulum"]) == 0
+    out = capsys.readouterr().out
+    assert "58 entries" in out and "every closed form equals its derivation" in out
+    assert main(["sympy", "--model", "triple"]) == 2

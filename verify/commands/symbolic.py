@@ -1,0 +1,46 @@
+"""``pendverify sympy``: the closed forms against a Lagrangian derivation, term by term."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def register(sub) -> None:
+    p = sub.add_parser(
+        "sympy", help="derive M, C, H, D, B, W from the model's energies with SymPy and compare term by term"
+    )
+    p.add_argument("--model", help="double_pendulum or cart_double_pendulum (default: both)")
+    p.add_argument(
+        "--analytic", metavar="FILE", help="your own model file instead (it must define energies())"
+    )
+    p.add_argument("--json", help="also write the comparison as JSON to this path")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    import json
+
+    from pendverify.analytic import MODELS
+    from pendverify.atomic import write_atomic
+    from pendverify.errors import PendverifyError, UnknownNameError
+    from pendverify.plugin import load_model_class
+    from pendverify.sympy_check import compare, format_report
+
+    if args.analytic and args.model:
+        raise PendverifyError("give either --model (a built-in model) or --analytic (a model file), not both")
+    if args.analytic:
+        classes = [load_model_class(args.analytic)]
+    else:
+        names = [args.model] if args.model else list(MODELS)
+        for name in names:
+            if name not in MODELS:
+                raise UnknownNameError("model", name, tuple(MODELS))
+        classes = [MODELS[n] for n in names]
+    reports = [compare(cls) for cls in classes]
+    print("\n\n".join(format_report(r) for r in reports))
+    if args.json:
+        write_atomic(
+            args.json, json.dumps([r.as_dict() for r in reports], indent=2, ensure_ascii=False) + "\n"
+        )
+        print(f"report written to {args.json}")
+    return 0 if all(r.passed for r in reports) else 1
