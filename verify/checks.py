@@ -108,18 +108,18 @@ def norm2(A) -> float:
     return float(np.linalg.norm(A, 2))
 
 
-def position_lever(model, q) -> float:
-    """max |x_i|/ℓ_i over linear coordinates, with ℓ_i the radius of gyration of ``rate_scale``.
+def world_lever(model, system, q) -> float:
+    """A ≥ 1: how much larger Pinocchio's world-frame terms are than M's diagonal (scaled).
 
-    Pinocchio expresses spatial inertias and velocities in the world frame, so a
-    cart far from the origin carries lever arms |x| into its intermediate terms:
-    inverses grow like (x/ℓ)², Coriolis terms like x/ℓ, and cancel in the result.
+    Pinocchio expresses spatial inertias about the world origin, so a joint whose
+    subtree sits far from it (a cart 10 m along the rail, a small link 2 at the
+    end of a long link 1) carries second moments m·|c|² ≫ M_ii into its
+    recursions, which cancel in the result.  Inverses round in proportion to A,
+    Coriolis terms to √A.  (``pendverify.near_singular.term_amplification``.)
     """
-    angular = np.array(model.angular)
-    if not (np.any(~angular) and np.any(angular)):
-        return 0.0
-    S = model.diagonal_scale(q)
-    return float(np.max(np.abs(q[~angular]) / np.sqrt(np.min(S[angular]) / S[~angular])))
+    from pendverify.near_singular import term_amplification
+
+    return term_amplification(model, system, q)
 
 
 def _force_scale(model, state, w) -> float:
@@ -173,7 +173,7 @@ def _coriolis(model, system, s):
     w = weights(model, s.q)
     diff = system.coriolis_matrix(s.q, s.v) - model.coriolis_matrix(s.q, s.v)
     rates = max(rate_scale(model, s.q, s.v) + _damping_rate(model, w), 1.0)
-    return Sample(np.max(np.abs(scaled_matrix(diff, w))), rates * (1.0 + position_lever(model, s.q)))
+    return Sample(np.max(np.abs(scaled_matrix(diff, w))), rates * np.sqrt(world_lever(model, system, s.q)))
 
 
 def _skew(model, system, s):
@@ -197,7 +197,7 @@ def _minverse(model, system, s):
     Minv_scaled = scaled_matrix(model.inverse_mass_matrix(s.q), sqrt_s)
     M_scaled = scaled_matrix(model.mass_matrix(s.q), 1.0 / sqrt_s)
     # δ(M⁻¹) = −M⁻¹ δM M⁻¹ with |δM̃| ~ ε‖M̃‖
-    scale = norm2(Minv_scaled) ** 2 * norm2(M_scaled) * (1.0 + position_lever(model, s.q) ** 2)
+    scale = norm2(Minv_scaled) ** 2 * norm2(M_scaled) * world_lever(model, system, s.q)
     return Sample(np.max(np.abs(scaled_matrix(diff, sqrt_s))), scale)
 
 
