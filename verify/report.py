@@ -51,6 +51,14 @@ class Report:
         return json.dumps(self.as_dict(), indent=2, ensure_ascii=False) + "\n"
 
 
+def text_table(header: tuple[str, ...], rows: list[tuple[str, ...]]) -> list[str]:
+    """Left-aligned columns under a ruled header, as lines."""
+    widths = [max(len(h), *(len(row[i]) for row in rows)) for i, h in enumerate(header)]
+    line = "  ".join(h.ljust(w) for h, w in zip(header, widths, strict=True))
+    body = ["  ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)).rstrip() for row in rows]
+    return [line, "-" * len(line), *body]
+
+
 def _state_text(state: dict) -> str:
     q = ", ".join(f"{x:.3g}" for x in state["q"])
     return f"{state['label']} q=({q})"
@@ -69,10 +77,7 @@ def format_table(report: Report) -> str:
         )
         for r in report.results
     ]
-    widths = [max(len(h), *(len(row[i]) for row in rows)) for i, h in enumerate(header)]
-    line = "  ".join(h.ljust(w) for h, w in zip(header, widths, strict=True))
-    out = [line, "-" * len(line)]
-    out += ["  ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)).rstrip() for row in rows]
+    out = text_table(header, rows)
     out.append("")
     out.append(
         "error and tolerance are relative, in diagonally scaled coordinates: "

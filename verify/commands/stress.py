@@ -32,6 +32,8 @@ def _num(x, fmt=".2e") -> str:
 
 
 def format_table(report) -> str:
+    from pendverify.report import text_table
+
     header = ("case", "quantity", "error", "tolerance", "κ(M)", "κ̃(M)", "result")
     rows = [
         (
@@ -45,10 +47,7 @@ def format_table(report) -> str:
         )
         for r in report.results
     ]
-    widths = [max(len(h), *(len(row[i]) for row in rows)) for i, h in enumerate(header)]
-    line = "  ".join(h.ljust(w) for h, w in zip(header, widths, strict=True))
-    out = [line, "-" * len(line)]
-    out += ["  ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)).rstrip() for row in rows]
+    out = text_table(header, rows)
     out.append("")
     out.append(
         "error and tolerance are relative, in diagonally scaled coordinates; κ̃(M) is κ(M) after "
