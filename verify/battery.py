@@ -143,7 +143,8 @@ def invariant_items(model_name, params, urdf: str, settings: BatterySettings) ->
 def stress_items(model_name, params, settings: BatterySettings) -> list[BatteryItem]:
     """The stress cases that apply to any parameter set, run on this one.
 
-    Large angles (|θ| ≈ 1e6 rad, with the θ + 2πk invariance), high speeds
+    Large angles (|θ| ≈ 1e6 rad, with the θ + 2πk invariance; states beyond the
+    trust rule there are refused and recorded, not failed), high speeds
     (|q̇| ≤ 1e3), zero gravity, and the conditioning guard of
     ``pendverify.near_singular`` over the sampled states: a set whose
     comparisons would need refusing (near-singular M) is not certified.
@@ -152,7 +153,9 @@ def stress_items(model_name, params, settings: BatterySettings) -> list[BatteryI
 
     ctx = stress.Context(stress.FULL, settings.seed)
     cases = [
-        stress.large_angle_case("large angles", lambda: params),
+        # at |θ| ≈ 1e6 rad a set with κ̃ in the hundreds is beyond the trust rule: such
+        # states are refused and recorded, and every state that is compared must pass
+        stress.large_angle_case("large angles", lambda: params, expect="any"),
         stress.high_speed_case("high speeds", lambda: params),
         stress.checks_case("zero gravity", "gravity", lambda: params.replace(g=0.0)),
         stress.checks_case("conditioning", "conditioning", lambda: params),
@@ -160,7 +163,8 @@ def stress_items(model_name, params, settings: BatterySettings) -> list[BatteryI
     items = []
     for case in cases:
         r = stress.run_case(case, ctx)
-        passed = r.passed and r.refused == 0 and r.level != "refuse"
+        refusals_allowed = case.name == "large angles"
+        passed = r.passed and (refusals_allowed or r.refused == 0) and r.level != "refuse"
         items.append(
             BatteryItem(
                 f"stress:{case.name.replace(' ', '-')}",
