@@ -1,1 +1,15 @@
-"""Visualisation: Meshcat scenes and review pages (see the render issue)."""
+"""Visualisation: trajectories as self-contained browser animations, and the review page.
+
+* ``geometry``  — the URDF's visuals through Pinocchio's visual model, posed by forward kinematics;
+* ``recorder``  — meshcat commands recorded in memory and written as one HTML file (no server);
+* ``animation`` — frames, camera, tip trace: ``render_html(Trajectory)``;
+* ``plots``     — energy and work-balance figures (matplotlib, SVG);
+* ``review``    — the review page ``index.html``;
+* ``browser``   — headless Chromium over the DevTools pipe, for screenshots and tests.
+"""
+
+import warnings
+
+with warnings.catch_warnings():  # meshcat's server module imports pyzmq's deprecated ioloop shim
+    warnings.simplefilter("ignore", DeprecationWarning)
+    import meshcat  # noqa: F401

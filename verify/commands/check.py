@@ -26,14 +26,37 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def run(args: argparse.Namespace) -> int:
-    from pendverify.atomic import write_atomic
+def build_report(targets, samples: int, seed: int):
+    """Every applicable check on every target, with diagnoses of the failures: one Report."""
     from pendverify.checks import run_checks
     from pendverify.diagnose import diagnose
+    from pendverify.report import Report
+    from pendverify.sampling import sample_states
+    from pendverify.targets import applicable_checks
+
+    report = Report(seed=seed, states={}, results=[])
+    for target in targets:
+        states = sample_states(target.model, samples, seed)
+        report.states[target.label] = len(states)
+        report.sources[target.label] = target.source
+        if target.notes:
+            report.notes[target.label] = target.notes
+        results = run_checks(
+            target.label, target.model, target.system, states, seed, applicable_checks(target.model)
+        )
+        diagnoses = diagnose(target.model, target.system, results)
+        if diagnoses:
+            report.diagnoses[target.label] = diagnoses
+        report.results += results
+    return report
+
+
+def run(args: argparse.Namespace) -> int:
+    from pendverify.atomic import write_atomic
     from pendverify.errors import PendverifyError
-    from pendverify.report import Report, format_table
-    from pendverify.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED, sample_states
-    from pendverify.targets import applicable_checks, default_target, erd_targets, plugin_target, user_target
+    from pendverify.report import format_table
+    from pendverify.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
+    from pendverify.targets import default_target, erd_targets, plugin_target, user_target
 
     samples = DEFAULT_RANDOM_STATES if args.samples is None else args.samples
     seed = DEFAULT_SEED if args.seed is None else args.seed
@@ -50,19 +73,7 @@ def run(args: argparse.Namespace) -> int:
         targets = [default_target(name) for name in names]
         if args.erd and (args.model in (None, "double_pendulum")):
             targets += erd_targets()
-    report = Report(seed=seed, states={}, results=[])
-    for target in targets:
-        states = sample_states(target.model, samples, seed)
-        report.states[target.label] = len(states)
-        report.sources[target.label] = target.source
-        if target.notes:
-            report.notes[target.label] = target.notes
-        names = applicable_checks(target.model)
-        results = run_checks(target.label, target.model, target.system, states, seed, names)
-        diagnoses = diagnose(target.model, target.system, results)
-        if diagnoses:
-            report.diagnoses[target.label] = diagnoses
-        report.results += results
+    report = build_report(targets, samples, seed)
     report.elapsed_s = time.perf_counter() - args.started
     print(format_table(report))
     if args.json:

@@ -11,6 +11,7 @@ def register(sub) -> None:
     p.add_argument("-o", "--output", help="write the trajectory (npz)")
     p.add_argument("--csv", action="store_true", help="also write a CSV beside the npz")
     p.add_argument("--engine", choices=("aba", "closed_form", "both"), help="override the scene's engine")
+    p.add_argument("--html", help="also write a self-contained HTML animation (as `pendverify render`)")
     p.set_defaults(func=run)
 
 
@@ -54,4 +55,9 @@ def run(args: argparse.Namespace) -> int:
             csv = Path(args.output).with_suffix(".csv")
             write_atomic(csv, result.to_csv())
             print(f"CSV written to {csv}")
+    if args.html:
+        from pendverify.viz.animation import Trajectory, render_html
+
+        write_atomic(args.html, render_html(Trajectory.from_run(result)))
+        print(f"animation written to {args.html}")
     return 0 if result.passed else 1

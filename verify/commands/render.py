@@ -1,0 +1,57 @@
+"""``pendverify render SCENE.toml -o OUT.html``: a trajectory as a self-contained browser animation.
+
+The scene is simulated (as ``pendverify simulate`` does), or, with
+``--trajectory FILE.npz``, a saved run is loaded instead: its t, q and the
+metadata's model and parameters, from which the same URDF is written again.
+The page plays from file:// with no server and no network (``pendverify.viz``).
+"""
+
+from __future__ import annotations
+
+import argparse
+
+
+def register(sub) -> None:
+    p = sub.add_parser(
+        "render",
+        help="write a self-contained HTML animation of a scene (meshcat, plays from file://)",
+    )
+    p.add_argument("scene", nargs="?", help="a scene file (TOML) to simulate")
+    p.add_argument("-o", "--output", required=True, help="the HTML file to write")
+    p.add_argument("--trajectory", help="render a saved run (npz of `pendverify simulate -o`) instead")
+    p.add_argument("--trace", action="store_true", help="draw the path of the tip as it moves")
+    p.add_argument("--engine", choices=("aba", "closed_form", "both"), help="override the scene's engine")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from pendverify.atomic import write_atomic
+    from pendverify.errors import InputError
+    from pendverify.scene import load_scene
+    from pendverify.viz.animation import Trajectory, render_html
+
+    if args.scene is None and args.trajectory is None:
+        raise InputError("<command line>", "scene", None, "give a scene file, or --trajectory FILE.npz")
+    status = 0
+    if args.trajectory:
+        traj = Trajectory.from_npz(args.trajectory)
+        if args.scene is not None:
+            scene = load_scene(args.scene)
+            if scene.model != traj.params.model:
+                raise InputError(
+                    args.trajectory, "metadata.model", traj.params.model, f"the scene is {scene.model!r}"
+                )
+    else:
+        from pendverify.simulate import simulate
+
+        result = simulate(load_scene(args.scene), args.engine)
+        traj = Trajectory.from_run(result)
+        if not result.passed:
+            print(f"note: {traj.title}: an invariant FAILS (see `pendverify simulate {args.scene}`)")
+            status = 1
+    page = render_html(traj, trace=args.trace)
+    write_atomic(args.output, page)
+    duration = traj.t[-1] - traj.t[0]
+    size_mb = len(page.encode()) / 1e6
+    print(f"animation of {traj.title} ({duration:g} s) written to {args.output} ({size_mb:.2f} MB)")
+    return status

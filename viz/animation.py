@@ -1,0 +1,229 @@
+"""A trajectory as a meshcat animation in one self-contained HTML file.
+
+Pipeline: the trajectory's samples (t, θ) are resampled to ``fps`` frames per
+second on the trajectory's own time base (linear interpolation; the shipped
+scenes sample at 100 Hz, so 50 fps keeps every other sample exactly), every
+frame is posed by Pinocchio (``VisualSystem.placements``), and the poses become
+keyframes of a meshcat ``Animation`` whose clip rate is the same ``fps``:
+frame k is shown at t = k/fps, i.e. in real time.  Every clip spans the whole
+duration, so the looping clips stay in step.
+
+Camera: a perspective camera (``FOV_DEG``) looks at the plane of motion face on
+(``VisualSystem.view_normal``: along the hinge axis for the double pendulum,
+across the rail for the cart, rail to the right).  It is aimed at the centre of
+the box swept by the moving parts over the whole run (the model is shifted so
+that this centre sits at the viewer's origin, where meshcat's orbit controls
+aim) and backed off until that box, with ``MARGIN``, fits a viewport at least
+``MIN_ASPECT`` wide.  The world's
+static parts (the cart's rail) are drawn but not framed.  Grid and axes are
+hidden and the background is plain light grey, so the model's colours stand out.
+
+Tip trace (optional): the path of the far end of the last rod, cut into short
+lines that appear as the tip passes them, so the trace grows with the motion.
+
+Size: the three.js viewer bundle (0.85 MB) dominates.  Only the visuals on a
+moving joint get keys (position + quaternion, float32), about 18 kB per second
+of animation for the double pendulum: a 10 s run is 1.04 MB (1.24 MB with the
+trace).  Each mesh is sent once, whatever the number of frames.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import meshcat.geometry as mg
+import meshcat.transformations as tf
+import numpy as np
+from meshcat.animation import Animation
+
+from pendverify.analytic import MODELS, PARAMETER_TYPES, ParameterSet
+from pendverify.errors import InputError
+from pendverify.viz.geometry import ROOT, UP, VisualSystem
+from pendverify.viz.recorder import SceneRecorder
+
+DEFAULT_FPS = 50.0
+FPS_RANGE = (30.0, 60.0)
+FOV_DEG = 30.0
+MARGIN = 1.15
+MIN_ASPECT = 4.0 / 3.0
+BACKGROUND = [0.94, 0.94, 0.94]
+TRACE_COLOUR = 0x5B2C83  # dark purple: unlike every URDF material
+TRACE_CHUNK_S = 0.05  # s of motion per trace segment (at most MAX_TRACE_CHUNKS)
+MAX_TRACE_CHUNKS = 200
+REPETITIONS = 1_000_000  # loop for as long as anyone watches
+
+
+class TrajectoryError(InputError):
+    """A saved trajectory cannot be rendered."""
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """What is rendered: sample times in [s], model coordinates θ, the parameter set, a title."""
+
+    t: np.ndarray
+    q: np.ndarray
+    params: ParameterSet
+    title: str
+    source: str = "<run>"
+
+    def __post_init__(self) -> None:
+        if self.t.ndim != 1 or len(self.t) < 2:
+            raise TrajectoryError(self.source, "t", self.t.shape, "expected at least two sample times")
+        if self.q.ndim != 2 or self.q.shape[0] != len(self.t):
+            raise TrajectoryError(
+                self.source, "q", self.q.shape, f"expected {len(self.t)} rows, one per time"
+            )
+        n = len(MODELS[self.params.model].coordinates)
+        if self.q.shape[1] != n:
+            raise TrajectoryError(
+                self.source, "q", self.q.shape, f"expected {n} columns for {self.params.model}"
+            )
+        if not (np.all(np.isfinite(self.t)) and np.all(np.isfinite(self.q))):
+            raise TrajectoryError(self.source, "q", "…", "expected finite numbers")
+        if not np.all(np.diff(self.t) > 0):
+            raise TrajectoryError(self.source, "t", "…", "expected strictly increasing times")
+
+    @classmethod
+    def from_run(cls, run) -> Trajectory:
+        """A ``pendverify.simulate.Run``."""
+        return cls(np.asarray(run.t), np.asarray(run.q), run.scene.params, run.scene.name, run.scene.source)
+
+    @classmethod
+    def from_npz(cls, path: str | Path) -> Trajectory:
+        """A file of ``pendverify simulate -o FILE.npz``: t, q, and the metadata's model and parameters."""
+        path = Path(path)
+        source = str(path)
+        if not path.is_file():
+            raise TrajectoryError(source, "<file>", source, "trajectory file not found")
+        try:
+            with np.load(path, allow_pickle=False) as npz:
+                t, q, meta = npz["t"], npz["q"], json.loads(str(npz["metadata"]))
+        except KeyError as exc:
+            raise TrajectoryError(source, str(exc).strip("'"), None, "missing array in the npz") from None
+        except (ValueError, OSError) as exc:
+            raise TrajectoryError(source, "<file>", source, f"not a pendverify npz: {exc}") from None
+        model = meta.get("model")
+        if model not in PARAMETER_TYPES:
+            raise TrajectoryError(
+                source, "metadata.model", model, f"expected one of {', '.join(PARAMETER_TYPES)}"
+            )
+        params = PARAMETER_TYPES[model].from_mapping(
+            meta.get("parameters", {}), source, "metadata.parameters."
+        )
+        t = np.asarray(t, dtype=float)
+        q = np.asarray(q, dtype=float)
+        q = q.reshape(len(t), -1) if q.ndim == 1 and len(t) else q
+        return cls(t, q, params, str(meta.get("scene", path.stem)), source)
+
+
+def resample(t: np.ndarray, q: np.ndarray, fps: float) -> tuple[np.ndarray, np.ndarray]:
+    """Frames at t0 + k/fps for every k within the run, θ linearly interpolated."""
+    n = math.floor((t[-1] - t[0]) * fps + 1e-9) + 1
+    times = t[0] + np.arange(n) / fps
+    frames = np.column_stack([np.interp(times, t, q[:, i]) for i in range(q.shape[1])])
+    return times, frames
+
+
+@dataclass(frozen=True)
+class Camera:
+    target: np.ndarray  # world point the camera orbits, in [m]
+    position: np.ndarray  # camera position relative to the target, world axes, in [m]
+    fov_deg: float
+
+
+def frame_camera(points: np.ndarray, radii: np.ndarray, normal: np.ndarray) -> Camera:
+    """Aim at the box swept by spheres (points, radii) and back off until it fits the view."""
+    right = np.cross(UP, normal)
+    axes = np.stack([right, UP, normal])
+    local = points @ axes.T
+    lo = (local - radii[:, None]).min(axis=0)
+    hi = (local + radii[:, None]).max(axis=0)
+    centre = (lo + hi) / 2
+    half_w, half_h = (hi - lo)[:2] / 2
+    half_fov = math.radians(FOV_DEG) / 2
+    distance = MARGIN * max(half_h, half_w / MIN_ASPECT, 0.05) / math.tan(half_fov) + (hi[2] - centre[2])
+    return Camera(centre @ axes, distance * normal, FOV_DEG)
+
+
+def _to_camera_frame(v: np.ndarray) -> list[float]:
+    """World axes (z up) to meshcat's ``/Cameras/default/rotated`` frame (y up)."""
+    return [float(v[0]), float(v[2]), float(-v[1])]
+
+
+def _set_camera(vis, camera: Camera) -> None:
+    """Place the camera; the model moves so that the target sits at the viewer's origin.
+
+    meshcat's orbit controls always aim at the world origin, so the whole model
+    (node ``ROOT``) is shifted by −target instead of moving the camera's target.
+    """
+    vis[ROOT].set_transform(tf.translation_matrix(-camera.target))
+    cam = vis["/Cameras/default/rotated/<object>"]
+    cam.set_property("position", _to_camera_frame(camera.position))
+    cam.set_property("fov", camera.fov_deg)
+    vis["/Grid"].set_property("visible", False)
+    vis["/Axes"].set_property("visible", False)
+    vis["/Background"].set_property("top_color", BACKGROUND)
+    vis["/Background"].set_property("bottom_color", BACKGROUND)
+
+
+def _trace(vis, anim: Animation, tips: np.ndarray, fps: float) -> None:
+    n = len(tips)
+    per = max(round(TRACE_CHUNK_S * fps), math.ceil((n - 1) / MAX_TRACE_CHUNKS), 1)
+    last = float(n - 1)
+    material = mg.LineBasicMaterial(color=TRACE_COLOUR)
+    for k, start in enumerate(range(0, n - 1, per)):
+        stop = min(start + per, n - 1)
+        path = f"{ROOT}/trace/{k:03d}"
+        vis[path].set_object(mg.Line(mg.PointsGeometry(tips[start : stop + 1].T.copy()), material))
+        clip = anim.at_frame(vis, 0)[path].get_clip()
+        for frame, shown in ((0.0, False), (float(stop), True), (last, True)):
+            clip.set_property(frame, "visible", "boolean", shown)
+
+
+def build_scene(traj: Trajectory, trace: bool = False, fps: float = DEFAULT_FPS) -> SceneRecorder:
+    """Record the model, the camera and the animation of a trajectory (no server involved)."""
+    if not FPS_RANGE[0] <= fps <= FPS_RANGE[1]:
+        raise TrajectoryError(traj.source, "fps", fps, f"expected {FPS_RANGE[0]:g} to {FPS_RANGE[1]:g}")
+    visual = VisualSystem.from_params(traj.params)
+    recorder = SceneRecorder()
+    vis = recorder.visualizer()
+    visual.load_into(vis)
+    times, frames = resample(traj.t, traj.q, fps)
+    poses = np.array([visual.placements(theta) for theta in frames])  # (frames, objects, 4, 4)
+    objects = visual.objects
+    for i, obj in enumerate(objects):
+        vis[visual.node(obj)].set_transform(poses[0, i])
+
+    anim = Animation(default_framerate=fps)
+    moving = [i for i, o in enumerate(objects) if o.parentJoint != 0]
+    for k in range(len(times)):
+        frame = anim.at_frame(vis, k)
+        for i in moving:
+            frame[visual.node(objects[i])].set_transform(poses[k, i])
+
+    tip_index, tip_local = visual.tip_point()
+    tips = poses[:, tip_index, :3, :3] @ tip_local + poses[:, tip_index, :3, 3]
+    if trace:
+        _trace(vis, anim, tips, fps)
+
+    radii = np.array([visual.radius(objects[i]) for i in moving])
+    points = poses[:, moving, :3, 3].reshape(-1, 3)
+    all_radii = np.tile(radii, len(times))
+    camera = frame_camera(
+        np.vstack([points, tips]), np.concatenate([all_radii, np.zeros(len(tips))]), visual.view_normal()
+    )
+    _set_camera(vis, camera)
+    vis.set_animation(anim, play=True, repetitions=REPETITIONS)
+    return recorder
+
+
+def render_html(traj: Trajectory, trace: bool = False, fps: float = DEFAULT_FPS) -> str:
+    """The self-contained HTML page that plays ``traj`` in real time."""
+    recorder = build_scene(traj, trace, fps)
+    duration = traj.t[-1] - traj.t[0]
+    caption = f"{traj.title} — {traj.params.model}, {duration:g} s"
+    return recorder.html(f"{traj.title} (pendverify)", caption)

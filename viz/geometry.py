@@ -1,0 +1,114 @@
+"""The URDF's visuals as meshcat objects, posed by Pinocchio's forward kinematics.
+
+The geometry on screen is the geometry that was verified: the URDF text comes
+from ``pendverify.urdf_writer.urdf_for`` (the same writer the checks and the
+simulator use), Pinocchio parses its ``<visual>`` elements into a visual
+``GeometryModel``, and ``pinocchio.visualize.MeshcatVisualizer`` turns every
+``GeometryObject`` (box, cylinder, sphere, with the URDF material colour) into a
+meshcat object at ``<root>/visuals/<geometry name>``.  Poses come from
+``forwardKinematics`` + ``updateGeometryPlacements`` at the Pinocchio
+configuration ``cmap.configuration(θ)`` of the model coordinates θ.
+
+Only the poses of geometries attached to a moving joint are animated; those on
+the world (the pendulum's pivot block, the cart's rail) are placed once.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from pendverify.analytic import ParameterSet
+from pendverify.robot import PinocchioSystem
+from pendverify.urdf_writer import urdf_for
+
+ROOT = "pendverify"
+UP = np.array([0.0, 0.0, 1.0])
+
+
+@dataclass
+class VisualSystem:
+    """A Pinocchio model with its visual geometry and the coordinate map of its closed form."""
+
+    system: PinocchioSystem
+    visual_model: pin.GeometryModel
+    visual_data: pin.GeometryData
+    urdf: str
+
+    @classmethod
+    def from_params(cls, params: ParameterSet) -> VisualSystem:
+        """The system whose URDF ``urdf_for(params)`` writes, with its visuals."""
+        urdf = urdf_for(params)
+        system = PinocchioSystem.from_urdf(params.model, urdf, params.g, f"<URDF of {params.model}>")
+        visual_model = pin.buildGeomFromUrdfString(system.model, urdf, pin.GeometryType.VISUAL)
+        return cls(system, visual_model, visual_model.createData(), urdf)
+
+    @property
+    def objects(self) -> list[pin.GeometryObject]:
+        return list(self.visual_model.geometryObjects)
+
+    def node(self, obj: pin.GeometryObject) -> str:
+        """The meshcat path of a geometry object, as Pinocchio's MeshcatVisualizer names it."""
+        return f"{ROOT}/visuals/{obj.name}"
+
+    def moving(self) -> list[pin.GeometryObject]:
+        """Geometry objects attached to a joint (not to the world)."""
+        return [o for o in self.objects if o.parentJoint != 0]
+
+    def load_into(self, vis) -> None:
+        """Send every visual to a meshcat visualizer through Pinocchio's MeshcatVisualizer."""
+        from pinocchio.visualize import MeshcatVisualizer
+
+        viz = MeshcatVisualizer(self.system.model, visual_model=self.visual_model)
+        viz.initViewer(viewer=vis)
+        viz.loadViewerModel(rootNodeName=ROOT)
+
+    def placements(self, theta: np.ndarray) -> list[np.ndarray]:
+        """The 4×4 world pose of every geometry object at model coordinates θ."""
+        model, data = self.system.model, self.system.data
+        q = self.system.cmap.configuration(np.asarray(theta, dtype=float))
+        pin.forwardKinematics(model, data, q)
+        pin.updateGeometryPlacements(model, data, self.visual_model, self.visual_data)
+        return [self.visual_data.oMg[i].homogeneous.copy() for i in range(len(self.objects))]
+
+    def tip_point(self) -> tuple[int, np.ndarray]:
+        """(geometry index, point in that geometry's frame) of the tip of the last link.
+
+        The tip is the far end of the last joint's cylinder (a coal cylinder runs
+        along its local z); without a cylinder, the last joint's origin.
+        """
+        last = max(o.parentJoint for o in self.objects)
+        for i, obj in enumerate(self.objects):
+            if obj.parentJoint == last and type(obj.geometry).__name__ == "Cylinder":
+                return i, np.array([0.0, 0.0, obj.geometry.halfLength])
+        i = next(i for i, o in enumerate(self.objects) if o.parentJoint == last)
+        return i, self.objects[i].placement.inverse().translation  # the joint's origin
+
+    def radius(self, obj: pin.GeometryObject) -> float:
+        """A bounding radius of a primitive about its own origin, in [m]."""
+        geom = obj.geometry
+        kind = type(geom).__name__
+        if kind == "Box":
+            return float(np.linalg.norm(geom.halfSide))
+        if kind == "Cylinder":
+            return float(np.hypot(geom.halfLength, geom.radius))
+        if kind == "Sphere":
+            return float(geom.radius)
+        return 0.0
+
+    def view_normal(self) -> np.ndarray:
+        """Unit vector from the system towards the camera: the plane of motion seen face on.
+
+        For a cart, the rail's direction points to the right of the screen; for a
+        fixed-base chain, the horizontal h = up × a of ``pendverify.robot`` does.
+        """
+        model, data = self.system.model, self.system.data
+        pin.computeJointJacobians(model, data, pin.neutral(model))
+        motion = data.J[:, 0]  # joint 1's motion: linear part for a slider, angular for a hinge
+        if np.linalg.norm(motion[3:]) == 0.0:
+            normal = np.cross(motion[:3], UP)  # then up × normal = the rail's direction
+        else:
+            normal = motion[3:]  # then up × normal = h
+        return normal / np.linalg.norm(normal)
