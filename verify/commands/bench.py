@@ -1,0 +1,77 @@
+"""``pendverify bench accuracy [--quick] [-o DIR]``: the work–precision benchmark.
+
+Writes DIR/work_precision.png (the plot), DIR/work_precision.csv (every point)
+and DIR/work_precision.md (the tables), and prints the tables.  BLAS is limited
+to one thread for the whole run: through threadpoolctl when installed, else
+through the environment (effective only if numpy is not imported yet); the
+report says which.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+BLAS_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+
+
+def register(sub) -> None:
+    p = sub.add_parser("bench", help="benchmarks (never asserted in tests)")
+    what = p.add_subparsers(dest="benchmark", required=True)
+    a = what.add_parser(
+        "accuracy", help="work–precision: error against wall time for each integrator and engine"
+    )
+    a.add_argument(
+        "--quick", action="store_true", help="fewer tolerances and shorter runs (well under a minute)"
+    )
+    a.add_argument("-o", "--output", default="bench-out", help="output folder (default: bench-out)")
+    a.add_argument("--svg", action="store_true", help="also write the plot as SVG")
+    a.set_defaults(func=run)
+
+
+def limit_blas() -> tuple[object, str]:
+    """(a context to hold for the run, how BLAS was limited to one thread)."""
+    import contextlib
+    import os
+    import sys
+
+    numpy_loaded = "numpy" in sys.modules
+    for name in BLAS_VARIABLES:
+        os.environ[name] = "1"
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:
+        how = "1 (environment)" if not numpy_loaded else "not limited (numpy loaded first, no threadpoolctl)"
+        return contextlib.nullcontext(), how
+    return threadpool_limits(limits=1), "1 (threadpoolctl)"
+
+
+def run(args: argparse.Namespace) -> int:
+    guard, blas = limit_blas()
+    with guard:
+        from pathlib import Path
+
+        from pendverify.atomic import write_atomic
+        from pendverify.benchplot import render
+        from pendverify.benchreport import fraction, ratios, to_csv, to_markdown
+        from pendverify.benchrun import run_benchmark
+        from pendverify.workprecision import FULL, QUICK
+
+        config = QUICK if args.quick else FULL
+        results = run_benchmark(config, log=lambda msg: print(msg, flush=True), blas=blas)
+        out = Path(args.output)
+        markdown = to_markdown(results)
+        write_atomic(out / "work_precision.csv", to_csv(results))
+        write_atomic(out / "work_precision.md", markdown)
+        write_atomic(out / "work_precision.png", render(results, "png"))
+        if args.svg:
+            write_atomic(out / "work_precision.svg", render(results, "svg"))
+    print()
+    print(markdown)
+    for name, (r, rm, met) in ratios(results).items():
+        target = "1/8" if name == "single" else "1/50"
+        print(
+            f"fast path / scipy DOP853, {name}: {fraction(r)} (min), {fraction(rm)} (median); "
+            f"target ≤ {target}: {'met' if met else 'NOT met'}"
+        )
+    print(f"written: {out}/work_precision.png, .csv, .md")
+    return 0
