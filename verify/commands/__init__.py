@@ -27,3 +27,22 @@ def positive_int(text: str) -> int:
 
 def non_negative_int(text: str) -> int:
     return _int_at_least(0, text)
+
+
+def builtin_models(model: str | None, analytic: str | None) -> list[str]:
+    """The built-in models that --model names (all when omitted; none with --analytic).
+
+    Refuses --model together with --analytic, and unknown names, with one-line errors.
+    """
+    from pendverify.analytic import MODELS
+    from pendverify.errors import PendverifyError, UnknownNameError
+
+    if analytic and model:
+        raise PendverifyError("give either --model (a built-in model) or --analytic (a model file), not both")
+    if analytic:
+        return []
+    names = [model] if model else list(MODELS)
+    for name in names:
+        if name not in MODELS:
+            raise UnknownNameError("model", name, tuple(MODELS))
+    return names

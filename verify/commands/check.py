@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import time
 
-from pendverify.commands import non_negative_int
+from pendverify.commands import builtin_models, non_negative_int
 
 
 def register(sub) -> None:
@@ -53,23 +53,18 @@ def build_report(targets, samples: int, seed: int):
 
 def run(args: argparse.Namespace) -> int:
     from pendverify.atomic import write_atomic
-    from pendverify.errors import PendverifyError
     from pendverify.report import format_table
     from pendverify.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
     from pendverify.targets import default_target, erd_targets, plugin_target, user_target
 
     samples = DEFAULT_RANDOM_STATES if args.samples is None else args.samples
     seed = DEFAULT_SEED if args.seed is None else args.seed
+    names = builtin_models(args.model, args.analytic)
     if args.analytic:
-        if args.model:
-            raise PendverifyError(
-                "give either --model (a built-in model) or --analytic (a model file), not both"
-            )
         targets = [plugin_target(args.analytic, args.urdf, args.params)]
     elif args.urdf or args.params:
         targets = [user_target(args.model, args.urdf, args.params)]
     else:
-        names = [args.model] if args.model else ["double_pendulum", "cart_double_pendulum"]
         targets = [default_target(name) for name in names]
         if args.erd and (args.model in (None, "double_pendulum")):
             targets += erd_targets()

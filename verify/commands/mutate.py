@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from pendverify.commands import non_negative_int
+from pendverify.commands import builtin_models, non_negative_int
 
 
 def register(sub) -> None:
@@ -38,24 +38,18 @@ def register(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     import json
 
-    from pendverify.analytic import MODELS
     from pendverify.atomic import write_atomic
-    from pendverify.errors import PendverifyError, UnknownNameError
+    from pendverify.errors import PendverifyError
     from pendverify.mutate import DEFAULT_MUTATION_STATES, format_report, run_mutation
     from pendverify.sampling import DEFAULT_SEED
     from pendverify.targets import default_target, plugin_target
 
-    if args.analytic and args.model:
-        raise PendverifyError("give either --model (a built-in model) or --analytic (a model file), not both")
+    names = builtin_models(args.model, args.analytic)
     if args.analytic:
         targets = [plugin_target(args.analytic, args.urdf, args.params)]
     elif args.urdf or args.params:
         raise PendverifyError("--urdf and --params go with --analytic; built-in models use their defaults")
     else:
-        names = [args.model] if args.model else list(MODELS)
-        for name in names:
-            if name not in MODELS:
-                raise UnknownNameError("model", name, tuple(MODELS))
         targets = [default_target(n) for n in names]
     samples = DEFAULT_MUTATION_STATES if args.samples is None else args.samples
     seed = DEFAULT_SEED if args.seed is None else args.seed

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from pendverify.commands import builtin_models
+
 
 def register(sub) -> None:
     p = sub.add_parser(
@@ -22,20 +24,11 @@ def run(args: argparse.Namespace) -> int:
 
     from pendverify.analytic import MODELS
     from pendverify.atomic import write_atomic
-    from pendverify.errors import PendverifyError, UnknownNameError
     from pendverify.plugin import load_model_class
     from pendverify.sympy_check import compare, format_report
 
-    if args.analytic and args.model:
-        raise PendverifyError("give either --model (a built-in model) or --analytic (a model file), not both")
-    if args.analytic:
-        classes = [load_model_class(args.analytic)]
-    else:
-        names = [args.model] if args.model else list(MODELS)
-        for name in names:
-            if name not in MODELS:
-                raise UnknownNameError("model", name, tuple(MODELS))
-        classes = [MODELS[n] for n in names]
+    names = builtin_models(args.model, args.analytic)
+    classes = [load_model_class(args.analytic)] if args.analytic else [MODELS[n] for n in names]
     reports = [compare(cls) for cls in classes]
     print("\n\n".join(format_report(r) for r in reports))
     if args.json:
