@@ -28,7 +28,8 @@ def test_default_check_passes_and_writes_json(tmp_path, capsys):
     for r in report["results"]:
         assert JSON_FIELDS <= set(r)
         assert r["max_error"] <= r["tolerance"]
-    assert {r["check"] for r in report["results"]} == set(CHECK_NAMES)
+    # erd's mesh URDFs carry a centre of mass 2 µm off the seed's joint line: a model-form row
+    assert {r["check"] for r in report["results"]} == {*CHECK_NAMES, "model-form"}
     assert not list(out_json.parent.glob(".*.tmp")), "temporary file left behind"
 
 

@@ -25,15 +25,20 @@ def test_simple_urdf_parameters_are_read_off_exactly():
     # link 1 points up at q = 0: θ1 = q1 + π/2; axis +x, so no sign change
     assert system.geometry.cmap.theta0[0] == pytest.approx(math.pi / 2, rel=1e-15)
     assert system.geometry.cmap.T.tolist() == [[1.0, 0.0], [0.0, 1.0]]
-    assert system.geometry.gravity_allowance.tolist() == [0.0, 0.0]
+    assert system.geometry.model_form is None and system.allowance.tolist() == [0.0, 0.0]
 
 
 def test_mesh_urdf_off_line_centre_of_mass_is_reported():
     system = PinocchioSystem.from_urdf("double_pendulum", double_pendulum_urdfs()["double_pendulum"])
-    (note, *_) = system.geometry.notes
-    assert "off the joint-1→joint-2 line" in note
-    # m1·g·d with d = 2.1727e-6 m from the URDF's inertial origin
-    assert system.geometry.gravity_allowance[0] == pytest.approx(0.26703 * 9.81 * 2.1727e-6, rel=1e-3)
+    form = system.geometry.model_form
+    assert "off the joint-1→joint-2 line" in form.what
+    assert any(
+        "off the joint-1→joint-2 line" in note and "within the model-form threshold" in note
+        for note in system.notes
+    )
+    # m1·g·d with d = 2.1727e-6 m from the URDF's inertial origin, 7.6e-6 of H1's size
+    assert system.allowance[0] == pytest.approx(0.26703 * 9.81 * 2.1727e-6, rel=1e-3)
+    assert form.relative == pytest.approx(7.6e-6, rel=1e-2)
     assert system.geometry.params.r1 == pytest.approx(math.hypot(0.036012, 2.1727e-6), rel=1e-12)
 
 

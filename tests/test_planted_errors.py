@@ -15,7 +15,9 @@ import pytest
 from pendverify.analytic import CartDoublePendulum, DoublePendulum
 from pendverify.checks import CHECK_NAMES, run_checks
 from pendverify.cli import main
+from pendverify.robot import PinocchioSystem
 from pendverify.sampling import sample_states
+from pendverify.urdf_writer import urdf_for
 
 from .conftest import SEED, default_params, system_for
 
@@ -134,10 +136,16 @@ def test_every_check_can_fail(name):
         if cls.name == name:
             failed |= {k for k, r in _results(cls).items() if not r.passed}
     if name == "double_pendulum":
-        failed |= {"skew", "minverse", "energy"} & _failing_extra_dp()
+        failed |= {"skew", "minverse", "energy", "damping"} & _failing_extra_dp()
     else:
-        failed |= {"gravity", "minverse", "rnea"} & _failing_extra_cart()
+        failed |= {"gravity", "minverse", "rnea", "damping"} & _failing_extra_cart()
     assert failed == set(CHECK_NAMES), f"never seen failing: {set(CHECK_NAMES) - failed}"
+
+
+def _damped_urdf_results(model, text: str) -> dict:
+    params = model.params
+    system = PinocchioSystem.from_urdf(params.model, text, params.g)
+    return {r.check: r for r in run_checks("damped", model, system, sample_states(model, 20, SEED), SEED)}
 
 
 def _failing_extra_dp():
@@ -164,6 +172,10 @@ def _failing_extra_dp():
     failed = set()
     for cls in (NotChristoffel, InverseTypo, PotentialTypo):
         failed |= {k for k, r in _results(cls).items() if not r.passed}
+    # a URDF whose joint damping is b1·10 while the hand model keeps the set's b1
+    params = default_params("double_pendulum")
+    text = urdf_for(params.replace(b1=10 * params.b1))
+    failed |= {k for k, r in _damped_urdf_results(DoublePendulum(params), text).items() if not r.passed}
     return failed
 
 
@@ -181,6 +193,13 @@ def _failing_extra_cart():
     failed = set()
     for cls in (GravitySign, InverseTypo):
         failed |= {k for k, r in _results(cls).items() if not r.passed}
+    # joint dampers on the relative joint: Tᵀ·diag(b)·T couples θ1 and θ2, the seed's D does not
+    params = default_params("cart_double_pendulum")
+    text = urdf_for(params).replace(
+        '<joint name="pole2" type="revolute">',
+        '<joint name="pole2" type="revolute">\n    <dynamics damping="0.02"/>',
+    )
+    failed |= {k for k, r in _damped_urdf_results(CartDoublePendulum(params), text).items() if not r.passed}
     return failed
 
 

@@ -233,7 +233,7 @@ def test_check_conditioning_refuses_with_a_message():
     with pytest.raises(IllConditionedError) as info:
         check_conditioning(CartDoublePendulum(params), np.zeros(3), what="cart")
     assert str(info.value).startswith("cart at q = (0, 0, 0): too ill-conditioned to verify: κ̃(M) = 3.69e+12")
-    assert str(info.value).endswith("> 1e-06; refused")
+    assert str(info.value).endswith("> 1e-06 (the trust limit); refused")
 
 
 def test_conditioning_levels_and_scaling():

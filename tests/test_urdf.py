@@ -81,7 +81,11 @@ def test_unparsable_and_missing_urdf(tmp_path):
         load_model(tmp_path / "nothing.urdf")
     bad = tmp_path / "bad.urdf"
     bad.write_text("<robot name='x'><link name='a'/><joint name='j' type='revolute'></robot>")
-    with pytest.raises(UrdfShapeError, match=r"bad\.urdf: Pinocchio cannot parse it as URDF"):
+    with pytest.raises(UrdfShapeError, match=r"bad\.urdf: malformed XML at line 1, column \d+: mismatched"):
+        load_model(bad)
+    # well-formed XML that Pinocchio refuses: its own reason, not a generic sentence
+    bad.write_text("<robot name='x'><link name='a'/><joint name='j' type='revolute'/></robot>")
+    with pytest.raises(UrdfShapeError, match=r"bad\.urdf: Pinocchio cannot parse it as URDF: .*j"):
         load_model(bad)
 
 

@@ -367,3 +367,9 @@ def test_every_shipped_family_is_present():
     assert {"double_pendulum", "double_pendulum_continuous", "double_pendulum_simple"} <= {
         n.split("/")[1] for n in SHIPPED if n.startswith("example-robot-data/")
     }
+
+
+def test_a_zero_joint_axis_is_refused():
+    # Pinocchio accepts it as a revolute joint about nothing
+    text = pendulum().replace('<axis xyz="1 0 0"/>', '<axis xyz="0 0 0"/>', 1)
+    assert "joint 'j1' <axis> xyz = '0 0 0': a joint axis must not be the zero vector" in refusal(text)

@@ -39,6 +39,7 @@ import numpy as np
 from pendverify.analytic import ClosedFormModel
 from pendverify.robot import PinocchioSystem
 from pendverify.sampling import State
+from pendverify.verdict import FAIL, PASS
 
 EPS = float(np.finfo(float).eps)
 
@@ -58,6 +59,8 @@ class Check:
     closed_form: str
     K: float
     evaluate: Callable[[ClosedFormModel, PinocchioSystem, State], Sample]
+    #: "" when the check applies to this model and system, else why it is not run
+    requires: Callable[[ClosedFormModel, PinocchioSystem | None], str] = lambda model, system: ""
 
 
 @dataclass
@@ -75,6 +78,12 @@ class CheckResult:
     worst_state: dict
     passed: bool
     notes: list[str] = field(default_factory=list)
+    #: pass, warn, fail or refused (``pendverify.verdict``); ``passed`` is pass or warn
+    status: str = ""
+
+    def __post_init__(self) -> None:
+        if not self.status:
+            self.status = PASS if self.passed else FAIL
 
     def as_dict(self) -> dict:
         return dict(self.__dict__)
@@ -137,8 +146,7 @@ def _force_scale(model, state, w) -> float:
 
 
 def _allowance(system) -> np.ndarray:
-    a = system.geometry.gravity_allowance
-    return np.zeros(system.model.nv) if a is None else a
+    return system.allowance
 
 
 # --- the checks ---------------------------------------------------------------------------
@@ -226,16 +234,56 @@ def _energy(model, system, s):
     return Sample(kinetic + abs(dv_pin - dv_hand), kinetic_scale + potential_scale, allowance)
 
 
+def _damping(model, system, s):
+    """The URDF's <dynamics damping> seen in the model's coordinates (Tᵀ·diag(b)·T) against D.
+
+    Pinocchio keeps the damping but none of its algorithms applies it, so no other
+    check can see a URDF whose damping disagrees with the hand model's D.
+    """
+    w = weights(model, s.q)
+    D_urdf = system.cmap.matrix_to_model(np.diag(system.urdf_damping()))
+    D = model.damping_matrix()
+    diff = np.abs(scaled_matrix(D_urdf - D, w))
+    scale = max(np.max(np.abs(scaled_matrix(D, w))), np.max(np.abs(scaled_matrix(D_urdf, w))))
+    note = ""
+    if np.max(diff) > 0:
+        i, j = np.unravel_index(np.argmax(diff), diff.shape)
+        names = model.coordinates
+        note = (
+            f"D[{names[i]},{names[j]}]: the URDF's <dynamics damping> gives {D_urdf[i, j]:.6g}, "
+            f"the hand model {D[i, j]:.6g}"
+        )
+    return Sample(float(np.max(diff)), float(scale), note=note)
+
+
+def _needs_matrix_c(model, system) -> str:
+    if model.has_coriolis_matrix:
+        return ""
+    name = model.__name__ if isinstance(model, type) else type(model).__name__
+    return (
+        f"not run: {name} gives the force C·q̇ (coriolis_force), not a matrix C; "
+        "C·q̇ is checked by rnea and aba"
+    )
+
+
+def _needs_urdf_damping(model, system) -> str:
+    if system is None or system.urdf_damping() is not None:
+        return ""
+    return "not run: the URDF declares no <dynamics damping>, so there is nothing to compare D with"
+
+
 CHECKS: tuple[Check, ...] = (
     Check("crba", "crba (symmetrised)", "M(q)", 8, _crba),
     Check("rnea", "rnea(q, q̇, 0)", "C(q,q̇)·q̇ + H(q), friction removed", 16, _rnea),
     Check("gravity", "computeGeneralizedGravity", "H(q)", 16, _gravity),
-    Check("coriolis", "computeCoriolisMatrix", "C(q,q̇) without friction", 16, _coriolis),
-    Check("skew", "Ṁ (RNEA derivatives) − 2C", "skew-symmetric", 16, _skew),
+    Check("coriolis", "computeCoriolisMatrix", "C(q,q̇) without friction", 16, _coriolis, _needs_matrix_c),
+    Check("skew", "Ṁ (RNEA derivatives) − 2C", "skew-symmetric", 16, _skew, _needs_matrix_c),
     Check("det", "det(crba) by LU", "closed-form det M(q) > 0", 16, _det),
     Check("minverse", "computeMinverse", "M(q)⁻¹ (closed form)", 16, _minverse),
     Check("aba", "aba(q, q̇, Bu + Ww − Dq̇)", "closed-form q̈ (f + g·u, M⁻¹f)", 16, _aba),
     Check("energy", "kinetic + potential energy", "½q̇ᵀMq̇, V(q) − V(0)", 16, _energy),
+    # Tᵀ·diag(b)·T: each entry a sum of at most n products of exact decimals' roundings
+    Check("damping", "<dynamics damping> (Tᵀ·diag(b)·T)", "D", 8, _damping, _needs_urdf_damping),
 )
 CHECK_NAMES = tuple(c.name for c in CHECKS)
 
@@ -280,5 +328,27 @@ def run_check(check: Check, label: str, model, system, states, seed: int) -> Che
     )
 
 
+def not_applicable(model, system=None) -> dict[str, str]:
+    """{check: why it is not run} for the checks this model (and URDF, if given) cannot take."""
+    reasons = {c.name: c.requires(model, system) for c in CHECKS}
+    return {name: why for name, why in reasons.items() if why}
+
+
+def skipped_notes(model, system=None) -> list[str]:
+    """One note per reason some checks are not run: "coriolis, skew not run: …"."""
+    by_reason: dict[str, list[str]] = {}
+    for name, why in not_applicable(model, system).items():
+        by_reason.setdefault(why, []).append(name)
+    return [f"{', '.join(names)} {why}" for why, names in by_reason.items()]
+
+
+def applicable_checks(model, system=None) -> tuple[str, ...]:
+    """The checks a model (and its URDF, if given) can take, in the table's order."""
+    skipped = not_applicable(model, system)
+    return tuple(name for name in CHECK_NAMES if name not in skipped)
+
+
 def run_checks(label, model, system, states, seed, names=CHECK_NAMES) -> list[CheckResult]:
+    """The named checks that apply to ``model`` and ``system``, each on every state."""
+    names = set(names) & set(applicable_checks(model, system))
     return [run_check(c, label, model, system, states, seed) for c in CHECKS if c.name in names]

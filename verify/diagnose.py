@@ -1,8 +1,19 @@
 """Name the known trap behind a failure, in words next to the numbers.
 
 When checks fail, each hypothesis below is tested against the model and the
-URDF; the ones that explain the failure *exactly* (to a relative 1e-6, or by
-making every check pass) become a sentence in the report.
+URDF, and the ones that explain the failure become a sentence in the report
+that says how well they fit: the *residual*, the part of the discrepancy the
+hypothesis leaves unexplained, relative to the whole.  A residual at rounding
+level (≤ ``EXACT_RESIDUAL``) is an exact fit; up to ``FIT_RESIDUAL`` (1e-3) the
+trap is named with its residual and the sentence says that a smaller
+difference remains (a URDF rotation written as 3.1416 for π leaves 7e-6);
+beyond it the hypothesis is not named.
+
+Never a wrong diagnosis: a trap of these kinds changes M or H by a relative
+amount of order one (a degree is 1.7e-2), so a failure smaller than
+``TRAP_MIN_ERROR`` (1e-6, relative) is never blamed on one — and states
+beyond the trust limit (``pendverify.near_singular``) are refused before any
+check or diagnosis sees them.
 
 pivot inertia (``crba`` fails)
     M_urdf − M_hand is fitted by Σ_b c_b K_b, where K_b is body b's parallel-axis
@@ -28,20 +39,21 @@ coordinate conventions (any check fails)
 
 from __future__ import annotations
 
-import dataclasses
 import itertools
 import math
 
 import numpy as np
 import pinocchio as pin
 
-from pendverify.checks import run_checks
+from pendverify.checks import applicable_checks, run_checks
 from pendverify.coordinates import CoordinateMap
 from pendverify.robot import PinocchioSystem
 from pendverify.sampling import sample_states
-from pendverify.targets import applicable_checks
 
-FIT_RTOL = 1e-6  # relative residual of a fit that counts as exact
+FIT_RTOL = 1e-6  # relative residual of the damping fit that counts as exact
+EXACT_RESIDUAL = 1e-9  # a residual at rounding level (of the fitted data, ~1e-15, with margin)
+FIT_RESIDUAL = 1e-3  # the most a named trap may leave unexplained
+TRAP_MIN_ERROR = 1e-6  # smallest relative failure a convention or inertia trap can cause
 COEFF_TOL = 1e-3  # how close a fitted coefficient must be to an integer
 DIAGNOSIS_STATES = 8  # random states per hypothesis, besides the special ones
 DIAGNOSIS_SEED = 4242
@@ -53,6 +65,17 @@ def _states(model):
 
 def _fmt(values) -> str:
     return "(" + ", ".join(f"{x:.6g}" for x in values) + ")"
+
+
+def _fit(residual: float) -> str:
+    """How well a pattern fits, in words, with its residual."""
+    if residual <= EXACT_RESIDUAL:
+        return "exactly"
+    return f"up to a relative residual of {residual:.2g} (a smaller difference remains as well)"
+
+
+def _largest_failure(results) -> float:
+    return max((r.max_error for r in results if not r.passed), default=0.0)
 
 
 # --- pivot inertia ---------------------------------------------------------------------------
@@ -95,26 +118,30 @@ def pivot_inertia(model, system, failing, states) -> str | None:
         rows.append(np.column_stack([terms[n].ravel() for n in names]))
         target.append((system.mass_matrix(s.q) - model.mass_matrix(s.q)).ravel())
     A, b = np.vstack(rows), np.concatenate(target)
-    coeff, *_ = np.linalg.lstsq(A, b, rcond=None)
-    if np.linalg.norm(A @ coeff - b) > FIT_RTOL * np.linalg.norm(b):
+    if not np.linalg.norm(b) > 0:
         return None
+    coeff, *_ = np.linalg.lstsq(A, b, rcond=None)
     rounded = np.round(coeff)
     if np.any(np.abs(coeff - rounded) > COEFF_TOL) or not np.any(rounded) or np.any(np.abs(rounded) > 1):
         return None
+    residual = float(np.linalg.norm(A @ rounded - b) / np.linalg.norm(b))
+    if residual > FIT_RESIDUAL:
+        return None
+    fit = _fit(residual)
     mr2 = {n: float(np.max(np.abs(_parallel_axis_terms(system, np.zeros(model.nv))[n]))) for n in names}
     plus = [n for n, c in zip(names, rounded, strict=True) if c > 0]
     minus = [n for n, c in zip(names, rounded, strict=True) if c < 0]
     parts = []
     if plus:
         parts.append(
-            f"M_urdf − M_hand is exactly the parallel-axis term m·r² of {', '.join(plus)} "
+            f"M_urdf − M_hand is {fit} the parallel-axis term m·r² of {', '.join(plus)} "
             f"(m·r² = {', '.join(f'{mr2[n]:.6g} kg·m²' for n in plus)}): inertia given about the pivot "
             "instead of the centre of mass — a URDF <inertia> is about the centre of mass, "
             "I_com = I_pivot − m·r²"
         )
     if minus:
         parts.append(
-            f"M_hand − M_urdf is exactly the parallel-axis term m·r² of {', '.join(minus)} "
+            f"M_hand − M_urdf is {fit} the parallel-axis term m·r² of {', '.join(minus)} "
             f"(m·r² = {', '.join(f'{mr2[n]:.6g} kg·m²' for n in minus)}): the hand model adds m·r² to an "
             "inertia that is already about the pivot (I_pivot = I_com + m·r², counted twice)"
         )
@@ -166,17 +193,19 @@ def missing_damping(model, system, failing, states) -> str | None:
 # --- coordinate conventions ------------------------------------------------------------------
 def _with_map(system: PinocchioSystem, T, theta0) -> PinocchioSystem:
     cmap = CoordinateMap(np.asarray(T, float), np.asarray(theta0, float), system.cmap.joint_nq)
-    geometry = dataclasses.replace(system.geometry, cmap=cmap)
-    g = -float(system.model.gravity.linear[2])
-    return PinocchioSystem(system.model.copy(), geometry, g, system.source)
+    return system.with_map(cmap)
 
 
-def _fits(model, system, states) -> bool:
+def _discrepancy(model, system, states) -> tuple[float, bool]:
+    """(largest relative error of crba and gravity, whether every applicable check passes)."""
     quick = run_checks("diagnosis", model, system, states, DIAGNOSIS_SEED, names=("crba", "gravity"))
+    largest = max(r.max_error for r in quick)
     if not all(r.passed for r in quick):
-        return False
-    names = applicable_checks(model)
-    return all(r.passed for r in run_checks("diagnosis", model, system, states, DIAGNOSIS_SEED, names))
+        return largest, False
+    names = applicable_checks(model, system)
+    return largest, all(
+        r.passed for r in run_checks("diagnosis", model, system, states, DIAGNOSIS_SEED, names)
+    )
 
 
 def _difference_matrix(model) -> np.ndarray:
@@ -219,6 +248,16 @@ def _map_candidates(model, system):
             T,
             fixed,
         )
+        nonzero = [i for i in np.flatnonzero(angular) if theta0[i] != 0]
+        for i in nonzero if len(nonzero) >= 2 else ():
+            one = theta0.copy()
+            one[i] = theta0[i] * deg
+            yield (
+                f"degrees vs radians: the offset of {model.coordinates[i]}, {theta0[i]:.6g}, is in degrees "
+                f"while the others are in radians; read as {one[i]:.6g} rad, every check passes",
+                T,
+                one,
+            )
     S = np.diag(np.where(angular, deg, 1.0))
     yield (
         "degrees vs radians: the hand model's angles behave as degrees; scaled by π/180 every check passes",
@@ -248,11 +287,22 @@ def _map_candidates(model, system):
 
 
 def coordinate_conventions(model, system, failing, states) -> str | None:
+    before, _ = _discrepancy(model, system, states)
+    if not before > 0:
+        return None
     for sentence, T, theta0 in _map_candidates(model, system):
         if abs(np.linalg.det(T)) < 1e-12:
             continue
-        if _fits(model, _with_map(system, T, theta0), states):
-            return sentence
+        after, every_check_passes = _discrepancy(model, _with_map(system, T, theta0), states)
+        residual = after / before
+        if every_check_passes:
+            fit = "an exact fit" if residual <= EXACT_RESIDUAL else "a fit within the tolerances"
+            return f"{sentence} ({fit}: residual {residual:.2g} of the discrepancy)"
+        if residual <= FIT_RESIDUAL:
+            return (
+                sentence.replace("every check passes", f"all but {residual:.2g} of the discrepancy goes")
+                + "; a smaller difference remains as well"
+            )
     return None
 
 
@@ -260,14 +310,16 @@ HYPOTHESES = (pivot_inertia, missing_damping, coordinate_conventions)
 
 
 def diagnose(model, system, results) -> list[str]:
-    """One sentence per known trap that explains the failing checks exactly."""
+    """One sentence per known trap that explains the failing checks, with how well it fits."""
     failing = {r.check for r in results if not r.passed}
     if not failing:
         return []
+    # a convention or inertia trap changes M or H by O(1): never blame one for a rounding-size failure
+    hypotheses = HYPOTHESES if _largest_failure(results) >= TRAP_MIN_ERROR else (missing_damping,)
     states = _states(model)
     out = []
     with np.errstate(all="ignore"):
-        for hypothesis in HYPOTHESES:
+        for hypothesis in hypotheses:
             sentence = hypothesis(model, system, failing, states)
             if sentence:
                 out.append(sentence)

@@ -39,13 +39,13 @@ from dataclasses import dataclass, field
 import numpy as np
 import sympy as sp
 
-from pendverify.checks import CHECK_NAMES, CHECKS, run_check
+from pendverify.checks import CHECK_NAMES, CHECKS, applicable_checks, run_check
 from pendverify.errors import PendverifyError, UnknownNameError
 from pendverify.lagrange import mass_matrix_rate
 from pendverify.mutants import Mutant, generate, is_coriolis_form
 from pendverify.sampling import sample_states
 from pendverify.symbolic import SymbolicModel, entries, is_zero, probe, show
-from pendverify.targets import applicable_checks
+from pendverify.verdict import CHRISTOFFEL_CONSISTENT, NON_CHRISTOFFEL
 
 DETECTED, EQUIVALENT, SURVIVED = "detected", "equivalent", "survived"
 FIRST_RANDOM = 4  # random states in the first round, after the special ones
@@ -149,7 +149,7 @@ def _failing(model, system, states, seed, order=None, stop: bool = False) -> lis
     Pinocchio side refuses) fails too.
     """
     failing = []
-    names = applicable_checks(model)
+    names = applicable_checks(model, system)
     for check in order or CHECKS:
         if check.name not in names:
             continue
@@ -195,8 +195,8 @@ def _coriolis_equivalence(sm: SymbolicModel, mutant: Mutant) -> str | None:
     C = sm.evaluate("coriolis_matrix", "qv") + delta
     N = mass_matrix_rate(sm.evaluate("mass_matrix", "q"), sm.symbols["q"], sm.symbols["v"]) - 2 * C
     if all(is_zero(e, sm.angles) for e in N + N.T):
-        return "same C·q̇ and Ṁ − 2C still skew: a Christoffel-consistent factorisation of C"
-    return "same C·q̇ but Ṁ − 2C no longer skew: a valid C·q̇, not a Christoffel-consistent C"
+        return CHRISTOFFEL_CONSISTENT
+    return NON_CHRISTOFFEL
 
 
 def _differences(sm: SymbolicModel, mutant: Mutant) -> list:

@@ -27,6 +27,21 @@ with, A = ``term_amplification`` ≥ 1 (below).  The rounding bound is
   A comparison whose tolerance exceeds 1e-6 can no longer tell a 1 ppm
   modelling error (β off by 1e-6, one of the planted-error tests) from rounding.
 
+A third source limits what a comparison can *see*.  In scaled coordinates an
+error in the terms of a coordinate j with a small scale S_j that leaks into its
+coupling with a coordinate i of large scale S_i — a wrong coordinate map does
+exactly that (absolute vs relative angles moves M_jj into M_ij) — appears with
+the size √(S_j/S_i) of the error.  Against a tolerance K·ε·(1 + |θ|max) such an
+error is invisible below K·ε·(1 + |θ|max)·s, s = √(max S / min S) the *scale
+spread*, so the bound is
+
+    bound = K·ε·max(κ̃·((1 + |θ|max) + (A − 1)),  (1 + |θ|max)·s).
+
+The spread term refuses only extreme sets: a link 1 of 1e30 kg on a link 2 of
+0.8 kg (s ≈ 1e15; absolute and relative angles then give the same checks to
+ε), never the mass and length ratios of up to 1e6 in ``pendverify stress``
+(s ≤ 2e3 there).
+
 So angles beyond about 2.8e8/κ̃ rad are refused however well-conditioned M is:
 an angle that large is only known to ε·|θ|.  For the default cart (m = 1.5 kg,
 m2 = 0.75 kg, l1 = 0.5 m, l2 = 0.75 m) at θ1 = θ2 = 0, κ̃ ≈ 3.7/m1 (m1 in kg) and
@@ -86,6 +101,7 @@ KAPPA_K = 16  # the K of the checks that solve with M (aba, minverse)
 WARN_REL = 1e-10  # predicted relative error above which results carry a warning
 REFUSE_REL = 1e-6  # predicted relative error above which results are refused
 REFERENCE_DIGITS = 50
+AMPLIFICATION_CACHE = 4096  # states whose term amplification a system remembers
 STUDY_MASSES = tuple(10.0**-k for k in range(17))  # m1 in kg
 
 
@@ -98,6 +114,9 @@ class IllConditionedError(PendverifyError):
     kappa_scaled: float
     bound: float
     amplification: float = 1.0
+    spread: float = 1.0
+    #: the bound comes from the scale spread, not from κ̃ and A
+    by_spread: bool = False
 
     def __str__(self) -> str:
         q = ", ".join(f"{x:.6g}" for x in self.q)
@@ -106,10 +125,16 @@ class IllConditionedError(PendverifyError):
             if self.amplification >= 10
             else ""
         )
+        if self.by_spread:
+            return (
+                f"{self.what} at q = ({q}): cannot be verified: M's diagonal scales span a factor "
+                f"{self.spread**2:.3g}, so an error of a relative {self.bound:.2g} in the smaller ones would "
+                f"not show against rounding ({self.bound:.2g} > {REFUSE_REL:g}, the trust limit); refused"
+            )
         return (
             f"{self.what} at q = ({q}): too ill-conditioned to verify: κ̃(M) = {self.kappa_scaled:.3g} "
             f"after diagonal scaling{terms}, so rounding alone can cause a relative error of "
-            f"{self.bound:.2g} > {REFUSE_REL:g}; refused"
+            f"{self.bound:.2g} > {REFUSE_REL:g} (the trust limit); refused"
         )
 
 
@@ -122,6 +147,8 @@ class Conditioning:
     bound: float
     level: str  # "ok", "warn" or "refuse"
     amplification: float = 1.0
+    spread: float = 1.0
+    by_spread: bool = False
 
     @property
     def note(self) -> str:
@@ -150,15 +177,34 @@ def conditioning(
     if np.all(S > 0) and np.all(np.isfinite(S)):
         root = np.sqrt(S)
         kappa_scaled = _cond(M / np.outer(root, root))
+        spread = math.sqrt(float(np.max(S) / np.min(S)))
     else:
-        kappa_scaled = math.inf
-    bound = KAPPA_K * EPS * kappa_scaled * ((1.0 + abs(angle)) + (amplification - 1.0))
+        kappa_scaled = spread = math.inf
+    growth = 1.0 + abs(angle)
+    rounding, visibility = kappa_scaled * (growth + (amplification - 1.0)), growth * spread
+    bound = KAPPA_K * EPS * max(rounding, visibility)
     level = "ok" if bound <= WARN_REL else "warn" if bound <= REFUSE_REL else "refuse"
-    return Conditioning(_cond(M), kappa_scaled, bound, level, amplification)
+    return Conditioning(_cond(M), kappa_scaled, bound, level, amplification, spread, visibility > rounding)
 
 
 def term_amplification(model, system, q) -> float:
-    """A ≥ 1: how much larger than the result (in the model's scaled coordinates) Pinocchio's terms are."""
+    """A ≥ 1: how much larger than the result (in the model's scaled coordinates) Pinocchio's terms are.
+
+    The trust guard and two checks ask for it at every state: answers are kept on the
+    system, keyed by the state, with the model and Pinocchio data they came from (held,
+    so that their ids cannot be reused while the entry lives).
+    """
+    key = np.asarray(q, dtype=float).tobytes()
+    cache = system.__dict__.setdefault("_amplification_cache", {})
+    entry = cache.get(key)
+    if entry is None or entry[0] is not model or entry[1] is not system.data:
+        if len(cache) >= AMPLIFICATION_CACHE:
+            cache.clear()
+        entry = cache[key] = (model, system.data, _term_amplification(model, system, q))
+    return entry[2]
+
+
+def _term_amplification(model, system, q) -> float:
     import pinocchio as pin
 
     pm, data = system.model, system.data
@@ -211,6 +257,8 @@ def check_conditioning(model, q, system=None, what: str | None = None) -> Condit
             verdict.kappa_scaled,
             verdict.bound,
             verdict.amplification,
+            verdict.spread,
+            verdict.by_spread,
         )
     return verdict
 

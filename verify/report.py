@@ -11,6 +11,7 @@ import pinocchio
 
 from pendverify import __version__
 from pendverify.checks import CheckResult
+from pendverify.verdict import FAIL, LABELS, PASS, REFUSED, WARN, worst
 
 
 @dataclass
@@ -23,13 +24,27 @@ class Report:
     elapsed_s: float = 0.0
     #: Known traps that explain a target's failures (``pendverify.diagnose``), in words.
     diagnoses: dict[str, list[str]] = field(default_factory=dict)
+    #: What a user must know although the checks pass (``pendverify.verdict``), per target.
+    warnings: dict[str, list[str]] = field(default_factory=dict)
+    #: --strict: warnings count as failures.
+    strict: bool = False
+
+    @property
+    def status(self) -> str:
+        """pass, warn, fail or refused: the worst of the results and the warnings."""
+        level = worst([r.status for r in self.results] + ([WARN] if self.warnings else []))
+        return FAIL if self.strict and level == WARN else level
 
     @property
     def passed(self) -> bool:
-        return all(r.passed for r in self.results)
+        """True for pass and pass with warnings (without ``strict``)."""
+        return self.status in (PASS, WARN)
 
     def failures(self) -> list[CheckResult]:
-        return [r for r in self.results if not r.passed]
+        return [r for r in self.results if r.status == FAIL]
+
+    def refusals(self) -> list[CheckResult]:
+        return [r for r in self.results if r.status == REFUSED]
 
     def as_dict(self) -> dict:
         return {
@@ -41,9 +56,12 @@ class Report:
             "states": self.states,
             "elapsed_s": round(self.elapsed_s, 3),
             "passed": self.passed,
+            "status": self.status,
+            "strict": self.strict,
             "sources": self.sources,
             "notes": self.notes,
             "diagnoses": self.diagnoses,
+            "warnings": self.warnings,
             "results": [r.as_dict() for r in self.results],
         }
 
@@ -60,6 +78,8 @@ def text_table(header: tuple[str, ...], rows: list[tuple[str, ...]]) -> list[str
 
 
 def _state_text(state: dict) -> str:
+    if not state.get("q"):
+        return state["label"]
     q = ", ".join(f"{x:.3g}" for x in state["q"])
     return f"{state['label']} q=({q})"
 
@@ -73,7 +93,7 @@ def format_table(report: Report) -> str:
             f"{r.max_error:.2e}",
             f"{r.tolerance:.2e}",
             _state_text(r.worst_state),
-            "pass" if r.passed else "FAIL",
+            LABELS[r.status],
         )
         for r in report.results
     ]
@@ -86,6 +106,9 @@ def format_table(report: Report) -> str:
     for model, notes in report.notes.items():
         for note in notes:
             out.append(f"note [{model}]: {note}")
+    for model, sentences in report.warnings.items():
+        for sentence in sentences:
+            out.append(f"warning [{model}]: {sentence}")
     for r in report.failures():
         for note in r.notes:
             out.append(f"fail [{r.model} {r.check}]: {note}")
@@ -93,9 +116,27 @@ def format_table(report: Report) -> str:
         for sentence in sentences:
             out.append(f"diagnosis [{model}]: {sentence}")
     total = sum(report.states.values())
-    verdict = "all checks pass" if report.passed else f"{len(report.failures())} check(s) FAIL"
     out.append(
         f"{len(report.results)} checks on {len(report.states)} model(s), {total} states "
-        f"(seed {report.seed}), {report.elapsed_s:.2f} s: {verdict}"
+        f"(seed {report.seed}), {report.elapsed_s:.2f} s: {verdict_sentence(report)}"
     )
     return "\n".join(out)
+
+
+def verdict_sentence(report: Report) -> str:
+    """The report's verdict in words: pass, pass with warnings, FAIL or refused."""
+    warned = sum(len(w) for w in report.warnings.values())
+    parts = []
+    if report.failures():
+        parts.append(f"{len(report.failures())} check(s) FAIL")
+    if report.refusals():
+        parts.append(f"{len(report.refusals())} check(s) refused (beyond the trust limit: not verified)")
+    if parts:
+        if warned:
+            parts.append(f"{warned} warning(s)")
+        return ", ".join(parts)
+    if warned:
+        if report.strict:
+            return f"FAIL: {warned} warning(s), which --strict counts as failures"
+        return f"pass with {warned} warning(s)"
+    return "all checks pass"

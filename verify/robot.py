@@ -22,6 +22,7 @@ the model's coordinates.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -29,11 +30,17 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from pendverify.analytic import DoublePendulumParams, ParameterSet
+from pendverify.analytic import MODELS, DoublePendulumParams, ParameterSet
 from pendverify.coordinates import CoordinateMap
 from pendverify.errors import ParameterError, UrdfShapeError
+from pendverify.urdf_strict import UrdfFacts, build_pinocchio_model
 from pendverify.validate import finite_state
 
+#: Largest relative size (|ΔH_i| / Σ|terms of H_i|) of a term the closed form cannot express
+#: for which a URDF still counts as inside the model's family.  1e-4 passes mesh-derived
+#: centres of mass rounded at the micrometre (example-robot-data: 7.6e-6) and fails
+#: a 0.1 mm offset on a 0.5 m pendulum; ``pendverify check --model-form-rtol`` sets it.
+MODEL_FORM_RTOL = 1e-4
 PARALLEL_TOL = 1e-9  # |sin| of the angle between axes that count as parallel
 DEFAULT_G = 9.81  # m/s², Pinocchio's default, used when a URDF alone is given
 
@@ -63,26 +70,114 @@ class UrdfGeometry:
     cmap: CoordinateMap
     #: Parameters read off the URDF (double pendulum only; None for the cart).
     params: ParameterSet | None = None
-    #: Known bound on |H_urdf − H_seed| per coordinate that the seed's form cannot
-    #: represent (an off-line centre of mass); zero for URDFs inside the family.
-    gravity_allowance: np.ndarray | None = None
+    #: A term of the URDF the closed form cannot express (an off-line centre of
+    #: mass); None for URDFs inside the family.
+    model_form: ModelForm | None = None
     notes: list[str] = field(default_factory=list)
 
 
-def load_model(urdf: str | Path, source: str | None = None) -> tuple[pin.Model, str]:
-    """Parse a URDF file (or XML text) into a Pinocchio model; errors name the source."""
+@dataclass
+class ModelForm:
+    """A URDF slightly outside a closed form's family: a term the closed form cannot express.
+
+    ``relative`` is the term's size over the size of the quantity it enters
+    (|ΔH_i| / Σ|terms of H_i|); ``allowance`` the bound on |ΔH| per coordinate that
+    the checks may add while ``relative`` stays within the threshold
+    (``MODEL_FORM_RTOL``, ``pendverify check --model-form-rtol``).
+    """
+
+    what: str
+    relative: float
+    allowance: np.ndarray
+
+    def within(self, rtol: float) -> bool:
+        return self.relative <= rtol
+
+    def sentence(self, rtol: float) -> str:
+        """What the term is, how large, and what the threshold makes of it."""
+        if self.within(rtol):
+            verdict = f"within the model-form threshold {rtol:g}: the checks allow for it"
+        else:
+            verdict = (
+                f"above the model-form threshold {rtol:g} (--model-form-rtol): the URDF lies outside "
+                "the closed form's family, and no allowance is made"
+            )
+        return f"{self.what}; that is {self.relative:.3g} of H1, {verdict}"
+
+
+def _anchor_base(model: pin.Model) -> float:
+    """Move each joint fixed to the world so that it sits at the origin; return the largest shift.
+
+    A fixed base's dynamics do not depend on where it stands (gravity is uniform;
+    V changes by a constant), but Pinocchio expresses spatial inertias about the
+    world origin, so a base 1 km away makes its terms 1e6 times larger than the
+    result and rounds them accordingly.  Only the translation of the placements
+    of joints whose parent is the world changes; their rotation, which orients
+    the robot against gravity, stays.
+    """
+    shift = 0.0
+    for j in range(1, model.njoints):
+        if model.parents[j] == 0:
+            placement = model.jointPlacements[j]
+            shift = max(shift, float(np.linalg.norm(placement.translation)))
+            model.jointPlacements[j] = pin.SE3(placement.rotation, np.zeros(3))
+    return shift
+
+
+@dataclass
+class LoadedUrdf:
+    """A URDF in Pinocchio, read strictly first (``pendverify.urdf_strict``), its base at the origin."""
+
+    model: pin.Model
+    source: str
+    text: str
+    facts: UrdfFacts
+    #: distance of the fixed base from the world origin in the file [m]
+    base_offset: float = 0.0
+    #: what Pinocchio's parser logged while reading the file
+    log: list[str] = field(default_factory=list)
+
+    def notes(self) -> list[str]:
+        out = [f"Pinocchio's URDF parser logged: {line}" for line in self.log]
+        if self.base_offset > 0:
+            out.append(
+                f"the fixed base stands {self.base_offset:.6g} m from the world origin; it is evaluated "
+                "at the origin (a fixed base's dynamics do not depend on where it stands)"
+            )
+        return out
+
+
+def load_urdf(urdf: str | Path, source: str | None = None) -> LoadedUrdf:
+    """Read a URDF file (or XML text) strictly, parse it with Pinocchio and anchor its base at the origin."""
     if isinstance(urdf, Path) or (isinstance(urdf, str) and not urdf.lstrip().startswith("<")):
         path = Path(urdf)
         source = source or str(path)
         if not path.is_file():
             raise UrdfShapeError(source, "file not found")
-        text = path.read_text()
+        text = read_text_file(path, source)
     else:
         text, source = urdf, source or "<urdf text>"
+    model, facts, log = build_pinocchio_model(text, source)
+    offset = _anchor_base(model)
+    return LoadedUrdf(model, source, text, facts, offset, log)
+
+
+def load_model(urdf: str | Path, source: str | None = None) -> tuple[pin.Model, str]:
+    """A URDF in Pinocchio (see ``load_urdf``); errors name the source."""
+    loaded = load_urdf(urdf, source)
+    return loaded.model, loaded.source
+
+
+def read_text_file(path: Path, source: str) -> str:
+    """A user's text file as UTF-8 (a byte-order mark allowed); anything else is one clear error."""
     try:
-        return pin.buildModelFromXML(text), source
-    except (RuntimeError, ValueError) as exc:
-        raise UrdfShapeError(source, f"Pinocchio cannot parse it as URDF: {exc}") from None
+        return path.read_bytes().decode("utf-8-sig")
+    except IsADirectoryError:
+        raise UrdfShapeError(source, "is a directory, not a file") from None
+    except UnicodeDecodeError as exc:
+        raise UrdfShapeError(source, f"not UTF-8 text (byte {exc.start}: {exc.reason})") from None
+    except OSError as exc:
+        raise UrdfShapeError(source, f"cannot be read: {exc.strerror}") from None
 
 
 def _frames_at_zero(model: pin.Model):
@@ -144,18 +239,19 @@ def double_pendulum_geometry(model: pin.Model, source: str, g: float | None = No
     def plane(v: np.ndarray) -> np.ndarray:
         return np.array([v @ horizontal, v @ up])
 
-    p1, p2 = data.oMi[1].translation, data.oMi[2].translation
-    c1 = data.oMi[1].act(model.inertias[1].lever)
-    c2 = data.oMi[2].act(model.inertias[2].lever)
-    link = plane(p2 - p1)
+    # Local frames only: joint 2 seen from joint 1 and each centre of mass from its own
+    # joint, rotated into the world's orientation (rotations do not grow with distance).
+    R1, R2 = data.oMi[1].rotation, data.oMi[2].rotation
+    link = plane(R1 @ model.jointPlacements[2].translation)
     l1 = float(np.linalg.norm(link))
     _require(l1 > 0, source, "joint 2 lies on joint 1's axis (l1 = 0)")
     gamma1 = math.atan2(link[1], link[0])
     along, across = link / l1, np.array([-link[1], link[0]]) / l1
-    r1_along = float(plane(c1 - p1) @ along)
-    d1 = float(plane(c1 - p1) @ across)  # centre of mass off the joint line
+    com1 = plane(R1 @ model.inertias[1].lever)
+    r1_along = float(com1 @ along)
+    d1 = float(com1 @ across)  # centre of mass off the joint line
     r1 = math.hypot(r1_along, d1)  # the seed's r1 is the distance, which is all M sees
-    com2 = plane(c2 - p2)
+    com2 = plane(R2 @ model.inertias[2].lever)
     r2 = float(np.linalg.norm(com2))
     psi2 = math.atan2(com2[1], com2[0]) if r2 > 0 else gamma1
 
@@ -185,21 +281,24 @@ def double_pendulum_geometry(model: pin.Model, source: str, g: float | None = No
     nq = tuple(model.joints[i].nq for i in (1, 2))
     cmap = CoordinateMap(np.diag([1.0, sign2]), np.array([gamma1, psi2 - gamma1]), nq)
     notes = []
-    allowance = np.zeros(2)
+    model_form = None
     if d1 != 0.0:
         # |ΔH1| = m1·g·|(r1 − r_along) cos θ1 + d1 sin θ1| ≤ m1·g·|c1 − seed's c1|
-        allowance[0] = params.m1 * g * math.hypot(r1 - r1_along, d1)
-        notes.append(
-            f"link 1's centre of mass is {d1:.3g} m off the joint-1→joint-2 line "
-            f"({math.atan2(d1, r1_along):.2g} rad); the seed's H cannot express this, "
-            f"so H1 is allowed to differ by up to m1·g·|offset| = {allowance[0]:.3g} N·m"
+        allowance = np.array([params.m1 * g * math.hypot(r1 - r1_along, d1), 0.0])
+        h1_scale = g * (params.m1 * params.r1 + params.m2 * (params.l1 + params.r2))
+        model_form = ModelForm(
+            f"link 1's centre of mass is {abs(d1):.3g} m off the joint-1→joint-2 line "
+            f"({math.atan2(d1, r1_along):.2g} rad); the seed's H has no term for it: "
+            f"up to m1·g·|offset| = {allowance[0]:.3g} N·m on H1",
+            float(allowance[0] / h1_scale),
+            allowance,
         )
     if gamma1 != 0.0 or psi2 != gamma1 or sign2 < 0:
         notes.append(
             f"angle map: θ1 = q1 {gamma1:+.6g} rad, "
             f"θ2 = {'' if sign2 > 0 else '−'}q2 {psi2 - gamma1:+.6g} rad"
         )
-    return UrdfGeometry(cmap, params, allowance, notes)
+    return UrdfGeometry(cmap, params, model_form, notes)
 
 
 def cart_double_pendulum_geometry(model: pin.Model, source: str) -> UrdfGeometry:
@@ -226,9 +325,11 @@ def cart_double_pendulum_geometry(model: pin.Model, source: str) -> UrdfGeometry
     def lean(v: np.ndarray) -> float:
         return math.atan2(v @ rail, v @ up)
 
-    p1, p2 = data.oMi[2].translation, data.oMi[3].translation
-    c2 = data.oMi[3].act(model.inertias[3].lever)
-    phi1, phi2 = lean(p2 - p1), lean(c2 - p2) - lean(p2 - p1)
+    # rod 1 (joint 1 → joint 2) and rod 2 (joint 2 → its centre of mass), in local frames
+    rod1 = data.oMi[2].rotation @ model.jointPlacements[3].translation
+    rod2 = data.oMi[3].rotation @ model.inertias[3].lever
+    p1 = data.oMi[2].translation  # the base is anchored at the origin (``load_urdf``)
+    phi1, phi2 = lean(rod1), lean(rod2) - lean(rod1)
     # θ = A q + θ0 with A = [[1,0,0],[0,s1,0],[0,s1,s2]]; T = A⁻¹.
     A = np.array([[1.0, 0, 0], [0, s1, 0], [0, s1, s2]])
     theta0 = np.array([float(p1 @ rail), phi1, phi1 + phi2])
@@ -239,27 +340,82 @@ def cart_double_pendulum_geometry(model: pin.Model, source: str) -> UrdfGeometry
 class PinocchioSystem:
     """A Pinocchio model evaluated in a closed-form model's coordinates."""
 
-    def __init__(self, model: pin.Model, geometry: UrdfGeometry, g: float, source: str):
+    def __init__(
+        self,
+        model: pin.Model,
+        geometry: UrdfGeometry,
+        g: float,
+        source: str,
+        urdf: LoadedUrdf | None = None,
+        model_form_rtol: float = MODEL_FORM_RTOL,
+    ):
         self.model = model
         self.model.gravity.linear = np.array([0.0, 0.0, -g])
         self.data = model.createData()
         self.cmap = geometry.cmap
         self.geometry = geometry
         self.source = source
+        self.urdf = urdf
+        #: the model-form threshold (``MODEL_FORM_RTOL``; ``check --model-form-rtol``)
+        self.model_form_rtol = model_form_rtol
         self._no_gravity = model.copy()
         self._no_gravity.gravity.linear = np.zeros(3)
         self._no_gravity_data = self._no_gravity.createData()
 
     @classmethod
     def from_urdf(cls, model_name: str, urdf: str | Path, g: float | None = None, source: str | None = None):
-        model, source = load_model(urdf, source)
-        if model_name == "double_pendulum":
-            geometry = double_pendulum_geometry(model, source, g)
-        elif model_name == "cart_double_pendulum":
-            geometry = cart_double_pendulum_geometry(model, source)
-        else:
-            raise ValueError(f"no URDF reader for model {model_name!r}")
-        return cls(model, geometry, DEFAULT_G if g is None else g, source)
+        """A built-in model's URDF (path or XML text), seen through that model's ``urdf_geometry``."""
+        loaded = load_urdf(urdf, source)
+        geometry = MODELS[model_name].urdf_geometry(loaded.model, loaded.source, g)
+        return cls(loaded.model, geometry, DEFAULT_G if g is None else g, loaded.source, loaded)
+
+    @property
+    def allowance(self) -> np.ndarray:
+        """|ΔH| per coordinate the checks allow for a term the closed form cannot express.
+
+        The model-form bound while the term is within ``model_form_rtol``; beyond it,
+        nothing: the URDF is outside the family and the checks say so by failing.
+        """
+        form = self.geometry.model_form
+        if form is not None and form.within(self.model_form_rtol):
+            return form.allowance.copy()
+        return np.zeros(self.model.nv)
+
+    @property
+    def notes(self) -> list[str]:
+        """What reading the URDF noticed: parser messages, the base's offset, the map, the model form."""
+        out = self.urdf.notes() if self.urdf is not None else []
+        out += self.geometry.notes
+        form = self.geometry.model_form
+        if form is not None and form.within(self.model_form_rtol):  # beyond it, a failing row says so
+            out.append(form.sentence(self.model_form_rtol))
+        return out
+
+    def with_map(self, cmap: CoordinateMap) -> PinocchioSystem:
+        """The same URDF seen through another coordinate map (for testing hypotheses)."""
+        geometry = dataclasses.replace(self.geometry, cmap=cmap)
+        g = -float(self.model.gravity.linear[2])
+        return PinocchioSystem(self.model.copy(), geometry, g, self.source, self.urdf, self.model_form_rtol)
+
+    def urdf_damping(self) -> np.ndarray | None:
+        """The joints' <dynamics damping> (joint coordinates, Pinocchio's order), or None if no joint has one.
+
+        Pinocchio reads a missing attribute as 0; only the strict reader knows it was absent.
+        """
+        if self.urdf is None:
+            return None
+        declared = {
+            name: d.damping for name, d in self.urdf.facts.joint_dynamics.items() if d.damping is not None
+        }
+        if not declared:
+            return None
+        return np.array([declared.get(self.model.names[j], 0.0) for j in range(1, self.model.njoints)])
+
+    def urdf_coulomb_friction(self) -> dict[str, float]:
+        """{joint: <dynamics friction>} for every joint whose Coulomb friction is non-zero."""
+        if self.urdf is None:
+            return {}
+        return {name: d.friction for name, d in self.urdf.facts.joint_dynamics.items() if d.friction}
 
     def _qv(self, theta, theta_dot=None):
         # Pinocchio turns a NaN angle into NaN results without a word: refuse it here.

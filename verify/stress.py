@@ -58,7 +58,7 @@ import numpy as np
 
 from pendverify.analytic import MODELS, CartDoublePendulumParams, DoublePendulumParams
 from pendverify.analytic.params import default_parameter_file, load_parameter_file
-from pendverify.checks import CHECKS, EPS, Check, Sample, run_check
+from pendverify.checks import CHECKS, EPS, Check, Sample, applicable_checks, run_check
 from pendverify.errors import PendverifyError
 from pendverify.near_singular import (
     REFUSE_REL,
@@ -270,7 +270,8 @@ def compare(name: str, model, system, states: list[State], seed: int) -> _Compar
         kappa_raw, kappa_scaled = max(kappa_raw, c.kappa_raw), max(kappa_scaled, c.kappa_scaled)
         amplification = max(amplification, c.amplification)
         level = "warn" if c.level == "warn" else level
-    checks = [guarded(c, lambda state: factor[id(state)]) for c in CHECKS]
+    names = applicable_checks(model, system)
+    checks = [guarded(c, lambda state: factor[id(state)]) for c in CHECKS if c.name in names]
     with np.errstate(all="ignore"):
         results = [run_check(c, name, model, system, kept, seed) for c in checks] if kept else []
     return _Comparison(results, len(kept), refused, kappa_raw, kappa_scaled, amplification, level)

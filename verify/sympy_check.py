@@ -38,6 +38,7 @@ from pendverify.errors import PendverifyError
 from pendverify.lagrange import Lagrangian, derive, mass_matrix_rate
 from pendverify.plugin import where
 from pendverify.symbolic import SymbolicModel, entries, is_zero, show, to_sympy
+from pendverify.verdict import CHRISTOFFEL_CONSISTENT, NON_CHRISTOFFEL
 
 EQUAL, DIFFERS, WARNING, SKIPPED = "equal", "DIFFERS", "warning", "skipped"
 
@@ -117,10 +118,8 @@ def _coriolis(sm, lag) -> Comparison:
         same_bias, skew = coriolis_verdict(C_hand, lag, sm)
         if same_bias:
             result.status = WARNING
-            result.note = "C differs from the Christoffel form but gives the same C·q̇; " + (
-                "Ṁ − 2C is skew: a Christoffel-consistent factorisation"
-                if skew
-                else "Ṁ − 2C is not skew: only C·q̇ is right (passivity-based uses of C will fail)"
+            result.note = (
+                CHRISTOFFEL_CONSISTENT if skew else NON_CHRISTOFFEL + " (passivity-based uses of C will fail)"
             )
     return result
 

@@ -28,7 +28,7 @@ from pendverify.analytic.params import (
 from pendverify.erd import double_pendulum_urdfs
 from pendverify.errors import ParameterError, PendverifyError, UnknownNameError
 from pendverify.plugin import load_model_class
-from pendverify.robot import DEFAULT_G, PinocchioSystem, load_model
+from pendverify.robot import DEFAULT_G, PinocchioSystem, load_urdf
 from pendverify.urdf_writer import urdf_for
 
 PARAMETER_MATCH_RTOL = 1e-9
@@ -43,27 +43,6 @@ class Target:
     notes: list[str] = field(default_factory=list)
 
 
-MATRIX_C_CHECKS = ("coriolis", "skew")
-
-
-def applicable_checks(model: ClosedFormModel | type[ClosedFormModel]) -> tuple[str, ...]:
-    """The checks a model can take: those comparing the matrix C need a model that has one."""
-    from pendverify.checks import CHECK_NAMES
-
-    if model.has_coriolis_matrix:
-        return CHECK_NAMES
-    return tuple(c for c in CHECK_NAMES if c not in MATRIX_C_CHECKS)
-
-
-def skipped_checks_note(cls: type[ClosedFormModel]) -> list[str]:
-    if cls.has_coriolis_matrix:
-        return []
-    return [
-        f"{', '.join(MATRIX_C_CHECKS)} not run: {cls.__name__} gives the force C·q̇ "
-        "(coriolis_force), not a matrix C; C·q̇ is checked by rnea and aba"
-    ]
-
-
 def committed_urdf(model: str) -> Path:
     return Path(str(files("pendverify.urdf") / f"{model}.urdf"))
 
@@ -74,11 +53,17 @@ def _model_class(name: str):
     return MODELS[name]
 
 
-def system_for(cls: type[ClosedFormModel], urdf, g: float | None = None, source: str | None = None):
+def system_for(
+    cls: type[ClosedFormModel],
+    urdf,
+    g: float | None = None,
+    source: str | None = None,
+):
     """A URDF (path or XML text) in Pinocchio, seen in ``cls``'s coordinates via its ``urdf_geometry``."""
-    pin_model, source = load_model(urdf, source)
-    geometry = cls.urdf_geometry(pin_model, source, g)
-    return PinocchioSystem(pin_model, geometry, DEFAULT_G if g is None else g, source)
+    loaded = load_urdf(urdf, source)
+    geometry = cls.urdf_geometry(loaded.model, loaded.source, g)
+    g = DEFAULT_G if g is None else g
+    return PinocchioSystem(loaded.model, geometry, g, loaded.source, loaded)
 
 
 def default_target(model_name: str) -> Target:
@@ -94,7 +79,7 @@ def erd_targets() -> list[Target]:
     for stem, path in double_pendulum_urdfs().items():
         system = system_for(cls, path)
         model = cls(system.geometry.params)
-        targets.append(Target(f"erd:{stem}", model, system, str(path), list(system.geometry.notes)))
+        targets.append(Target(f"erd:{stem}", model, system, str(path)))
     return targets
 
 
@@ -115,7 +100,7 @@ def model_target(cls: type[ClosedFormModel], urdf: str, params: ParameterSet | N
     """A model class, a URDF file and (unless the URDF fixes them) its parameters: built-in or plug-in."""
     g = getattr(params, "g", None)
     system = system_for(cls, urdf, g)
-    notes = list(system.geometry.notes)
+    notes = []
     read = system.geometry.params
     if params is None:
         if read is None:
@@ -126,7 +111,6 @@ def model_target(cls: type[ClosedFormModel], urdf: str, params: ParameterSet | N
         notes.append("parameters read off the URDF")
     elif read is not None:
         notes += parameter_differences(read, params)
-    notes += skipped_checks_note(cls)
     if not hasattr(params, "g"):
         notes.append(f"the parameter set has no g: Pinocchio's gravity is {DEFAULT_G} m/s²")
     try:

@@ -351,6 +351,8 @@ def _check_element(element: ET.Element, parent: str, place: _Place, source: str)
     for attr in NON_NEGATIVE.get(tag, ()):
         if attr in values and min(values[attr]) < 0:
             fail(f" {attr} = {element.attrib[attr]!r}: must be ≥ 0")
+    if tag == "axis" and parent == "joint" and "xyz" in values and not any(values["xyz"]):
+        fail(f" xyz = {element.attrib['xyz']!r}: a joint axis must not be the zero vector")
     if tag == "dynamics" and parent == "joint" and not {"damping", "friction"} & element.attrib.keys():
         fail(": has neither 'damping' nor 'friction' (urdfdom refuses an empty <dynamics>)")
     if tag == "inertial":

@@ -29,6 +29,17 @@ def non_negative_int(text: str) -> int:
     return _int_at_least(0, text)
 
 
+def positive_float(text: str) -> float:
+    """A finite number > 0, for options such as a tolerance."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not (value > 0 and value < float("inf")):
+        raise argparse.ArgumentTypeError(f"{value} must be a finite number > 0")
+    return value
+
+
 def builtin_models(model: str | None, analytic: str | None) -> list[str]:
     """The built-in models that --model names (all when omitted; none with --analytic).
 

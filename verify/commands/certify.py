@@ -103,7 +103,7 @@ def run_certify(args: argparse.Namespace) -> int:
     if failed:
         print(f"NOT certified: {len(failed)} item(s) failed: {', '.join(i.name for i in failed)}")
         return 1
-    notes = PinocchioSystem.from_urdf(model_name, urdf, params.g).geometry.notes
+    notes = PinocchioSystem.from_urdf(model_name, urdf, params.g).notes
     cert = build_certificate(name, model_name, params, urdf, settings, items, notes=notes)
     path = write_bundle(args.output, name, params, urdf, cert, force=args.force)
     print(f"certified: {path} (digest {cert['digest']['value'][:16]}…)")

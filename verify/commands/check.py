@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import time
 
-from pendverify.commands import builtin_models, non_negative_int
+from pendverify.commands import builtin_models, non_negative_int, positive_float
 
 
 def register(sub) -> None:
@@ -23,39 +23,29 @@ def register(sub) -> None:
     p.add_argument("--seed", type=non_negative_int, default=None, help="seed of the state sampler")
     p.add_argument("--json", help="also write the report as JSON to this path")
     p.add_argument("--no-erd", dest="erd", action="store_false", help="skip example-robot-data's URDFs")
+    p.add_argument(
+        "--strict",
+        action="store_true",
+        help="warnings (a C that is not the Christoffel one, a URDF's Coulomb friction) count as failures",
+    )
+    p.add_argument(
+        "--model-form-rtol",
+        type=positive_float,
+        default=None,
+        metavar="R",
+        help="largest relative size of a URDF term the closed form cannot express, e.g. a centre of "
+        "mass off the seed's joint line (default 1e-4)",
+    )
     p.set_defaults(func=run)
-
-
-def build_report(targets, samples: int, seed: int):
-    """Every applicable check on every target, with diagnoses of the failures: one Report."""
-    from pendverify.checks import run_checks
-    from pendverify.diagnose import diagnose
-    from pendverify.report import Report
-    from pendverify.sampling import sample_states
-    from pendverify.targets import applicable_checks
-
-    report = Report(seed=seed, states={}, results=[])
-    for target in targets:
-        states = sample_states(target.model, samples, seed)
-        report.states[target.label] = len(states)
-        report.sources[target.label] = target.source
-        if target.notes:
-            report.notes[target.label] = target.notes
-        results = run_checks(
-            target.label, target.model, target.system, states, seed, applicable_checks(target.model)
-        )
-        diagnoses = diagnose(target.model, target.system, results)
-        if diagnoses:
-            report.diagnoses[target.label] = diagnoses
-        report.results += results
-    return report
 
 
 def run(args: argparse.Namespace) -> int:
     from pendverify.atomic import write_atomic
     from pendverify.report import format_table
+    from pendverify.robot import MODEL_FORM_RTOL
     from pendverify.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
     from pendverify.targets import default_target, erd_targets, plugin_target, user_target
+    from pendverify.verification import build_report
 
     samples = DEFAULT_RANDOM_STATES if args.samples is None else args.samples
     seed = DEFAULT_SEED if args.seed is None else args.seed
@@ -68,7 +58,8 @@ def run(args: argparse.Namespace) -> int:
         targets = [default_target(name) for name in names]
         if args.erd and (args.model in (None, "double_pendulum")):
             targets += erd_targets()
-    report = build_report(targets, samples, seed)
+    rtol = MODEL_FORM_RTOL if args.model_form_rtol is None else args.model_form_rtol
+    report = build_report(targets, samples, seed, strict=args.strict, model_form_rtol=rtol)
     report.elapsed_s = time.perf_counter() - args.started
     print(format_table(report))
     if args.json:

@@ -34,9 +34,9 @@ def register(sub) -> None:
 
 def check_report(samples: int | None, seed: int | None, erd: bool):
     """The report ``pendverify check`` prints with its default targets."""
-    from pendverify.commands.check import build_report
     from pendverify.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
     from pendverify.targets import default_target, erd_targets
+    from pendverify.verification import build_report
 
     targets = [default_target(name) for name in ("double_pendulum", "cart_double_pendulum")]
     if erd:
