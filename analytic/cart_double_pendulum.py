@@ -94,8 +94,8 @@ class CartDoublePendulum(ClosedFormModel):
 
     @classmethod
     def urdf_geometry(cls, pin_model, source, g):
-        """Read the map (absolute angles from upright) off the URDF (``pendverify.robot``)."""
-        from pendverify.robot import cart_double_pendulum_geometry
+        """Read the map (absolute angles from upright) off the URDF (``pendverify.robot.system``)."""
+        from pendverify.robot.system import cart_double_pendulum_geometry
 
         return cart_double_pendulum_geometry(pin_model, source)
 

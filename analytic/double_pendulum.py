@@ -102,8 +102,8 @@ class DoublePendulum(ClosedFormModel):
 
     @classmethod
     def urdf_geometry(cls, pin_model, source, g):
-        """Read the map, the offsets and the seed's parameters off the URDF (``pendverify.robot``)."""
-        from pendverify.robot import double_pendulum_geometry
+        """Read the map, the offsets and the seed's parameters off the URDF (``pendverify.robot.system``)."""
+        from pendverify.robot.system import double_pendulum_geometry
 
         return double_pendulum_geometry(pin_model, source, g)
 

@@ -6,7 +6,7 @@ A model describes
 
 in *its own* coordinates q (whatever the hand derivation used: absolute or
 relative angles, any zero).  Pinocchio's joint coordinates are reached through a
-``CoordinateMap`` (``pendverify.coordinates``); nothing here knows about them.
+``CoordinateMap`` (``pendverify.robot.coordinates``); nothing here knows about them.
 
 ``C`` is the Coriolis/centrifugal matrix without friction, ``D`` the viscous
 friction matrix, ``H`` the gravity vector, ``B`` the input map and ``W`` the
@@ -22,7 +22,7 @@ A model file for ``pendverify check --analytic FILE`` defines one subclass of
 is a complete one.  Beyond the abstract methods below it declares:
 
 * ``urdf_joints``, ``joint_transform``, ``joint_offset``: the coordinate map
-  q = T (θ − θ0) to the URDF's joints (``pendverify.coordinates``), given
+  q = T (θ − θ0) to the URDF's joints (``pendverify.robot.coordinates``), given
   explicitly — a plug-in's map is never guessed from the URDF's geometry.  Row k of
   T belongs to joint ``urdf_joints[k]``; T defaults to the identity, θ0 to zero.
   The built-in models override ``urdf_geometry`` instead, reading the map (and
@@ -60,7 +60,7 @@ from pendverify.analytic.params import ParameterSet
 if TYPE_CHECKING:  # pragma: no cover
     import pinocchio as pin
 
-    from pendverify.robot import UrdfGeometry
+    from pendverify.robot.system import UrdfGeometry
 
 #: The scalar functions closed forms call through ``self.math``: Python's own, numerically.
 NUMERIC_MATH = types.SimpleNamespace(
@@ -225,7 +225,7 @@ class ClosedFormModel(ABC):
         By default the map this class declares (``urdf_joints``, ``joint_transform``,
         ``joint_offset``); the built-in models read theirs off the URDF's geometry.
         """
-        from pendverify.joint_map import declared_geometry
+        from pendverify.robot.joint_map import declared_geometry
 
         return declared_geometry(cls, pin_model, source)
 

@@ -28,7 +28,7 @@ work τ1 φ̇1 + τ2 (φ̇2 − φ̇1); in absolute angles both become non-diago
     D = [ b1 + b2   −b2 ]     B = [ 1   −1 ]     V = −g (e cos φ1 + m2 r2 cos φ2)
         [ −b2        b2 ]         [ 0    1 ]
 
-The URDF is the project's own double-pendulum URDF (``pendverify.urdf_writer``),
+The URDF is the project's own double-pendulum URDF (``pendverify.robot.writer``),
 whose joint angles are θ1 from the horizontal (+y) and θ2 relative to link 1.
 So q1 = φ1 − π/2 and q2 = φ2 − φ1: the map q = T (φ − φ0) is linear *and*
 offset, T = [[1, 0], [−1, 1]], φ0 = (π/2, π/2).
@@ -187,7 +187,7 @@ class HangingDoublePendulum(ClosedFormModel):
 
 def hanging_double_pendulum_urdf(p: HangingDoublePendulumParams) -> str:
     """The project's double-pendulum URDF of the same physical parameters."""
-    from pendverify.urdf_writer import double_pendulum_urdf
+    from pendverify.robot.writer import double_pendulum_urdf
 
     return double_pendulum_urdf(DoublePendulumParams(**p.as_dict()), name="hanging_double_pendulum")
 

@@ -7,9 +7,9 @@ import pytest
 
 from pendverify.analytic import MODELS
 from pendverify.analytic.params import default_parameter_file, load_parameter_file
-from pendverify.robot import PinocchioSystem
-from pendverify.sampling import sample_states
-from pendverify.urdf_writer import urdf_for
+from pendverify.checks.sampling import sample_states
+from pendverify.robot.system import PinocchioSystem
+from pendverify.robot.writer import urdf_for
 
 SEED = 1234
 MODEL_NAMES = tuple(MODELS)

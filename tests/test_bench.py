@@ -13,9 +13,11 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from pendverify import benchrun, engines, workprecision
-from pendverify.benchreport import ratios
+from pendverify.bench import run as benchrun
+from pendverify.bench import workprecision
+from pendverify.bench.report import ratios
 from pendverify.cli import main
+from pendverify.simulation import engines
 
 ORDER_TOLERANCE = 0.3
 REFERENCE_MARGIN = 1000.0

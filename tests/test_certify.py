@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from pendverify.analytic.params import default_parameter_file
-from pendverify.certificate import SCHEMA, digest_of
+from pendverify.certify.certificate import SCHEMA, digest_of
 from pendverify.cli import main
 
 from .conftest import default_params
@@ -91,7 +91,7 @@ def test_existing_certificate_is_not_overwritten(certified, capsys):
 
 
 def test_failing_set_writes_nothing(tmp_path, capsys):
-    from pendverify.urdf_writer import urdf_for
+    from pendverify.robot.writer import urdf_for
 
     urdf = tmp_path / "robot.urdf"
     urdf.write_text(urdf_for(default_params("double_pendulum").replace(I2=0.0135 * 1.01)))

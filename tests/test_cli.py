@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import json
 
-from pendverify.checks import CHECK_NAMES
+from pendverify.checks.catalogue import CHECK_NAMES
 from pendverify.cli import main
-from pendverify.erd import double_pendulum_urdfs
+from pendverify.robot.erd import double_pendulum_urdfs
 
 from .conftest import default_params
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from pendverify.analytic import CartDoublePendulum
-from pendverify.coordinates import CoordinateMap
+from pendverify.robot.coordinates import CoordinateMap
 
 from .conftest import assert_close, default_params, system_for
 

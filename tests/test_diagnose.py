@@ -15,14 +15,14 @@ import numpy as np
 import pytest
 
 from pendverify.analytic import CartDoublePendulum, DoublePendulum
-from pendverify.checks import run_checks
+from pendverify.checks.catalogue import run_checks
+from pendverify.checks.diagnose import diagnose
+from pendverify.checks.sampling import sample_states
+from pendverify.checks.targets import system_for
 from pendverify.cli import main
-from pendverify.coordinates import CoordinateMap
-from pendverify.diagnose import diagnose
-from pendverify.robot import PinocchioSystem
-from pendverify.sampling import sample_states
-from pendverify.targets import system_for
-from pendverify.urdf_writer import urdf_for
+from pendverify.robot.coordinates import CoordinateMap
+from pendverify.robot.system import PinocchioSystem
+from pendverify.robot.writer import urdf_for
 
 from .conftest import SEED, default_params
 

@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 from pendverify.cli import main
-from pendverify.urdf_writer import urdf_for
+from pendverify.robot.writer import urdf_for
 
 from .conftest import default_params
 

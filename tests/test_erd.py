@@ -6,8 +6,8 @@ import math
 
 import pytest
 
-from pendverify.erd import double_pendulum_urdfs
-from pendverify.robot import PinocchioSystem
+from pendverify.robot.erd import double_pendulum_urdfs
+from pendverify.robot.system import PinocchioSystem
 
 
 def test_urdfs_are_found_in_the_installed_distribution():

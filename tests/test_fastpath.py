@@ -13,12 +13,12 @@ import pytest
 from scipy.integrate import DOP853, solve_ivp
 from scipy.integrate._ivp import dop853_coefficients
 
-from pendverify import fastpath, fixedstep, kernels, reference, taylor
 from pendverify.analytic import MODELS
-from pendverify.dynamics import build_dynamics
-from pendverify.fastpath import FastPathError, FastSystem
-from pendverify.scene import load_scene, parse_scene
-from pendverify.workprecision import make_problem
+from pendverify.bench.workprecision import make_problem
+from pendverify.numerics import fastpath, fixedstep, kernels, reference, taylor
+from pendverify.numerics.fastpath import FastPathError, FastSystem
+from pendverify.simulation.dynamics import build_dynamics
+from pendverify.simulation.scene import load_scene, parse_scene
 
 from .conftest import SEED, assert_close, default_params
 
@@ -395,6 +395,6 @@ def test_cached_kernels_are_current():
     stamp = kernels.source_stamp()
     for module in (fastpath, fixedstep):
         assert module.KERNELS_STAMP == stamp, (
-            f"pendverify.kernels changed: set KERNELS_STAMP = {stamp!r} in {module.__name__}"
+            f"pendverify.numerics.kernels changed: set KERNELS_STAMP = {stamp!r} in {module.__name__}"
         )
         assert module.CACHE

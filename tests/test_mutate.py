@@ -15,13 +15,13 @@ import pytest
 
 from pendverify.analytic import DoublePendulum
 from pendverify.analytic.interface import ClosedForm
+from pendverify.checks.targets import Target, system_for
+from pendverify.checks.verdict import CHRISTOFFEL_CONSISTENT, NON_CHRISTOFFEL
 from pendverify.cli import main
-from pendverify.mutants import OPERATORS, generate
-from pendverify.mutate import DETECTED, EQUIVALENT, SURVIVED, numeric_model, run_mutation
-from pendverify.symbolic import SymbolicModel
-from pendverify.targets import Target, system_for
-from pendverify.urdf_writer import urdf_for
-from pendverify.verdict import CHRISTOFFEL_CONSISTENT, NON_CHRISTOFFEL
+from pendverify.robot.writer import urdf_for
+from pendverify.symbolic.model import SymbolicModel
+from pendverify.symbolic.mutants import OPERATORS, generate
+from pendverify.symbolic.mutate import DETECTED, EQUIVALENT, SURVIVED, numeric_model, run_mutation
 
 from .conftest import default_params
 
@@ -135,9 +135,9 @@ def test_a_christoffel_consistent_refactoring_is_an_equivalent_mutant():
     import sympy as sp
 
     from pendverify.analytic import CartDoublePendulum
-    from pendverify.mutants import Mutant
-    from pendverify.mutate import classify
-    from pendverify.sampling import sample_states
+    from pendverify.checks.sampling import sample_states
+    from pendverify.symbolic.mutants import Mutant
+    from pendverify.symbolic.mutate import classify
 
     params = default_params("cart_double_pendulum")
     model = CartDoublePendulum(params)

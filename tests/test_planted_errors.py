@@ -13,11 +13,11 @@ import numpy as np
 import pytest
 
 from pendverify.analytic import CartDoublePendulum, DoublePendulum
-from pendverify.checks import CHECK_NAMES, run_checks
+from pendverify.checks.catalogue import CHECK_NAMES, run_checks
+from pendverify.checks.sampling import sample_states
 from pendverify.cli import main
-from pendverify.robot import PinocchioSystem
-from pendverify.sampling import sample_states
-from pendverify.urdf_writer import urdf_for
+from pendverify.robot.system import PinocchioSystem
+from pendverify.robot.writer import urdf_for
 
 from .conftest import SEED, default_params, system_for
 
@@ -210,7 +210,7 @@ def test_the_untouched_models_pass(model_name):
 
 # --- a URDF that disagrees with its parameter set -----------------------------------------
 def _urdf_and_params(tmp_path, model, urdf_params):
-    from pendverify.urdf_writer import urdf_for
+    from pendverify.robot.writer import urdf_for
 
     urdf = tmp_path / "robot.urdf"
     urdf.write_text(urdf_for(urdf_params))

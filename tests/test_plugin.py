@@ -15,12 +15,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pendverify.checks import CHECK_NAMES, run_checks
+from pendverify.analytic.plugin import load_model_class
+from pendverify.checks.catalogue import CHECK_NAMES, run_checks
+from pendverify.checks.sampling import sample_states
+from pendverify.checks.targets import plugin_target
 from pendverify.cli import main
 from pendverify.errors import PendverifyError
-from pendverify.plugin import load_model_class
-from pendverify.sampling import sample_states
-from pendverify.targets import plugin_target
 
 from .conftest import SEED
 
@@ -254,7 +254,7 @@ def test_a_model_with_only_the_force_c_qdot_is_verified(tmp_path, capsys):
     checks = {r["check"] for r in json.loads(out_json.read_text())["results"]}
     assert checks == set(CHECK_NAMES) - {"coriolis", "skew"}
 
-    from pendverify.sympy_check import EQUAL, compare
+    from pendverify.symbolic.compare import EQUAL, compare
 
     report = compare(load_model_class(path))
     assert report.passed

@@ -9,7 +9,7 @@ model takes a variable millisecond.
 
 Tolerances follow the suite's scheme: K·ε·((1 + |θ|max) + (A − 1)) times the
 size of the terms involved (A is Pinocchio's term amplification,
-``pendverify.near_singular``).  Residuals (rnea(aba(τ)) − τ, the power balance)
+``pendverify.checks.trust``).  Residuals (rnea(aba(τ)) − τ, the power balance)
 need no κ̃(M); a forward error (aba(rnea(a)) − a) is measured against ‖M̃⁻¹‖
 times the terms, and M⁻¹·M − I against ‖M̃⁻¹‖·‖M̃‖.  Measured over 300 random
 examples, the largest error is about a tenth of its tolerance.  States the trust
@@ -32,10 +32,10 @@ from pendverify.analytic import (
     DoublePendulum,
     DoublePendulumParams,
 )
-from pendverify.checks import EPS
-from pendverify.near_singular import assess
-from pendverify.robot import PinocchioSystem
-from pendverify.urdf_writer import urdf_for
+from pendverify.checks.catalogue import EPS
+from pendverify.checks.trust import assess
+from pendverify.robot.system import PinocchioSystem
+from pendverify.robot.writer import urdf_for
 
 K = 16
 SETTINGS = settings(

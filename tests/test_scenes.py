@@ -11,9 +11,9 @@ import pytest
 
 from pendverify.analytic import CartDoublePendulum, DoublePendulum
 from pendverify.cli import main
-from pendverify.dynamics import build_dynamics
-from pendverify.scene import SceneError, load_scene, parse_scene
-from pendverify.simulate import simulate
+from pendverify.simulation.dynamics import build_dynamics
+from pendverify.simulation.scene import SceneError, load_scene, parse_scene
+from pendverify.simulation.simulate import simulate
 
 REPO = Path(__file__).resolve().parents[1]
 SHIPPED = sorted((REPO / "scenes").glob("*.toml"))
@@ -164,7 +164,7 @@ class CoriolisSignFlip(DoublePendulum):
 
 
 def test_energy_drift_detects_a_wrong_energy(monkeypatch):
-    from pendverify import dynamics
+    from pendverify.simulation import dynamics
 
     monkeypatch.setitem(dynamics.MODELS, "double_pendulum", WrongEnergy)
     result = run(dp_scene(gravity=True), engine="closed_form")
@@ -173,7 +173,7 @@ def test_energy_drift_detects_a_wrong_energy(monkeypatch):
 
 
 def test_work_balance_detects_a_wrong_closed_form(monkeypatch):
-    from pendverify import dynamics
+    from pendverify.simulation import dynamics
 
     monkeypatch.setitem(dynamics.MODELS, "double_pendulum", CoriolisSignFlip)
     doc = dp_scene(
@@ -186,7 +186,7 @@ def test_work_balance_detects_a_wrong_closed_form(monkeypatch):
 
 
 def test_engine_comparison_detects_a_wrong_closed_form(monkeypatch):
-    from pendverify import dynamics
+    from pendverify.simulation import dynamics
 
     class BetaOff(DoublePendulum):
         @property
@@ -218,7 +218,7 @@ def test_npz_and_csv_are_written(tmp_path, capsys):
 
 
 def test_failed_run_leaves_no_file(tmp_path, monkeypatch):
-    from pendverify import simulate as sim_module
+    from pendverify.simulation import simulate as sim_module
 
     def boom(*args, **kwargs):
         raise RuntimeError("integrator died")

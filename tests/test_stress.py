@@ -12,12 +12,13 @@ import math
 import numpy as np
 import pytest
 
-from pendverify import near_singular, stress
-from pendverify import stress_integrators as si
 from pendverify.analytic import CartDoublePendulum, DoublePendulum
+from pendverify.checks import trust as near_singular
+from pendverify.checks.trust import Conditioning, IllConditionedError, check_conditioning
 from pendverify.cli import main
 from pendverify.errors import InputError
-from pendverify.near_singular import Conditioning, IllConditionedError, check_conditioning
+from pendverify.stress import catalogue as stress
+from pendverify.stress import integrators as si
 from pendverify.validate import finite_state, model_state
 
 from .conftest import default_params
@@ -210,7 +211,7 @@ def test_trust_study_fails_without_the_guard(monkeypatch):
 
 
 def test_trust_study_fails_on_garbage_aba(monkeypatch):
-    from pendverify.robot import PinocchioSystem
+    from pendverify.robot.system import PinocchioSystem
 
     real = PinocchioSystem.acceleration
     monkeypatch.setattr(PinocchioSystem, "acceleration", lambda self, *a: real(self, *a) * (1 + 1e-9))

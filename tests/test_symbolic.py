@@ -15,16 +15,16 @@ import sympy as sp
 
 from pendverify.analytic import MODELS, CartDoublePendulum, DoublePendulum
 from pendverify.analytic.interface import Energies
-from pendverify.checks import run_checks
+from pendverify.checks.catalogue import run_checks
+from pendverify.checks.sampling import sample_states
+from pendverify.checks.targets import system_for
+from pendverify.checks.verdict import CHRISTOFFEL_CONSISTENT, NON_CHRISTOFFEL
 from pendverify.cli import main
 from pendverify.errors import PendverifyError
-from pendverify.lagrange import derive
-from pendverify.sampling import sample_states
-from pendverify.symbolic import SymbolicModel, is_zero
-from pendverify.sympy_check import DIFFERS, EQUAL, SKIPPED, WARNING, compare
-from pendverify.targets import system_for
-from pendverify.urdf_writer import urdf_for
-from pendverify.verdict import CHRISTOFFEL_CONSISTENT, NON_CHRISTOFFEL
+from pendverify.robot.writer import urdf_for
+from pendverify.symbolic.compare import DIFFERS, EQUAL, SKIPPED, WARNING, compare
+from pendverify.symbolic.lagrange import derive
+from pendverify.symbolic.model import SymbolicModel, is_zero
 
 from .conftest import SEED, default_params
 

@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 from pendverify.analytic import DoublePendulum
-from pendverify.checks import run_checks
+from pendverify.checks.catalogue import run_checks
+from pendverify.checks.sampling import sample_states
 from pendverify.errors import UrdfShapeError
-from pendverify.robot import PinocchioSystem, load_model
-from pendverify.sampling import sample_states
-from pendverify.urdf_writer import urdf_for
+from pendverify.robot.system import PinocchioSystem, load_model
+from pendverify.robot.writer import urdf_for
 
 from .conftest import SEED, default_params
 
@@ -23,7 +23,7 @@ REPO = Path(__file__).resolve().parents[1]
 def test_committed_urdfs_match_the_generator(model_name):
     committed = (REPO / "urdf" / f"{model_name}.urdf").read_text()
     assert committed == urdf_for(default_params(model_name)), (
-        f"urdf/{model_name}.urdf is stale: regenerate it with pendverify.urdf_writer.urdf_for"
+        f"urdf/{model_name}.urdf is stale: regenerate it with pendverify.robot.writer.urdf_for"
     )
 
 

@@ -9,9 +9,9 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from pendverify.erd import double_pendulum_urdfs
 from pendverify.errors import UrdfShapeError
-from pendverify.urdf_strict import (
+from pendverify.robot.erd import double_pendulum_urdfs
+from pendverify.robot.strict import (
     JointDynamics,
     UrdfFacts,
     build_pinocchio_model,

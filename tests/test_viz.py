@@ -23,9 +23,9 @@ import umsgpack
 from PIL import Image
 
 from pendverify.cli import main
-from pendverify.scene import load_scene, parse_scene
-from pendverify.simulate import simulate
-from pendverify.urdf_writer import COLOURS
+from pendverify.robot.writer import COLOURS
+from pendverify.simulation.scene import load_scene, parse_scene
+from pendverify.simulation.simulate import simulate
 from pendverify.viz.animation import DEFAULT_FPS, Trajectory, TrajectoryError, build_scene, render_html
 from pendverify.viz.browser import Chromium, find_chromium
 from pendverify.viz.geometry import VisualSystem
@@ -214,7 +214,7 @@ def test_energy_plot_and_review_page_escape_user_strings():
     )
     svg = energy_plot_svg(run)
     assert svg.lstrip().startswith("<?xml") and "t [s]" in svg and "energy [J]" in svg
-    from pendverify.report import Report
+    from pendverify.checks.report import Report
 
     evil = '<script>alert("x")</script>'
     scene = SceneReview(

@@ -1,1 +1,1 @@
-"""URDFs of the default parameter sets, written by ``pendverify.urdf_writer``."""
+"""URDFs of the default parameter sets, written by ``pendverify.robot.writer``."""

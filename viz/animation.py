@@ -89,7 +89,7 @@ class Trajectory:
 
     @classmethod
     def from_run(cls, run) -> Trajectory:
-        """A ``pendverify.simulate.Run``."""
+        """A ``pendverify.simulation.simulate.Run``."""
         return cls(np.asarray(run.t), np.asarray(run.q), run.scene.params, run.scene.name, run.scene.source)
 
     @classmethod

@@ -1,7 +1,7 @@
 """The URDF's visuals as meshcat objects, posed by Pinocchio's forward kinematics.
 
 The geometry on screen is the geometry that was verified: the URDF text comes
-from ``pendverify.urdf_writer.urdf_for`` (the same writer the checks and the
+from ``pendverify.robot.writer.urdf_for`` (the same writer the checks and the
 simulator use), Pinocchio parses its ``<visual>`` elements into a visual
 ``GeometryModel``, and ``pinocchio.visualize.MeshcatVisualizer`` turns every
 ``GeometryObject`` (box, cylinder, sphere, with the URDF material colour) into a
@@ -21,8 +21,8 @@ import numpy as np
 import pinocchio as pin
 
 from pendverify.analytic import ParameterSet
-from pendverify.robot import PinocchioSystem
-from pendverify.urdf_writer import urdf_for
+from pendverify.robot.system import PinocchioSystem
+from pendverify.robot.writer import urdf_for
 
 ROOT = "pendverify"
 UP = np.array([0.0, 0.0, 1.0])
@@ -102,7 +102,7 @@ class VisualSystem:
         """Unit vector from the system towards the camera: the plane of motion seen face on.
 
         For a cart, the rail's direction points to the right of the screen; for a
-        fixed-base chain, the horizontal h = up × a of ``pendverify.robot`` does.
+        fixed-base chain, the horizontal h = up × a of ``pendverify.robot.system`` does.
         """
         model, data = self.system.model, self.system.data
         pin.computeJointJacobians(model, data, pin.neutral(model))

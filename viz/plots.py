@@ -1,6 +1,6 @@
 """Energy and work-balance plots of a run (matplotlib, Agg, SVG).
 
-Top panel: the energy flows of ``pendverify.invariants`` along the samples,
+Top panel: the energy flows of ``pendverify.simulation.invariants`` along the samples,
 
     ΔE(t) = E(t) − E(0),   W_in(t) = ∫ q̇ᵀ(B u + W w) dt,   W_diss(t) = ∫ q̇ᵀ D q̇ dt,
 

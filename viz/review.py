@@ -48,7 +48,7 @@ class SceneReview:
     source: str  # the scene file, as given
     animation: str  # path of the animation, relative to index.html
     plot: str  # path of the energy plot, relative to index.html
-    invariants: list  # pendverify.invariants.InvariantResult
+    invariants: list  # pendverify.simulation.invariants.InvariantResult
     passed: bool
     model: str = ""
     duration_s: float = 0.0
@@ -95,7 +95,7 @@ def check_matrix(report) -> str:
 
 
 def check_table(report) -> str:
-    """The verification table of ``pendverify check`` (a ``pendverify.report.Report``).
+    """The verification table of ``pendverify check`` (a ``pendverify.checks.report.Report``).
 
     A check × model matrix of error / tolerance first, then the table exactly as
     the command prints it (with the worst states) in a collapsible block.

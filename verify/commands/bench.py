@@ -51,10 +51,10 @@ def run(args: argparse.Namespace) -> int:
         from pathlib import Path
 
         from pendverify.atomic import write_atomic
-        from pendverify.benchplot import render
-        from pendverify.benchreport import fraction, ratios, to_csv, to_markdown
-        from pendverify.benchrun import run_benchmark
-        from pendverify.workprecision import FULL, QUICK
+        from pendverify.bench.plot import render
+        from pendverify.bench.report import fraction, ratios, to_csv, to_markdown
+        from pendverify.bench.run import run_benchmark
+        from pendverify.bench.workprecision import FULL, QUICK
 
         config = QUICK if args.quick else FULL
         results = run_benchmark(config, log=lambda msg: print(msg, flush=True), blas=blas)

@@ -33,7 +33,7 @@ def _resolve_urdf(spec: str):
     from pendverify.errors import UrdfShapeError
 
     if spec.startswith("erd:"):
-        from pendverify.erd import double_pendulum_urdfs
+        from pendverify.robot.erd import double_pendulum_urdfs
 
         found = double_pendulum_urdfs()
         stem = spec[4:]
@@ -59,11 +59,11 @@ def run_certify(args: argparse.Namespace) -> int:
     from dataclasses import replace
 
     from pendverify.analytic.params import load_parameter_file
-    from pendverify.battery import BatterySettings, run_battery
-    from pendverify.certificate import build_certificate, refuse_existing, write_bundle
+    from pendverify.certify.battery import BatterySettings, run_battery
+    from pendverify.certify.certificate import build_certificate, refuse_existing, write_bundle
     from pendverify.errors import PendverifyError
-    from pendverify.robot import PinocchioSystem
-    from pendverify.urdf_writer import urdf_for
+    from pendverify.robot.system import PinocchioSystem
+    from pendverify.robot.writer import urdf_for
 
     if args.sweep:
         return _run_sweep(args)
@@ -114,9 +114,9 @@ def _run_sweep(args) -> int:
     import sys
 
     from pendverify.analytic import PARAMETER_TYPES
-    from pendverify.battery import BatteryItem, BatterySettings
-    from pendverify.certificate import build_certificate, write_bundle
-    from pendverify.sweep import executor_for, load_sweep, run_sweep, summary_table
+    from pendverify.certify.battery import BatteryItem, BatterySettings
+    from pendverify.certify.certificate import build_certificate, write_bundle
+    from pendverify.certify.sweep import executor_for, load_sweep, run_sweep, summary_table
 
     sweep = load_sweep(args.sweep)
     executor, resource = executor_for(args.scheduler, args.workers)
@@ -143,8 +143,8 @@ def run_recheck(args: argparse.Namespace) -> int:
     import json
 
     from pendverify.analytic import PARAMETER_TYPES
-    from pendverify.battery import BatterySettings, run_battery
-    from pendverify.certificate import CertificateError, compare_items, verify_digest
+    from pendverify.certify.battery import BatterySettings, run_battery
+    from pendverify.certify.certificate import CertificateError, compare_items, verify_digest
 
     try:
         with open(args.certificate, encoding="utf-8") as fh:

@@ -39,10 +39,10 @@ def run(args: argparse.Namespace) -> int:
     import json
 
     from pendverify.atomic import write_atomic
+    from pendverify.checks.sampling import DEFAULT_SEED
+    from pendverify.checks.targets import default_target, plugin_target
     from pendverify.errors import PendverifyError
-    from pendverify.mutate import DEFAULT_MUTATION_STATES, format_report, run_mutation
-    from pendverify.sampling import DEFAULT_SEED
-    from pendverify.targets import default_target, plugin_target
+    from pendverify.symbolic.mutate import DEFAULT_MUTATION_STATES, format_report, run_mutation
 
     names = builtin_models(args.model, args.analytic)
     if args.analytic:

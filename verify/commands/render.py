@@ -27,7 +27,7 @@ def register(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     from pendverify.atomic import write_atomic
     from pendverify.errors import InputError
-    from pendverify.scene import load_scene
+    from pendverify.simulation.scene import load_scene
     from pendverify.viz.animation import Trajectory, render_html
 
     if args.scene is None and args.trajectory is None:
@@ -42,7 +42,7 @@ def run(args: argparse.Namespace) -> int:
                     args.trajectory, "metadata.model", traj.params.model, f"the scene is {scene.model!r}"
                 )
     else:
-        from pendverify.simulate import simulate
+        from pendverify.simulation.simulate import simulate
 
         result = simulate(load_scene(args.scene), args.engine)
         traj = Trajectory.from_run(result)

@@ -34,9 +34,9 @@ def register(sub) -> None:
 
 def check_report(samples: int | None, seed: int | None, erd: bool):
     """The report ``pendverify check`` prints with its default targets."""
-    from pendverify.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
-    from pendverify.targets import default_target, erd_targets
-    from pendverify.verification import build_report
+    from pendverify.checks.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
+    from pendverify.checks.targets import default_target, erd_targets
+    from pendverify.checks.verification import build_report
 
     targets = [default_target(name) for name in ("double_pendulum", "cart_double_pendulum")]
     if erd:
@@ -75,8 +75,8 @@ def run(args: argparse.Namespace) -> int:
     import time
 
     from pendverify.atomic import write_atomic
-    from pendverify.scene import load_scene
-    from pendverify.simulate import simulate
+    from pendverify.simulation.scene import load_scene
+    from pendverify.simulation.simulate import simulate
     from pendverify.viz.animation import Trajectory, render_html
     from pendverify.viz.plots import energy_plot_svg
     from pendverify.viz.review import SceneReview, review_page

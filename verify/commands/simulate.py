@@ -42,8 +42,8 @@ def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from pendverify.atomic import write_atomic
-    from pendverify.scene import load_scene
-    from pendverify.simulate import simulate
+    from pendverify.simulation.scene import load_scene
+    from pendverify.simulation.simulate import simulate
 
     scene = load_scene(args.scene)
     result = simulate(scene, args.engine)

@@ -32,7 +32,7 @@ def _num(x, fmt=".2e") -> str:
 
 
 def format_table(report) -> str:
-    from pendverify.report import text_table
+    from pendverify.checks.report import text_table
 
     header = ("case", "quantity", "error", "tolerance", "κ(M)", "κ̃(M)", "result")
     rows = [
@@ -67,7 +67,7 @@ def format_table(report) -> str:
 
 
 def format_study(study) -> str:
-    from pendverify.near_singular import REFUSE_REL, StudyRow
+    from pendverify.checks.trust import REFUSE_REL, StudyRow
 
     labels = {
         "det_closed_form": "det closed",
@@ -152,7 +152,7 @@ def _finite_json(value):
 def run(args: argparse.Namespace) -> int:
     from pendverify.atomic import write_atomic
     from pendverify.errors import UnknownNameError
-    from pendverify.stress import CASE_NAMES, FULL, QUICK, SEED, run_catalogue
+    from pendverify.stress.catalogue import CASE_NAMES, FULL, QUICK, SEED, run_catalogue
 
     for name in args.case or ():
         if name not in CASE_NAMES:

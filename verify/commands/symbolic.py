@@ -23,9 +23,9 @@ def run(args: argparse.Namespace) -> int:
     import json
 
     from pendverify.analytic import MODELS
+    from pendverify.analytic.plugin import load_model_class
     from pendverify.atomic import write_atomic
-    from pendverify.plugin import load_model_class
-    from pendverify.sympy_check import compare, format_report
+    from pendverify.symbolic.compare import compare, format_report
 
     names = builtin_models(args.model, args.analytic)
     classes = [load_model_class(args.analytic)] if args.analytic else [MODELS[n] for n in names]

@@ -1,0 +1,124 @@
+"""Load a user's closed-form model from a Python file (``--analytic FILE``).
+
+The file is imported by path under a private module name.  It must define
+exactly one concrete subclass of ``pendverify.analytic.ClosedFormModel``
+(classes it merely imports do not count) with
+
+* ``name`` (a non-empty string), equal to the ``model`` key of its parameter
+  files and to ``params_type.model``;
+* ``params_type``: a frozen dataclass subclassing ``ParameterSet`` whose fields
+  are ``quantity(kind, doc)`` entries;
+* ``coordinates`` and ``angular`` of equal length, ``inputs`` and ``disturbances``;
+* every abstract method of the interface, and the coordinate map
+  (``urdf_joints``, ``joint_transform``, ``joint_offset``; see ``pendverify.robot.joint_map``).
+
+``examples/cart_pole.py`` is a complete plug-in.  The built-in models are
+plug-ins of the same kind: ``--analytic analytic/double_pendulum.py`` loads the
+seed through this same path.  Every problem is a ``PendverifyError`` naming the
+file (and the line, for an exception raised while importing it).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib.util
+import inspect
+import sys
+import traceback
+from pathlib import Path
+
+from pendverify.analytic import ClosedFormModel, ParameterSet
+from pendverify.errors import PendverifyError
+
+
+def where(cls: type) -> str:
+    """The file that defines a class (for error messages), or its module's name."""
+    try:
+        return inspect.getfile(cls)
+    except (TypeError, OSError):  # pragma: no cover - classes built at run time
+        return cls.__module__
+
+
+def _import(path: Path):
+    name = f"pendverify_plugin_{abs(hash(str(path.resolve())))}"
+    spec = importlib.util.spec_from_file_location(name, path)
+    if spec is None or spec.loader is None:
+        raise PendverifyError(f"{path}: not a Python file that can be imported")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module  # dataclasses look their module up while the file runs
+    try:
+        spec.loader.exec_module(module)
+    except Exception as exc:
+        del sys.modules[name]
+        if isinstance(exc, SyntaxError) and exc.lineno:
+            line, text = f", line {exc.lineno}", exc.msg
+        else:
+            frames = [f for f in traceback.extract_tb(exc.__traceback__) if Path(f.filename) == path]
+            line, text = (f", line {frames[-1].lineno}" if frames else ""), str(exc)
+        raise PendverifyError(f"{path}{line}: importing it failed: {type(exc).__name__}: {text}") from None
+    return module
+
+
+def _validate(cls: type[ClosedFormModel], path: Path) -> None:
+    def fail(problem: str):
+        raise PendverifyError(f"{path}: {cls.__name__}: {problem}")
+
+    if inspect.isabstract(cls):
+        fail(f"methods of the interface not implemented: {', '.join(sorted(cls.__abstractmethods__))}")
+    name = getattr(cls, "name", None)
+    if not isinstance(name, str) or not name:
+        fail("needs a class attribute name = '<model name>'")
+    params_type = getattr(cls, "params_type", None)
+    if not (inspect.isclass(params_type) and issubclass(params_type, ParameterSet)):
+        fail("params_type must be a ParameterSet subclass (a frozen dataclass of quantity() fields)")
+    if not dataclasses.is_dataclass(params_type):
+        fail(f"params_type {params_type.__name__} must be decorated with @dataclasses.dataclass(frozen=True)")
+    if params_type.model != name:
+        fail(f"params_type.model is {params_type.model!r} but name is {name!r}; they must be equal")
+    for f in dataclasses.fields(params_type):
+        if "kind" not in f.metadata:
+            fail(f"parameter {f.name} must be declared with quantity(kind, doc)")
+    coordinates = getattr(cls, "coordinates", None)
+    angular = getattr(cls, "angular", None)
+    if (
+        not isinstance(coordinates, tuple)
+        or not coordinates
+        or not all(isinstance(c, str) for c in coordinates)
+    ):
+        fail("coordinates must be a non-empty tuple of names")
+    if not isinstance(angular, tuple) or len(angular) != len(coordinates):
+        fail(f"angular must be a tuple of {len(coordinates)} booleans, one per coordinate")
+    for attr in ("inputs", "disturbances"):
+        value = getattr(cls, attr)
+        if not isinstance(value, tuple) or not all(isinstance(x, str) for x in value):
+            fail(f"{attr} must be a tuple of names")
+
+
+def load_model_class(path: str | Path) -> type[ClosedFormModel]:
+    """The one ClosedFormModel subclass a model file defines, validated."""
+    path = Path(path)
+    if not path.is_file():
+        raise PendverifyError(f"{path}: model file not found")
+    if path.suffix != ".py":
+        raise PendverifyError(f"{path}: a model file is Python source (.py)")
+    module = _import(path)
+    found = [
+        obj
+        for obj in vars(module).values()
+        if inspect.isclass(obj)
+        and issubclass(obj, ClosedFormModel)
+        and obj is not ClosedFormModel
+        and obj.__module__ == module.__name__
+    ]
+    if not found:
+        raise PendverifyError(
+            f"{path}: defines no subclass of pendverify.analytic.ClosedFormModel "
+            "(see examples/cart_pole.py for a complete model file)"
+        )
+    if len(found) > 1:
+        raise PendverifyError(
+            f"{path}: defines {len(found)} ClosedFormModel subclasses "
+            f"({', '.join(c.__name__ for c in found)}); a model file defines exactly one"
+        )
+    _validate(found[0], path)
+    return found[0]

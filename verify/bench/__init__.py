@@ -1,0 +1,1 @@
+"""Benchmarks: work-precision diagrams and timing, figures as ratios measured in the same run."""

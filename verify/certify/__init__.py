@@ -1,0 +1,1 @@
+"""The certification battery, certificates and sweeps."""

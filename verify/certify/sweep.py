@@ -1,0 +1,216 @@
+"""Sweeps: certify many parameter sets in parallel through ``concurrent.futures``.
+
+A sweep file (TOML)::
+
+    model = "double_pendulum"
+    base = "default"       # the set the ranges vary ("default" or a parameter file)
+    mode = "random"        # random (seeded, uniform or log-uniform) | grid
+    count = 200            # random only
+    seed = 7
+    samples = 200          # battery states per set (default 200)
+    duration = 1.0         # s of simulation per effect (default 1)
+    [ranges]
+    m1 = [0.5, 2.0]                                      # linear, [min, max]
+    I1 = { min = 0.01, max = 0.05, scale = "log", points = 3 }   # points: grid only
+
+Tasks run on local processes by default, or on a Dask distributed cluster
+(``--scheduler tcp://HOST:PORT``) through its Client's executor; the task is
+the same pure function either way, so both produce the same certificates.
+"""
+
+from __future__ import annotations
+
+import itertools
+from concurrent.futures import Executor, ProcessPoolExecutor
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from pendverify.analytic import MODELS, PARAMETER_TYPES
+from pendverify.analytic.params import default_parameter_file, load_parameter_file, read_toml
+from pendverify.certify.battery import BatterySettings, run_battery
+from pendverify.errors import InputError, PendverifyError
+from pendverify.robot.writer import urdf_for
+
+
+class SweepError(InputError):
+    """A sweep file breaks a rule."""
+
+
+@dataclass(frozen=True)
+class Sweep:
+    model: str
+    sets: list[tuple[str, dict]]  # (name, parameter values)
+    settings: BatterySettings
+
+
+def _range(source, key, value):
+    if isinstance(value, list):
+        spec = {"min": value[0] if value else None, "max": value[1] if len(value) > 1 else None}
+        if len(value) != 2:
+            raise SweepError(source, f"ranges.{key}", value, "expected [min, max] or a table {min, max, ...}")
+    elif isinstance(value, dict):
+        spec = dict(value)
+        for k in spec:
+            if k not in ("min", "max", "scale", "points"):
+                raise SweepError(
+                    source, f"ranges.{key}.{k}", spec[k], "unknown key; expected min, max, scale, points"
+                )
+    else:
+        raise SweepError(source, f"ranges.{key}", value, "expected [min, max] or a table {min, max, ...}")
+    for bound in ("min", "max"):
+        x = spec.get(bound)
+        if isinstance(x, bool) or not isinstance(x, (int, float)) or not np.isfinite(x):
+            raise SweepError(source, f"ranges.{key}.{bound}", x, "expected a finite number")
+    if spec["max"] < spec["min"]:
+        raise SweepError(source, f"ranges.{key}", value, "expected min <= max")
+    scale = spec.get("scale", "linear")
+    if scale not in ("linear", "log"):
+        raise SweepError(source, f"ranges.{key}.scale", scale, "expected linear or log")
+    if scale == "log" and spec["min"] <= 0:
+        raise SweepError(source, f"ranges.{key}.min", spec["min"], "a log range needs min > 0")
+    points = spec.get("points", 3)
+    if isinstance(points, bool) or not isinstance(points, int) or points < 1:
+        raise SweepError(source, f"ranges.{key}.points", points, "expected an integer >= 1")
+    return float(spec["min"]), float(spec["max"]), scale, points
+
+
+def load_sweep(path: str | Path) -> Sweep:
+    path = Path(path)
+    source = str(path)
+    data = read_toml(path)
+    allowed = ("model", "base", "mode", "count", "seed", "samples", "duration", "ranges")
+    for key, value in data.items():
+        if key not in allowed:
+            raise SweepError(source, key, value, f"unknown key; expected one of {', '.join(allowed)}")
+    model = data.get("model")
+    if model not in MODELS:
+        raise SweepError(source, "model", model, f"expected one of {', '.join(MODELS)}")
+    base_ref = data.get("base", "default")
+    base_path = default_parameter_file(model) if base_ref == "default" else path.parent / base_ref
+    base_model, _, base = load_parameter_file(base_path)
+    if base_model != model:
+        raise SweepError(source, "base", base_ref, f"that parameter file is for {base_model!r}")
+    mode = data.get("mode", "random")
+    if mode not in ("random", "grid"):
+        raise SweepError(source, "mode", mode, "expected random or grid")
+    ints = {}
+    for key, default in (("count", 100), ("seed", 0), ("samples", 200)):
+        value = data.get(key, default)
+        if isinstance(value, bool) or not isinstance(value, int) or value < (0 if key == "seed" else 1):
+            raise SweepError(source, key, value, f"expected an integer >= {0 if key == 'seed' else 1}")
+        ints[key] = value
+    duration = data.get("duration", 1.0)
+    if (
+        isinstance(duration, bool)
+        or not isinstance(duration, (int, float))
+        or not 0 < duration < float("inf")
+    ):
+        raise SweepError(source, "duration", duration, "expected a number > 0 (s, per simulated effect)")
+    ranges = data.get("ranges")
+    if not isinstance(ranges, dict) or not ranges:
+        raise SweepError(source, "ranges", ranges, "expected a table of at least one parameter range")
+    known = PARAMETER_TYPES[model].keys()
+    specs = {}
+    for key, value in ranges.items():
+        if key not in known:
+            raise SweepError(
+                source, f"ranges.{key}", value, f"unknown parameter; {model} has {', '.join(known)}"
+            )
+        specs[key] = _range(source, key, value)
+
+    values = []
+    if mode == "grid":
+        axes = [
+            np.geomspace(lo, hi, n) if scale == "log" else np.linspace(lo, hi, n)
+            for lo, hi, scale, n in specs.values()
+        ]
+        for combo in itertools.product(*axes):
+            values.append(dict(zip(specs, (float(x) for x in combo), strict=True)))
+    else:
+        rng = np.random.default_rng(ints["seed"])
+        for _ in range(ints["count"]):
+            row = {}
+            for key, (lo, hi, scale, _) in specs.items():
+                u = rng.uniform()
+                row[key] = float(
+                    np.exp(np.log(lo) + u * (np.log(hi) - np.log(lo)))
+                    if scale == "log"
+                    else lo + u * (hi - lo)
+                )
+            values.append(row)
+    width = len(str(len(values) - 1))
+    sets = [(f"{model}-{i:0{width}d}", {**base.as_dict(), **row}) for i, row in enumerate(values)]
+    return Sweep(
+        model, sets, BatterySettings(samples=ints["samples"], seed=ints["seed"], sim_duration=float(duration))
+    )
+
+
+def certify_task(model: str, name: str, values: dict, settings: dict) -> dict:
+    """One set through the battery; a pure function, so it runs anywhere."""
+    try:
+        params = PARAMETER_TYPES[model].from_mapping(values, f"<sweep set {name}>")
+    except PendverifyError as exc:
+        return {"name": name, "values": values, "error": str(exc), "items": []}
+    urdf = urdf_for(params, name)
+    items = run_battery(model, params, urdf, BatterySettings(**settings))
+    return {
+        "name": name,
+        "values": values,
+        "error": None,
+        "items": [i.as_dict() for i in items],
+        "urdf": urdf,
+    }
+
+
+def executor_for(scheduler: str | None, workers: int | None) -> tuple[Executor, object]:
+    """(executor, resource to close): local processes, or a Dask cluster's executor."""
+    if scheduler is None:
+        pool = ProcessPoolExecutor(max_workers=workers)
+        return pool, pool
+    try:
+        from distributed import Client
+    except ImportError:
+        raise PendverifyError("--scheduler needs Dask: pip install 'pendverify[dask]'") from None
+    try:
+        client = Client(scheduler, timeout="10s")
+    except OSError as exc:
+        raise PendverifyError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
+    return client.get_executor(), client
+
+
+def run_sweep(sweep: Sweep, executor: Executor, progress: bool = True):
+    """Yield task results in the sweep's order, updating a progress bar as they finish."""
+    from tqdm import tqdm
+
+    settings = sweep.settings.as_dict()
+    futures = [
+        executor.submit(certify_task, sweep.model, name, values, settings) for name, values in sweep.sets
+    ]
+    bar = tqdm(total=len(futures), desc="sweep", unit="set", disable=not progress)
+    results = []
+    for future in futures:
+        results.append(future.result())
+        bar.update(1)
+    bar.close()
+    return results
+
+
+def summary_table(results: list[dict]) -> str:
+    passed = [r for r in results if r["error"] is None and all(i["passed"] for i in r["items"])]
+    worst: dict[str, tuple[float, str]] = {}
+    for r in results:
+        for item in r["items"]:
+            margin = item["max_error"] / item["tolerance"] if item["tolerance"] > 0 else float("inf")
+            if margin > worst.get(item["name"], (-1.0, ""))[0]:
+                worst[item["name"]] = (margin, r["name"])
+    lines = [f"{len(passed)} passed, {len(results) - len(passed)} failed, {len(results)} sets"]
+    width = max((len(k) for k in worst), default=5)
+    lines.append(f"{'check'.ljust(width)}  worst error/tolerance  set")
+    lines += [f"{name.ljust(width)}  {m:21.3g}  {who}" for name, (m, who) in sorted(worst.items())]
+    failures = [r for r in results if r not in passed]
+    for r in failures[:20]:
+        reason = r["error"] or ", ".join(i["name"] for i in r["items"] if not i["passed"])
+        lines.append(f"FAIL {r['name']}: {reason}")
+    return "\n".join(lines)

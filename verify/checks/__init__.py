@@ -1,0 +1,1 @@
+"""The checks: states, tolerances, the trust rule, verdicts, diagnoses and the report."""

@@ -1,0 +1,142 @@
+"""The verification report: one table for people, one JSON document for machines."""
+
+from __future__ import annotations
+
+import json
+import platform
+from dataclasses import dataclass, field
+
+import numpy as np
+import pinocchio
+
+from pendverify import __version__
+from pendverify.checks.catalogue import CheckResult
+from pendverify.checks.verdict import FAIL, LABELS, PASS, REFUSED, WARN, worst
+
+
+@dataclass
+class Report:
+    seed: int
+    states: dict[str, int]
+    results: list[CheckResult]
+    notes: dict[str, list[str]] = field(default_factory=dict)
+    sources: dict[str, str] = field(default_factory=dict)
+    elapsed_s: float = 0.0
+    #: Known traps that explain a target's failures (``pendverify.checks.diagnose``), in words.
+    diagnoses: dict[str, list[str]] = field(default_factory=dict)
+    #: What a user must know although the checks pass (``pendverify.checks.verdict``), per target.
+    warnings: dict[str, list[str]] = field(default_factory=dict)
+    #: --strict: warnings count as failures.
+    strict: bool = False
+
+    @property
+    def status(self) -> str:
+        """pass, warn, fail or refused: the worst of the results and the warnings."""
+        level = worst([r.status for r in self.results] + ([WARN] if self.warnings else []))
+        return FAIL if self.strict and level == WARN else level
+
+    @property
+    def passed(self) -> bool:
+        """True for pass and pass with warnings (without ``strict``)."""
+        return self.status in (PASS, WARN)
+
+    def failures(self) -> list[CheckResult]:
+        return [r for r in self.results if r.status == FAIL]
+
+    def refusals(self) -> list[CheckResult]:
+        return [r for r in self.results if r.status == REFUSED]
+
+    def as_dict(self) -> dict:
+        return {
+            "pendverify": __version__,
+            "pinocchio": pinocchio.__version__,
+            "numpy": np.__version__,
+            "python": platform.python_version(),
+            "seed": self.seed,
+            "states": self.states,
+            "elapsed_s": round(self.elapsed_s, 3),
+            "passed": self.passed,
+            "status": self.status,
+            "strict": self.strict,
+            "sources": self.sources,
+            "notes": self.notes,
+            "diagnoses": self.diagnoses,
+            "warnings": self.warnings,
+            "results": [r.as_dict() for r in self.results],
+        }
+
+    def to_json(self) -> str:
+        return json.dumps(self.as_dict(), indent=2, ensure_ascii=False) + "\n"
+
+
+def text_table(header: tuple[str, ...], rows: list[tuple[str, ...]]) -> list[str]:
+    """Left-aligned columns under a ruled header, as lines."""
+    widths = [max(len(h), *(len(row[i]) for row in rows)) for i, h in enumerate(header)]
+    line = "  ".join(h.ljust(w) for h, w in zip(header, widths, strict=True))
+    body = ["  ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)).rstrip() for row in rows]
+    return [line, "-" * len(line), *body]
+
+
+def _state_text(state: dict) -> str:
+    if not state.get("q"):
+        return state["label"]
+    q = ", ".join(f"{x:.3g}" for x in state["q"])
+    return f"{state['label']} q=({q})"
+
+
+def format_table(report: Report) -> str:
+    header = ("model", "check", "error", "tolerance", "worst state", "result")
+    rows = [
+        (
+            r.model,
+            r.check,
+            f"{r.max_error:.2e}",
+            f"{r.tolerance:.2e}",
+            _state_text(r.worst_state),
+            LABELS[r.status],
+        )
+        for r in report.results
+    ]
+    out = text_table(header, rows)
+    out.append("")
+    out.append(
+        "error and tolerance are relative, in diagonally scaled coordinates: "
+        "tolerance = K·ε·(1 + |θ|max)·cond(T)² (+ model-form allowance)."
+    )
+    for model, notes in report.notes.items():
+        for note in notes:
+            out.append(f"note [{model}]: {note}")
+    for model, sentences in report.warnings.items():
+        for sentence in sentences:
+            out.append(f"warning [{model}]: {sentence}")
+    for r in report.failures():
+        for note in r.notes:
+            out.append(f"fail [{r.model} {r.check}]: {note}")
+    for model, sentences in report.diagnoses.items():
+        for sentence in sentences:
+            out.append(f"diagnosis [{model}]: {sentence}")
+    total = sum(report.states.values())
+    out.append(
+        f"{len(report.results)} checks on {len(report.states)} model(s), {total} states "
+        f"(seed {report.seed}), {report.elapsed_s:.2f} s: {verdict_sentence(report)}"
+    )
+    return "\n".join(out)
+
+
+def verdict_sentence(report: Report) -> str:
+    """The report's verdict in words: pass, pass with warnings, FAIL or refused."""
+    warned = sum(len(w) for w in report.warnings.values())
+    parts = []
+    if report.failures():
+        parts.append(f"{len(report.failures())} check(s) FAIL")
+    if report.refusals():
+        parts.append(f"{len(report.refusals())} check(s) refused (beyond the trust limit: not verified)")
+    if parts:
+        if warned:
+            parts.append(f"{warned} warning(s)")
+        return ", ".join(parts)
+    if warned:
+        if report.strict:
+            return f"FAIL: {warned} warning(s), which --strict counts as failures"
+        return f"pass with {warned} warning(s)"
+    return "all checks pass"

@@ -1,0 +1,160 @@
+"""What to verify: pairs of a closed-form model and a URDF loaded in Pinocchio.
+
+* the default parameter sets against their committed URDFs (``urdf/``);
+* example-robot-data's double-pendulum URDFs against the seed-000 closed form
+  with parameters read off the URDF itself;
+* a user's URDF against a user's parameter set, or (double pendulum) against
+  the parameters read off that URDF;
+* a user's own model file (``--analytic``, ``pendverify.analytic.plugin``) against a URDF.
+
+Built-in and plug-in models take one path: the URDF is loaded, the model class's
+``urdf_geometry`` hook gives the coordinate map (the seeds read it off the
+geometry, a plug-in declares it), and ``model_target`` pairs the two.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from importlib.resources import files
+from pathlib import Path
+
+from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
+from pendverify.analytic.params import (
+    default_parameter_file,
+    load_parameter_file,
+    parse_parameter_document,
+    read_toml,
+)
+from pendverify.analytic.plugin import load_model_class
+from pendverify.errors import ParameterError, PendverifyError, UnknownNameError
+from pendverify.robot.erd import double_pendulum_urdfs
+from pendverify.robot.system import DEFAULT_G, PinocchioSystem, load_urdf
+from pendverify.robot.writer import urdf_for
+
+PARAMETER_MATCH_RTOL = 1e-9
+
+
+@dataclass
+class Target:
+    label: str
+    model: ClosedFormModel
+    system: PinocchioSystem
+    source: str
+    notes: list[str] = field(default_factory=list)
+
+
+def committed_urdf(model: str) -> Path:
+    return Path(str(files("pendverify.urdf") / f"{model}.urdf"))
+
+
+def _model_class(name: str):
+    if name not in MODELS:
+        raise UnknownNameError("model", name, tuple(MODELS))
+    return MODELS[name]
+
+
+def system_for(
+    cls: type[ClosedFormModel],
+    urdf,
+    g: float | None = None,
+    source: str | None = None,
+):
+    """A URDF (path or XML text) in Pinocchio, seen in ``cls``'s coordinates via its ``urdf_geometry``."""
+    loaded = load_urdf(urdf, source)
+    geometry = cls.urdf_geometry(loaded.model, loaded.source, g)
+    g = DEFAULT_G if g is None else g
+    return PinocchioSystem(loaded.model, geometry, g, loaded.source, loaded)
+
+
+def default_target(model_name: str) -> Target:
+    _, _, params = load_parameter_file(default_parameter_file(model_name))
+    path = committed_urdf(model_name)
+    cls = _model_class(model_name)
+    return Target(model_name, cls(params), system_for(cls, path, params.g), str(path))
+
+
+def erd_targets() -> list[Target]:
+    targets = []
+    cls = _model_class("double_pendulum")
+    for stem, path in double_pendulum_urdfs().items():
+        system = system_for(cls, path)
+        model = cls(system.geometry.params)
+        targets.append(Target(f"erd:{stem}", model, system, str(path)))
+    return targets
+
+
+def parameter_differences(urdf_params: ParameterSet, given: ParameterSet) -> list[str]:
+    """Name each parameter where the URDF and the parameter set disagree."""
+    notes = []
+    for key, value in given.as_dict().items():
+        read = getattr(urdf_params, key)
+        if key == "l2":  # drawing length only: not in the dynamics
+            continue
+        if abs(read - value) > PARAMETER_MATCH_RTOL * max(abs(read), abs(value)):
+            rel = (read - value) / value if value else float("inf")
+            notes.append(f"the URDF gives {key} = {read:.6g}, the parameter set {value:.6g} ({rel:+.3%})")
+    return notes
+
+
+def model_target(cls: type[ClosedFormModel], urdf: str, params: ParameterSet | None) -> Target:
+    """A model class, a URDF file and (unless the URDF fixes them) its parameters: built-in or plug-in."""
+    g = getattr(params, "g", None)
+    system = system_for(cls, urdf, g)
+    notes = []
+    read = system.geometry.params
+    if params is None:
+        if read is None:
+            raise PendverifyError(
+                f"{urdf}: give --params: a {cls.name} URDF alone does not fix the closed form"
+            )
+        params = read if isinstance(read, cls.params_type) else cls.params_type(**read.as_dict())
+        notes.append("parameters read off the URDF")
+    elif read is not None:
+        notes += parameter_differences(read, params)
+    if not hasattr(params, "g"):
+        notes.append(f"the parameter set has no g: Pinocchio's gravity is {DEFAULT_G} m/s²")
+    try:
+        model = cls(params)
+    except Exception as exc:
+        raise PendverifyError(f"{cls.name}: building the model failed: {type(exc).__name__}: {exc}") from None
+    return Target(f"{cls.name}:{Path(urdf).stem}", model, system, system.source, notes)
+
+
+def user_target(model_name: str | None, urdf: str | None, params_file: str | None) -> Target:
+    """A target from the CLI's --model / --urdf / --params."""
+    params = None
+    if params_file:
+        file_model, _, params = load_parameter_file(params_file)
+        if model_name and model_name != file_model:
+            raise PendverifyError(f"{params_file}: model is {file_model!r}, but --model says {model_name!r}")
+        model_name = file_model
+    if model_name is None:
+        raise PendverifyError("name the model with --model, or give --params")
+    cls = _model_class(model_name)
+    if urdf is None:
+        # the URDF of this parameter set, as the project writes it
+        system = system_for(cls, urdf_for(params), params.g, f"<URDF of {params_file}>")
+        return Target(f"{model_name}:{Path(params_file).stem}", cls(params), system, system.source)
+    return model_target(cls, urdf, params)
+
+
+def plugin_parameters(cls: type[ClosedFormModel], model_file: str, params_file: str) -> ParameterSet:
+    """A parameter file for a plug-in: its ``model`` key must be the plug-in's name."""
+    data = read_toml(Path(params_file))
+    if data.get("model") != cls.name:
+        raise ParameterError(
+            params_file,
+            "model",
+            data.get("model"),
+            f"must be {cls.name!r}, the model defined in {model_file}",
+        )
+    return parse_parameter_document(data, params_file, {cls.name: cls.params_type})[2]
+
+
+def plugin_target(model_file: str, urdf: str | None, params_file: str | None) -> Target:
+    """A target from the CLI's --analytic / --urdf / --params."""
+    cls = load_model_class(model_file)
+    if urdf is None:
+        raise PendverifyError(f"{model_file}: give --urdf: the URDF to verify {cls.name} against")
+    params = plugin_parameters(cls, model_file, params_file) if params_file else None
+    return model_target(cls, urdf, params)

@@ -1,0 +1,133 @@
+"""Verify targets: guard the states, run the checks, judge, diagnose — one ``Report``.
+
+For each target (a closed-form model and a URDF in Pinocchio):
+
+1. the sampled states are guarded by the trust rule of ``pendverify.checks.trust``
+   (the one ``pendverify stress`` uses); a state beyond it is not compared, and
+   every check that could have been judged only there is ``refused``;
+2. every check that applies runs on the trusted states (``pendverify.checks.catalogue``);
+3. a URDF term the closed form cannot express (``robot.ModelForm``) becomes a
+   ``model-form`` row: its size relative to the quantity it enters, against the
+   model-form threshold;
+4. the verdict rules of ``pendverify.checks.verdict`` run: a C with the right C·q̇ but
+   not the Christoffel one is a warning, a URDF's Coulomb friction is a warning,
+   ``strict`` turns warnings into failures;
+5. failures on trusted states are diagnosed (``pendverify.checks.diagnose``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from pendverify.checks.catalogue import CheckResult, applicable_checks, run_checks, skipped_notes
+from pendverify.checks.diagnose import diagnose
+from pendverify.checks.report import Report
+from pendverify.checks.sampling import sample_states
+from pendverify.checks.trust import IllConditionedError, check_conditioning
+from pendverify.checks.verdict import FAIL, REFUSED, apply_strict, non_christoffel_c
+from pendverify.robot.system import MODEL_FORM_RTOL
+
+
+def trusted_states(target, states) -> tuple[list, list[str]]:
+    """(states within the trust limit, one sentence per refused state)."""
+    kept, refused = [], []
+    with np.errstate(all="ignore"):
+        for state in states:
+            try:
+                check_conditioning(target.model, state.q, target.system, what=target.label)
+            except IllConditionedError as exc:
+                refused.append(f"{state.label}: {exc}")
+            else:
+                kept.append(state)
+    return kept, refused
+
+
+def model_form_result(target, seed: int) -> CheckResult | None:
+    """The ``model-form`` row: a URDF term outside the closed form's family, against its threshold."""
+    form = target.system.geometry.model_form
+    if form is None:
+        return None
+    rtol = target.system.model_form_rtol
+    return CheckResult(
+        model=target.label,
+        check="model-form",
+        description="URDF terms the closed form cannot express, relative to the quantity they enter",
+        max_error=form.relative,
+        tolerance=rtol,
+        max_abs_error=float(np.max(form.allowance)),
+        samples=1,
+        seed=seed,
+        worst_state={"label": "URDF geometry", "q": []},
+        passed=form.within(rtol),
+        notes=[form.sentence(rtol)],
+    )
+
+
+def coulomb_warnings(target) -> list[str]:
+    """One sentence per joint whose URDF Coulomb friction the hand model has no term for."""
+    return [
+        f"joint {joint}: the URDF's <dynamics friction> = {value:g} (Coulomb) has no term in the hand "
+        "model; it is not compared, and Pinocchio's algorithms do not apply it either"
+        for joint, value in target.system.urdf_coulomb_friction().items()
+    ]
+
+
+def _refuse(results: list[CheckResult], refused: list[str], total: int) -> None:
+    """Checks that could not be judged on every state are refused, unless a trusted state failed.
+
+    With no trusted state at all, every check is refused: a failure there may be rounding.
+    """
+    all_refused = len(refused) == total
+    for r in results:
+        if all_refused or r.status != FAIL:
+            r.status, r.passed = REFUSED, False
+            r.notes.insert(0, f"{len(refused)} of {total} states refused, e.g. {refused[0]}")
+
+
+def verify_target(report: Report, target, samples: int, seed: int) -> None:
+    """Verify one target and add its results, notes, warnings and diagnoses to ``report``."""
+    label = target.label
+    states = sample_states(target.model, samples, seed)
+    kept, refused = trusted_states(target, states)
+    report.states[label] = len(states)
+    report.sources[label] = target.source
+    notes = target.system.notes + target.notes + skipped_notes(target.model, target.system)
+    names = applicable_checks(target.model, target.system)
+    with np.errstate(all="ignore"):
+        results = run_checks(label, target.model, target.system, kept or states, seed, names)
+    form = model_form_result(target, seed)
+    if form is not None:
+        results.append(form)
+    if refused:
+        _refuse(results, refused, len(states))
+        notes.append(
+            f"{len(refused)} of {len(states)} states refused by the trust rule "
+            f"(rounding bound above the trust limit): {refused[0]}"
+        )
+    warnings = coulomb_warnings(target)
+    sentence = non_christoffel_c(results)
+    if sentence:
+        warnings.append(sentence)
+    if report.strict:
+        apply_strict(results)
+    failing = [r for r in results if r.status == FAIL and r.check != "model-form"]
+    if failing and kept:
+        diagnoses = diagnose(target.model, target.system, failing)
+        if diagnoses:
+            report.diagnoses[label] = diagnoses
+    if notes:
+        report.notes[label] = notes
+    if warnings:
+        report.warnings[label] = warnings
+    report.results += results
+
+
+def build_report(
+    targets, samples: int, seed: int, strict: bool = False, model_form_rtol: float = MODEL_FORM_RTOL
+) -> Report:
+    """Every applicable check on every target, judged and diagnosed: one Report."""
+    report = Report(seed=seed, states={}, results=[], strict=strict)
+    for target in targets:
+        target.system.model_form_rtol = model_form_rtol
+        verify_target(report, target, samples, seed)
+    return report

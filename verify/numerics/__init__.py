@@ -1,0 +1,1 @@
+"""Compiled and high-precision back ends: the fast path, fixed-step methods, Taylor references."""

@@ -1,0 +1,1 @@
+"""Scenes: declared effects, right-hand sides, integrators and invariants."""

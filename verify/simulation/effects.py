@@ -1,0 +1,292 @@
+"""Actuation u(t, q, q̇) and disturbance w(t) laws a scene can switch on.
+
+Actuation (``[effects.actuation]``), u in the model's inputs (N·m per joint for
+the double pendulum, N on the cart):
+
+=========  =====================================================================
+type       keys
+=========  =====================================================================
+constant   value = [u…]
+step       time (s), after = [u…], before = [u…] (default zeros)
+sine       amplitude = [u…], frequency (Hz > 0), phase (rad, 0), offset = [u…]
+table      times = [t0 < t1 < …] (s), values = [[u…], …]: piecewise linear, held at the ends
+lqr        cart only: Q = [6 weights ≥ 0] on (q, θ1, θ2, q̇, θ̇1, θ̇2), R = [1 weight > 0],
+           saturation (N, optional).  u = −K x about the upright equilibrium.
+pd         double pendulum only: kp = [2], kd = [2] (≥ 0), target = [θ1, θ2] (rad):
+           u = kp (target − θ) − kd θ̇
+=========  =====================================================================
+
+Disturbance (``[effects.disturbance]``, cart only), w on (q, θ1, θ2) in N, N·m, N·m:
+
+=========  =====================================================================
+impulse    time (s), impulse = [3] (N·s, N·m·s), width (s, 0.01): a rectangular pulse
+step       time (s), value = [3]
+noise      std = [3], bandwidth (Hz > 0), seed (integer), components (32): band-limited
+           noise as a sum of sinusoids with seeded frequencies in (0, bandwidth] and
+           phases; smooth, so the integrator needs no breakpoints
+=========  =====================================================================
+
+Every law lists its breakpoints (times where it jumps or kinks) so that the
+integrator can stop there rather than step over a discontinuity.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass
+class Law:
+    """u(t, q, q̇) or w(t): ``kind`` names the type; ``feedback`` laws read the state."""
+
+    kind: str
+    size: int
+    spec: dict = field(default_factory=dict)
+    feedback: bool = False
+
+    def breakpoints(self) -> list[float]:
+        return []
+
+    def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:  # pragma: no cover
+        raise NotImplementedError
+
+    def describe(self) -> str:
+        return self.kind
+
+
+@dataclass
+class Constant(Law):
+    value: np.ndarray = None
+
+    def __call__(self, t, q, v):
+        return self.value
+
+
+@dataclass
+class Step(Law):
+    time: float = 0.0
+    before: np.ndarray = None
+    after: np.ndarray = None
+
+    def breakpoints(self):
+        return [self.time]
+
+    def __call__(self, t, q, v):
+        return self.after if t >= self.time else self.before
+
+
+@dataclass
+class Sine(Law):
+    amplitude: np.ndarray = None
+    frequency: float = 1.0
+    phase: float = 0.0
+    offset: np.ndarray = None
+
+    def __call__(self, t, q, v):
+        return self.offset + self.amplitude * np.sin(2 * np.pi * self.frequency * t + self.phase)
+
+
+@dataclass
+class Table(Law):
+    times: np.ndarray = None
+    values: np.ndarray = None
+
+    def breakpoints(self):
+        return list(self.times)
+
+    def __call__(self, t, q, v):
+        return np.array([np.interp(t, self.times, col) for col in self.values.T])
+
+
+@dataclass
+class Pulse(Law):
+    time: float = 0.0
+    width: float = 0.01
+    impulse: np.ndarray = None
+
+    def breakpoints(self):
+        return [self.time, self.time + self.width]
+
+    def __call__(self, t, q, v):
+        inside = self.time <= t < self.time + self.width
+        return self.impulse / self.width if inside else np.zeros(self.size)
+
+
+@dataclass
+class Noise(Law):
+    std: np.ndarray = None
+    bandwidth: float = 1.0
+    seed: int = 0
+    components: int = 32
+    _freq: np.ndarray = None
+    _phase: np.ndarray = None
+
+    def __post_init__(self):
+        rng = np.random.default_rng(self.seed)
+        self._freq = rng.uniform(0.0, self.bandwidth, (self.size, self.components))
+        self._freq = np.where(self._freq == 0.0, self.bandwidth, self._freq)
+        self._phase = rng.uniform(0.0, 2 * np.pi, (self.size, self.components))
+
+    def __call__(self, t, q, v):
+        # each component has variance a²/2; N of them give std² when a = std·√(2/N)
+        a = self.std * np.sqrt(2.0 / self.components)
+        return a * np.sum(np.sin(2 * np.pi * self._freq * t + self._phase), axis=1)
+
+
+@dataclass
+class PD(Law):
+    kp: np.ndarray = None
+    kd: np.ndarray = None
+    target: np.ndarray = None
+
+    def __post_init__(self):
+        self.feedback = True
+
+    def __call__(self, t, q, v):
+        return self.kp * (self.target - q) - self.kd * v
+
+
+@dataclass
+class LQR(Law):
+    """u = −K x; K is set by the simulator from the linearisation (pendverify.simulation.lqr)."""
+
+    Q: np.ndarray = None
+    R: np.ndarray = None
+    saturation: float | None = None
+    K: np.ndarray | None = None
+
+    def __post_init__(self):
+        self.feedback = True
+
+    def __call__(self, t, q, v):
+        u = -self.K @ np.concatenate([q, v])
+        if self.saturation is not None:
+            u = np.clip(u, -self.saturation, self.saturation)
+        return u
+
+
+ACTUATION_TYPES = ("constant", "step", "sine", "table", "lqr", "pd")
+DISTURBANCE_TYPES = ("impulse", "step", "noise")
+
+
+def parse_actuation(r, model_cls) -> Law | None:
+    """An actuation law from the scene table reader ``r`` (None when absent)."""
+    if r is None:
+        return None
+    n = len(model_cls.inputs)
+    kind = r.string("type", ACTUATION_TYPES)
+    if kind == "constant":
+        r.only(("type", "value"))
+        return Constant(kind, n, value=r.vector("value", n))
+    if kind == "step":
+        r.only(("type", "time", "before", "after"))
+        return Step(
+            kind,
+            n,
+            time=r.number("time", minimum=0.0),
+            before=r.vector("before", n, default=[0.0] * n),
+            after=r.vector("after", n),
+        )
+    if kind == "sine":
+        r.only(("type", "amplitude", "frequency", "phase", "offset"))
+        return Sine(
+            kind,
+            n,
+            amplitude=r.vector("amplitude", n),
+            frequency=r.number("frequency", positive=True),
+            phase=r.number("phase", default=0.0),
+            offset=r.vector("offset", n, default=[0.0] * n),
+        )
+    if kind == "table":
+        r.only(("type", "times", "values"))
+        times = r.get("times")
+        if not isinstance(times, list) or len(times) < 2:
+            r.fail("times", times, "expected a list of at least 2 increasing times")
+        times = r.vector("times", len(times), minimum=0.0)
+        if np.any(np.diff(times) <= 0):
+            r.fail("times", times.tolist(), "expected strictly increasing times")
+        rows = r.get("values")
+        if not isinstance(rows, list) or len(rows) != len(times):
+            r.fail("values", rows, f"expected {len(times)} rows, one per time")
+        values = np.array([_row(r, "values", row, n, i) for i, row in enumerate(rows)])
+        return Table(kind, n, times=times, values=values)
+    if kind == "lqr":
+        if model_cls.name != "cart_double_pendulum":
+            r.fail("type", kind, f"LQR is for the cart about upright; {model_cls.name} takes pd")
+        r.only(("type", "Q", "R", "saturation"))
+        sat = r.number("saturation", positive=True) if r.has("saturation") else None
+        return LQR(
+            kind,
+            n,
+            Q=r.vector("Q", 2 * len(model_cls.coordinates), minimum=0.0),
+            R=_positive(r, "R", n),
+            saturation=sat,
+        )
+    # pd
+    if model_cls.name != "double_pendulum":
+        r.fail("type", kind, f"PD acts on the fixed-base pendulum's joints; {model_cls.name} takes lqr")
+    r.only(("type", "kp", "kd", "target"))
+    nv = len(model_cls.coordinates)
+    return PD(
+        kind,
+        n,
+        kp=r.vector("kp", nv, minimum=0.0),
+        kd=r.vector("kd", nv, minimum=0.0),
+        target=r.vector("target", nv, default=[0.0] * nv),
+    )
+
+
+def _row(r, key, row, n, i):
+    if not isinstance(row, list) or len(row) != n or any(isinstance(x, bool) for x in row):
+        r.fail(f"{key}[{i}]", row, f"expected a list of {n} numbers")
+    arr = np.array(row, dtype=float) if all(isinstance(x, (int, float)) for x in row) else None
+    if arr is None or not np.all(np.isfinite(arr)):
+        r.fail(f"{key}[{i}]", row, f"expected a list of {n} finite numbers")
+    return arr
+
+
+def _positive(r, key, n):
+    arr = r.vector(key, n)
+    if np.any(arr <= 0):
+        r.fail(key, arr.tolist(), "expected numbers > 0")
+    return arr
+
+
+def parse_disturbance(r, model_cls) -> Law | None:
+    if r is None:
+        return None
+    n = len(model_cls.disturbances)
+    if n == 0:
+        r.fail("type", r.get("type", None), f"the {model_cls.name} model has no disturbance input")
+    kind = r.string("type", DISTURBANCE_TYPES)
+    if kind == "impulse":
+        r.only(("type", "time", "impulse", "width"))
+        return Pulse(
+            kind,
+            n,
+            time=r.number("time", minimum=0.0),
+            width=r.number("width", default=0.01, positive=True),
+            impulse=r.vector("impulse", n),
+        )
+    if kind == "step":
+        r.only(("type", "time", "value"))
+        return Step(
+            kind, n, time=r.number("time", minimum=0.0), before=np.zeros(n), after=r.vector("value", n)
+        )
+    r.only(("type", "std", "bandwidth", "seed", "components"))
+    seed = r.get("seed")
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        r.fail("seed", seed, "expected an integer >= 0")
+    components = r.get("components", 32)
+    if isinstance(components, bool) or not isinstance(components, int) or components < 1:
+        r.fail("components", components, "expected an integer >= 1")
+    return Noise(
+        kind,
+        n,
+        std=r.vector("std", n, minimum=0.0),
+        bandwidth=r.number("bandwidth", positive=True),
+        seed=seed,
+        components=components,
+    )

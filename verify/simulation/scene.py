@@ -1,0 +1,273 @@
+"""Scene files: what to simulate, and which effects are switched on.
+
+A scene is a TOML file::
+
+    name = "Damped double pendulum"
+    model = "double_pendulum"
+    params = "default"          # "default", a parameter file relative to the scene,
+                                # or an inline [parameters] table instead
+    engine = "aba"              # aba (Pinocchio, default) | closed_form | both
+
+    [initial]
+    q = [1.2, -0.4]             # model coordinates (rad, m), as in the model's docstring
+    v = [0.0, 0.0]              # rates (rad/s, m/s); zeros when omitted
+
+    [time]
+    duration = 10.0             # s, > 0
+    sample_rate = 100.0         # Hz of the output samples, > 0
+
+    [integrator]
+    method = "DOP853"           # RK45 | RK23 | DOP853 | Radau | BDF | LSODA (adaptive) | rk4 (fixed step)
+    rtol = 1e-10                # adaptive methods
+    atol = 1e-10
+    # step = 1e-3               # rk4 only, s
+
+    [effects]                   # every effect is off unless turned on here
+    gravity = true              # true (the parameter set's g), false, or a value in m/s²
+    damping = true              # true (the parameter set's), false, or a list per coordinate
+    [effects.actuation]         # u: see pendverify.simulation.effects for every type and its keys
+    type = "sine"
+    amplitude = [0.5, 0.0]
+    frequency = 0.5
+    [effects.disturbance]       # w, cart model only: impulse | step | noise
+    type = "impulse"
+    time = 1.0
+    impulse = [2.0, 0.0, 0.0]
+
+Every error names the file, the key, the value and the expected type or range.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from pendverify.analytic import MODELS, PARAMETER_TYPES, ParameterSet
+from pendverify.analytic.params import default_parameter_file, load_parameter_file, read_toml
+from pendverify.errors import InputError
+from pendverify.simulation.effects import Law, parse_actuation, parse_disturbance
+
+ADAPTIVE_METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
+FIXED_STEP_METHODS = ("rk4",)
+ENGINES = ("aba", "closed_form", "both")
+
+
+class SceneError(InputError):
+    """A scene file breaks a rule."""
+
+
+@dataclass(frozen=True)
+class Integrator:
+    method: str
+    rtol: float = 1e-9
+    atol: float = 1e-9
+    step: float | None = None
+
+    @property
+    def adaptive(self) -> bool:
+        return self.method in ADAPTIVE_METHODS
+
+    def describe(self) -> str:
+        if self.adaptive:
+            return f"{self.method} (rtol {self.rtol:g}, atol {self.atol:g})"
+        return f"{self.method} (step {self.step:g} s)"
+
+
+@dataclass(frozen=True)
+class Scene:
+    name: str
+    source: str
+    model: str
+    params: ParameterSet
+    params_source: str
+    engine: str
+    q0: np.ndarray
+    v0: np.ndarray
+    duration: float
+    sample_rate: float
+    integrator: Integrator
+    gravity: float | None  # m/s², None when off
+    damping: np.ndarray | None  # D's diagonal, None when off
+    actuation: Law | None  # u(t, q, q̇), None when off
+    disturbance: Law | None  # w(t), None when off
+
+    @property
+    def conservative(self) -> bool:
+        return self.damping is None and self.actuation is None and self.disturbance is None
+
+
+class _Reader:
+    """Typed access to one table of a scene, with errors that name the key."""
+
+    def __init__(self, table: dict, source: str, prefix: str = ""):
+        self.table, self.source, self.prefix = table, source, prefix
+
+    def fail(self, key: str, value: object, rule: str):
+        raise SceneError(self.source, self.prefix + key, value, rule)
+
+    def only(self, allowed: tuple[str, ...]) -> None:
+        for key, value in self.table.items():
+            if key not in allowed:
+                self.fail(key, value, f"unknown key; expected one of {', '.join(allowed)}")
+
+    def has(self, key: str) -> bool:
+        return key in self.table
+
+    def get(self, key: str, default: Any = ...):
+        if key not in self.table:
+            if default is ...:
+                self.fail(key, None, "missing key")
+            return default
+        return self.table[key]
+
+    def sub(self, key: str, required: bool = True) -> _Reader | None:
+        value = self.get(key, ... if required else None)
+        if value is None:
+            return None
+        if not isinstance(value, dict):
+            self.fail(key, value, "expected a table")
+        return _Reader(value, self.source, f"{self.prefix}{key}.")
+
+    def string(self, key: str, choices: tuple[str, ...] | None = None, default: Any = ...) -> str:
+        value = self.get(key, default)
+        if not isinstance(value, str):
+            self.fail(key, value, "expected a string" + (f": one of {', '.join(choices)}" if choices else ""))
+        if choices and value not in choices:
+            self.fail(key, value, f"expected one of {', '.join(choices)}")
+        return value
+
+    def number(self, key: str, default: Any = ..., positive: bool = False, minimum: float | None = None):
+        value = self.get(key, default)
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            self.fail(key, value, "expected a number")
+        x = float(value)
+        if not math.isfinite(x):
+            self.fail(key, value, "expected a finite number")
+        if positive and not x > 0:
+            self.fail(key, value, "expected a number > 0")
+        if minimum is not None and x < minimum:
+            self.fail(key, value, f"expected a number >= {minimum:g}")
+        return x
+
+    def vector(self, key: str, length: int, default: Any = ..., minimum: float | None = None) -> np.ndarray:
+        value = self.get(key, default)
+        if isinstance(value, (int, float)) and not isinstance(value, bool) and length == 1:
+            value = [value]
+        if not isinstance(value, list) or any(
+            isinstance(x, bool) or not isinstance(x, (int, float)) for x in value
+        ):
+            self.fail(key, value, f"expected a list of {length} numbers")
+        if len(value) != length:
+            self.fail(key, value, f"expected a list of {length} numbers, got {len(value)}")
+        arr = np.array(value, dtype=float)
+        if not np.all(np.isfinite(arr)):
+            self.fail(key, value, "expected finite numbers")
+        if minimum is not None and np.any(arr < minimum):
+            self.fail(key, value, f"expected numbers >= {minimum:g}")
+        return arr
+
+    def boolean_or_number(self, key: str, default: Any = False):
+        value = self.get(key, default)
+        if isinstance(value, bool):
+            return value
+        return self.number(key, minimum=0.0)
+
+
+def _parameters(top: _Reader, model: str, scene_path: Path) -> tuple[ParameterSet, str]:
+    if top.has("parameters"):
+        if top.has("params"):
+            top.fail("params", top.get("params"), "give either params or [parameters], not both")
+        table = top.sub("parameters")
+        return PARAMETER_TYPES[model].from_mapping(table.table, top.source, "parameters."), "inline"
+    ref = top.string("params", default="default")
+    path = default_parameter_file(model) if ref == "default" else (scene_path.parent / ref)
+    if ref != "default" and not path.is_file():
+        top.fail("params", ref, f"parameter file not found (looked for {path})")
+    file_model, _, params = load_parameter_file(path)
+    if file_model != model:
+        top.fail("params", ref, f"that parameter file is for model {file_model!r}, the scene is {model!r}")
+    return params, str(path)
+
+
+def parse_scene(data: dict, source: str, base: Path | None = None) -> Scene:
+    """Validate a scene document (already parsed TOML) into a Scene."""
+    top = _Reader(data, source)
+    top.only(("name", "model", "params", "parameters", "engine", "initial", "time", "integrator", "effects"))
+    model = top.string("model", tuple(MODELS))
+    model_cls = MODELS[model]
+    n = len(model_cls.coordinates)
+    params, params_source = _parameters(top, model, base or Path(source))
+    name = top.string("name", default=Path(source).stem)
+    engine = top.string("engine", ENGINES, default="aba")
+
+    initial = top.sub("initial")
+    initial.only(("q", "v"))
+    q0 = initial.vector("q", n)
+    v0 = initial.vector("v", n, default=[0.0] * n)
+
+    time = top.sub("time")
+    time.only(("duration", "sample_rate"))
+    duration = time.number("duration", positive=True)
+    sample_rate = time.number("sample_rate", default=100.0, positive=True)
+
+    integ = top.sub("integrator")
+    integ.only(("method", "rtol", "atol", "step"))
+    method = integ.string("method", ADAPTIVE_METHODS + FIXED_STEP_METHODS)
+    if method in ADAPTIVE_METHODS:
+        if integ.has("step"):
+            integ.fail("step", integ.get("step"), f"{method} is adaptive: give rtol and atol, not step")
+        rtol = integ.number("rtol", default=1e-9, positive=True)
+        atol = integ.number("atol", default=rtol, positive=True)
+        integrator = Integrator(method, rtol, atol)
+    else:
+        for key in ("rtol", "atol"):
+            if integ.has(key):
+                integ.fail(key, integ.get(key), f"{method} has a fixed step: give step, not {key}")
+        step = integ.number("step", positive=True)
+        if step > duration:
+            integ.fail("step", step, f"expected a step <= the duration ({duration:g} s)")
+        integrator = Integrator(method, step=step)
+
+    effects = top.sub("effects", required=False) or _Reader({}, source, "effects.")
+    effects.only(("gravity", "damping", "actuation", "disturbance"))
+    g = effects.boolean_or_number("gravity")
+    gravity = params.g if g is True else (None if g is False else g)
+    damping_value = effects.get("damping", False)
+    if isinstance(damping_value, bool):
+        damping = np.diag(model_cls(params).damping_matrix()).copy() if damping_value else None
+    else:
+        damping = effects.vector("damping", n, minimum=0.0)
+    actuation = parse_actuation(effects.sub("actuation", required=False), model_cls)
+    disturbance = parse_disturbance(effects.sub("disturbance", required=False), model_cls)
+    return Scene(
+        name=name,
+        source=source,
+        model=model,
+        params=params,
+        params_source=params_source,
+        engine=engine,
+        q0=q0,
+        v0=v0,
+        duration=duration,
+        sample_rate=sample_rate,
+        integrator=integrator,
+        gravity=gravity,
+        damping=damping,
+        actuation=actuation,
+        disturbance=disturbance,
+    )
+
+
+def load_scene(path: str | Path) -> Scene:
+    path = Path(path)
+    if not path.is_file():
+        raise SceneError(str(path), "<file>", str(path), "scene file not found")
+    try:
+        data = read_toml(path)
+    except InputError as exc:
+        raise SceneError(exc.source, exc.key, exc.value, exc.rule) from None
+    return parse_scene(data, str(path), path)

@@ -1,0 +1,184 @@
+"""Run a scene: integrate, sample, check its invariants, compare engines.
+
+``simulate(scene)`` returns a ``Run`` holding the samples (t, q, v, u, w, E),
+the integrator's own steps, the invariant results and, with engine ``both``,
+the comparison of Pinocchio's ABA with the closed-form right-hand side
+evaluated at the *same* states along the trajectory (two chaotic trajectories
+separate for reasons that are not model errors, so they are never diffed).
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import platform
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from pendverify import __version__
+from pendverify.checks.catalogue import EPS, norm2, rate_scale, scaled_matrix, weights
+from pendverify.simulation.dynamics import Dynamics, build_dynamics
+from pendverify.simulation.integrate import Integration, integrate
+from pendverify.simulation.invariants import (
+    InvariantResult,
+    adaptive_bound,
+    energy_scale,
+    evaluate,
+    richardson_bound,
+)
+from pendverify.simulation.scene import Integrator, Scene
+
+ENGINE_K = 16.0  # as the aba check: K·ε·(1 + |θ|max)
+
+
+@dataclass
+class Run:
+    scene: Scene
+    dynamics: Dynamics
+    integration: Integration
+    t: np.ndarray
+    q: np.ndarray
+    v: np.ndarray
+    u: np.ndarray
+    w: np.ndarray
+    energy: np.ndarray
+    invariants: list[InvariantResult]
+    engine_comparison: InvariantResult | None = None
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def passed(self) -> bool:
+        checks = [*self.invariants, *([self.engine_comparison] if self.engine_comparison else [])]
+        return all(c.passed for c in checks)
+
+    def metadata(self) -> dict:
+        import pinocchio
+
+        s = self.scene
+        return {
+            "scene": s.name,
+            "scene_file": s.source,
+            "model": s.model,
+            "parameters": s.params.as_dict(),
+            "parameters_source": s.params_source,
+            "engine": self.dynamics.engine if s.engine != "both" else "both",
+            "integrator": s.integrator.describe(),
+            "steps": int(len(self.integration.steps_t) - 1),
+            "rhs_evaluations": int(self.integration.nfev),
+            "terms": self.dynamics.terms,
+            "invariants": [i.as_dict() for i in self.invariants],
+            "passed": self.passed,
+            "versions": {
+                "pendverify": __version__,
+                "pinocchio": pinocchio.__version__,
+                "numpy": np.__version__,
+                "python": platform.python_version(),
+            },
+        }
+
+    def to_npz_bytes(self) -> bytes:
+        buf = io.BytesIO()
+        np.savez(
+            buf,
+            t=self.t,
+            q=self.q,
+            v=self.v,
+            u=self.u,
+            w=self.w,
+            energy=self.energy,
+            metadata=np.array(json.dumps(self.metadata())),
+        )
+        return buf.getvalue()
+
+    def to_csv(self) -> str:
+        coords = self.dynamics.model.coordinates
+        cols = (
+            ["t"]
+            + list(coords)
+            + [f"d{c}" for c in coords]
+            + [f"u_{n}" for n in self.dynamics.model.inputs]
+            + [f"w_{n}" for n in self.dynamics.model.disturbances]
+            + ["energy"]
+        )
+        data = np.column_stack([self.t, self.q, self.v, self.u, self.w, self.energy])
+        lines = [",".join(cols)] + [",".join(repr(float(x)) for x in row) for row in data]
+        return "\n".join(lines) + "\n"
+
+
+def _breakpoints(scene: Scene) -> list[float]:
+    laws = [law for law in (scene.actuation, scene.disturbance) if law is not None]
+    return sorted({b for law in laws for b in law.breakpoints()})
+
+
+def _engine_comparison(dyn: Dynamics, steps_t, steps_x) -> InvariantResult:
+    """ABA against the closed-form right-hand side at the trajectory's own states."""
+    n, model = dyn.nv, dyn.model
+    worst_ratio, worst = -1.0, (0.0, 0.0, 0.0)
+    for t, x in zip(steps_t, steps_x, strict=True):
+        q, v = x[:n], x[n : 2 * n]
+        tau_in, tau_diss = dyn.generalized_force(t, q, v)
+        tau = tau_in + tau_diss
+        a_pin = dyn.acceleration(q, v, tau, "aba")
+        a_cf = dyn.acceleration(q, v, tau, "closed_form")
+        w = weights(model, q)
+        Minv = norm2(scaled_matrix(model.inverse_mass_matrix(q), 1 / w))
+        M = norm2(scaled_matrix(model.mass_matrix(q), w))
+        forces = rate_scale(model, q, v) * np.sum(np.abs(v / w)) + np.max(w * model.gravity_scale())
+        forces += np.max(w * (np.abs(tau_in) + np.abs(tau_diss)))
+        scale = Minv * (forces + M * np.max(np.abs(a_pin / w)))
+        err = np.max(np.abs((a_pin - a_cf) / w)) / scale
+        tol = ENGINE_K * EPS * (1 + np.max(np.abs(q[np.array(model.angular)]), initial=0.0))
+        if err / tol > worst_ratio:
+            worst_ratio, worst = err / tol, (err, tol, t)
+    err, tol, t = worst
+    return InvariantResult(
+        "engines agree: ABA vs closed-form q̈ at the same states",
+        float(err),
+        float(tol),
+        bool(worst_ratio <= 1.0),
+        f"worst at t = {t:.4g} s over {len(steps_t)} states",
+    )
+
+
+def simulate(scene: Scene, engine: str | None = None, urdf: str | None = None) -> Run:
+    engine = engine or scene.engine
+    dyn = build_dynamics(scene, engine, urdf)
+    x0 = np.concatenate([scene.q0, scene.v0, [0.0, 0.0]])
+    n_samples = int(np.floor(scene.duration * scene.sample_rate + 1e-9)) + 1
+    sample_times = np.arange(n_samples) / scene.sample_rate
+    bps = _breakpoints(scene)
+    run = integrate(dyn.rhs, x0, scene.duration, scene.integrator, sample_times, bps, label=scene.name)
+    scale = energy_scale(dyn, run.steps_x)
+    if scene.integrator.adaptive:
+        bound = adaptive_bound(dyn, run.steps_x, scene.integrator, scale)
+    else:
+        half = Integrator(scene.integrator.method, step=scene.integrator.step / 2)
+        fine = integrate(dyn.rhs, x0, scene.duration, half, run.steps_t, bps, label=f"{scene.name} (h/2)")
+        _, r_h = _residual(dyn, run.steps_x)
+        _, r_half = _residual(dyn, fine.samples_x)
+        bound = richardson_bound(r_h, r_half, scale)
+    invariants = evaluate(dyn, scene, run.steps_t, run.steps_x, bound, scale)
+    comparison = _engine_comparison(dyn, run.steps_t, run.steps_x) if engine == "both" else None
+
+    n = dyn.nv
+    q, v = run.samples_x[:, :n], run.samples_x[:, n : 2 * n]
+    uw = [dyn.inputs(t, qi, vi) for t, qi, vi in zip(run.samples_t, q, v, strict=True)]
+    u = np.array([a for a, _ in uw]).reshape(len(uw), -1)
+    w = np.array([b for _, b in uw]).reshape(len(uw), -1)
+    energy = np.array([dyn.energy(qi, vi) for qi, vi in zip(q, v, strict=True)])
+    result = Run(scene, dyn, run, run.samples_t, q, v, u, w, energy, invariants, comparison)
+    if scene.actuation is not None and scene.actuation.kind == "lqr":
+        spec = scene.actuation.spec
+        result.notes.append(
+            f"LQR: Pinocchio (computeABADerivatives) vs closed-form linearisation differ by "
+            f"{spec['linearisation_error']:.2e} (relative); closed-loop max Re λ = "
+            f"{spec['closed_loop_max_real']:.3g} 1/s"
+        )
+    return result
+
+
+def _residual(dyn, xs):
+    from pendverify.simulation.invariants import residual
+
+    return residual(dyn, xs)

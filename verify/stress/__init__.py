@@ -1,0 +1,1 @@
+"""Hard cases that must stay numerically stable, or be refused."""

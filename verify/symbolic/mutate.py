@@ -1,0 +1,359 @@
+"""Mutation sensitivity: how many single-term mutants of a model do the checks catch?
+
+Each mutant (``pendverify.symbolic.mutants``) becomes a numeric model: a subclass of the
+model's class whose one mutated method calls the original and overwrites the
+mutated entry with the lambdified mutant expression (the other entries keep
+their original rounding; methods that call the mutated one see the mutant, as
+they would in source code).  The nine checks run on it, and it is classified:
+
+detected
+    some check fails.  The check aimed at the mutated method runs first (M →
+    crba, C → coriolis, C·q̇ → rnea, H → gravity, V → energy, det → det,
+    M⁻¹ → minverse, D, B, W, f → aba), then the others, first on the special states and a few
+    random ones, then on all the sampled states; the run stops at the first
+    failure and reports that check (``all_checks`` runs every check on every
+    mutant, for the full profile of which checks see what).
+equivalent
+    the mutant does not change the dynamics, proved symbolically
+    (``pendverify.symbolic.model.is_zero``): the expression is identical, or
+    simplifies to the original, or V changes by a constant, or — for a
+    Coriolis-type form — C·q̇ is unchanged (a different factorisation of C; the
+    report says whether Ṁ − 2C stays skew, i.e. whether the factorisation is
+    Christoffel-consistent, and which checks flag it: a warning, not a failure).
+    A mutant that is zero only for this parameter set is reported as equivalent
+    *for these parameters*, naming that.
+survived
+    no check fails and no equivalence is proved: a gap in the verification.
+
+Detection rate = detected / (all − equivalent); the target is 100 %.  Before
+any mutant runs, the untouched model and one *control* per method (every
+entry replaced by its own lambdified expression) must pass every check, so that
+a detection is never caused by the lambdified rounding itself.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import sympy as sp
+
+from pendverify.checks.catalogue import CHECK_NAMES, CHECKS, applicable_checks, run_check
+from pendverify.checks.sampling import sample_states
+from pendverify.checks.verdict import CHRISTOFFEL_CONSISTENT, NON_CHRISTOFFEL
+from pendverify.errors import PendverifyError, UnknownNameError
+from pendverify.symbolic.lagrange import mass_matrix_rate
+from pendverify.symbolic.model import SymbolicModel, entries, is_zero, probe, show
+from pendverify.symbolic.mutants import Mutant, generate, is_coriolis_form
+
+DETECTED, EQUIVALENT, SURVIVED = "detected", "equivalent", "survived"
+FIRST_RANDOM = 4  # random states in the first round, after the special ones
+#: |mutant − original| / (|original| + 1) above this at a sampled state cannot be rounding
+DIFFERENT_RTOL = 1e-9
+AIMED_AT = {
+    "mass_matrix": "crba",
+    "coriolis_matrix": "coriolis",
+    "gravity": "gravity",
+    "potential_energy": "energy",
+    "det_mass_matrix": "det",
+    "inverse_mass_matrix": "minverse",
+    "coriolis_force": "rnea",
+}
+DEFAULT_MUTATION_STATES = 40
+
+
+@dataclass
+class Outcome:
+    method: str
+    operator: str
+    description: str
+    verdict: str
+    reason: str = ""
+    checks: list[str] = field(default_factory=list)
+
+    def as_dict(self) -> dict:
+        return dict(self.__dict__)
+
+
+@dataclass
+class MutationReport:
+    model: str
+    source: str
+    seed: int
+    states: int
+    outcomes: list[Outcome]
+    controls: list[str]
+    elapsed_s: float = 0.0
+    all_checks: bool = False
+
+    def count(self, verdict: str, method: str | None = None) -> int:
+        return sum(o.verdict == verdict and (method is None or o.method == method) for o in self.outcomes)
+
+    @property
+    def rate(self) -> float:
+        relevant = len(self.outcomes) - self.count(EQUIVALENT)
+        return self.count(DETECTED) / relevant if relevant else 1.0
+
+    @property
+    def passed(self) -> bool:
+        return self.count(SURVIVED) == 0
+
+    def as_dict(self) -> dict:
+        return {
+            "model": self.model,
+            "source": self.source,
+            "seed": self.seed,
+            "states": self.states,
+            "mutants": len(self.outcomes),
+            "detected": self.count(DETECTED),
+            "equivalent": self.count(EQUIVALENT),
+            "survived": self.count(SURVIVED),
+            "detection_rate": self.rate,
+            "controls": self.controls,
+            "all_checks": self.all_checks,
+            "elapsed_s": round(self.elapsed_s, 3),
+            "outcomes": [o.as_dict() for o in self.outcomes],
+        }
+
+
+# --- numeric mutants ------------------------------------------------------------------------
+def numeric_model(model, sm: SymbolicModel, method: str, changes):
+    """A model whose ``method`` returns the original value with ``changes`` written in."""
+    cls = type(model)
+    args = cls.closed_forms[method].args
+    symbols = sm.flat_arguments(args) + list(sm.parameters.values())
+    functions = [
+        (index, sp.lambdify(symbols, expr, modules="math", docstring_limit=0)) for index, _, expr in changes
+    ]
+    values = [getattr(model.params, name) for name in sm.parameters]
+    original = getattr(cls, method)
+    scalar = not isinstance(sm.closed_forms[method], sp.MatrixBase)
+
+    def mutated(self, *a):
+        flat = [float(x) for arg in a for x in np.ravel(arg)]
+        if scalar:
+            return float(functions[0][1](*flat, *values))
+        out = np.array(original(self, *a), dtype=float)
+        for index, f in functions:
+            out.flat[index] = f(*flat, *values)
+        return out
+
+    return type(f"{cls.__name__}Mutant", (cls,), {method: mutated})(model.params)
+
+
+def _failing(model, system, states, seed, order=None, stop: bool = False) -> list[str]:
+    """The checks that fail (in ``order``; the first only, with ``stop``).
+
+    A check whose evaluation raises (a mutant with a singular M, or whose NaN the
+    Pinocchio side refuses) fails too.
+    """
+    failing = []
+    names = applicable_checks(model, system)
+    for check in order or CHECKS:
+        if check.name not in names:
+            continue
+        try:
+            if not run_check(check, "mutant", model, system, states, seed).passed:
+                failing.append(check.name)
+        except (ArithmeticError, ValueError, np.linalg.LinAlgError, PendverifyError) as exc:
+            # the unmutated model and the controls passed: the mutant caused this
+            failing.append(f"{check.name} (raises {type(exc).__name__})")
+        if stop and failing:
+            break
+    return failing
+
+
+def _order(method: str, form) -> tuple:
+    """The check aimed at ``method`` first, then the others."""
+    aimed = AIMED_AT.get(method, "coriolis" if form.args == "qv" else "aba")
+    return tuple(sorted(CHECKS, key=lambda c: c.name != aimed))
+
+
+def _numerically_different(model, mutated, method, args, states) -> bool:
+    """True if the mutant's value differs from the original beyond any rounding at a sampled state."""
+    for s in states:
+        a = [{"q": s.q, "v": s.v, "u": s.u, "w": s.w}[k] for k in args]
+        with np.errstate(all="ignore"):
+            new = np.asarray(getattr(mutated, method)(*a), dtype=float)
+            old = np.asarray(getattr(model, method)(*a), dtype=float)
+            if np.any(np.abs(new - old) > DIFFERENT_RTOL * (np.abs(old) + 1.0)):
+                return True
+    return False
+
+
+# --- equivalence ----------------------------------------------------------------------------
+def _coriolis_equivalence(sm: SymbolicModel, mutant: Mutant) -> str | None:
+    """The reason text if the mutant keeps C·q̇ (a different factorisation of C), else None."""
+    n = len(sm.symbols["q"])
+    delta = sp.zeros(n, n)
+    for index, old, new in mutant.changes:
+        delta[index // n, index % n] = new - old
+    bias = delta * sm.column("v")
+    if any(probe(e) for e in bias) or not all(is_zero(e, sm.angles) for e in bias):
+        return None
+    C = sm.evaluate("coriolis_matrix", "qv") + delta
+    N = mass_matrix_rate(sm.evaluate("mass_matrix", "q"), sm.symbols["q"], sm.symbols["v"]) - 2 * C
+    if all(is_zero(e, sm.angles) for e in N + N.T):
+        return CHRISTOFFEL_CONSISTENT
+    return NON_CHRISTOFFEL
+
+
+def _differences(sm: SymbolicModel, mutant: Mutant) -> list:
+    diffs = [new - old for _, old, new in mutant.changes]
+    if mutant.method == "potential_energy":  # V matters up to a constant
+        return [d.diff(x) for d in diffs for x in sm.symbols["q"]]
+    return diffs
+
+
+def _equivalence(sm: SymbolicModel, mutant: Mutant, params) -> str | None:
+    """Why the mutant is equivalent, if it is (symbolic proof); None otherwise."""
+    diffs = _differences(sm, mutant)
+    if all(is_zero(d, sm.angles) for d in diffs):
+        if mutant.method == "potential_energy":
+            return "V changes by a constant only, which no equation of motion sees"
+        return "simplifies to the original expression"
+    values = {s: sp.Rational(repr(getattr(params, n))) for n, s in sm.parameters.items()}
+    if all(is_zero(d.xreplace(values), sm.angles) for d in diffs):
+        used = sorted({s.name for d in diffs for s in d.free_symbols if s in values.keys()})
+        return f"equivalent for this parameter set only (the change vanishes at {', '.join(used)} as given)"
+    return None
+
+
+def classify(model, system, sm, mutant: Mutant, rounds, seed, all_checks: bool = False) -> Outcome:
+    out = Outcome(mutant.method, mutant.operator, mutant.description, SURVIVED)
+    if mutant.identical:
+        out.verdict, out.reason = EQUIVALENT, "identical expression after SymPy's canonical ordering"
+        return out
+    value = sm.closed_forms[mutant.method]
+    coriolis = is_coriolis_form(sm, mutant.method, value) and _coriolis_equivalence(sm, mutant)
+    form = sm.cls.closed_forms[mutant.method]
+    mutated = numeric_model(model, sm, mutant.method, mutant.changes)
+    order = _order(mutant.method, form)
+    with np.errstate(all="ignore"):  # a mutant may well divide by zero: that is a detection
+        for states in rounds:
+            out.checks = _failing(mutated, system, states, seed, order, stop=not (all_checks or coriolis))
+            if out.checks:
+                break
+    if coriolis:
+        flagged = f"; flagged by {', '.join(out.checks)} (warning)" if out.checks else ""
+        out.verdict, out.reason = EQUIVALENT, coriolis + flagged
+    elif out.checks and _numerically_different(model, mutated, mutant.method, form.args, rounds[-1]):
+        out.verdict = DETECTED
+    else:
+        # not detected, or detected although no difference shows at 50 digits: prove or report
+        reason = _equivalence(sm, mutant, model.params)
+        if reason and out.checks:
+            reason += (
+                f"; yet {', '.join(out.checks)} failed: rounding of the lambdified form exceeds a tolerance"
+            )
+        if reason:
+            out.verdict, out.reason = EQUIVALENT, reason
+        elif out.checks:
+            out.verdict = DETECTED
+        else:
+            diff = show(_differences(sm, mutant)[0], sm.angles, 100)
+            out.reason = f"no check fails, and the change {diff} is not zero: a gap in the checks"
+    return out
+
+
+# --- the run --------------------------------------------------------------------------------
+def _controls(model, system, sm, states, seed) -> list[str]:
+    done = []
+    failing = _failing(model, system, states, seed)
+    if failing:
+        raise PendverifyError(
+            f"{sm.cls.__name__}: the unmutated model fails {', '.join(failing)}; "
+            "mutation sensitivity needs a model that passes every check (run pendverify check)"
+        )
+    for method, value in sm.closed_forms.items():
+        changes = [(i, e, e) for i, e in enumerate(entries(value))]
+        if not changes:
+            continue
+        failing = _failing(numeric_model(model, sm, method, changes), system, states, seed)
+        if failing:
+            raise PendverifyError(
+                f"{sm.cls.__name__}.{method}: its own lambdified expressions fail {', '.join(failing)}; "
+                "the mutants' rounding would not be comparable"
+            )
+        done.append(method)
+    return done
+
+
+def run_mutation(
+    target,
+    samples: int = DEFAULT_MUTATION_STATES,
+    seed: int = 20260301,
+    all_checks: bool = False,
+    methods: tuple[str, ...] | None = None,
+) -> MutationReport:
+    """Generate, run and classify every mutant of ``target.model`` (of ``methods`` only, if given)."""
+    started = time.perf_counter()
+    model, system = target.model, target.system
+    sm = SymbolicModel.of(type(model))
+    unknown = sorted(set(methods or ()) - set(sm.cls.closed_forms))
+    if unknown:
+        raise UnknownNameError("closed form", ", ".join(unknown), tuple(sm.cls.closed_forms))
+    states = sample_states(model, samples, seed)
+    first = len(states) - samples + min(FIRST_RANDOM, samples)
+    rounds = [r for r in (states[:first], states[first:]) if r]
+    controls = _controls(model, system, sm, states, seed)
+    mutants = [m for m in generate(sm) if methods is None or m.method in methods]
+    outcomes = [classify(model, system, sm, m, rounds, seed, all_checks) for m in mutants]
+    return MutationReport(
+        target.label,
+        target.source,
+        seed,
+        len(states),
+        outcomes,
+        controls,
+        time.perf_counter() - started,
+        all_checks,
+    )
+
+
+def format_report(report: MutationReport) -> str:
+    methods = list(dict.fromkeys(o.method for o in report.outcomes))
+    header = ("method", "mutants", "detected", "equivalent", "survived")
+    rows = [
+        (
+            m,
+            str(sum(o.method == m for o in report.outcomes)),
+            str(report.count(DETECTED, m)),
+            str(report.count(EQUIVALENT, m)),
+            str(report.count(SURVIVED, m)),
+        )
+        for m in methods
+    ]
+    rows.append(
+        (
+            "all",
+            str(len(report.outcomes)),
+            str(report.count(DETECTED)),
+            str(report.count(EQUIVALENT)),
+            str(report.count(SURVIVED)),
+        )
+    )
+    widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(header)]
+    line = "  ".join(h.ljust(w) for h, w in zip(header, widths, strict=True))
+    out = [f"mutate [{report.model}] ({report.source})", line, "-" * len(line)]
+    out += ["  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True)).rstrip() for r in rows]
+    by_check = {
+        c: sum(any(k.split()[0] == c for k in o.checks) for o in report.outcomes if o.verdict == DETECTED)
+        for c in CHECK_NAMES
+    }
+    what = "failing" if report.all_checks else "first failing (aimed check first)"
+    out.append(f"detections per {what} check: " + ", ".join(f"{c} {n}" for c, n in by_check.items()))
+    for o in report.outcomes:
+        if o.verdict == EQUIVALENT:
+            out.append(f"equivalent: {o.description} — {o.reason}")
+    for o in report.outcomes:
+        if o.verdict == SURVIVED:
+            out.append(f"SURVIVED: {o.description} — {o.reason}")
+    relevant = len(report.outcomes) - report.count(EQUIVALENT)
+    out.append(
+        f"detection rate {report.rate:.1%} ({report.count(DETECTED)}/{relevant} non-equivalent mutants), "
+        f"{report.count(EQUIVALENT)} equivalent, {report.states} states (seed {report.seed}), "
+        f"controls pass for {len(report.controls)} methods, {report.elapsed_s:.1f} s"
+    )
+    return "\n".join(out)
