@@ -92,12 +92,8 @@ class CartDoublePendulum(ClosedFormModel):
         "f": ClosedForm("qvuw", "-C*v - H - D*v + B*u + W*w"),
     }
 
-    @classmethod
-    def urdf_geometry(cls, pin_model, source, g):
-        """Read the map (absolute angles from upright) off the URDF (``pendverify.robot.system``)."""
-        from pendverify.robot.system import cart_double_pendulum_geometry
-
-        return cart_double_pendulum_geometry(pin_model, source)
+    #: the map is read off the URDF (``pendverify.robot.seed_geometry``)
+    geometry_reader = "cart_double_pendulum"
 
     def mass_matrix(self, y):
         p = self.params

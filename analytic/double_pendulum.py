@@ -100,12 +100,9 @@ class DoublePendulum(ClosedFormModel):
         "seed_coriolis_matrix": ClosedForm("qv", "C + D"),
     }
 
-    @classmethod
-    def urdf_geometry(cls, pin_model, source, g):
-        """Read the map, the offsets and the seed's parameters off the URDF (``pendverify.robot.system``)."""
-        from pendverify.robot.system import double_pendulum_geometry
-
-        return double_pendulum_geometry(pin_model, source, g)
+    #: the map, the offsets and the seed's parameters are read off the URDF
+    #: (``pendverify.robot.seed_geometry``)
+    geometry_reader = "double_pendulum"
 
     # --- the appendix constants ------------------------------------------------------
     @property

@@ -25,8 +25,8 @@ is a complete one.  Beyond the abstract methods below it declares:
   q = T (θ − θ0) to the URDF's joints (``pendverify.robot.coordinates``), given
   explicitly — a plug-in's map is never guessed from the URDF's geometry.  Row k of
   T belongs to joint ``urdf_joints[k]``; T defaults to the identity, θ0 to zero.
-  The built-in models override ``urdf_geometry`` instead, reading the map (and
-  their parameters) off the URDF; every model goes through that one hook.
+  The built-in models name a registered reader in ``geometry_reader`` instead,
+  which reads the map (and their parameters) off the URDF's geometry.
 * optionally ``energies``: kinetic and potential energy, Rayleigh dissipation and
   input power, for ``pendverify sympy``, which derives M, C, H, D, B, W from them
   (Lagrange) and compares them with the closed forms term by term.
@@ -51,16 +51,11 @@ import math
 import types
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 
 from pendverify.analytic.params import ParameterSet
-
-if TYPE_CHECKING:  # pragma: no cover
-    import pinocchio as pin
-
-    from pendverify.robot.system import UrdfGeometry
 
 #: The scalar functions closed forms call through ``self.math``: Python's own, numerically.
 NUMERIC_MATH = types.SimpleNamespace(
@@ -132,6 +127,9 @@ class ClosedFormModel(ABC):
     urdf_joints: ClassVar[tuple[str, ...]] = ()
     joint_transform: ClassVar[Any] = None
     joint_offset: ClassVar[Any] = None
+    #: The registered reader that reads the map (and parameters) off a URDF's geometry
+    #: (``pendverify.robot.geometry``); "" for a model that declares its map instead.
+    geometry_reader: ClassVar[str] = ""
     #: False for models that give only the force C·q̇ (``BiasOnlyModel``).
     has_coriolis_matrix: ClassVar[bool] = True
 
@@ -217,17 +215,6 @@ class ClosedFormModel(ABC):
         Called only with SymPy symbols (``self.math`` is SymPy's then).
         """
         return None
-
-    @classmethod
-    def urdf_geometry(cls, pin_model: pin.Model, source: str, g: float | None) -> UrdfGeometry:
-        """The coordinate map to a URDF's joints (and anything else read off the URDF).
-
-        By default the map this class declares (``urdf_joints``, ``joint_transform``,
-        ``joint_offset``); the built-in models read theirs off the URDF's geometry.
-        """
-        from pendverify.robot.joint_map import declared_geometry
-
-        return declared_geometry(cls, pin_model, source)
 
 
 class BiasOnlyModel(ClosedFormModel):

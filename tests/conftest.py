@@ -9,7 +9,6 @@ from pendverify.analytic import MODELS
 from pendverify.analytic.params import default_parameter_file, load_parameter_file
 from pendverify.checks.sampling import sample_states
 from pendverify.robot.system import PinocchioSystem
-from pendverify.robot.writer import urdf_for
 
 SEED = 1234
 MODEL_NAMES = tuple(MODELS)
@@ -20,7 +19,7 @@ def default_params(name: str):
 
 
 def system_for(params) -> PinocchioSystem:
-    return PinocchioSystem.from_urdf(params.model, urdf_for(params), params.g)
+    return PinocchioSystem.for_params(params)
 
 
 @pytest.fixture(params=MODEL_NAMES)

@@ -18,7 +18,6 @@ from pendverify.analytic import CartDoublePendulum, DoublePendulum
 from pendverify.checks.catalogue import run_checks
 from pendverify.checks.diagnose import diagnose
 from pendverify.checks.sampling import sample_states
-from pendverify.checks.targets import system_for
 from pendverify.cli import main
 from pendverify.robot.coordinates import CoordinateMap
 from pendverify.robot.system import PinocchioSystem
@@ -36,7 +35,7 @@ def _diagnoses(model, system, planted: bool = True):
 
 
 def _dp_system(params):
-    return system_for(DoublePendulum, urdf_for(params), params.g)
+    return PinocchioSystem.for_model(DoublePendulum, urdf_for(params), params.g)
 
 
 # --- inertia about the pivot -----------------------------------------------------------------
@@ -87,7 +86,7 @@ def test_hand_model_adding_m_r2_twice_is_named():
 # --- absolute vs relative angles -------------------------------------------------------------
 def test_absolute_angles_against_a_relative_map_are_named():
     params = default_params("cart_double_pendulum")
-    right = system_for(CartDoublePendulum, urdf_for(params), params.g)
+    right = PinocchioSystem.for_model(CartDoublePendulum, urdf_for(params), params.g)
     identity = CoordinateMap(np.eye(3), np.zeros(3), right.cmap.joint_nq)  # forgot: joint 2 is relative
     wrong = PinocchioSystem(
         right.model.copy(), dataclasses.replace(right.geometry, cmap=identity), params.g, "x"

@@ -15,9 +15,10 @@ import pytest
 
 from pendverify.analytic import DoublePendulum
 from pendverify.analytic.interface import ClosedForm
-from pendverify.checks.targets import Target, system_for
+from pendverify.checks.targets import Target
 from pendverify.checks.verdict import CHRISTOFFEL_CONSISTENT, NON_CHRISTOFFEL
 from pendverify.cli import main
+from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
 from pendverify.symbolic.model import SymbolicModel
 from pendverify.symbolic.mutants import OPERATORS, generate
@@ -93,7 +94,9 @@ class WithDrawing(DoublePendulum):
 
 
 def _target(cls, params):
-    return Target(cls.name, cls(params), system_for(DoublePendulum, urdf_for(params), params.g), "<test>")
+    return Target(
+        cls.name, cls(params), PinocchioSystem.for_model(DoublePendulum, urdf_for(params), params.g), "<test>"
+    )
 
 
 def test_survivors_are_reported_as_a_gap():
@@ -141,7 +144,7 @@ def test_a_christoffel_consistent_refactoring_is_an_equivalent_mutant():
 
     params = default_params("cart_double_pendulum")
     model = CartDoublePendulum(params)
-    system = system_for(CartDoublePendulum, urdf_for(params), params.g)
+    system = PinocchioSystem.for_model(CartDoublePendulum, urdf_for(params), params.g)
     sm = SymbolicModel.of(CartDoublePendulum)
     C = sm.closed_forms["coriolis_matrix"]
     v, m1 = sm.symbols["v"], sm.parameters["m1"]

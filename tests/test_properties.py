@@ -35,7 +35,6 @@ from pendverify.analytic import (
 from pendverify.checks.catalogue import EPS
 from pendverify.checks.trust import assess
 from pendverify.robot.system import PinocchioSystem
-from pendverify.robot.writer import urdf_for
 
 K = 16
 SETTINGS = settings(
@@ -93,7 +92,7 @@ def case(draw):
     """(model, system, q, v, u, w, verdict) for a drawn parameter set and state."""
     params = draw(st.one_of(double_pendulum(), cart()))
     model = (DoublePendulum if isinstance(params, DoublePendulumParams) else CartDoublePendulum)(params)
-    system = PinocchioSystem.from_urdf(params.model, urdf_for(params), params.g)
+    system = PinocchioSystem.for_params(params)
     angular = np.array(model.angular)
     unit = st.floats(-1.0, 1.0)
     q = np.array([draw(unit) for _ in angular]) * np.where(angular, 10.0, 1.0)
@@ -211,7 +210,7 @@ def test_a_wrong_energy_rate_is_caught():
     params = CartDoublePendulumParams(
         m=1.5, m1=0.5, m2=0.75, l1=0.5, l2=0.75, d1=0.1, d2=0.01, d3=0.01, g=9.81
     )
-    model, system = Pump(params), PinocchioSystem.from_urdf(params.model, urdf_for(params), params.g)
+    model, system = Pump(params), PinocchioSystem.for_params(params)
     q, v = np.array([0.1, 0.4, -0.3]), np.array([0.5, 1.0, -2.0])
     c = (model, system, q, v, np.zeros(1), np.zeros(3), assess(model, q, system))
     with pytest.raises(AssertionError, match="closed form: dE/dt"):
@@ -222,7 +221,7 @@ def _default_case(model_cls=CartDoublePendulum):
     params = CartDoublePendulumParams(
         m=1.5, m1=0.5, m2=0.75, l1=0.5, l2=0.75, d1=0.1, d2=0.01, d3=0.01, g=9.81
     )
-    model, system = model_cls(params), PinocchioSystem.from_urdf(params.model, urdf_for(params), params.g)
+    model, system = model_cls(params), PinocchioSystem.for_params(params)
     q, v = np.array([0.1, 0.4, -0.3]), np.array([0.5, 1.0, -2.0])
     return model, system, q, v, np.array([2.0]), np.array([0.1, -0.2, 0.3]), assess(model, q, system)
 

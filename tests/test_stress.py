@@ -19,6 +19,7 @@ from pendverify.cli import main
 from pendverify.errors import InputError
 from pendverify.stress import catalogue as stress
 from pendverify.stress import integrators as si
+from pendverify.stress import trust_study
 from pendverify.validate import finite_state, model_state
 
 from .conftest import default_params
@@ -259,7 +260,7 @@ def test_term_amplification_grows_with_the_square_of_the_lever_arm():
 
 
 def test_zero_mass_aba_is_finite_nonsense_and_refused():
-    accel, refused = near_singular.zero_mass_demo(default_params("cart_double_pendulum"))
+    accel, refused = trust_study.zero_mass_demo(default_params("cart_double_pendulum"))
     assert np.all(np.isfinite(accel)) and np.max(np.abs(accel)) > 1e9
     assert refused
 
@@ -270,8 +271,8 @@ def test_reference_matches_the_closed_form():
     for name, q in (("cart_double_pendulum", [0.1, 0.7, -1.2]), ("double_pendulum", [0.3, 1.1])):
         params = default_params(name)
         model = stress.MODELS[name](params)
-        with mp.workdps(near_singular.REFERENCE_DIGITS):
-            M = near_singular.reference_mass_matrix(params, q)
+        with mp.workdps(trust_study.REFERENCE_DIGITS):
+            M = trust_study.reference_mass_matrix(params, q)
             ref = np.array([[float(M[i, j]) for j in range(M.cols)] for i in range(M.rows)])
         np.testing.assert_allclose(model.mass_matrix(np.array(q)), ref, rtol=2e-15, atol=1e-16)
 

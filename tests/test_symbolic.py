@@ -17,10 +17,10 @@ from pendverify.analytic import MODELS, CartDoublePendulum, DoublePendulum
 from pendverify.analytic.interface import Energies
 from pendverify.checks.catalogue import run_checks
 from pendverify.checks.sampling import sample_states
-from pendverify.checks.targets import system_for
 from pendverify.checks.verdict import CHRISTOFFEL_CONSISTENT, NON_CHRISTOFFEL
 from pendverify.cli import main
 from pendverify.errors import PendverifyError
+from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
 from pendverify.symbolic.compare import DIFFERS, EQUAL, SKIPPED, WARNING, compare
 from pendverify.symbolic.lagrange import derive
@@ -75,7 +75,7 @@ def test_shared_wrong_assumption_passes_numerically_but_not_symbolically():
         I1=params.I1 - params.m1 * params.r1**2, I2=params.I2 - params.m2 * params.r2**2
     )
     model = PivotInertia(params)
-    system = system_for(DoublePendulum, urdf_for(urdf_params), params.g)
+    system = PinocchioSystem.for_model(DoublePendulum, urdf_for(urdf_params), params.g)
     results = run_checks("pivot", model, system, sample_states(model, 40, SEED), SEED)
     assert all(r.passed for r in results), [r.check for r in results if not r.passed]
 

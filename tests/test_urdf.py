@@ -12,7 +12,8 @@ from pendverify.analytic import DoublePendulum
 from pendverify.checks.catalogue import run_checks
 from pendverify.checks.sampling import sample_states
 from pendverify.errors import UrdfShapeError
-from pendverify.robot.system import PinocchioSystem, load_model
+from pendverify.robot.system import PinocchioSystem
+from pendverify.robot.urdf import load_model
 from pendverify.robot.writer import urdf_for
 
 from .conftest import SEED, default_params

@@ -38,6 +38,7 @@ import numpy as np
 
 from pendverify.analytic import ClosedFormModel
 from pendverify.checks.sampling import State
+from pendverify.checks.trust import term_amplification
 from pendverify.checks.verdict import FAIL, PASS
 from pendverify.robot.system import PinocchioSystem
 
@@ -126,8 +127,6 @@ def world_lever(model, system, q) -> float:
     recursions, which cancel in the result.  Inverses round in proportion to A,
     Coriolis terms to √A.  (``pendverify.checks.trust.term_amplification``.)
     """
-    from pendverify.checks.trust import term_amplification
-
     return term_amplification(model, system, q)
 
 

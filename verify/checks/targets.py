@@ -8,7 +8,7 @@
 * a user's own model file (``--analytic``, ``pendverify.analytic.plugin``) against a URDF.
 
 Built-in and plug-in models take one path: the URDF is loaded, the model class's
-``urdf_geometry`` hook gives the coordinate map (the seeds read it off the
+geometry reader (or declared map) gives the coordinate map (the seeds read it off the
 geometry, a plug-in declares it), and ``model_target`` pairs the two.
 """
 
@@ -28,7 +28,8 @@ from pendverify.analytic.params import (
 from pendverify.analytic.plugin import load_model_class
 from pendverify.errors import ParameterError, PendverifyError, UnknownNameError
 from pendverify.robot.erd import double_pendulum_urdfs
-from pendverify.robot.system import DEFAULT_G, PinocchioSystem, load_urdf
+from pendverify.robot.seed_geometry import DEFAULT_G
+from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
 
 PARAMETER_MATCH_RTOL = 1e-9
@@ -53,31 +54,18 @@ def _model_class(name: str):
     return MODELS[name]
 
 
-def system_for(
-    cls: type[ClosedFormModel],
-    urdf,
-    g: float | None = None,
-    source: str | None = None,
-):
-    """A URDF (path or XML text) in Pinocchio, seen in ``cls``'s coordinates via its ``urdf_geometry``."""
-    loaded = load_urdf(urdf, source)
-    geometry = cls.urdf_geometry(loaded.model, loaded.source, g)
-    g = DEFAULT_G if g is None else g
-    return PinocchioSystem(loaded.model, geometry, g, loaded.source, loaded)
-
-
 def default_target(model_name: str) -> Target:
     _, _, params = load_parameter_file(default_parameter_file(model_name))
     path = committed_urdf(model_name)
     cls = _model_class(model_name)
-    return Target(model_name, cls(params), system_for(cls, path, params.g), str(path))
+    return Target(model_name, cls(params), PinocchioSystem.for_model(cls, path, params.g), str(path))
 
 
 def erd_targets() -> list[Target]:
     targets = []
     cls = _model_class("double_pendulum")
     for stem, path in double_pendulum_urdfs().items():
-        system = system_for(cls, path)
+        system = PinocchioSystem.for_model(cls, path)
         model = cls(system.geometry.params)
         targets.append(Target(f"erd:{stem}", model, system, str(path)))
     return targets
@@ -99,7 +87,7 @@ def parameter_differences(urdf_params: ParameterSet, given: ParameterSet) -> lis
 def model_target(cls: type[ClosedFormModel], urdf: str, params: ParameterSet | None) -> Target:
     """A model class, a URDF file and (unless the URDF fixes them) its parameters: built-in or plug-in."""
     g = getattr(params, "g", None)
-    system = system_for(cls, urdf, g)
+    system = PinocchioSystem.for_model(cls, urdf, g)
     notes = []
     read = system.geometry.params
     if params is None:
@@ -133,7 +121,7 @@ def user_target(model_name: str | None, urdf: str | None, params_file: str | Non
     cls = _model_class(model_name)
     if urdf is None:
         # the URDF of this parameter set, as the project writes it
-        system = system_for(cls, urdf_for(params), params.g, f"<URDF of {params_file}>")
+        system = PinocchioSystem.for_model(cls, urdf_for(params), params.g, f"<URDF of {params_file}>")
         return Target(f"{model_name}:{Path(params_file).stem}", cls(params), system, system.source)
     return model_target(cls, urdf, params)
 

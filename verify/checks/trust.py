@@ -1,4 +1,4 @@
-"""Near-singular mass matrices: how far results can be trusted, measured against 50 digits.
+"""The trust rule: how far a comparison with a (near-singular) mass matrix can be trusted.
 
 The cart seed's mass matrix loses rank as the middle bob vanishes::
 
@@ -68,41 +68,24 @@ Pinocchio's M⁻¹ a relative error of 1.3e6·ε although κ̃ ≈ 12; a 1 km li
 two rods' levers) and ≈ 1.5e3 for the default cart 10 m away.  A is an upper
 estimate: measured errors stay about 10 to 1000 times below ε·κ̃·A.
 
-What ``trust_study`` measures
------------------------------
-For m1 = 1, 0.1, ..., 1e-16 kg and three aligned states it compares with a
-50-digit mpmath reference built from the *same* float parameters and state
-(M, f, det M, M⁻¹ and q̈ = M⁻¹f evaluated in ``REFERENCE_DIGITS`` digits):
-
-* det M: the seed's closed form (a sum of non-negative terms) and the LU
-  determinant of Pinocchio's CRBA;
-* q̈: the closed form (an LU solve with M) and Pinocchio's ABA;
-* M⁻¹: the closed form (adjugate / closed-form det) and ``computeMinverse``.
-
-Errors are relative, in the scaled coordinates (q̈ and M⁻¹ scaled by √S).
-The measured trust limit is the smallest m1 from which on every quantity stays
-within ``REFUSE_REL`` of the reference; the guard must refuse everything below
-it and must never accept a state whose measured error exceeds its bound.
+The measured side of this rule — the m1 → 0 study against 50-digit mpmath —
+lives in ``pendverify.stress.trust_study``.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
-import mpmath as mp
 import numpy as np
 
-from pendverify.analytic import CartDoublePendulum, CartDoublePendulumParams, DoublePendulumParams
 from pendverify.errors import PendverifyError
 
 EPS = float(np.finfo(float).eps)
 KAPPA_K = 16  # the K of the checks that solve with M (aba, minverse)
 WARN_REL = 1e-10  # predicted relative error above which results carry a warning
 REFUSE_REL = 1e-6  # predicted relative error above which results are refused
-REFERENCE_DIGITS = 50
 AMPLIFICATION_CACHE = 4096  # states whose term amplification a system remembers
-STUDY_MASSES = tuple(10.0**-k for k in range(17))  # m1 in kg
 
 
 @dataclass
@@ -261,238 +244,3 @@ def check_conditioning(model, q, system=None, what: str | None = None) -> Condit
             verdict.by_spread,
         )
     return verdict
-
-
-# --- the 50-digit reference ---------------------------------------------------------------
-def _mpf(x) -> mp.mpf:
-    return mp.mpf(float(x))  # exact: every double is an mpf
-
-
-def reference_mass_matrix(params, q) -> mp.matrix:
-    """M(q) of either seed in ``REFERENCE_DIGITS`` digits (call inside ``mp.workdps``)."""
-    if isinstance(params, CartDoublePendulumParams):
-        m, m1, m2, l1, l2 = (_mpf(x) for x in (params.m, params.m1, params.m2, params.l1, params.l2))
-        t1, t2 = _mpf(q[1]), _mpf(q[2])
-        m12 = m1 + m2
-        c1, c2, c12 = mp.cos(t1), mp.cos(t2), mp.cos(t1 - t2)
-        return mp.matrix(
-            [
-                [m + m12, l1 * m12 * c1, m2 * l2 * c2],
-                [l1 * m12 * c1, l1**2 * m12, l1 * l2 * m2 * c12],
-                [m2 * l2 * c2, l1 * l2 * m2 * c12, l2**2 * m2],
-            ]
-        )
-    if isinstance(params, DoublePendulumParams):
-        m1, m2, l1, r1, r2, I1, I2 = (
-            _mpf(x) for x in (params.m1, params.m2, params.l1, params.r1, params.r2, params.I1, params.I2)
-        )
-        alpha = I1 + I2 + m1 * r1**2 + m2 * (l1**2 + r2**2)
-        beta, delta = m2 * l1 * r2, I2 + m2 * r2**2
-        c2 = mp.cos(_mpf(q[1]))
-        return mp.matrix([[alpha + 2 * beta * c2, delta + beta * c2], [delta + beta * c2, delta]])
-    raise TypeError(f"no reference for {type(params).__name__}")
-
-
-def reference_cart_rhs(p: CartDoublePendulumParams, y, yd, u, w) -> mp.matrix:
-    """The cart seed's f(y, ẏ, u, w) in ``REFERENCE_DIGITS`` digits."""
-    m1, m2, l1, l2, g = (_mpf(x) for x in (p.m1, p.m2, p.l1, p.l2, p.g))
-    d = [_mpf(x) for x in (p.d1, p.d2, p.d3)]
-    t1, t2 = _mpf(y[1]), _mpf(y[2])
-    s1, s2, s12 = mp.sin(t1), mp.sin(t2), mp.sin(t1 - t2)
-    v = [_mpf(x) for x in yd]
-    ww = [_mpf(x) for x in w]
-    return mp.matrix(
-        [
-            l1 * (m1 + m2) * v[1] ** 2 * s1 + m2 * l2 * v[2] ** 2 * s2 - d[0] * v[0] + _mpf(u[0]) + ww[0],
-            -l1 * l2 * m2 * v[2] ** 2 * s12 + g * (m1 + m2) * l1 * s1 - d[1] * v[1] + ww[1],
-            l1 * l2 * m2 * v[1] ** 2 * s12 + g * l2 * m2 * s2 - d[2] * v[2] + ww[2],
-        ]
-    )
-
-
-def _rel(approx, exact) -> float:
-    """max |approx − exact| / max |exact| over entries, in 50 digits; inf for non-finite input."""
-    approx = np.atleast_1d(np.asarray(approx, dtype=float)).ravel()
-    if not np.all(np.isfinite(approx)):
-        return math.inf
-    exact = list(exact)
-    scale = max(abs(x) for x in exact)
-    return float(max(abs(_mpf(a) - e) for a, e in zip(approx, exact, strict=True)) / scale)
-
-
-# --- the m1 → 0 study -----------------------------------------------------------------------
-def study_states() -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
-    """(y, ẏ, u, w) at which det M ∝ m1: θ1 = θ2 = 0, θ1 = θ2 = 0.7, and θ2 = θ1 + 1e-12."""
-    v = np.array([0.3, 1.0, -2.0])
-    u = np.array([0.5])
-    return {
-        "theta1=theta2=0, torque on rod 1": (np.zeros(3), v, u, np.array([0.0, 1.0, 0.0])),
-        "theta1=theta2=0.7": (np.array([0.3, 0.7, 0.7]), v, u, np.zeros(3)),
-        "theta2=theta1+1e-12": (np.array([0.3, 0.7, 0.7 + 1e-12]), v, u, np.zeros(3)),
-    }
-
-
-@dataclass
-class StudyRow:
-    """One (m1, state) of the study: relative errors against the 50-digit reference."""
-
-    m1: float
-    state: str
-    kappa_raw: float
-    kappa_scaled: float
-    bound: float
-    level: str
-    det_closed_form: float
-    det_lu: float
-    accel_closed_form: float
-    accel_aba: float
-    minv_closed_form: float
-    minv_pinocchio: float
-
-    QUANTITIES = (
-        "det_closed_form",
-        "det_lu",
-        "accel_closed_form",
-        "accel_aba",
-        "minv_closed_form",
-        "minv_pinocchio",
-    )
-
-    def errors(self) -> dict[str, float]:
-        return {name: getattr(self, name) for name in self.QUANTITIES}
-
-    @property
-    def worst(self) -> float:
-        return max(self.errors().values())
-
-
-@dataclass
-class StudyResult:
-    rows: list[StudyRow]
-    #: smallest m1 from which on every quantity is within REFUSE_REL of the reference
-    measured_limit: float
-    #: smallest m1 the guard accepts at every study state
-    accepted_limit: float
-    #: per quantity, the smallest m1 from which on it stays within REFUSE_REL
-    limit_per_quantity: dict[str, float]
-    #: accepted rows whose measured error exceeds the predicted rounding bound
-    violations: list[str] = field(default_factory=list)
-    zero_mass_note: str = ""
-    zero_mass_refused: bool = False
-
-
-def _measure(params, label, y, v, u, w) -> StudyRow:
-    from pendverify.robot.system import PinocchioSystem
-    from pendverify.robot.writer import urdf_for
-
-    model = CartDoublePendulum(params)
-    system = PinocchioSystem.from_urdf(params.model, urdf_for(params), params.g)
-    verdict = assess(model, y, system)
-    root = np.sqrt(model.diagonal_scale(y))
-    with mp.workdps(REFERENCE_DIGITS):
-        M = reference_mass_matrix(params, y)
-        det_ref = mp.det(M)
-        a_ref = mp.lu_solve(M, reference_cart_rhs(params, y, v, u, w))
-        Minv_ref = M**-1
-        a_scaled = [a_ref[i] * _mpf(root[i]) for i in range(3)]
-        Minv_scaled = [Minv_ref[i, j] * _mpf(root[i] * root[j]) for i in range(3) for j in range(3)]
-        tau = model.input_matrix() @ u + model.disturbance_matrix() @ w - model.damping_matrix() @ v
-        with np.errstate(all="ignore"):
-            try:
-                a_cf = model.acceleration(y, v, u, w)
-            except np.linalg.LinAlgError:
-                a_cf = np.full(3, np.nan)
-            Minv_cf = model.inverse_mass_matrix(y)
-        return StudyRow(
-            m1=params.m1,
-            state=label,
-            kappa_raw=verdict.kappa_raw,
-            kappa_scaled=verdict.kappa_scaled,
-            bound=verdict.bound,
-            level=verdict.level,
-            det_closed_form=_rel(model.det_mass_matrix(y), [det_ref]),
-            det_lu=_rel(system.det_mass_matrix(y), [det_ref]),
-            accel_closed_form=_rel(a_cf * root, a_scaled),
-            accel_aba=_rel(system.acceleration(y, v, tau) * root, a_scaled),
-            minv_closed_form=_rel(Minv_cf * np.outer(root, root), Minv_scaled),
-            minv_pinocchio=_rel(system.inverse_mass_matrix(y) * np.outer(root, root), Minv_scaled),
-        )
-
-
-def _limit(rows: list[StudyRow], ok) -> float:
-    """Smallest m1 such that ``ok`` holds for every row with that m1 and every larger one."""
-    limit = math.inf
-    for m1 in sorted({r.m1 for r in rows}, reverse=True):
-        if not all(ok(r) for r in rows if r.m1 == m1):
-            break
-        limit = m1
-    return limit
-
-
-def zero_mass_demo(base: CartDoublePendulumParams):
-    """Pinocchio with m1 = 0 (set in the loaded model; a parameter set refuses it).
-
-    Returns (ABA's q̈ at θ2 = θ1 + 1e-12, whether ``check_conditioning`` refused).
-    """
-    import pinocchio as pin
-
-    from pendverify.robot.system import PinocchioSystem
-    from pendverify.robot.writer import urdf_for
-
-    system = PinocchioSystem.from_urdf(base.model, urdf_for(base), base.g)
-    inertia = system.model.inertias[2]  # rod 1's bob
-    system.model.inertias[2] = pin.Inertia(0.0, inertia.lever, inertia.inertia)
-    system.data = system.model.createData()
-    y, v, u, _ = study_states()["theta2=theta1+1e-12"]
-    model = CartDoublePendulum(base)
-    tau = model.input_matrix() @ u - model.damping_matrix() @ v
-    with np.errstate(all="ignore"):
-        accel = system.acceleration(y, v, tau)
-    try:
-        check_conditioning(model, y, system, what="cart with m1 = 0 (Pinocchio)")
-    except IllConditionedError:
-        return accel, True
-    return accel, False
-
-
-def trust_study(base: CartDoublePendulumParams, masses=STUDY_MASSES) -> StudyResult:
-    """The m1 → 0 sweep of the cart seed at the study states."""
-    rows = [
-        _measure(base.replace(m1=m1), label, *state)
-        for m1 in masses
-        for label, state in study_states().items()
-    ]
-    violations = [
-        f"m1 = {r.m1:.0e}, {r.state}: measured {r.worst:.2g} > bound {r.bound:.2g}"
-        for r in rows
-        if r.level != "refuse" and not r.worst <= r.bound
-    ]
-    per_quantity = {
-        name: _limit(rows, lambda r, name=name: getattr(r, name) <= REFUSE_REL)
-        for name in StudyRow.QUANTITIES
-    }
-    accel, refused = zero_mass_demo(base)
-    note = "ABA at m1 = 0, θ2 = θ1 + 1e-12: q̈ = (" + ", ".join(f"{a:.3g}" for a in accel) + ")"
-    note += ", finite" if np.all(np.isfinite(accel)) else ", not finite"
-    return StudyResult(
-        rows=rows,
-        measured_limit=_limit(rows, lambda r: r.worst <= REFUSE_REL),
-        accepted_limit=_limit(rows, lambda r: r.level != "refuse"),
-        limit_per_quantity=per_quantity,
-        violations=violations,
-        zero_mass_note=note,
-        zero_mass_refused=refused,
-    )
-
-
-def det_accuracy(params, q) -> tuple[float, float]:
-    """(closed-form det, LU det of the CRBA): relative errors against the 50-digit det."""
-    from pendverify.analytic import MODELS
-    from pendverify.robot.system import PinocchioSystem
-    from pendverify.robot.writer import urdf_for
-
-    model = MODELS[params.model](params)
-    system = PinocchioSystem.from_urdf(params.model, urdf_for(params), params.g)
-    with mp.workdps(REFERENCE_DIGITS):
-        exact = mp.det(reference_mass_matrix(params, q))
-        return _rel(model.det_mass_matrix(q), [exact]), _rel(system.det_mass_matrix(q), [exact])

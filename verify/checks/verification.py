@@ -25,7 +25,7 @@ from pendverify.checks.report import Report
 from pendverify.checks.sampling import sample_states
 from pendverify.checks.trust import IllConditionedError, check_conditioning
 from pendverify.checks.verdict import FAIL, REFUSED, apply_strict, non_christoffel_c
-from pendverify.robot.system import MODEL_FORM_RTOL
+from pendverify.robot.geometry import MODEL_FORM_RTOL
 
 
 def trusted_states(target, states) -> tuple[list, list[str]]:

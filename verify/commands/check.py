@@ -45,7 +45,7 @@ def run(args: argparse.Namespace) -> int:
     from pendverify.checks.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
     from pendverify.checks.targets import default_target, erd_targets, plugin_target, user_target
     from pendverify.checks.verification import build_report
-    from pendverify.robot.system import MODEL_FORM_RTOL
+    from pendverify.robot.geometry import MODEL_FORM_RTOL
 
     samples = DEFAULT_RANDOM_STATES if args.samples is None else args.samples
     seed = DEFAULT_SEED if args.seed is None else args.seed

@@ -67,7 +67,8 @@ def format_table(report) -> str:
 
 
 def format_study(study) -> str:
-    from pendverify.checks.trust import REFUSE_REL, StudyRow
+    from pendverify.checks.trust import REFUSE_REL
+    from pendverify.stress.trust_study import StudyRow
 
     labels = {
         "det_closed_form": "det closed",

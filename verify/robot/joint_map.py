@@ -21,7 +21,7 @@ import pinocchio as pin
 from pendverify.analytic.plugin import where
 from pendverify.errors import PendverifyError, UrdfShapeError
 from pendverify.robot.coordinates import CoordinateMap
-from pendverify.robot.system import UrdfGeometry
+from pendverify.robot.geometry import UrdfGeometry
 
 
 def _matrix(cls, name: str, value, shape: tuple[int, ...]) -> np.ndarray:

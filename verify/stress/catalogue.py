@@ -24,7 +24,7 @@ Groups and what passes
 ``high speed``
     The same with rates up to 1e3 rad/s; every quantity must stay finite.
 ``near singular`` (study)
-    ``pendverify.checks.trust.trust_study``: m1 = 1 … 1e-16 kg against a
+    ``pendverify.stress.trust_study``: m1 = 1 … 1e-16 kg against a
     50-digit reference.  Passes when every state the guard accepts is within its
     predicted rounding bound and within 1e-6, the guard refuses below the
     measured trust limit, and m1 = 0 (where ABA returns finite nonsense) is refused.
@@ -60,15 +60,10 @@ from pendverify.analytic import MODELS, CartDoublePendulumParams, DoublePendulum
 from pendverify.analytic.params import default_parameter_file, load_parameter_file
 from pendverify.checks.catalogue import CHECKS, EPS, Check, Sample, applicable_checks, run_check
 from pendverify.checks.sampling import DEFAULT_SEED, State, sample_states
-from pendverify.checks.trust import (
-    REFUSE_REL,
-    IllConditionedError,
-    StudyResult,
-    check_conditioning,
-    study_states,
-    trust_study,
-)
+from pendverify.checks.trust import REFUSE_REL, IllConditionedError, check_conditioning
 from pendverify.errors import PendverifyError
+from pendverify.robot.system import PinocchioSystem
+from pendverify.stress.trust_study import StudyResult, study_states, trust_study
 from pendverify.validate import model_state
 
 SEED = DEFAULT_SEED
@@ -198,10 +193,7 @@ def cart(**changes) -> CartDoublePendulumParams:
 
 # --- comparing closed form and Pinocchio --------------------------------------------------------
 def system_for(params):
-    from pendverify.robot.system import PinocchioSystem
-    from pendverify.robot.writer import urdf_for
-
-    return PinocchioSystem.from_urdf(params.model, urdf_for(params), params.g)
+    return PinocchioSystem.for_params(params)
 
 
 # Terms the core checks' scales leave out (to be moved into ``pendverify.checks.catalogue``):
@@ -510,7 +502,8 @@ def det_case(ctx: Context, name: str) -> StressResult:
 
 def dp_det_case(ctx: Context, name: str) -> StressResult:
     """The double pendulum's closed-form det, αδ − δ² − β²cos²θ2, is a difference: no better than LU."""
-    from pendverify.checks.trust import KAPPA_K, assess, det_accuracy
+    from pendverify.checks.trust import KAPPA_K, assess
+    from pendverify.stress.trust_study import det_accuracy
 
     base = default("double_pendulum").replace(I1=0.0, I2=0.0)  # point masses: det → m1 r1² m2 r2² at θ2 = 0
     rows = []
