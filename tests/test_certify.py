@@ -199,3 +199,17 @@ def test_battery_covers_stress_cases(certified):
         "stress:zero-gravity",
         "stress:conditioning",
     }
+
+
+def test_the_battery_s_stress_items_run_on_the_urdf_being_certified():
+    """A URDF with link 2's inertia 1 % off fails the stress items too, not only the core checks."""
+    from pendverify.certify.battery import BatterySettings, stress_items
+    from pendverify.robot.writer import urdf_for
+
+    params = default_params("double_pendulum")
+    settings = BatterySettings(samples=20)
+    wrong = urdf_for(params.replace(I2=params.I2 * 1.01))
+    own = stress_items("double_pendulum", params, settings)
+    given = stress_items("double_pendulum", params, settings, wrong)
+    assert all(i.passed for i in own)
+    assert not any(i.passed for i in given if i.name != "stress:conditioning"), [i.name for i in given]

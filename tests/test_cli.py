@@ -76,3 +76,21 @@ def test_bad_parameter_file_is_exit_2(tmp_path, capsys):
     )
     assert main(["check", "--params", str(path)]) == 2
     assert f"{path}: key 'parameters.b1' = -1.0: a damping must be" in capsys.readouterr().err
+
+
+def test_json_reports_are_standard_json_even_with_an_infinite_error():
+    """A det check that fails on a non-positive det M has an infinite error: written as "inf"."""
+    from pendverify.checks.catalogue import CheckResult
+    from pendverify.checks.report import Report
+
+    failed = CheckResult(
+        "m", "det", "d", float("inf"), 1e-15, float("inf"), 1, 1, {"label": "s", "q": []}, False
+    )
+    text = Report(seed=1, states={"m": 1}, results=[failed]).to_json()
+
+    def refuse(name):
+        raise AssertionError(f"non-standard JSON constant {name}")
+
+    document = json.loads(text, parse_constant=refuse)
+    assert document["results"][0]["max_error"] == "inf"
+    assert document["status"] == "fail"

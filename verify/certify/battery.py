@@ -141,18 +141,19 @@ def invariant_items(model_name, params, urdf: str, settings: BatterySettings) ->
     return items
 
 
-def stress_items(model_name, params, settings: BatterySettings) -> list[BatteryItem]:
+def stress_items(model_name, params, settings: BatterySettings, urdf: str | None = None) -> list[BatteryItem]:
     """The stress cases that apply to any parameter set, run on this one.
 
     Large angles (|θ| ≈ 1e6 rad, with the θ + 2πk invariance; states beyond the
     trust rule there are refused and recorded, not failed), high speeds
     (|q̇| ≤ 1e3), zero gravity, and the conditioning guard of
     ``pendverify.checks.trust`` over the sampled states: a set whose
-    comparisons would need refusing (near-singular M) is not certified.
+    comparisons would need refusing (near-singular M) is not certified.  They run
+    on ``urdf``, the URDF being certified (the project's own for the set if None).
     """
     from pendverify.stress import catalogue as stress
 
-    ctx = stress.Context(stress.FULL, settings.seed)
+    ctx = stress.Context(stress.FULL, settings.seed, urdf=urdf)
     cases = [
         # at |θ| ≈ 1e6 rad a set with κ̃ in the hundreds is beyond the trust rule: such
         # states are refused and recorded, and every state that is compared must pass
@@ -188,6 +189,6 @@ def run_battery(
     system = PinocchioSystem.from_urdf(model_name, urdf, params.g, f"<URDF being certified: {model_name}>")
     return (
         check_items(model, system, settings)
-        + stress_items(model_name, params, settings)
+        + stress_items(model_name, params, settings, urdf)
         + invariant_items(model_name, params, urdf, settings)
     )

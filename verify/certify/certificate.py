@@ -30,17 +30,14 @@ shortest round-trip repr — so any edit to any field changes the digest.
 from __future__ import annotations
 
 import hashlib
-import json
-import platform
 from datetime import datetime, timezone
 
 import numpy as np
-import pinocchio
 
-from pendverify import __version__
 from pendverify.analytic import MODELS, ParameterSet
 from pendverify.certify.battery import BatteryItem, BatterySettings
 from pendverify.errors import PendverifyError
+from pendverify.jsonio import to_json, versions
 
 SCHEMA = "pendverify-certificate/1"
 
@@ -50,7 +47,7 @@ class CertificateError(PendverifyError):
 
 
 def canonical_json(obj: dict) -> str:
-    return json.dumps(obj, sort_keys=True, separators=(",", ":"), ensure_ascii=False, allow_nan=False)
+    return to_json(obj, canonical=True)
 
 
 def digest_of(cert: dict) -> str:
@@ -68,15 +65,6 @@ def derived_constants(model_name: str, params: ParameterSet) -> dict[str, float]
         "l1_m1_plus_m2": p.l1 * (p.m1 + p.m2),
         "m2_l2": p.m2 * p.l2,
         "det_M_upright": model.det_mass_matrix(np.zeros(3)),
-    }
-
-
-def versions() -> dict[str, str]:
-    return {
-        "pendverify": __version__,
-        "pinocchio": pinocchio.__version__,
-        "numpy": np.__version__,
-        "python": platform.python_version(),
     }
 
 
@@ -108,7 +96,7 @@ def build_certificate(
 
 
 def certificate_text(cert: dict) -> str:
-    return json.dumps(cert, indent=2, ensure_ascii=False, allow_nan=False) + "\n"
+    return to_json(cert)
 
 
 def verify_digest(cert: dict, source: str) -> None:

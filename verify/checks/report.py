@@ -2,16 +2,11 @@
 
 from __future__ import annotations
 
-import json
-import platform
 from dataclasses import dataclass, field
 
-import numpy as np
-import pinocchio
-
-from pendverify import __version__
 from pendverify.checks.catalogue import CheckResult
 from pendverify.checks.verdict import FAIL, LABELS, PASS, REFUSED, WARN, worst
+from pendverify.jsonio import to_json, versions
 
 
 @dataclass
@@ -48,10 +43,7 @@ class Report:
 
     def as_dict(self) -> dict:
         return {
-            "pendverify": __version__,
-            "pinocchio": pinocchio.__version__,
-            "numpy": np.__version__,
-            "python": platform.python_version(),
+            **versions(),
             "seed": self.seed,
             "states": self.states,
             "elapsed_s": round(self.elapsed_s, 3),
@@ -66,7 +58,7 @@ class Report:
         }
 
     def to_json(self) -> str:
-        return json.dumps(self.as_dict(), indent=2, ensure_ascii=False) + "\n"
+        return to_json(self.as_dict())
 
 
 def text_table(header: tuple[str, ...], rows: list[tuple[str, ...]]) -> list[str]:

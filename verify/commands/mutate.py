@@ -36,12 +36,12 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    import json
 
     from pendverify.atomic import write_atomic
     from pendverify.checks.sampling import DEFAULT_SEED
     from pendverify.checks.targets import default_target, plugin_target
     from pendverify.errors import PendverifyError
+    from pendverify.jsonio import to_json
     from pendverify.symbolic.mutate import DEFAULT_MUTATION_STATES, format_report, run_mutation
 
     names = builtin_models(args.model, args.analytic)
@@ -57,8 +57,6 @@ def run(args: argparse.Namespace) -> int:
     reports = [run_mutation(t, samples, seed, args.all_checks, methods) for t in targets]
     print("\n\n".join(format_report(r) for r in reports))
     if args.json:
-        write_atomic(
-            args.json, json.dumps([r.as_dict() for r in reports], indent=2, ensure_ascii=False) + "\n"
-        )
+        write_atomic(args.json, to_json([r.as_dict() for r in reports]))
         print(f"report written to {args.json}")
     return 0 if all(r.passed for r in reports) else 1

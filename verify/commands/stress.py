@@ -10,9 +10,6 @@ evidence atomically.
 from __future__ import annotations
 
 import argparse
-import json
-import math
-import platform
 import time
 
 from pendverify.commands import non_negative_int
@@ -108,10 +105,7 @@ def format_study(study) -> str:
 def report_dict(report) -> dict:
     import dataclasses
 
-    import numpy as np
-    import pinocchio
-
-    from pendverify import __version__
+    from pendverify.jsonio import versions
 
     study = None
     if report.study is not None:
@@ -126,10 +120,7 @@ def report_dict(report) -> dict:
             "rows": [dataclasses.asdict(r) for r in s.rows],
         }
     return {
-        "pendverify": __version__,
-        "pinocchio": pinocchio.__version__,
-        "numpy": np.__version__,
-        "python": platform.python_version(),
+        **versions(),
         "seed": report.seed,
         "settings": dataclasses.asdict(report.settings),
         "elapsed_s": round(report.elapsed_s, 3),
@@ -139,20 +130,10 @@ def report_dict(report) -> dict:
     }
 
 
-def _finite_json(value):
-    """JSON has no inf or NaN: write them as strings."""
-    if isinstance(value, float) and not math.isfinite(value):
-        return str(value)
-    if isinstance(value, dict):
-        return {k: _finite_json(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_finite_json(v) for v in value]
-    return value
-
-
 def run(args: argparse.Namespace) -> int:
     from pendverify.atomic import write_atomic
     from pendverify.errors import UnknownNameError
+    from pendverify.jsonio import to_json
     from pendverify.stress.catalogue import CASE_NAMES, FULL, QUICK, SEED, run_catalogue
 
     for name in args.case or ():
@@ -177,7 +158,7 @@ def run(args: argparse.Namespace) -> int:
         document["elapsed_s"] = round(elapsed, 3)
         write_atomic(
             args.json,
-            json.dumps(_finite_json(document), indent=2, ensure_ascii=False, allow_nan=False) + "\n",
+            to_json(document),
         )
         print(f"report written to {args.json}")
     return 0 if not failures else 1

@@ -20,11 +20,11 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    import json
 
     from pendverify.analytic import MODELS
     from pendverify.analytic.plugin import load_model_class
     from pendverify.atomic import write_atomic
+    from pendverify.jsonio import to_json
     from pendverify.symbolic.compare import compare, format_report
 
     names = builtin_models(args.model, args.analytic)
@@ -32,8 +32,6 @@ def run(args: argparse.Namespace) -> int:
     reports = [compare(cls) for cls in classes]
     print("\n\n".join(format_report(r) for r in reports))
     if args.json:
-        write_atomic(
-            args.json, json.dumps([r.as_dict() for r in reports], indent=2, ensure_ascii=False) + "\n"
-        )
+        write_atomic(args.json, to_json([r.as_dict() for r in reports]))
         print(f"report written to {args.json}")
     return 0 if all(r.passed for r in reports) else 1

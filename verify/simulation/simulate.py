@@ -10,14 +10,12 @@ separate for reasons that are not model errors, so they are never diffed).
 from __future__ import annotations
 
 import io
-import json
-import platform
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from pendverify import __version__
 from pendverify.checks.catalogue import EPS, norm2, rate_scale, scaled_matrix, weights
+from pendverify.jsonio import to_json, versions
 from pendverify.simulation.dynamics import Dynamics, build_dynamics
 from pendverify.simulation.integrate import Integration, integrate
 from pendverify.simulation.invariants import (
@@ -53,7 +51,6 @@ class Run:
         return all(c.passed for c in checks)
 
     def metadata(self) -> dict:
-        import pinocchio
 
         s = self.scene
         return {
@@ -69,12 +66,7 @@ class Run:
             "terms": self.dynamics.terms,
             "invariants": [i.as_dict() for i in self.invariants],
             "passed": self.passed,
-            "versions": {
-                "pendverify": __version__,
-                "pinocchio": pinocchio.__version__,
-                "numpy": np.__version__,
-                "python": platform.python_version(),
-            },
+            "versions": versions(),
         }
 
     def to_npz_bytes(self) -> bytes:
@@ -87,7 +79,7 @@ class Run:
             u=self.u,
             w=self.w,
             energy=self.energy,
-            metadata=np.array(json.dumps(self.metadata())),
+            metadata=np.array(to_json(self.metadata())),
         )
         return buf.getvalue()
 

@@ -149,6 +149,14 @@ class Context:
     settings: Settings = FULL
     seed: int = SEED
     study: StudyResult | None = None
+    #: the URDF (text or path) the cases compare with; None: the one the project writes for each set
+    urdf: str | None = None
+
+    def system(self, params):
+        """Pinocchio's side for a parameter set: ``urdf`` if given (the battery's), else the project's."""
+        if self.urdf is None:
+            return system_for(params)
+        return PinocchioSystem.for_model(MODELS[params.model], self.urdf, params.g, "<URDF being certified>")
 
     def trust_study(self) -> StudyResult:
         if self.study is None:
@@ -345,7 +353,7 @@ def checks_case(
         params = params_fn()
         model = _model(params, model_cls)
         states = _states(model, ctx) + (extra_states(model) if extra_states else [])
-        comp = compare(name, model, system_for(params), states, ctx.seed)
+        comp = compare(name, model, ctx.system(params), states, ctx.seed)
         return _result_from(name, comp, expect)
 
     return Case(name, group, run)
@@ -404,7 +412,7 @@ def large_angle_case(name: str, params_fn, model_cls=None, expect: str = "none")
     def run(ctx: Context, name: str) -> StressResult:
         params = params_fn()
         model = _model(params, model_cls)
-        system = system_for(params)
+        system = ctx.system(params)
         states = shifted_states(model, _states(model, ctx))
         direct = compare(name, model, system, states, ctx.seed)
         invariance = compare(name, model, ReducedAngleSystem(system, model.angular), states, ctx.seed)
@@ -427,7 +435,7 @@ def high_speed_case(name: str, params_fn, model_cls=None) -> Case:
 
         params = params_fn()
         model = _model(params, model_cls)
-        system = system_for(params)
+        system = ctx.system(params)
         states = [dataclasses.replace(s, v=s.v * (HIGH_RATE / RATE_RANGE)) for s in _states(model, ctx)]
         comp = compare(name, model, system, states, ctx.seed)
         finite = all(np.isfinite(r.max_abs_error) for r in comp.results)
