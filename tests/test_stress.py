@@ -12,14 +12,14 @@ import math
 import numpy as np
 import pytest
 
-from pendverify.analytic import CartDoublePendulum, DoublePendulum
+from pendverify.analytic import MODELS, CartDoublePendulum, DoublePendulum
 from pendverify.checks import trust as near_singular
 from pendverify.checks.trust import Conditioning, IllConditionedError, check_conditioning
 from pendverify.cli import main
 from pendverify.errors import InputError
+from pendverify.stress import cases, framework, sim_cases, trust_study
 from pendverify.stress import catalogue as stress
 from pendverify.stress import integrators as si
-from pendverify.stress import trust_study
 from pendverify.validate import finite_state, model_state
 
 from .conftest import default_params
@@ -28,7 +28,7 @@ from .conftest import default_params
 @pytest.fixture(scope="module")
 def ctx():
     """One context for the module, so the trust study runs once."""
-    return stress.Context(stress.QUICK)
+    return framework.Context(framework.QUICK)
 
 
 def _case(name):
@@ -42,7 +42,7 @@ def test_case_passes(ctx, name):
     assert result.passed, f"{name}: {result.quantity} {result.error} > {result.tolerance}; {result.note}"
     if result.error is not None:
         assert result.error <= result.tolerance, name
-    assert result.seed == stress.SEED
+    assert result.seed == framework.SEED
 
 
 def test_catalogue_covers_the_issue():
@@ -83,7 +83,7 @@ def test_cli_quick_table_json_and_exit_status(tmp_path, capsys):
         assert text in out
     assert "measured trust limit (every quantity): m1 ≥ 1e-08 kg" in out
     report = json.loads(out_json.read_text())
-    assert report["passed"] is True and report["seed"] == stress.SEED
+    assert report["passed"] is True and report["seed"] == framework.SEED
     assert sorted(r["case"] for r in report["results"]) == sorted(cases)  # in catalogue order
     for r in report["results"]:
         assert {"error", "tolerance", "kappa_raw", "kappa_scaled", "invariant", "passed", "verdict"} <= set(r)
@@ -96,7 +96,7 @@ def test_cli_unknown_case_is_exit_2(capsys):
 
 
 def test_cli_failure_is_exit_1(monkeypatch, capsys):
-    monkeypatch.setattr(stress, "model_state", lambda *a, **k: None)  # the NaN guard is gone
+    monkeypatch.setattr(cases, "model_state", lambda *a, **k: None)  # the NaN guard is gone
     assert main(["stress", "--quick", "--case", "NaN, inf, negative, zero"]) == 1
     out = capsys.readouterr().out
     assert "FAIL" in out and "1 case(s) FAIL" in out
@@ -155,22 +155,22 @@ class CartPushed(CartDoublePendulum):
 @pytest.mark.parametrize(
     "case",
     [
-        stress.checks_case(
-            "planted β", "mass ratio", lambda: stress.dp_link_mass_ratio(1e-6), model_cls=BetaOff
+        framework.checks_case(
+            "planted β", "mass ratio", lambda: framework.dp_link_mass_ratio(1e-6), model_cls=BetaOff
         ),
-        stress.checks_case(
-            "planted C", "length", lambda: stress.cart(l1=1e3, l2=1e3), model_cls=CartCoriolisSignFlip
+        framework.checks_case(
+            "planted C", "length", lambda: framework.cart(l1=1e3, l2=1e3), model_cls=CartCoriolisSignFlip
         ),
-        stress.checks_case("planted β km", "length", lambda: stress.dp_scaled(1e3), model_cls=BetaOff),
-        stress.large_angle_case("planted period", lambda: default_params("double_pendulum"), NotPeriodic),
-        stress.high_speed_case("planted NaN", lambda: default_params("double_pendulum"), NaNAtHighSpeed),
-        stress.stiff_sim_case(
-            "planted pump", lambda: stress.cart(d1=1e4, d2=1e4, d3=1e4), (0.0, 3.0, 3.4), EnergyPump
+        framework.checks_case("planted β km", "length", lambda: framework.dp_scaled(1e3), model_cls=BetaOff),
+        cases.large_angle_case("planted period", lambda: default_params("double_pendulum"), NotPeriodic),
+        cases.high_speed_case("planted NaN", lambda: default_params("double_pendulum"), NaNAtHighSpeed),
+        sim_cases.stiff_sim_case(
+            "planted pump", lambda: framework.cart(d1=1e4, d2=1e4, d3=1e4), (0.0, 3.0, 3.4), EnergyPump
         ),
-        stress.long_horizon_case("planted C long", model_cls=WrongCoriolis),
-        stress.zero_gravity_sim_case(
+        sim_cases.long_horizon_case("planted C long", model_cls=WrongCoriolis),
+        sim_cases.zero_gravity_sim_case(
             "planted push",
-            lambda: stress.cart(g=0.0, d1=0.0, d2=0.0, d3=0.0),
+            lambda: framework.cart(g=0.0, d1=0.0, d2=0.0, d3=0.0),
             (0, 0.3, -0.4),
             (0.5, 1, -2),
             0,
@@ -188,7 +188,7 @@ def test_planted_error_fails_its_case(ctx, case):
 
 def test_planted_large_angle_passes_at_small_angles(ctx):
     """The non-periodic term is invisible in the ordinary check: only the 2πk invariance sees it."""
-    case = stress.checks_case(
+    case = framework.checks_case(
         "small angles", "large angle", lambda: default_params("double_pendulum"), model_cls=NotPeriodic
     )
     assert stress.run_case(case, ctx).passed
@@ -196,7 +196,9 @@ def test_planted_large_angle_passes_at_small_angles(ctx):
 
 def test_without_the_guard_the_singular_cases_fail(monkeypatch, ctx):
     """Refusal is what keeps a 1e12-conditioned case from passing garbage: disable it, and it fails."""
-    monkeypatch.setattr(stress, "check_conditioning", lambda *a, **k: Conditioning(1.0, 1.0, 0.0, "ok", 1.0))
+    monkeypatch.setattr(
+        framework, "check_conditioning", lambda *a, **k: Conditioning(1.0, 1.0, 0.0, "ok", 1.0)
+    )
     for name in ("double pendulum l1 1e3 m, l2 1e-3 m", "cart rods 1e-3 m / 1e3 m"):
         result = stress.run_case(_case(name), ctx)
         assert not result.passed, name
@@ -205,7 +207,7 @@ def test_without_the_guard_the_singular_cases_fail(monkeypatch, ctx):
 
 def test_trust_study_fails_without_the_guard(monkeypatch):
     monkeypatch.setattr(near_singular, "assess", lambda *a, **k: Conditioning(1.0, 1.0, 1e-15, "ok", 1.0))
-    ctx = stress.Context(stress.QUICK)
+    ctx = framework.Context(framework.QUICK)
     result = stress.run_case(_case("cart m1 → 0: trust study"), ctx)
     assert not result.passed
     assert "m1 = 0: NOT refused" in result.invariant
@@ -216,7 +218,7 @@ def test_trust_study_fails_on_garbage_aba(monkeypatch):
 
     real = PinocchioSystem.acceleration
     monkeypatch.setattr(PinocchioSystem, "acceleration", lambda self, *a: real(self, *a) * (1 + 1e-9))
-    result = stress.run_case(_case("cart m1 → 0: trust study"), stress.Context(stress.QUICK))
+    result = stress.run_case(_case("cart m1 → 0: trust study"), framework.Context(framework.QUICK))
     assert not result.passed
     assert "measured" in result.note and "> bound" in result.note
 
@@ -225,7 +227,7 @@ def test_det_case_fails_on_a_cancelling_det(monkeypatch):
     monkeypatch.setattr(
         CartDoublePendulum, "det_mass_matrix", lambda self, y: float(np.linalg.det(self.mass_matrix(y)))
     )
-    result = stress.det_case(stress.Context(stress.QUICK), "det")
+    result = cases.det_case(framework.Context(framework.QUICK), "det")
     assert not result.passed and result.error > 1e-10
 
 
@@ -251,7 +253,7 @@ def test_conditioning_levels_and_scaling():
 
 def test_term_amplification_grows_with_the_square_of_the_lever_arm():
     params = default_params("cart_double_pendulum").replace(l1=1e-3, l2=1e-3)
-    model, system = CartDoublePendulum(params), stress.system_for(params)
+    model, system = CartDoublePendulum(params), framework.system_for(params)
     near, one, eight = (
         near_singular.term_amplification(model, system, np.array([x, 0.7, 0.7])) for x in (0.0, 1.0, 8.0)
     )
@@ -270,7 +272,7 @@ def test_reference_matches_the_closed_form():
 
     for name, q in (("cart_double_pendulum", [0.1, 0.7, -1.2]), ("double_pendulum", [0.3, 1.1])):
         params = default_params(name)
-        model = stress.MODELS[name](params)
+        model = MODELS[name](params)
         with mp.workdps(trust_study.REFERENCE_DIGITS):
             M = trust_study.reference_mass_matrix(params, q)
             ref = np.array([[float(M[i, j]) for j in range(M.cols)] for i in range(M.rows)])

@@ -151,16 +151,17 @@ def stress_items(model_name, params, settings: BatterySettings, urdf: str | None
     comparisons would need refusing (near-singular M) is not certified.  They run
     on ``urdf``, the URDF being certified (the project's own for the set if None).
     """
+    from pendverify.stress import cases, framework
     from pendverify.stress import catalogue as stress
 
-    ctx = stress.Context(stress.FULL, settings.seed, urdf=urdf)
+    ctx = framework.Context(framework.FULL, settings.seed, urdf=urdf)
     cases = [
         # at |θ| ≈ 1e6 rad a set with κ̃ in the hundreds is beyond the trust rule: such
         # states are refused and recorded, and every state that is compared must pass
-        stress.large_angle_case("large angles", lambda: params, expect="any"),
-        stress.high_speed_case("high speeds", lambda: params),
-        stress.checks_case("zero gravity", "gravity", lambda: params.replace(g=0.0)),
-        stress.checks_case("conditioning", "conditioning", lambda: params),
+        cases.large_angle_case("large angles", lambda: params, expect="any"),
+        cases.high_speed_case("high speeds", lambda: params),
+        framework.checks_case("zero gravity", "gravity", lambda: params.replace(g=0.0)),
+        framework.checks_case("conditioning", "conditioning", lambda: params),
     ]
     items = []
     for case in cases:

@@ -134,7 +134,8 @@ def run(args: argparse.Namespace) -> int:
     from pendverify.atomic import write_atomic
     from pendverify.errors import UnknownNameError
     from pendverify.jsonio import to_json
-    from pendverify.stress.catalogue import CASE_NAMES, FULL, QUICK, SEED, run_catalogue
+    from pendverify.stress.catalogue import CASE_NAMES, run_catalogue
+    from pendverify.stress.framework import FULL, QUICK, SEED
 
     for name in args.case or ():
         if name not in CASE_NAMES:

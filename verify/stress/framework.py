@@ -1,0 +1,315 @@
+"""The stress framework: results, settings, the guarded comparison and the parameter sets.
+
+The cases live in ``pendverify.stress.cases`` (states and parameters) and
+``pendverify.stress.sim_cases`` (simulations); ``pendverify.stress.catalogue`` lists them.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from pendverify.analytic import MODELS, CartDoublePendulumParams, DoublePendulumParams
+from pendverify.analytic.params import default_parameter_file, load_parameter_file
+from pendverify.checks.catalogue import CHECKS, EPS, Check, Sample, applicable_checks, run_check
+from pendverify.checks.sampling import DEFAULT_SEED, State, sample_states
+from pendverify.checks.trust import IllConditionedError, check_conditioning
+from pendverify.robot.system import PinocchioSystem
+from pendverify.stress.trust_study import StudyResult, trust_study
+from pendverify.validate import model_state
+
+SEED = DEFAULT_SEED
+TINY = float(np.finfo(float).tiny)
+ANGLE_SHIFT = 1e6  # rad: large-angle states sit near ±ANGLE_SHIFT
+HIGH_RATE = 1e3  # rad/s (m/s for the cart): the largest rate of the high-speed states
+STIFF_DAMPING = 1e4  # N·m·s/rad (N·s/m on the cart)
+ENERGY_INCREASE_TOL = 1e-12  # largest allowed per-step energy rise, relative to the energy scale
+BOUNDED_GROWTH = 1.5  # symplectic: late-half max |ΔE| ≤ this × early-half max |ΔE|
+MIN_R2 = 0.9  # RK4's energy error must be this close to a straight line in t
+MIN_ORDER_RATIO = 10.0  # RK4 drift slope at h over slope at h/2 (2⁴ = 16 for order 4)
+MOMENTUM_K = 64  # cyclic momentum: allowed drift per step, in ε times |p|scale
+RK4_UNSTABLE = 2.0  # |R(hλ)| above this predicts an RK4 blow-up
+DP_DET_MASSES = (1e-3, 1e-6, 1e-9)  # kg, m1 of the point-mass double pendulum in the det comparison
+ORDER_FRACTION = 0.2  # share of the long horizon over which RK4 at h/2 measures its slope
+
+
+@dataclass
+class StressResult:
+    """One row of the catalogue: the evidence of one hard case."""
+
+    case: str
+    quantity: str
+    error: float | None
+    tolerance: float | None
+    kappa_raw: float | None
+    kappa_scaled: float | None
+    invariant: str | None
+    passed: bool
+    note: str = ""
+    #: worst conditioning verdict over the accepted states: ok, warn (fewer digits)
+    level: str = "ok"
+    refused: int = 0
+    seed: int = SEED
+    seconds: float = 0.0
+
+    @property
+    def verdict(self) -> str:
+        """FAIL; refused (as the case expects: no state could be verified); or pass, with qualifiers."""
+        if not self.passed:
+            return "FAIL"
+        if self.level == "refuse":
+            return "refused"
+        extra = (["warn"] if self.level == "warn" else []) + (
+            [f"{self.refused} refused"] if self.refused else []
+        )
+        return f"pass ({', '.join(extra)})" if extra else "pass"
+
+    def as_dict(self) -> dict:
+        d = dataclasses.asdict(self)
+        d["verdict"] = self.verdict
+        return d
+
+
+@dataclass(frozen=True)
+class Settings:
+    """Sizes of the catalogue; ``QUICK`` keeps every case but shortens the work."""
+
+    random_states: int = 24
+    long_horizon: float = 1e4  # s
+    long_step: float = 2.0  # s
+    stiff_horizon: float = 10.0  # s
+    stiff_step: float = 0.05  # s
+    explicit_horizon: float = 2e-3  # s of RK45 on the stiff system
+    zero_g_steps: int = 1000
+    zero_g_step: float = 0.01  # s
+    study_masses: tuple[float, ...] = tuple(10.0**-k for k in range(17))
+
+
+FULL = Settings()
+QUICK = Settings(
+    random_states=6,
+    long_horizon=2e3,
+    stiff_horizon=2.0,
+    explicit_horizon=5e-4,
+    zero_g_steps=300,
+    study_masses=(1.0, 1e-4, 1e-7, 1e-8, 1e-12, 1e-16),
+)
+
+
+@dataclass
+class Context:
+    settings: Settings = FULL
+    seed: int = SEED
+    study: StudyResult | None = None
+    #: the URDF (text or path) the cases compare with; None: the one the project writes for each set
+    urdf: str | None = None
+
+    def system(self, params):
+        """Pinocchio's side for a parameter set: ``urdf`` if given (the battery's), else the project's."""
+        if self.urdf is None:
+            return system_for(params)
+        return PinocchioSystem.for_model(MODELS[params.model], self.urdf, params.g, "<URDF being certified>")
+
+    def trust_study(self) -> StudyResult:
+        if self.study is None:
+            self.study = trust_study(default("cart_double_pendulum"), self.settings.study_masses)
+        return self.study
+
+
+@dataclass(frozen=True)
+class Case:
+    name: str
+    group: str
+    run: Callable[[Context, str], StressResult]
+
+
+# --- parameter sets --------------------------------------------------------------------------
+def default(model: str):
+    return load_parameter_file(default_parameter_file(model))[2]
+
+
+def dp_scaled(length: float = 1.0, **changes) -> DoublePendulumParams:
+    """The default double pendulum with every length × ``length`` (inertias × length²)."""
+    p = default("double_pendulum")
+    s = length
+    p = p.replace(l1=p.l1 * s, l2=p.l2 * s, r1=p.r1 * s, r2=p.r2 * s, I1=p.I1 * s * s, I2=p.I2 * s * s)
+    return p.replace(**changes)
+
+
+def dp_link_mass_ratio(ratio: float) -> DoublePendulumParams:
+    """m1/m2 = ratio (m2 kept); link 1's inertia scales with its mass."""
+    p = default("double_pendulum")
+    return p.replace(m1=ratio * p.m2, I1=p.I1 * ratio * p.m2 / p.m1)
+
+
+def dp_link_lengths(s1: float, s2: float) -> DoublePendulumParams:
+    p = default("double_pendulum")
+    return p.replace(l1=p.l1 * s1, r1=p.r1 * s1, I1=p.I1 * s1**2, l2=p.l2 * s2, r2=p.r2 * s2, I2=p.I2 * s2**2)
+
+
+def cart(**changes) -> CartDoublePendulumParams:
+    return default("cart_double_pendulum").replace(**changes)
+
+
+# --- comparing closed form and Pinocchio --------------------------------------------------------
+def system_for(params):
+    return PinocchioSystem.for_params(params)
+
+
+# Terms the core checks' scales leave out (to be moved into ``pendverify.checks.catalogue``):
+#  * the closed forms may build the friction-free C as (seed's C) − D, so C, C·q̇ and Ṁ − 2C
+#    carry rounding of size ε·|D̃| (the double pendulum at b = 1e4, or at b = 0.05 on a 1 mm
+#    scale, where β·θ̇ ≪ b);
+#  * Pinocchio's rounding is ε times its world-frame terms, A times the result
+#    (``pendverify.checks.trust.term_amplification``), added as an allowance K·ε·(A − 1)·scale,
+#    so that it adds to the angle's rounding rather than multiplying it;
+#  * a scale of 0 (g = 0 at rest): the quantity must then be exactly 0.
+_FRICTION_TERMS = {"coriolis": "matrix", "skew": "matrix", "rnea": "force"}
+
+
+def _friction_scale(model, state, kind: str) -> float:
+    w = 1.0 / np.sqrt(model.diagonal_scale(state.q))
+    D = np.abs(model.damping_matrix()) * np.outer(w, w)
+    if kind == "matrix":
+        return float(np.max(D))
+    return float(np.max(D @ np.abs(state.v / w)))
+
+
+def guarded(check: Check, amplification: Callable[[State], float]) -> Check:
+    """A core check with the scale terms above added; ``amplification(state)`` gives A."""
+    kind = _FRICTION_TERMS.get(check.name)
+
+    def evaluate(model, system, state):
+        s = check.evaluate(model, system, state)
+        scale = s.scale + (_friction_scale(model, state, kind) if kind else 0.0)
+        if not scale > 0:
+            return Sample(s.error, 1.0 if s.error == 0 else TINY, s.allowance, s.note)
+        extra = check.K * EPS * (amplification(state) - 1.0) * scale
+        return Sample(s.error, scale, s.allowance + extra, s.note)
+
+    return dataclasses.replace(check, evaluate=evaluate)
+
+
+def _ratio(r) -> float:
+    return r.max_error / r.tolerance if r.tolerance > 0 else math.inf
+
+
+@dataclass
+class _Comparison:
+    results: list
+    kept: int
+    refused: list[str]
+    kappa_raw: float
+    kappa_scaled: float
+    amplification: float
+    level: str
+
+
+def compare(name: str, model, system, states: list[State], seed: int) -> _Comparison:
+    """Guard every state (validity, conditioning), then run the nine checks on the accepted ones."""
+    kept, refused, factor = [], [], {}
+    kappa_raw = kappa_scaled = amplification = 0.0
+    level = "ok"
+    for s in states:
+        model_state(model, s.q, s.v, s.u, s.w, source=f"<{name}: {s.label}>")
+        try:
+            c = check_conditioning(model, s.q, system, what=name)
+        except IllConditionedError as exc:
+            refused.append(str(exc))
+            continue
+        kept.append(s)
+        factor[id(s)] = c.amplification
+        kappa_raw, kappa_scaled = max(kappa_raw, c.kappa_raw), max(kappa_scaled, c.kappa_scaled)
+        amplification = max(amplification, c.amplification)
+        level = "warn" if c.level == "warn" else level
+    names = applicable_checks(model, system)
+    checks = [guarded(c, lambda state: factor[id(state)]) for c in CHECKS if c.name in names]
+    with np.errstate(all="ignore"):
+        results = [run_check(c, name, model, system, kept, seed) for c in checks] if kept else []
+    return _Comparison(results, len(kept), refused, kappa_raw, kappa_scaled, amplification, level)
+
+
+#: What a case expects of the trust rule: no refusal, some states refused (and some
+#: verified), every state refused, or whatever (at least one state verified).
+EXPECT = ("none", "some", "all", "any")
+
+
+def _refusals_ok(comp: _Comparison, expect: str) -> bool:
+    refused, kept = len(comp.refused), comp.kept
+    return {
+        "none": refused == 0,
+        "some": refused > 0 and kept > 0,
+        "all": kept == 0 and refused > 0,
+        "any": kept > 0,
+    }[expect]
+
+
+def _result_from(name, comp: _Comparison, expect: str = "none", invariant=None, extra_ok=True, note=""):
+    notes = [note] if note else []
+    failed = [r for r in comp.results if not r.passed]
+    if comp.results:
+        worst = max(comp.results, key=_ratio)
+        error, tolerance = worst.max_error, worst.tolerance
+        quantity = f"{worst.check} (worst of {len(comp.results)} checks, {comp.kept} states)"
+        if failed:
+            notes.append(
+                "FAIL "
+                + ", ".join(
+                    f"{r.check} {r.max_error:.2g} > {r.tolerance:.2g} at {r.worst_state['label']}"
+                    for r in failed
+                )
+            )
+    else:
+        error = tolerance = None
+        quantity = "no state verified"
+    if comp.refused:
+        notes.append(
+            f"refused {len(comp.refused)} of {len(comp.refused) + comp.kept} states, e.g. {comp.refused[0]}"
+        )
+    refusals_ok = _refusals_ok(comp, expect)
+    if not refusals_ok:
+        notes.append(
+            f"refusals: expected {expect!r}, got {len(comp.refused)} of {len(comp.refused) + comp.kept}"
+        )
+    return StressResult(
+        case=name,
+        quantity=quantity,
+        error=error,
+        tolerance=tolerance,
+        kappa_raw=comp.kappa_raw if comp.kept else None,
+        kappa_scaled=comp.kappa_scaled if comp.kept else None,
+        invariant=invariant,
+        passed=not failed and refusals_ok and extra_ok,
+        note="; ".join(notes),
+        level="refuse" if comp.kept == 0 else comp.level,
+        refused=len(comp.refused),
+    )
+
+
+def _model(params, model_cls=None):
+    """The closed-form model of a parameter set (``model_cls`` plants a different one, for tests)."""
+    return (model_cls or MODELS[params.model])(params)
+
+
+def _states(model, ctx: Context) -> list[State]:
+    return sample_states(model, ctx.settings.random_states, ctx.seed)
+
+
+def checks_case(
+    name: str, group: str, params_fn, expect: str = "none", extra_states=None, model_cls=None
+) -> Case:
+    if expect not in EXPECT:
+        raise ValueError(f"expect must be one of {EXPECT}")
+
+    def run(ctx: Context, name: str) -> StressResult:
+        params = params_fn()
+        model = _model(params, model_cls)
+        states = _states(model, ctx) + (extra_states(model) if extra_states else [])
+        comp = compare(name, model, ctx.system(params), states, ctx.seed)
+        return _result_from(name, comp, expect)
+
+    return Case(name, group, run)
