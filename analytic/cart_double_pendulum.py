@@ -205,6 +205,16 @@ class CartDoublePendulum(ClosedFormModel):
             power=(u[0] + w[0]) * qd + w[1] * t1 + w[2] * t2,
         )
 
+    def derived_constants(self) -> dict[str, float]:
+        """The coefficients of M: m + m1 + m2, l1·(m1 + m2), m2·l2, and det M at upright."""
+        p = self.params
+        return {
+            "m_total": p.m + p.m1 + p.m2,
+            "l1_m1_plus_m2": p.l1 * (p.m1 + p.m2),
+            "m2_l2": p.m2 * p.l2,
+            "det_M_upright": self.det_mass_matrix(np.zeros(3)),
+        }
+
     def special_states(self):
         pi = math.pi
         return {

@@ -104,6 +104,10 @@ class DoublePendulum(ClosedFormModel):
     #: (``pendverify.robot.seed_geometry``)
     geometry_reader = "double_pendulum"
 
+    def derived_constants(self) -> dict[str, float]:
+        """α, β, δ of the seed's appendix."""
+        return {"alpha": self.alpha, "beta": self.beta, "delta": self.delta}
+
     # --- the appendix constants ------------------------------------------------------
     @property
     def alpha(self) -> float:

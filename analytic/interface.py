@@ -209,6 +209,10 @@ class ClosedFormModel(ABC):
         """Named configurations every check visits (upright, folded, aligned...)."""
 
     # --- optional hooks ------------------------------------------------------------------
+    def derived_constants(self) -> dict[str, float]:
+        """Named constants the closed forms are built from (recorded in certificates); none by default."""
+        return {}
+
     def energies(self, q, v, u, w) -> Energies | None:
         """T, V, R and the input power, for the SymPy derivation; None if not given.
 

@@ -32,8 +32,6 @@ from __future__ import annotations
 import hashlib
 from datetime import datetime, timezone
 
-import numpy as np
-
 from pendverify.analytic import MODELS, ParameterSet
 from pendverify.certify.battery import BatteryItem, BatterySettings
 from pendverify.errors import PendverifyError
@@ -56,16 +54,8 @@ def digest_of(cert: dict) -> str:
 
 
 def derived_constants(model_name: str, params: ParameterSet) -> dict[str, float]:
-    model = MODELS[model_name](params)
-    if model_name == "double_pendulum":
-        return {"alpha": model.alpha, "beta": model.beta, "delta": model.delta}
-    p = params
-    return {
-        "m_total": p.m + p.m1 + p.m2,
-        "l1_m1_plus_m2": p.l1 * (p.m1 + p.m2),
-        "m2_l2": p.m2 * p.l2,
-        "det_M_upright": model.det_mass_matrix(np.zeros(3)),
-    }
+    """The model's own derived constants (``ClosedFormModel.derived_constants``)."""
+    return {k: float(v) for k, v in MODELS[model_name](params).derived_constants().items()}
 
 
 def build_certificate(

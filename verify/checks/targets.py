@@ -27,6 +27,7 @@ from pendverify.analytic.params import (
 )
 from pendverify.analytic.plugin import load_model_class
 from pendverify.errors import ParameterError, PendverifyError, UnknownNameError
+from pendverify.robot.erd import MODEL as ERD_MODEL
 from pendverify.robot.erd import double_pendulum_urdfs
 from pendverify.robot.seed_geometry import DEFAULT_G
 from pendverify.robot.system import PinocchioSystem
@@ -63,7 +64,7 @@ def default_target(model_name: str) -> Target:
 
 def erd_targets() -> list[Target]:
     targets = []
-    cls = _model_class("double_pendulum")
+    cls = _model_class(ERD_MODEL)
     for stem, path in double_pendulum_urdfs().items():
         system = PinocchioSystem.for_model(cls, path)
         model = cls(system.geometry.params)

@@ -45,6 +45,7 @@ def run(args: argparse.Namespace) -> int:
     from pendverify.checks.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
     from pendverify.checks.targets import default_target, erd_targets, plugin_target, user_target
     from pendverify.checks.verification import build_report
+    from pendverify.robot.erd import MODEL as ERD_MODEL
     from pendverify.robot.geometry import MODEL_FORM_RTOL
 
     samples = DEFAULT_RANDOM_STATES if args.samples is None else args.samples
@@ -56,7 +57,7 @@ def run(args: argparse.Namespace) -> int:
         targets = [user_target(args.model, args.urdf, args.params)]
     else:
         targets = [default_target(name) for name in names]
-        if args.erd and (args.model in (None, "double_pendulum")):
+        if args.erd and (args.model in (None, ERD_MODEL)):
             targets += erd_targets()
     rtol = MODEL_FORM_RTOL if args.model_form_rtol is None else args.model_form_rtol
     report = build_report(targets, samples, seed, strict=args.strict, model_form_rtol=rtol)

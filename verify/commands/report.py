@@ -34,11 +34,12 @@ def register(sub) -> None:
 
 def check_report(samples: int | None, seed: int | None, erd: bool):
     """The report ``pendverify check`` prints with its default targets."""
+    from pendverify.analytic import MODELS
     from pendverify.checks.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
     from pendverify.checks.targets import default_target, erd_targets
     from pendverify.checks.verification import build_report
 
-    targets = [default_target(name) for name in ("double_pendulum", "cart_double_pendulum")]
+    targets = [default_target(name) for name in MODELS]
     if erd:
         targets += erd_targets()
     return build_report(

@@ -13,6 +13,8 @@ from pathlib import Path
 from pendverify.errors import PendverifyError
 
 DISTRIBUTION = "example-robot-data"
+#: the built-in model whose family example-robot-data's double-pendulum URDFs belong to
+MODEL = "double_pendulum"
 DOUBLE_PENDULUM_DIR = "double_pendulum_description/urdf"
 
 

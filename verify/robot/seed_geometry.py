@@ -159,13 +159,15 @@ def double_pendulum_geometry(model: pin.Model, source: str, g: float | None = No
     model_form = None
     if d1 != 0.0:
         # |ΔH1| = m1·g·|(r1 − r_along) cos θ1 + d1 sin θ1| ≤ m1·g·|c1 − seed's c1|
-        allowance = np.array([params.m1 * g * math.hypot(r1 - r1_along, d1), 0.0])
-        h1_scale = g * (params.m1 * params.r1 + params.m2 * (params.l1 + params.r2))
+        offset = math.hypot(r1 - r1_along, d1)
+        allowance = np.array([params.m1 * g * offset, 0.0])
+        # relative to H1's size g·(m1 r1 + m2 (l1 + r2)); g cancels, so g = 0 is no special case
+        relative = params.m1 * offset / (params.m1 * params.r1 + params.m2 * (params.l1 + params.r2))
         model_form = ModelForm(
             f"link 1's centre of mass is {abs(d1):.3g} m off the joint-1→joint-2 line "
             f"({math.atan2(d1, r1_along):.2g} rad); the seed's H has no term for it: "
             f"up to m1·g·|offset| = {allowance[0]:.3g} N·m on H1",
-            float(allowance[0] / h1_scale),
+            float(relative),
             allowance,
         )
     if gamma1 != 0.0 or psi2 != gamma1 or sign2 < 0:
