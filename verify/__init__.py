@@ -1,3 +1,61 @@
-"""pendverify: checks hand-derived pendulum dynamics against their URDF in Pinocchio."""
+"""pendverify: checks hand-derived pendulum dynamics against their URDF in Pinocchio.
+
+The Python API (``pendverify.api``, ``pendverify.testing``)::
+
+    import pendverify
+
+    report = pendverify.check("double_pendulum")     # a CheckReport; print(report) gives the CLI's table
+    run = pendverify.simulate("scenes/damped_double_pendulum.toml")
+
+The names below are imported on first use, so ``import pendverify`` stays cheap: it imports
+neither Pinocchio nor SymPy.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
 
 __version__ = "0.1.0"
+
+#: public name -> the module that defines it, imported when the name is first used
+_LAZY = {
+    "check": "pendverify.api",
+    "load_model": "pendverify.api",
+    "load_params": "pendverify.api",
+    "load_urdf": "pendverify.api",
+    "simulate": "pendverify.api",
+    "CheckReport": "pendverify.api",
+    "assert_verified": "pendverify.testing",
+    "PendverifyError": "pendverify.errors",
+}
+
+__all__ = [
+    "CheckReport",
+    "PendverifyError",
+    "__version__",
+    "assert_verified",
+    "check",
+    "load_model",
+    "load_params",
+    "load_urdf",
+    "simulate",
+]
+
+if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
+    from pendverify.api import CheckReport, check, load_model, load_params, load_urdf, simulate
+    from pendverify.errors import PendverifyError
+    from pendverify.testing import assert_verified
+
+
+def __getattr__(name: str) -> Any:
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'pendverify' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})

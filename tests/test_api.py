@@ -1,0 +1,328 @@
+"""The Python API (``pendverify.check``, ``simulate``, ``load_*``, ``pendverify.testing``).
+
+It goes through the functions the CLI calls, so its table is the CLI's; a model class
+written here with a planted error fails, and ``assert_verified`` shows the table; bad
+input is a one-line ``PendverifyError``; ``import pendverify`` does not load Pinocchio.
+"""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import pendverify
+from pendverify.analytic import DoublePendulum, DoublePendulumParams
+from pendverify.analytic.params import default_parameter_file, load_parameter_file, read_toml
+from pendverify.checks.report import Report
+from pendverify.checks.targets import committed_urdf
+from pendverify.cli import main
+from pendverify.errors import PendverifyError
+from pendverify.robot.system import PinocchioSystem
+from pendverify.robot.writer import urdf_for
+from pendverify.testing import assert_verified
+
+REPO = Path(__file__).resolve().parents[1]
+EXAMPLES = REPO / "examples"
+SCENES = REPO / "scenes"
+CART_POLE = (EXAMPLES / "cart_pole.py", EXAMPLES / "cart_pole.urdf", EXAMPLES / "cart_pole.toml")
+FEW = 60  # random states where the test is about the API, not the breadth of the sample
+TIMING = re.compile(r", \d+\.\d+ s: ")
+
+
+def default_values(name: str = "double_pendulum") -> dict[str, float]:
+    return load_parameter_file(default_parameter_file(name))[2].as_dict()
+
+
+def comparable(table: str) -> list[str]:
+    """The table's lines, with the time taken (the only figure that differs between runs) blanked."""
+    return [TIMING.sub(", … s: ", line) for line in table.splitlines()]
+
+
+def cli_table(capsys, *argv: str) -> tuple[int, str]:
+    status = main(["check", *argv])
+    return status, capsys.readouterr().out.rstrip("\n")
+
+
+# --- check --------------------------------------------------------------------------------------------
+def test_check_builtin_name_gives_the_cli_table(capsys):
+    report = pendverify.check("double_pendulum")
+    assert isinstance(report, pendverify.CheckReport) and isinstance(report, Report)
+    assert report.passed and report.status == "pass"
+    assert str(report) == report.table()
+    # the evidence: every check, its error within its tolerance, where it was worst
+    assert {r.check for r in report.results} >= {"crba", "rnea", "coriolis", "aba", "energy"}
+    for r in report.results:
+        assert r.model == "double_pendulum" and r.status == "pass"
+        assert 0 <= r.max_error <= r.tolerance < 1e-11, r
+        assert r.worst_state["label"]
+    assert report.states == {"double_pendulum": 410} and report.seed == 20260301
+
+    status, cli = cli_table(capsys, "--model", "double_pendulum", "--no-erd")
+    assert status == 0
+    api_lines, cli_lines = report.table().splitlines(), cli.splitlines()
+    assert TIMING.search(cli_lines[-1]) and TIMING.search(api_lines[-1])
+    assert api_lines[:-1] == cli_lines[:-1]  # every line but the timing line, verbatim
+    assert comparable(report.table()) == comparable(cli)
+
+
+def test_plugin_file_with_its_urdf_and_parameters_passes_as_on_the_cli(capsys):
+    report = assert_verified(*CART_POLE, samples=FEW)
+    assert report.passed and {r.model for r in report.results} == {"cart_pole:cart_pole"}
+    model, urdf, params = (str(p) for p in CART_POLE)
+    status, cli = cli_table(
+        capsys, "--analytic", model, "--urdf", urdf, "--params", params, "--samples", str(FEW)
+    )
+    assert status == 0
+    assert comparable(report.table()) == comparable(cli)
+
+    # the same model as a class and its parameters as a mapping: the same figures
+    cls = pendverify.load_model(CART_POLE[0])
+    assert pendverify.load_model(cls) is cls
+    values = read_toml(CART_POLE[2])["parameters"]
+    again = pendverify.check(cls, str(CART_POLE[1]), values, samples=FEW)
+    assert [(r.check, r.max_error, r.status) for r in again.results] == [
+        (r.check, r.max_error, r.status) for r in report.results
+    ]
+
+
+def test_builtin_with_parameters_from_a_file_a_mapping_or_urdf_text():
+    by_file = pendverify.check(
+        "double_pendulum", params=default_parameter_file("double_pendulum"), samples=FEW
+    )
+    assert by_file.passed and by_file.states == {"double_pendulum:double_pendulum": FEW + 10}
+    by_mapping = pendverify.check("double_pendulum", params=default_values(), samples=FEW)
+    assert by_mapping.passed and list(by_mapping.states) == ["double_pendulum:inline"]
+    params = pendverify.load_params(DoublePendulum, default_values())
+    assert isinstance(params, DoublePendulumParams)
+    by_text = pendverify.check(DoublePendulum, urdf_for(params), params, samples=FEW)
+    assert by_text.passed and list(by_text.states) == ["double_pendulum:urdf-text"]
+    assert [r.max_error for r in by_mapping.results] == [r.max_error for r in by_file.results]
+
+
+def test_load_urdf_gives_pinocchio_in_the_models_coordinates():
+    params = pendverify.load_params("double_pendulum", default_parameter_file("double_pendulum"))
+    system = pendverify.load_urdf("double_pendulum", committed_urdf("double_pendulum"), params.g)
+    assert isinstance(system, PinocchioSystem)
+    q = np.array([0.4, -1.1])
+    np.testing.assert_allclose(system.mass_matrix(q), DoublePendulum(params).mass_matrix(q), rtol=1e-13)
+    np.testing.assert_allclose(system.gravity(q), DoublePendulum(params).gravity(q), rtol=1e-13)
+
+
+# --- a model class written here, with its map declared as a plug-in's ----------------------------------
+class SignFlipParams(DoublePendulumParams):
+    model = "sign_flip"
+
+
+class SignFlip(DoublePendulum):
+    """The seed with a declared coordinate map; ``flip`` plants a sign error in one Coriolis term."""
+
+    name = "sign_flip"
+    params_type = SignFlipParams
+    geometry_reader = ""  # declare the map, as a plug-in does
+    urdf_joints = ("joint1", "joint2")
+    joint_offset = (0.0, 0.0)
+    flip = True
+
+    def seed_coriolis_matrix(self, q, v):
+        C = super().seed_coriolis_matrix(q, v)
+        if self.flip:
+            C[1, 0] = -C[1, 0]  # β sin θ2 θ̇1 written as −β sin θ2 θ̇1
+        return C
+
+
+class Unflipped(SignFlip):
+    flip = False
+
+
+def test_a_planted_coriolis_sign_error_fails_and_assert_verified_shows_the_table():
+    urdf, values = committed_urdf("double_pendulum"), default_values()
+    control = assert_verified(Unflipped, urdf, values, samples=FEW)  # the map is right: all pass
+    assert "coordinate map declared by Unflipped" in control.table()
+
+    report = pendverify.check(SignFlip, urdf, values, samples=FEW)
+    assert not report.passed and report.status == "fail"
+    failed = {r.check for r in report.failures()}
+    assert {"rnea", "aba"} <= failed
+    assert "crba" not in failed and "gravity" not in failed
+    assert "FAIL" in report.table()
+
+    with pytest.raises(AssertionError) as caught:
+        assert_verified(SignFlip, urdf, values, samples=FEW)
+    message = str(caught.value)
+    assert comparable(message) == comparable(report.table())
+    assert "FAIL" in message and "sign_flip:double_pendulum" in message
+    assert re.search(r"sign_flip:double_pendulum\s+rnea .* FAIL", message)
+
+
+def test_strict_turns_a_warning_into_a_failure():
+    class TextbookC(Unflipped):
+        """A published C: the same C·q̇, but Ṁ − 2C is not skew-symmetric."""
+
+        def seed_coriolis_matrix(self, q, v):
+            b, s = self.beta, self.math.sin(q[1])
+            return np.array(
+                [[-2 * b * s * v[1] + self.params.b1, -b * s * v[1]], [b * s * v[0], self.params.b2]]
+            )
+
+    urdf, values = committed_urdf("double_pendulum"), default_values()
+    warned = assert_verified(TextbookC, urdf, values, samples=FEW)
+    assert warned.status == "warn" and warned.warnings
+    assert "not the Christoffel C" in warned.table() and "FAIL" not in warned.table()
+    with pytest.raises(AssertionError) as caught:
+        assert_verified(TextbookC, urdf, values, samples=FEW, strict=True)
+    assert "not the Christoffel C" in str(caught.value)
+    assert re.search(r"\s+coriolis .* FAIL", str(caught.value))
+
+
+# --- simulate -------------------------------------------------------------------------------------------
+def test_simulate_a_scene_file_returns_a_trajectory_whose_invariants_hold():
+    run = pendverify.simulate(SCENES / "damped_double_pendulum.toml")
+    assert run.passed and run.invariants and all(i.passed for i in run.invariants)
+    assert run.t[0] == 0.0 and run.t[-1] == pytest.approx(10.0)
+    assert run.q.shape == run.v.shape == (len(run.t), 2)
+    assert np.all(np.diff(run.energy) <= 1e-9 * np.max(np.abs(run.energy)))  # damped: E never rises
+
+
+def test_simulate_a_scene_mapping_with_both_engines():
+    scene = {
+        "name": "inline swing",
+        "model": "double_pendulum",
+        "initial": {"q": [0.3, 1.2]},
+        "time": {"duration": 1.0, "sample_rate": 50.0},
+        "integrator": {"method": "DOP853", "rtol": 1e-10, "atol": 1e-10},
+        "effects": {"gravity": True},
+    }
+    run = pendverify.simulate(scene, engine="both")
+    assert run.passed and run.engine_comparison is not None and run.engine_comparison.passed
+    assert len(run.t) == 51
+
+
+# --- bad input: one line, a PendverifyError -------------------------------------------------------------
+SYNTAX_ERROR = "import numpy\ndef broken(:\n"
+
+BAD_INPUTS = {
+    "unknown name": (lambda tmp: pendverify.check("tripple_pendulum"), "unknown model 'tripple_pendulum'"),
+    "missing model file": (lambda tmp: pendverify.check(tmp / "mine.py", "x.urdf"), "model file not found"),
+    "model file with a syntax error": (
+        lambda tmp: pendverify.load_model(_write(tmp / "bad.py", SYNTAX_ERROR)),
+        "bad.py, line 2: importing it failed",
+    ),
+    "not a model": (lambda tmp: pendverify.load_model(42), "got a int"),
+    "not a model class": (lambda tmp: pendverify.load_model(dict), "not a subclass"),
+    "plug-in without a URDF": (lambda tmp: pendverify.check(CART_POLE[0]), "give urdf"),
+    "negative samples": (lambda tmp: pendverify.check("double_pendulum", samples=-1), "'samples' = -1"),
+    "zero model-form rtol": (
+        lambda tmp: pendverify.check("double_pendulum", model_form_rtol=0.0),
+        "must be a finite number > 0",
+    ),
+    "a parameter document instead of the mapping": (
+        lambda tmp: pendverify.load_params("double_pendulum", {"parameters": default_values()}),
+        "key 'parameters'",
+    ),
+    "negative mass": (
+        lambda tmp: pendverify.load_params("double_pendulum", {**default_values(), "m1": -1.0}),
+        "key 'm1' = -1.0: a mass must be a finite number > 0",
+    ),
+    "missing parameter": (
+        lambda tmp: pendverify.load_params("double_pendulum", {"m1": 1.0}),
+        "missing key",
+    ),
+    "missing parameter file": (
+        lambda tmp: pendverify.check("double_pendulum", params=tmp / "none.toml"),
+        "file not found",
+    ),
+    "another model's parameter file": (
+        lambda tmp: pendverify.load_params(CART_POLE[0], default_parameter_file("double_pendulum")),
+        "must be 'cart_pole'",
+    ),
+    "another model's parameter set": (
+        lambda tmp: pendverify.load_params(SignFlip, DoublePendulumParams(**default_values())),
+        "sign_flip needs SignFlipParams",
+    ),
+    "missing URDF": (
+        lambda tmp: pendverify.load_urdf("double_pendulum", tmp / "none.urdf"),
+        "file not found",
+    ),
+    "non-finite gravity": (
+        lambda tmp: pendverify.load_urdf("double_pendulum", committed_urdf("double_pendulum"), float("nan")),
+        "key 'g' = nan",
+    ),
+    "malformed URDF text": (
+        lambda tmp: pendverify.check("double_pendulum", '<robot name="x"><link name="a"/>'),
+        "<urdf text>: malformed XML",
+    ),
+    "URDF and parameters of different models": (
+        lambda tmp: pendverify.check(CART_POLE[0], committed_urdf("double_pendulum"), CART_POLE[2]),
+        "do not match the URDF's movable joints",
+    ),
+    "missing scene": (lambda tmp: pendverify.simulate(tmp / "none.toml"), "scene file not found"),
+    "invalid scene": (
+        lambda tmp: pendverify.simulate(
+            {"model": "double_pendulum", "initial": {"q": [0, 0]}, "time": {"duration": -1.0}}
+        ),
+        "key 'time.duration' = -1.0",
+    ),
+    "unknown engine": (
+        lambda tmp: pendverify.simulate(SCENES / "damped_double_pendulum.toml", engine="euler"),
+        "unknown engine 'euler'",
+    ),
+    "a URDF for the closed form engine": (
+        lambda tmp: pendverify.simulate(
+            SCENES / "damped_double_pendulum.toml", committed_urdf("double_pendulum"), "closed_form"
+        ),
+        "does not use a URDF",
+    ),
+}
+
+
+def _write(path: Path, text: str) -> Path:
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize("case", BAD_INPUTS, ids=list(BAD_INPUTS))
+def test_bad_input_is_one_line_pendverify_error(tmp_path, case):
+    call, expected = BAD_INPUTS[case]
+    with pytest.raises(PendverifyError) as caught:
+        call(tmp_path)
+    message = str(caught.value)
+    assert "\n" not in message and expected in message, message
+
+
+def test_a_bad_input_is_not_an_assertion():
+    with pytest.raises(PendverifyError):
+        assert_verified("double_pendulum", params={"m1": 1.0})
+
+
+# --- import cost ----------------------------------------------------------------------------------------
+def test_import_pendverify_does_not_import_pinocchio_or_sympy():
+    script = textwrap.dedent(
+        """
+        import sys
+        import pendverify
+        heavy = {"pinocchio", "sympy", "scipy"} & set(sys.modules)
+        assert not heavy, heavy
+        assert pendverify.__version__ and "check" in dir(pendverify)
+        assert isinstance(pendverify.PendverifyError("x"), Exception)
+        assert "pinocchio" not in sys.modules
+        try:
+            pendverify.no_such_name
+        except AttributeError:
+            pass
+        else:
+            raise SystemExit("no AttributeError")
+        from pendverify import commands  # submodules still import as before
+        assert callable(pendverify.check) and "pinocchio" in sys.modules
+        assert all(getattr(pendverify, name) is not None for name in pendverify.__all__)
+        print("ok")
+        """
+    )
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "ok"

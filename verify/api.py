@@ -1,0 +1,303 @@
+"""pendverify as a Python library: the calls behind ``pendverify check`` and ``simulate``, without the CLI.
+
+Everything here composes the functions the commands call (``pendverify.checks.targets``,
+``pendverify.checks.verification``, ``pendverify.simulation``); nothing re-implements them, so
+a report made here has the same results, verdicts and table as the command line::
+
+    import pendverify
+
+    report = pendverify.check("double_pendulum")                 # the default set vs its URDF
+    report = pendverify.check("examples/cart_pole.py", "examples/cart_pole.urdf",
+                              "examples/cart_pole.toml")        # a model file, as --analytic
+    report.passed, report.status                                  # True, "pass"
+    print(report)                                                 # the table `pendverify check` prints
+    run = pendverify.simulate("scenes/damped_double_pendulum.toml")
+    run.t, run.q, run.v, run.passed
+
+Models are given as a built-in name (``pendverify.analytic.MODELS``), a model file (``.py``,
+one ``ClosedFormModel`` subclass, as ``--analytic``) or a ``ClosedFormModel`` subclass.  Bad
+input raises a ``pendverify.errors.PendverifyError`` whose message is one line naming the
+file or key, the value and the rule, as the CLI prints it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from collections.abc import Mapping
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
+from pendverify.analytic.params import check_value
+from pendverify.analytic.plugin import _validate, load_model_class, where
+from pendverify.checks.report import Report, format_table
+from pendverify.checks.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
+from pendverify.checks.targets import Target, default_target, model_target, plugin_parameters, user_target
+from pendverify.checks.verification import build_report
+from pendverify.errors import InputError, PendverifyError, UnknownNameError
+from pendverify.robot.geometry import MODEL_FORM_RTOL
+from pendverify.robot.system import PinocchioSystem
+
+if TYPE_CHECKING:
+    from pendverify.simulation.scene import Scene
+    from pendverify.simulation.simulate import Run
+
+#: A model: a built-in name, a model file (``.py``) or a ``ClosedFormModel`` subclass.
+ModelLike = str | Path | type[ClosedFormModel]
+#: Parameters: a TOML parameter file, the flat mapping of parameter values, or a parameter set.
+ParamsLike = str | Path | Mapping[str, float] | ParameterSet
+#: A URDF: a file path or the XML text itself.
+UrdfLike = str | Path
+
+#: ``source`` of the errors about the arguments of these functions.
+OPTIONS_SOURCE = "<pendverify API arguments>"
+#: ``source`` of an in-memory parameter mapping.
+INLINE = "<inline>"
+
+__all__ = [
+    "CheckReport",
+    "ModelLike",
+    "ParamsLike",
+    "UrdfLike",
+    "check",
+    "load_model",
+    "load_params",
+    "load_urdf",
+    "simulate",
+]
+
+
+class CheckReport(Report):
+    """The report of ``check``: a ``pendverify.checks.report.Report`` that prints as the CLI's table.
+
+    The evidence is in the fields of ``Report``: ``results`` (one ``CheckResult`` per model and
+    check: ``max_error``, ``tolerance``, ``max_abs_error``, ``worst_state``, ``status``, ``notes``),
+    ``notes``, ``warnings`` and ``diagnoses`` (per model label), ``states``, ``sources``, ``seed``,
+    ``strict``, ``elapsed_s``; ``passed``, ``status``, ``failures()``, ``refusals()``, ``as_dict()``
+    and ``to_json()`` (the document ``check --json`` writes).
+    """
+
+    def table(self) -> str:
+        """The text ``pendverify check`` prints: the table, notes, warnings, diagnoses, the verdict."""
+        return format_table(self)
+
+    def __str__(self) -> str:
+        return self.table()
+
+    def __repr__(self) -> str:
+        models = ", ".join(self.states)
+        return f"<CheckReport {self.status}: {len(self.results)} checks on {models}, seed {self.seed}>"
+
+    def _repr_pretty_(self, printer, cycle: bool) -> None:  # IPython / Jupyter: show the table
+        printer.text(repr(self) if cycle else self.table())
+
+    @classmethod
+    def from_report(cls, report: Report) -> CheckReport:
+        return cls(**{f.name: getattr(report, f.name) for f in dataclasses.fields(Report)})
+
+
+# --- loading ----------------------------------------------------------------------------------------
+def _is_builtin(cls: type[ClosedFormModel]) -> bool:
+    return MODELS.get(getattr(cls, "name", None)) is cls
+
+
+def load_model(source: ModelLike) -> type[ClosedFormModel]:
+    """A closed-form model class.
+
+    ``source`` is a built-in model's name (``"double_pendulum"``, ``"cart_double_pendulum"``), the
+    path of a model file (``.py``, exactly one ``ClosedFormModel`` subclass: what ``--analytic``
+    takes) or a ``ClosedFormModel`` subclass, which is validated as a model file's class is and
+    returned as is.
+    """
+    if isinstance(source, type):
+        if not issubclass(source, ClosedFormModel) or source is ClosedFormModel:
+            raise PendverifyError(
+                f"{source.__name__} is not a subclass of pendverify.analytic.ClosedFormModel"
+            )
+        if not _is_builtin(source):
+            _validate(source, Path(where(source)))
+        return source
+    if isinstance(source, (str, Path)):
+        text = str(source)
+        if isinstance(source, str) and text in MODELS:
+            return MODELS[text]
+        path = Path(text)
+        if isinstance(source, Path) or path.suffix == ".py" or len(path.parts) > 1 or path.is_file():
+            return load_model_class(text)
+        raise PendverifyError(
+            f"unknown model {text!r}: give a built-in model ({', '.join(MODELS)}), "
+            "a model file (.py) or a ClosedFormModel subclass"
+        )
+    raise PendverifyError(
+        "a model is a built-in name, a model file (.py) or a ClosedFormModel subclass; "
+        f"got a {type(source).__name__}"
+    )
+
+
+def load_params(model_cls: ModelLike, source: ParamsLike) -> ParameterSet:
+    """A validated parameter set of ``model_cls`` (a model as ``load_model`` takes it).
+
+    ``source`` is one of
+
+    * a parameter file (TOML: ``model``, optional ``name``, a ``[parameters]`` table), whose
+      ``model`` must be the model's name — read as ``pendverify check --params`` reads it;
+    * a mapping of the parameter values themselves, flat: ``{"m1": 1.0, "m2": 0.8, ...}`` (not a
+      ``{"parameters": {...}}`` document); unknown and missing keys are errors;
+    * a parameter set of the model's ``params_type``, returned as is.
+
+    Every value is checked against its quantity's rule (masses and lengths finite and > 0, the
+    rest finite and ≥ 0); an error names the file (or ``<inline>``), the key, the value and the rule.
+    """
+    cls = load_model(model_cls)
+    if isinstance(source, ParameterSet):
+        if not isinstance(source, cls.params_type):
+            raise PendverifyError(
+                f"{cls.name} needs {cls.params_type.__name__} parameters, got {type(source).__name__}; "
+                "pass a parameter file or a mapping of values (params.as_dict())"
+            )
+        return source
+    if isinstance(source, Mapping):
+        return cls.params_type.from_mapping(dict(source), INLINE)
+    if isinstance(source, (str, Path)):
+        return plugin_parameters(cls, where(cls), str(source))
+    raise PendverifyError(
+        f"parameters are a TOML file, a mapping of values or a {cls.params_type.__name__}; "
+        f"got a {type(source).__name__}"
+    )
+
+
+def load_urdf(model_cls: ModelLike, urdf: UrdfLike, g: float | None = None) -> PinocchioSystem:
+    """A URDF (file path or XML text) loaded in Pinocchio and seen in ``model_cls``'s coordinates.
+
+    The URDF is read strictly and its base anchored at the origin; the coordinate map is the
+    one the model reads off the geometry (built-in models) or declares (``urdf_joints``,
+    ``joint_transform``, ``joint_offset``).  ``g`` is the closed form's gravity (Pinocchio's
+    9.81 m/s² when None), a finite number ≥ 0.  This is ``PinocchioSystem.for_model``.
+    """
+    cls = load_model(model_cls)
+    if g is not None:
+        g = check_value(OPTIONS_SOURCE, "g", g, "gravity")
+    return PinocchioSystem.for_model(cls, _urdf_arg(urdf), g)
+
+
+# --- check -----------------------------------------------------------------------------------------
+def _is_urdf_text(urdf: UrdfLike) -> bool:
+    return isinstance(urdf, str) and urdf.lstrip().startswith("<")
+
+
+def _urdf_arg(urdf: UrdfLike) -> str:
+    if not isinstance(urdf, (str, Path)):
+        raise PendverifyError(f"a URDF is a file path or its XML text; got a {type(urdf).__name__}")
+    return str(urdf)
+
+
+def _count(key: str, value: Any) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+        raise InputError(OPTIONS_SOURCE, key, value, "must be an integer >= 0")
+    return value
+
+
+def _target(cls: type[ClosedFormModel], urdf: UrdfLike | None, params: ParamsLike | None) -> Target:
+    """The one target ``check`` verifies, built by the functions the CLI uses."""
+    builtin = _is_builtin(cls)
+    if urdf is None:
+        if not builtin:
+            raise PendverifyError(f"{where(cls)}: give urdf: the URDF to verify {cls.name} against")
+        if params is None:  # pendverify check --model NAME
+            return default_target(cls.name)
+        if isinstance(params, (str, Path)):  # pendverify check --params P
+            return user_target(cls.name, None, str(params))
+        # an in-memory set against the URDF the project writes for it
+        # (what user_target does for a file; it takes only a file)
+        values = load_params(cls, params)
+        system = PinocchioSystem.for_params(values, f"<URDF of the inline {cls.name} parameters>")
+        return Target(f"{cls.name}:inline", cls(values), system, system.source)
+    # --model/--analytic with --urdf [--params]
+    values = None if params is None else load_params(cls, params)
+    target = model_target(cls, _urdf_arg(urdf), values)
+    if _is_urdf_text(urdf):  # model_target names the target after the URDF file's stem
+        target.label = f"{cls.name}:urdf-text"
+    return target
+
+
+def check(
+    model: ModelLike,
+    urdf: UrdfLike | None = None,
+    params: ParamsLike | None = None,
+    *,
+    samples: int = DEFAULT_RANDOM_STATES,
+    seed: int = DEFAULT_SEED,
+    strict: bool = False,
+    model_form_rtol: float = MODEL_FORM_RTOL,
+) -> CheckReport:
+    """Compare Pinocchio on a URDF with a hand-derived closed form: ``pendverify check``.
+
+    * ``check("double_pendulum")``: the built-in model's default parameter set against its
+      committed URDF (``pendverify check --model double_pendulum --no-erd``);
+    * ``check(name, params=P)``: the closed form of P against the URDF the project writes for P;
+    * ``check(model, urdf, params)``: the URDF against the closed form of the parameters
+      (``--model``/``--analytic`` with ``--urdf`` and ``--params``); without ``params``, a
+      built-in model reads its parameters off the URDF.  A model file or class needs ``urdf``.
+
+    ``model``, ``params`` and ``urdf`` are taken as ``load_model``, ``load_params`` and
+    ``load_urdf`` take them.  ``samples`` random states are drawn with ``seed`` (plus each model's
+    special states); ``strict`` counts warnings as failures; ``model_form_rtol`` is the largest
+    relative size of a URDF term the closed form cannot express (``--model-form-rtol``).
+
+    Returns a ``CheckReport``; a failing check is a result, not an exception (see
+    ``pendverify.testing.assert_verified`` for that).  Bad input raises ``PendverifyError``.
+    """
+    started = time.perf_counter()
+    samples, seed = _count("samples", samples), _count("seed", seed)
+    if not isinstance(strict, bool):
+        raise InputError(OPTIONS_SOURCE, "strict", strict, "must be True or False")
+    if (
+        isinstance(model_form_rtol, bool)
+        or not isinstance(model_form_rtol, (int, float))
+        or not (0 < model_form_rtol < math.inf)
+    ):
+        raise InputError(OPTIONS_SOURCE, "model_form_rtol", model_form_rtol, "must be a finite number > 0")
+    target = _target(load_model(model), urdf, params)
+    report = build_report([target], samples, seed, strict=strict, model_form_rtol=float(model_form_rtol))
+    report.elapsed_s = time.perf_counter() - started
+    return CheckReport.from_report(report)
+
+
+# --- simulate --------------------------------------------------------------------------------------
+def simulate(
+    scene: str | Path | Mapping[str, Any] | Scene,
+    urdf: UrdfLike | None = None,
+    engine: str | None = None,
+) -> Run:
+    """Run a scene and check its invariants: ``pendverify simulate``.
+
+    ``scene`` is a scene file (TOML), a scene document as a mapping (the TOML's tables as dicts;
+    a ``params`` file named there is found relative to the current directory) or a ``Scene``.
+    ``urdf`` (path or XML text) replaces the URDF the project writes for the scene's parameter
+    set, for the ``aba`` and ``both`` engines.  ``engine`` (``aba``, ``closed_form`` or ``both``)
+    overrides the scene's.
+
+    Returns the ``pendverify.simulation.simulate.Run``: arrays ``t``, ``q``, ``v``, ``u``, ``w``,
+    ``energy``; ``invariants`` (name, error, tolerance, passed, detail); ``engine_comparison``
+    (engine ``both``); ``passed``; ``notes``; ``metadata()``, ``to_npz_bytes()``, ``to_csv()``.
+    """
+    from pendverify.simulation.scene import ENGINES, Scene, load_scene, parse_scene
+    from pendverify.simulation.simulate import simulate as run_scene
+
+    if isinstance(scene, Scene):
+        loaded = scene
+    elif isinstance(scene, Mapping):
+        loaded = parse_scene(dict(scene), "<inline scene>")
+    elif isinstance(scene, (str, Path)):
+        loaded = load_scene(scene)
+    else:
+        raise PendverifyError(f"a scene is a scene file, a mapping or a Scene; got a {type(scene).__name__}")
+    if engine is not None and engine not in ENGINES:
+        raise UnknownNameError("engine", str(engine), ENGINES)
+    if urdf is not None and (engine or loaded.engine) == "closed_form":
+        raise PendverifyError(
+            f"{loaded.source}: engine closed_form does not use a URDF; use engine aba or both"
+        )
+    return run_scene(loaded, engine, None if urdf is None else _urdf_arg(urdf))
