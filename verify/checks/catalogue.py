@@ -13,17 +13,22 @@ For each state the check computes the error e, a *scale* s (the size of the
 terms that produced the quantity, including cancellation and, for inverses and
 accelerations, the conditioning ‖M̃⁻¹‖) and passes when
 
-    e ≤ K·ε·(1 + |θ|max)·c_T·s + a,
+    e ≤ K·ε·((1 + |θ|max)·c_T + (A − 1))·s + a,
 
 where ε is machine epsilon, K the check's named constant, (1 + |θ|max) the
 growth of rounding in angles as large as |θ| (cos(θ + 2πk) is only as exact as
 θ is), c_T = cond₂(T)² the amplification of rounding that Pinocchio commits in
 its own joint coordinates by the map to the model's (1 for the double
-pendulum, 6.85 for the cart's relative joint), and a the known model-form
-allowance (zero unless the URDF lies outside
-the seed's family, see ``pendverify.robot.system``).  Reported: e/s and the tolerance
-(K·ε·(1 + |θ|max) + a/s) at the worst state, the state with the largest
-e / tolerance.
+pendulum, 6.85 for the cart's relative joint), A ≥ 1 the factor by which
+Pinocchio's world-frame terms exceed the result (``pendverify.checks.trust.
+term_amplification``: a cart far along its rail, a light link at the end of a
+long one), whose rounding adds to the angles' rather than multiplying it, and a
+the known model-form allowance (zero unless the URDF lies outside the
+closed form's family, see ``pendverify.robot.geometry``).  This is the one
+tolerance model: ``pendverify stress``, the certification battery and the
+simulator's checks call these checks as they are.  Reported: e/s and the
+tolerance (K·ε·((1 + |θ|max)·c_T + (A − 1)) + a/s) at the worst state, the state
+with the largest e / tolerance.
 
 How Ṁ is obtained (skew check): from Pinocchio's analytic RNEA derivatives with
 gravity off, Ṁ e_j = ∂τ/∂q(q, 0, e_j)·q̇, which does not use its Coriolis matrix.
@@ -38,8 +43,8 @@ import numpy as np
 
 from pendverify.analytic import ClosedFormModel
 from pendverify.checks.sampling import State
-from pendverify.checks.trust import term_amplification
-from pendverify.checks.verdict import FAIL, PASS
+from pendverify.checks.trust import REFUSE_REL, term_amplification
+from pendverify.checks.verdict import FAIL, PASS, REFUSED
 from pendverify.robot.system import PinocchioSystem
 
 EPS = float(np.finfo(float).eps)
@@ -62,6 +67,8 @@ class Check:
     evaluate: Callable[[ClosedFormModel, PinocchioSystem, State], Sample]
     #: "" when the check applies to this model and system, else why it is not run
     requires: Callable[[ClosedFormModel, PinocchioSystem | None], str] = lambda model, system: ""
+    #: whether the Pinocchio side is computed by its world-frame recursions (then A counts)
+    world_frame: bool = True
 
 
 @dataclass
@@ -124,8 +131,9 @@ def world_lever(model, system, q) -> float:
     Pinocchio expresses spatial inertias about the world origin, so a joint whose
     subtree sits far from it (a cart 10 m along the rail, a small link 2 at the
     end of a long link 1) carries second moments m·|c|² ≫ M_ii into its
-    recursions, which cancel in the result.  Inverses round in proportion to A,
-    Coriolis terms to √A.  (``pendverify.checks.trust.term_amplification``.)
+    recursions, which cancel in the result: its rounding is ε·A times the
+    result's scale, added to the angles' (``run_check``).
+    (``pendverify.checks.trust.term_amplification``.)
     """
     return term_amplification(model, system, q)
 
@@ -180,7 +188,7 @@ def _coriolis(model, system, s):
     w = weights(model, s.q)
     diff = system.coriolis_matrix(s.q, s.v) - model.coriolis_matrix(s.q, s.v)
     rates = max(rate_scale(model, s.q, s.v) + _damping_rate(model, w), 1.0)
-    return Sample(np.max(np.abs(scaled_matrix(diff, w))), rates * np.sqrt(world_lever(model, system, s.q)))
+    return Sample(np.max(np.abs(scaled_matrix(diff, w))), rates)
 
 
 def _skew(model, system, s):
@@ -204,7 +212,7 @@ def _minverse(model, system, s):
     Minv_scaled = scaled_matrix(model.inverse_mass_matrix(s.q), sqrt_s)
     M_scaled = scaled_matrix(model.mass_matrix(s.q), 1.0 / sqrt_s)
     # δ(M⁻¹) = −M⁻¹ δM M⁻¹ with |δM̃| ~ ε‖M̃‖
-    scale = norm2(Minv_scaled) ** 2 * norm2(M_scaled) * world_lever(model, system, s.q)
+    scale = norm2(Minv_scaled) ** 2 * norm2(M_scaled)
     return Sample(np.max(np.abs(scaled_matrix(diff, sqrt_s))), scale)
 
 
@@ -282,27 +290,39 @@ CHECKS: tuple[Check, ...] = (
     Check("aba", "aba(q, q̇, Bu + Ww − Dq̇)", "closed-form q̈ (f + g·u, M⁻¹f)", 16, _aba),
     Check("energy", "kinetic + potential energy", "½q̇ᵀMq̇, V(q) − V(0)", 16, _energy),
     # Tᵀ·diag(b)·T: each entry a sum of at most n products of exact decimals' roundings
-    Check("damping", "<dynamics damping> (Tᵀ·diag(b)·T)", "D", 8, _damping, _needs_urdf_damping),
+    Check("damping", "<dynamics damping> (Tᵀ·diag(b)·T)", "D", 8, _damping, _needs_urdf_damping, False),
 )
 CHECK_NAMES = tuple(c.name for c in CHECKS)
 
 
 def run_check(check: Check, label: str, model, system, states, seed: int) -> CheckResult:
-    """Evaluate one check on every state and keep the evidence of the worst one."""
+    """Evaluate one check on every state and keep the evidence of the worst one.
+
+    A state whose own rounding tolerance K·ε·((1 + |θ|)·c_T + (A − 1)) exceeds the
+    trust limit (``trust.REFUSE_REL``) is not judged: a tolerance that wide would
+    pass a 1 ppm modelling error.  The check is then ``refused`` (unless another
+    state fails), whatever the guard before it let through.
+    """
     worst_ratio, worst = -1.0, None
     max_abs = 0.0
-    amplification = system.cmap.amplification
+    c_T = system.cmap.amplification
     notes: list[str] = []
+    refused: list[tuple[State, float]] = []
     for state in states:
+        angle = float(np.max(np.abs(state.q[np.array(model.angular)]), initial=0.0))
+        lever = world_lever(model, system, state.q) if check.world_frame else 1.0
+        rounding = check.K * EPS * ((1.0 + angle) * c_T + (lever - 1.0))
+        if not rounding <= REFUSE_REL:
+            refused.append((state, rounding))
+            continue
         sample = check.evaluate(model, system, state)
         if sample.note and len(notes) < 3:
             notes.append(f"{state.label}: {sample.note}")
-        angle = float(np.max(np.abs(state.q[np.array(model.angular)]), initial=0.0))
         if sample.scale > 0:
-            rel_tol = check.K * EPS * (1.0 + angle) * amplification + sample.allowance / sample.scale
+            rel_tol = rounding + sample.allowance / sample.scale
             rel_err = sample.error / sample.scale
         else:  # nothing acts (at rest with g = 0): any error at all is a failure
-            rel_tol = check.K * EPS * (1.0 + angle) * amplification
+            rel_tol = rounding
             rel_err = 0.0 if sample.error == 0 else np.inf
         ratio = rel_err / rel_tol if np.isfinite(rel_err) else np.inf
         if np.isnan(rel_err):
@@ -311,6 +331,20 @@ def run_check(check: Check, label: str, model, system, states, seed: int) -> Che
         max_abs = max(max_abs, float(sample.error))
         if ratio > worst_ratio:
             worst_ratio, worst = ratio, (state, rel_err, rel_tol)
+    status = ""
+    if refused:
+        state, rounding = refused[0]
+        lever = world_lever(model, system, state.q)
+        notes.insert(
+            0,
+            f"{len(refused)} of {len(states)} states refused: at {state.label} the rounding tolerance "
+            f"{rounding:.2g} exceeds the trust limit {REFUSE_REL:g} (Pinocchio's terms {lever:.2g}× the "
+            "result)",
+        )
+        if worst is None:
+            worst = (state, float("nan"), rounding)
+        if worst_ratio <= 1.0:
+            status = REFUSED
     state, rel_err, rel_tol = worst
     return CheckResult(
         model=label,
@@ -322,8 +356,9 @@ def run_check(check: Check, label: str, model, system, states, seed: int) -> Che
         samples=len(states),
         seed=seed,
         worst_state=state.as_dict(),
-        passed=bool(worst_ratio <= 1.0),
+        passed=bool(worst_ratio <= 1.0) and not refused,
         notes=notes,
+        status=status,
     )
 
 

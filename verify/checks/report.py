@@ -93,7 +93,7 @@ def format_table(report: Report) -> str:
     out.append("")
     out.append(
         "error and tolerance are relative, in diagonally scaled coordinates: "
-        "tolerance = K·ε·(1 + |θ|max)·cond(T)² (+ model-form allowance)."
+        "tolerance = K·ε·((1 + |θ|max)·cond(T)² + (A − 1)) (+ model-form allowance)."
     )
     for model, notes in report.notes.items():
         for note in notes:

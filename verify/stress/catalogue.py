@@ -9,11 +9,11 @@ Groups and what passes
 ----------------------
 ``mass ratio``, ``length``, ``point mass``, ``stiff damping`` (closed form),
 ``zero gravity`` (closed form), ``near singular`` (single m1)
-    The nine checks of ``pendverify.checks.catalogue`` (closed form vs Pinocchio, tolerance
-    K·ε·(1 + |θ|max)·scale in diagonally scaled coordinates) on seeded states,
+    The checks of ``pendverify.checks.catalogue`` (closed form vs Pinocchio, tolerance
+    K·ε·((1 + |θ|max)·c_T + (A − 1))·scale in diagonally scaled coordinates) on seeded states,
     after ``check_conditioning``: a state the trust rule refuses is not compared.
-    ``framework.guarded`` adds to each check's scale what the core checks leave out (see
-    there).  Passes when every check passes on the accepted states and the
+    The tolerances are the core checks' own, A included (one tolerance
+    model).  Passes when every check passes on the accepted states and the
     refusals match what the case expects (``EXPECT``): none; some (aligned states
     of a near-singular cart); all (a 1e6 length ratio in one chain, singular to
     working precision); or any (a 1 mm pendulum on a cart up to 10 m from the

@@ -1,5 +1,9 @@
 """The stress framework: results, settings, the guarded comparison and the parameter sets.
 
+The comparison guards every state with the trust rule and then runs the core
+checks exactly as ``pendverify check`` does: one tolerance model
+(``pendverify.checks.catalogue``).
+
 The cases live in ``pendverify.stress.cases`` (states and parameters) and
 ``pendverify.stress.sim_cases`` (simulations); ``pendverify.stress.catalogue`` lists them.
 """
@@ -15,7 +19,7 @@ import numpy as np
 
 from pendverify.analytic import MODELS, CartDoublePendulumParams, DoublePendulumParams
 from pendverify.analytic.params import default_parameter_file, load_parameter_file
-from pendverify.checks.catalogue import CHECKS, EPS, Check, Sample, applicable_checks, run_check
+from pendverify.checks.catalogue import CHECKS, applicable_checks, run_check
 from pendverify.checks.sampling import DEFAULT_SEED, State, sample_states
 from pendverify.checks.trust import IllConditionedError, check_conditioning
 from pendverify.robot.system import PinocchioSystem
@@ -160,40 +164,6 @@ def system_for(params):
     return PinocchioSystem.for_params(params)
 
 
-# Terms the core checks' scales leave out (to be moved into ``pendverify.checks.catalogue``):
-#  * the closed forms may build the friction-free C as (seed's C) − D, so C, C·q̇ and Ṁ − 2C
-#    carry rounding of size ε·|D̃| (the double pendulum at b = 1e4, or at b = 0.05 on a 1 mm
-#    scale, where β·θ̇ ≪ b);
-#  * Pinocchio's rounding is ε times its world-frame terms, A times the result
-#    (``pendverify.checks.trust.term_amplification``), added as an allowance K·ε·(A − 1)·scale,
-#    so that it adds to the angle's rounding rather than multiplying it;
-#  * a scale of 0 (g = 0 at rest): the quantity must then be exactly 0.
-_FRICTION_TERMS = {"coriolis": "matrix", "skew": "matrix", "rnea": "force"}
-
-
-def _friction_scale(model, state, kind: str) -> float:
-    w = 1.0 / np.sqrt(model.diagonal_scale(state.q))
-    D = np.abs(model.damping_matrix()) * np.outer(w, w)
-    if kind == "matrix":
-        return float(np.max(D))
-    return float(np.max(D @ np.abs(state.v / w)))
-
-
-def guarded(check: Check, amplification: Callable[[State], float]) -> Check:
-    """A core check with the scale terms above added; ``amplification(state)`` gives A."""
-    kind = _FRICTION_TERMS.get(check.name)
-
-    def evaluate(model, system, state):
-        s = check.evaluate(model, system, state)
-        scale = s.scale + (_friction_scale(model, state, kind) if kind else 0.0)
-        if not scale > 0:
-            return Sample(s.error, 1.0 if s.error == 0 else TINY, s.allowance, s.note)
-        extra = check.K * EPS * (amplification(state) - 1.0) * scale
-        return Sample(s.error, scale, s.allowance + extra, s.note)
-
-    return dataclasses.replace(check, evaluate=evaluate)
-
-
 def _ratio(r) -> float:
     return r.max_error / r.tolerance if r.tolerance > 0 else math.inf
 
@@ -211,7 +181,7 @@ class _Comparison:
 
 def compare(name: str, model, system, states: list[State], seed: int) -> _Comparison:
     """Guard every state (validity, conditioning), then run the nine checks on the accepted ones."""
-    kept, refused, factor = [], [], {}
+    kept, refused = [], []
     kappa_raw = kappa_scaled = amplification = 0.0
     level = "ok"
     for s in states:
@@ -222,12 +192,11 @@ def compare(name: str, model, system, states: list[State], seed: int) -> _Compar
             refused.append(str(exc))
             continue
         kept.append(s)
-        factor[id(s)] = c.amplification
         kappa_raw, kappa_scaled = max(kappa_raw, c.kappa_raw), max(kappa_scaled, c.kappa_scaled)
         amplification = max(amplification, c.amplification)
         level = "warn" if c.level == "warn" else level
     names = applicable_checks(model, system)
-    checks = [guarded(c, lambda state: factor[id(state)]) for c in CHECKS if c.name in names]
+    checks = [c for c in CHECKS if c.name in names]
     with np.errstate(all="ignore"):
         results = [run_check(c, name, model, system, kept, seed) for c in checks] if kept else []
     return _Comparison(results, len(kept), refused, kappa_raw, kappa_scaled, amplification, level)
