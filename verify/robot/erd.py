@@ -32,3 +32,19 @@ def double_pendulum_urdfs() -> dict[str, Path]:
     if not found:
         raise PendverifyError(f"{DISTRIBUTION} {dist.version} ships no {DOUBLE_PENDULUM_DIR}/*.urdf")
     return dict(sorted(found.items()))
+
+
+def resolve_urdf(spec: str) -> tuple[Path, str]:
+    """(path, bundle name) of ``erd:NAME`` (example-robot-data's URDF NAME) or of a URDF path."""
+    from pendverify.errors import UrdfShapeError
+
+    if spec.startswith("erd:"):
+        found = double_pendulum_urdfs()
+        stem = spec[4:]
+        if stem not in found:
+            raise UrdfShapeError(spec, f"example-robot-data has no {stem!r}; it has {', '.join(found)}")
+        return found[stem], f"erd_{stem}"
+    path = Path(spec)
+    if not path.is_file():
+        raise UrdfShapeError(spec, "file not found")
+    return path, path.stem
