@@ -326,3 +326,14 @@ def test_import_pendverify_does_not_import_pinocchio_or_sympy():
     done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "ok"
+
+
+def test_certify_set_writes_a_bundle_that_recheck_accepts(tmp_path):
+    from pendverify.analytic.params import default_parameter_file
+    from pendverify.certify.issue import recheck
+
+    issued = pendverify.certify_set(tmp_path, default_parameter_file("double_pendulum"), samples=40)
+    assert issued.certified and issued.path == tmp_path / "double_pendulum.cert.json"
+    assert recheck(str(issued.path)).passed
+    with pytest.raises(pendverify.PendverifyError, match="exists"):
+        pendverify.certify_set(tmp_path, default_parameter_file("double_pendulum"), samples=40)

@@ -25,6 +25,7 @@ _LAZY = {
     "load_params": "pendverify.api",
     "load_urdf": "pendverify.api",
     "simulate": "pendverify.api",
+    "certify_set": "pendverify.api",
     "CheckReport": "pendverify.api",
     "assert_verified": "pendverify.testing",
     "PendverifyError": "pendverify.errors",
@@ -35,6 +36,7 @@ __all__ = [
     "PendverifyError",
     "__version__",
     "assert_verified",
+    "certify_set",
     "check",
     "load_model",
     "load_params",
@@ -43,7 +45,7 @@ __all__ = [
 ]
 
 if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
-    from pendverify.api import CheckReport, check, load_model, load_params, load_urdf, simulate
+    from pendverify.api import CheckReport, certify_set, check, load_model, load_params, load_urdf, simulate
     from pendverify.errors import PendverifyError
     from pendverify.testing import assert_verified
 

@@ -301,3 +301,39 @@ def simulate(
             f"{loaded.source}: engine closed_form does not use a URDF; use engine aba or both"
         )
     return run_scene(loaded, engine, None if urdf is None else _urdf_arg(urdf))
+
+
+def certify_set(
+    output: str | Path,
+    params: str | Path | None = None,
+    *,
+    urdf: str | Path | None = None,
+    model: str | None = None,
+    urdf_params: str | Path | None = None,
+    samples: int | None = None,
+    seed: int | None = None,
+    force: bool = False,
+):
+    """Run the full battery and, if every item passes, write a certificate bundle into ``output``.
+
+    As ``pendverify certify``: a parameter file ``params``; or a ``urdf`` (a path or
+    ``erd:NAME``) with ``urdf_params`` (the set it must match) or a built-in ``model``
+    whose parameters are read off the URDF.  Returns the issued result (``items``,
+    ``certified``, ``certificate``, ``path``).  (Not ``certify``: that name is the
+    ``pendverify.certify`` sub-package.)
+    """
+    from pendverify.certify.battery import BatterySettings
+    from pendverify.certify.issue import certification_input, issue
+
+    settings = BatterySettings()
+    if samples is not None:
+        settings = dataclasses.replace(settings, samples=_count("samples", samples))
+    if seed is not None:
+        settings = dataclasses.replace(settings, seed=_count("seed", seed))
+    target = certification_input(
+        None if params is None else str(params),
+        None if urdf is None else str(urdf),
+        model,
+        None if urdf_params is None else str(urdf_params),
+    )
+    return issue(target, settings, str(output), force)
