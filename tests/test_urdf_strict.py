@@ -14,11 +14,11 @@ from pendverify.robot.erd import double_pendulum_urdfs
 from pendverify.robot.strict import (
     JointDynamics,
     UrdfFacts,
-    build_pinocchio_model,
     inertia_tolerance,
     read_urdf_strictly,
     resolution,
 )
+from pendverify.robot.urdfdom import build_pinocchio_model
 
 REPO = Path(__file__).resolve().parents[1]
 SOURCE = "robot.urdf"

@@ -9,7 +9,8 @@ import numpy as np
 import pinocchio as pin
 
 from pendverify.errors import UrdfShapeError
-from pendverify.robot.strict import UrdfFacts, build_pinocchio_model
+from pendverify.robot.strict import UrdfFacts
+from pendverify.robot.urdfdom import build_pinocchio_model
 
 
 def _anchor_base(model: pin.Model) -> float:

@@ -1,0 +1,98 @@
+"""Pinocchio's URDF parser (urdfdom) run on text the strict reader accepted, its log captured.
+
+``build_pinocchio_model`` runs these checks, then ``pinocchio.buildModelFromXML`` with
+the C-level stderr (file descriptor 2) captured, so that a refusal names urdfdom's
+reason and whatever urdfdom logs during a successful parse is handed back to the
+caller instead of reaching the terminal.  The capture swaps the process-wide
+descriptor 2; calls are serialised by a lock, but another thread writing to fd 2 at
+the same moment is captured as well.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import sys
+import tempfile
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
+
+import pinocchio as pin
+
+from pendverify.errors import UrdfShapeError
+from pendverify.robot.strict import UrdfFacts, read_urdf_strictly
+
+
+def build_pinocchio_model(text: str, source: str) -> tuple[pin.Model, UrdfFacts, list[str]]:
+    """Read ``text`` strictly, then build its Pinocchio model with urdfdom's log captured.
+
+    Returns ``(model, facts, log)``: the model from ``pinocchio.buildModelFromXML``, the
+    facts from ``read_urdf_strictly`` and the records urdfdom logged while parsing, one
+    line each (often empty; e.g. "Error: Could not parse collision element for Link [l]"
+    when a collision shape is one urdfdom does not know).  If Pinocchio refuses the
+    text, ``UrdfShapeError`` carries urdfdom's reason instead of Pinocchio's generic
+    "does not contain a valid URDF model".
+    """
+    facts = read_urdf_strictly(text, source)
+    with _capture_fd2() as captured:
+        try:
+            model = pin.buildModelFromXML(text)
+        except (RuntimeError, ValueError) as exc:
+            failure: Exception | None = exc
+        else:
+            failure = None
+    log = log_records(captured.text)
+    if failure is not None:
+        reason = "; ".join(_LEVEL.sub("", record) for record in log) or " ".join(str(failure).split())
+        raise UrdfShapeError(source, f"Pinocchio cannot parse it as URDF: {reason}") from None
+    return model, facts, log
+
+
+_LEVEL = re.compile(r"^(Error|Warning|Info|Debug):\s*")
+
+
+def log_records(text: str) -> list[str]:
+    """urdfdom's stderr log as one line per record, without urdfdom's C++ source locations.
+
+    console_bridge writes each record as ``"Error:   message"`` (or ``Warning:``, ...)
+    followed by ``"         at line N in /path/file.cpp"``; the location names
+    urdfdom's source, not the user's file, so it is dropped.
+    """
+    records: list[str] = []
+    for line in text.splitlines():
+        stripped = line.strip()
+        if not stripped or re.fullmatch(r"at line \d+ in \S+", stripped):
+            continue
+        if _LEVEL.match(stripped) or not records:
+            records.append(stripped)
+        else:
+            records[-1] += " " + stripped
+    return [" ".join(r.split()) for r in records]
+
+
+class _Captured:
+    """The text written to file descriptor 2 inside a ``_capture_fd2`` block (set on exit)."""
+
+    text = ""
+
+
+_FD2_LOCK = threading.Lock()
+
+
+@contextmanager
+def _capture_fd2() -> Iterator[_Captured]:
+    """Redirect file descriptor 2 (where urdfdom's C++ ``std::cerr`` writes) into a temporary file."""
+    captured = _Captured()
+    with _FD2_LOCK, tempfile.TemporaryFile() as tmp:
+        sys.stderr.flush()
+        saved = os.dup(2)
+        try:
+            os.dup2(tmp.fileno(), 2)
+            yield captured
+        finally:
+            sys.stderr.flush()
+            os.dup2(saved, 2)
+            os.close(saved)
+            tmp.seek(0)
+            captured.text = tmp.read().decode("utf-8", errors="replace")
