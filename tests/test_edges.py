@@ -372,3 +372,17 @@ def test_a_heavy_link_within_the_trust_limit_still_catches_a_planted_error(tmp_p
     status, out, report = _check(capsys, "--params", toml, "--urdf", wrong, str(tmp_path / "y.json"))
     assert status == 1
     assert _results(report)["crba"]["status"] == "fail"
+
+
+def test_the_model_form_row_is_judged_even_when_states_are_refused(tmp_path, capsys):
+    # a link 1 of 1e30 kg refuses every state, but the off-line centre of mass is a URDF fact
+    params = default_params("double_pendulum").replace(m1=1e30)
+    text = _off_line(urdf_for(params), 0.02)
+    toml = _write(tmp_path, "heavy.toml", params.to_toml())
+    urdf = _write(tmp_path, "heavy_off.urdf", text)
+    status, out, report = _check(capsys, "--params", toml, "--urdf", urdf, str(tmp_path / "x.json"))
+    assert status == 1
+    results = _results(report)
+    assert results["model-form"]["status"] == "fail"
+    assert "the URDF lies outside the closed form's family" in out
+    assert {r["status"] for n, r in results.items() if n != "model-form"} == {"refused"}

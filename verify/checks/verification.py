@@ -95,15 +95,15 @@ def verify_target(report: Report, target, samples: int, seed: int) -> None:
     names = applicable_checks(target.model, target.system)
     with np.errstate(all="ignore"):
         results = run_checks(label, target.model, target.system, kept or states, seed, names)
-    form = model_form_result(target, seed)
-    if form is not None:
-        results.append(form)
     if refused:
         _refuse(results, refused, len(states))
         notes.append(
             f"{len(refused)} of {len(states)} states refused by the trust rule "
             f"(rounding bound above the trust limit): {refused[0]}"
         )
+    form = model_form_result(target, seed)  # a property of the URDF, judged at no state
+    if form is not None:
+        results.append(form)
     warnings = coulomb_warnings(target)
     sentence = non_christoffel_c(results)
     if sentence:
