@@ -122,3 +122,17 @@ def test_derived_defaults_agree_with_the_seeds_closed_forms():
     np.testing.assert_allclose(
         ClosedFormModel.acceleration(model, q, v, u, w), model.acceleration(q, v, u, w), rtol=1e-12
     )
+
+
+EXAMPLES = ["cart_pole", "furuta_pendulum", "hanging_double_pendulum", "triple_pendulum"]
+
+
+@pytest.mark.parametrize("name", EXAMPLES)
+def test_the_derived_gravity_scale_equals_the_examples_hand_written_ones(name):
+    from pendverify.analytic.params import load_parameter_file
+
+    cls = load_model_class(REPO / "examples" / f"{name}.py")
+    params = load_parameter_file(REPO / "examples" / f"{name}.toml", {cls.name: cls.params_type})[2]
+    model = cls(params)
+    derived = ClosedFormModel.gravity_scale(model)
+    np.testing.assert_allclose(derived, model.gravity_scale(), rtol=1e-14, atol=0)
