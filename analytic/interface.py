@@ -10,16 +10,32 @@ relative angles, any zero).  Pinocchio's joint coordinates are reached through a
 
 ``C`` is the Coriolis/centrifugal matrix without friction, ``D`` the viscous
 friction matrix, ``H`` the gravity vector, ``B`` the input map and ``W`` the
-disturbance map.  ``acceleration`` must be the model's *own* closed form (the
-seed's f + g·u, or M⁻¹·f), not a re-assembly from the other methods, so that a
-typo in any single place shows up in some check.
+disturbance map.
+
+What a model must and may write
+-------------------------------
+Required (abstract): ``mass_matrix`` M(q), ``coriolis_matrix`` C(q, q̇) (or
+``coriolis_force`` C·q̇ in a ``BiasOnlyModel``), ``gravity`` H(q) and
+``potential_energy`` V(q).  Optional, with a default: ``damping_matrix`` D (zero),
+``input_matrix`` B (required when ``inputs`` are declared), ``disturbance_matrix``
+W (zero).  Optional and *derived* when not written: ``det_mass_matrix`` (LU of M),
+``inverse_mass_matrix`` (solving with M), ``acceleration`` (M⁻¹(B u + W w − D q̇ −
+C q̇ − H)), ``special_states`` (the zero state only), and the tolerance scales
+``gravity_scale`` and ``diagonal_scale`` (Σ |terms| of H_i and of M_ii, read by
+SymPy from the model's own H and M).  ``hand_written()`` names the methods a model
+writes itself; a derived det M or M⁻¹ is not checked (nothing to check), and a
+derived q̈ is checked by ``aba`` as the composition of the parts, with a note.
+A hand-written ``acceleration`` must be the model's *own* closed form (the seed's
+f + g·u, or M⁻¹·f), not a re-assembly from the other methods, so that a typo in
+any single place shows up in some check.
 
 Writing your own model (a plug-in)
 ----------------------------------
 A model file for ``pendverify check --analytic FILE`` defines one subclass of
 ``ClosedFormModel`` and its parameter set (a frozen dataclass subclassing
 ``ParameterSet`` whose ``model`` equals the class's ``name``); ``examples/cart_pole.py``
-is a complete one.  Beyond the abstract methods below it declares:
+is a complete one, ``examples/minimal_double_pendulum.py`` a minimal one.  Beyond
+the abstract methods below it declares:
 
 * ``urdf_joints``, ``joint_transform``, ``joint_offset``: the coordinate map
   q = T (θ − θ0) to the URDF's joints (``pendverify.robot.coordinates``), given
@@ -156,36 +172,56 @@ class ClosedFormModel(ABC):
         """H(q) = ∂V/∂q."""
 
     @abstractmethod
-    def gravity_scale(self) -> np.ndarray:
-        """Σ |coefficients| of each H_i: a bound of |H_i(q)| over all q (units of H)."""
-
-    @abstractmethod
     def potential_energy(self, q: np.ndarray) -> float:
         """V(q), up to a constant."""
 
-    @abstractmethod
     def damping_matrix(self) -> np.ndarray:
-        """D: the generalized friction force is D·q̇."""
+        """D: the generalized friction force is D·q̇; none (frictionless) by default."""
+        return np.zeros((self.nv, self.nv))
 
-    @abstractmethod
     def input_matrix(self) -> np.ndarray:
-        """B (nv × number of inputs)."""
+        """B (nv × number of inputs); a model that declares ``inputs`` must write it."""
+        if self.inputs:
+            raise NotImplementedError(f"{self.name} declares inputs {self.inputs} but writes no input_matrix")
+        return np.zeros((self.nv, 0))
 
     def disturbance_matrix(self) -> np.ndarray:
         """W (nv × number of disturbances); none by default."""
         return np.zeros((self.nv, len(self.disturbances)))
 
-    @abstractmethod
+    # --- derived by default: a model may write them as closed forms -------------------
     def det_mass_matrix(self, q: np.ndarray) -> float:
-        """The closed form of det M(q)."""
+        """det M(q).  Derived by default (LU of M); a hand-written closed form is checked (``det``)."""
+        return float(np.linalg.det(np.asarray(self.mass_matrix(q), dtype=float)))
 
-    @abstractmethod
     def inverse_mass_matrix(self, q: np.ndarray) -> np.ndarray:
-        """The closed form of M(q)⁻¹."""
+        """M(q)⁻¹.  Derived by default (solving with M); a hand-written one is checked (``minverse``)."""
+        M = np.asarray(self.mass_matrix(q), dtype=float)
+        return np.linalg.solve(M, np.eye(self.nv))
 
-    @abstractmethod
     def acceleration(self, q: np.ndarray, v: np.ndarray, u: np.ndarray, w: np.ndarray) -> np.ndarray:
-        """q̈ from the model's own closed form (f + g·u, or M⁻¹·f)."""
+        """q̈.  Derived by default: M⁻¹ (B u + W w − D q̇ − C q̇ − H) from the model's own parts.
+
+        A model with its own closed form (the seed's f + g·u, or M⁻¹·f) writes it
+        here, *not* as a re-assembly of the other methods, so that a typo in any
+        single place shows up in some check.
+        """
+        M = np.asarray(self.mass_matrix(q), dtype=float)
+        force = (
+            self.input_matrix() @ np.asarray(u, dtype=float)
+            + self.disturbance_matrix() @ np.asarray(w, dtype=float)
+            - self.damping_matrix() @ v
+            - self.bias(q, v)
+        )
+        return np.linalg.solve(M, force)
+
+    def gravity_scale(self) -> np.ndarray:
+        """Σ |coefficients| of each H_i: a bound of |H_i(q)| over all q (units of H).
+
+        Derived by default from the model's own H, read by SymPy: every H_i expanded
+        into terms, each sin/cos bounded by 1 (``pendverify.symbolic.scales``).
+        """
+        return self._derived_scales().gravity()
 
     # --- derived quantities, shared ------------------------------------------------
     def bias(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -200,13 +236,46 @@ class ClosedFormModel(ABC):
 
         Tolerances compare quantities in the diagonally scaled coordinates
         z_i = √S_i·q_i, so that a cart in kg and a rod in kg·m² are judged alike.
-        Models whose M_ii can cancel override this with the sum of |terms|.
+        Derived by default as Σ |terms| of the model's own M_ii, each sin/cos
+        bounded by 1 (so an M_ii whose terms cancel, α + 2β cos θ2, is scaled by
+        α + 2|β|); |M_ii(q)| if SymPy cannot read M.
         """
-        return np.abs(np.diag(self.mass_matrix(q)))
+        return self._derived_scales().diagonal(q)
 
-    @abstractmethod
     def special_states(self) -> dict[str, np.ndarray]:
-        """Named configurations every check visits (upright, folded, aligned...)."""
+        """Named configurations every check visits (upright, folded...); the zero state by default."""
+        return {"zero": np.zeros(self.nv)}
+
+    # --- which quantities are hand-written --------------------------------------------------
+    @classmethod
+    def hand_written(cls) -> tuple[str, ...]:
+        """The interface methods this model writes itself (in ``INTERFACE_METHODS`` order).
+
+        A method counts as hand-written when the class, or a base that is a real
+        model, defines it; the interface's own defaults (``ClosedFormModel``,
+        ``BiasOnlyModel``) are derived, and the checks do not count them as evidence.
+        """
+        written = []
+        for name in INTERFACE_METHODS:
+            owner = next((k for k in cls.__mro__ if name in vars(k)), None)
+            if owner is not None and owner not in _INTERFACE_CLASSES:
+                written.append(name)
+        return tuple(written)
+
+    @classmethod
+    def written_closed_forms(cls) -> dict[str, ClosedForm]:
+        """``closed_forms`` less the interface's methods this model leaves to their defaults."""
+        written = set(cls.hand_written())
+        return {k: f for k, f in cls.closed_forms.items() if k not in STANDARD_CLOSED_FORMS or k in written}
+
+    def _derived_scales(self):
+        """The scales derived from M and H (``pendverify.symbolic.scales``), cached on the instance."""
+        scales = self.__dict__.get("_derived_scales_cache")
+        if scales is None:
+            from pendverify.symbolic.scales import DerivedScales
+
+            scales = self.__dict__["_derived_scales_cache"] = DerivedScales.of(self)
+        return scales
 
     # --- optional hooks ------------------------------------------------------------------
     def derived_constants(self) -> dict[str, float]:
@@ -244,3 +313,23 @@ class BiasOnlyModel(ClosedFormModel):
 
     def bias(self, q, v):
         return self.coriolis_force(q, v) + self.gravity(q)
+
+
+#: The interface's methods, in order: ``hand_written`` says which a model writes itself.
+INTERFACE_METHODS: tuple[str, ...] = (
+    "mass_matrix",
+    "coriolis_matrix",
+    "coriolis_force",
+    "gravity",
+    "potential_energy",
+    "damping_matrix",
+    "input_matrix",
+    "disturbance_matrix",
+    "det_mass_matrix",
+    "inverse_mass_matrix",
+    "acceleration",
+    "gravity_scale",
+    "diagonal_scale",
+    "special_states",
+)
+_INTERFACE_CLASSES = (ClosedFormModel, BiasOnlyModel)

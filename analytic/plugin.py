@@ -9,7 +9,8 @@ exactly one concrete subclass of ``pendverify.analytic.ClosedFormModel``
 * ``params_type``: a frozen dataclass subclassing ``ParameterSet`` whose fields
   are ``quantity(kind, doc)`` entries;
 * ``coordinates`` and ``angular`` of equal length, ``inputs`` and ``disturbances``;
-* every abstract method of the interface, and the coordinate map
+* every abstract method of the interface (M, C or C·q̇, H, V; ``input_matrix``
+  too when it declares ``inputs``), and the coordinate map
   (``urdf_joints``, ``joint_transform``, ``joint_offset``; see ``pendverify.robot.joint_map``).
 
 ``examples/cart_pole.py`` is a complete plug-in.  The built-in models are
@@ -92,6 +93,8 @@ def _validate(cls: type[ClosedFormModel], path: Path) -> None:
         value = getattr(cls, attr)
         if not isinstance(value, tuple) or not all(isinstance(x, str) for x in value):
             fail(f"{attr} must be a tuple of names")
+    if cls.inputs and "input_matrix" not in cls.hand_written():
+        fail(f"declares inputs {', '.join(cls.inputs)} but writes no input_matrix (B)")
 
 
 def load_model_class(path: str | Path) -> type[ClosedFormModel]:

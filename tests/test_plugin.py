@@ -143,8 +143,8 @@ def _run_file(tmp_path, capsys, text, extra=()):
             "defines 2 ClosedFormModel subclasses (HangingDoublePendulum, Second)",
         ),
         (
-            GOOD.replace("    def det_mass_matrix(self, q):", "    def _unused(self, q):"),
-            "methods of the interface not implemented: det_mass_matrix",
+            GOOD.replace("    def gravity(self, q):", "    def _unused(self, q):"),
+            "methods of the interface not implemented: gravity",
         ),
         (
             GOOD.replace('    model = "hanging_double_pendulum"', '    model = "other"'),

@@ -19,7 +19,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from pendverify.checks.catalogue import CheckResult, applicable_checks, run_checks, skipped_notes
+from pendverify.checks.catalogue import (
+    CheckResult,
+    applicable_checks,
+    derived_notes,
+    run_checks,
+    skipped_notes,
+)
 from pendverify.checks.diagnose import diagnose
 from pendverify.checks.report import Report
 from pendverify.checks.sampling import sample_states
@@ -91,7 +97,12 @@ def verify_target(report: Report, target, samples: int, seed: int) -> None:
     kept, refused = trusted_states(target, states)
     report.states[label] = len(states)
     report.sources[label] = target.source
-    notes = target.system.notes + target.notes + skipped_notes(target.model, target.system)
+    notes = (
+        target.system.notes
+        + target.notes
+        + skipped_notes(target.model, target.system)
+        + derived_notes(target.model)
+    )
     names = applicable_checks(target.model, target.system)
     with np.errstate(all="ignore"):
         results = run_checks(label, target.model, target.system, kept or states, seed, names)

@@ -23,6 +23,10 @@ acceleration                   M q̈_hand + (C + D) q̇ + H − B u − W w = 0,
 extra closed forms             what their ``equals`` says, e.g. the cart seed's
                                f = −C ẏ − H − D ẏ + B u + W w
 =============================  =============================================
+
+det M, M⁻¹ and q̈ that the model does not write (``hand_written``) are derived by
+the interface from M and the other parts: they are listed as ``skipped``, with
+the reason, and not compared.
 """
 
 from __future__ import annotations
@@ -139,6 +143,12 @@ def _acceleration(sm, lag) -> Comparison:
     return _compare("q̈", "acceleration", relation, residual, sm.angles)
 
 
+def _derived(quantity, method, relation, how) -> Comparison:
+    """A quantity the model does not write: derived by the interface, so nothing to compare."""
+    note = f"not hand-written: derived {how} by the interface, nothing to compare"
+    return Comparison(quantity, method, relation, SKIPPED, 0, note=note)
+
+
 def _extra(sm, lag, method, form) -> Comparison:
     try:
         expected = eval(form.equals, {"__builtins__": {}}, lag.namespace(sm))
@@ -191,18 +201,22 @@ def compare(model_cls: type[ClosedFormModel], label: str | None = None) -> Symbo
     if model_cls.disturbances:
         W_hand = sm.evaluate("disturbance_matrix", "")
         out.append(_compare("W", "disturbance_matrix", "hand − ∂²P/∂q̇∂w", W_hand - lag.W, angles))
-    out.append(
-        _compare(
-            "det M",
-            "det_mass_matrix",
-            "hand − det M",
-            sm.evaluate("det_mass_matrix", "q") - lag.M.det(),
-            angles,
-        )
-    )
-    inverse = sm.evaluate("inverse_mass_matrix", "q") * lag.M - sp.eye(n)
-    out.append(_compare("M⁻¹", "inverse_mass_matrix", "M⁻¹_hand · M − I", inverse, angles))
-    out.append(_acceleration(sm, lag))
+    written = model_cls.hand_written()
+    if "det_mass_matrix" in written:
+        det = sm.evaluate("det_mass_matrix", "q") - lag.M.det()
+        out.append(_compare("det M", "det_mass_matrix", "hand − det M", det, angles))
+    else:
+        out.append(_derived("det M", "det_mass_matrix", "hand − det M", "from M (LU)"))
+    if "inverse_mass_matrix" in written:
+        inverse = sm.evaluate("inverse_mass_matrix", "q") * lag.M - sp.eye(n)
+        out.append(_compare("M⁻¹", "inverse_mass_matrix", "M⁻¹_hand · M − I", inverse, angles))
+    else:
+        out.append(_derived("M⁻¹", "inverse_mass_matrix", "M⁻¹_hand · M − I", "from M (solving with M)"))
+    if "acceleration" in written:
+        out.append(_acceleration(sm, lag))
+    else:
+        relation = "M q̈_hand + (C + D) q̇ + H − B u − W w"
+        out.append(_derived("q̈", "acceleration", relation, "from M, C, H, D, B, W"))
     for method, form in model_cls.closed_forms.items():
         if form.equals and method != "coriolis_force":  # compared as C·q̇ above
             out.append(_extra(sm, lag, method, form))

@@ -146,8 +146,10 @@ class SymbolicModel:
 
     @cached_property
     def closed_forms(self) -> dict:
-        """Every declared closed form, evaluated."""
-        return {name: self.evaluate(name, form.args) for name, form in self.cls.closed_forms.items()}
+        """Every declared closed form the model writes itself, evaluated (derived defaults are not)."""
+        return {
+            name: self.evaluate(name, form.args) for name, form in self.cls.written_closed_forms().items()
+        }
 
     def column(self, kind: str) -> sp.Matrix:
         return sp.Matrix(len(self.symbols[kind]), 1, list(self.symbols[kind]))

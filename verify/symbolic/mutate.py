@@ -86,6 +86,10 @@ class MutationReport:
     controls: list[str]
     elapsed_s: float = 0.0
     all_checks: bool = False
+    #: interface methods the model does not write (derived by default): not mutated
+    derived: list[str] = field(default_factory=list)
+    #: hand-written methods no Pinocchio check sees (B, W with a derived q̈): not mutated
+    unseen: list[str] = field(default_factory=list)
 
     def count(self, verdict: str, method: str | None = None) -> int:
         return sum(o.verdict == verdict and (method is None or o.method == method) for o in self.outcomes)
@@ -112,6 +116,8 @@ class MutationReport:
             "detection_rate": self.rate,
             "controls": self.controls,
             "all_checks": self.all_checks,
+            "derived": self.derived,
+            "unseen": self.unseen,
             "elapsed_s": round(self.elapsed_s, 3),
             "outcomes": [o.as_dict() for o in self.outcomes],
         }
@@ -139,7 +145,11 @@ def numeric_model(model, sm: SymbolicModel, method: str, changes):
             out.flat[index] = f(*flat, *values)
         return out
 
-    return type(f"{cls.__name__}Mutant", (cls,), {method: mutated})(model.params)
+    mutant = type(f"{cls.__name__}Mutant", (cls,), {method: mutated})(model.params)
+    if {"gravity_scale", "diagonal_scale"} - set(cls.hand_written()):
+        # derived tolerance scales stay the original's, as hand-written ones would
+        mutant.__dict__["_derived_scales_cache"] = model._derived_scales()
+    return mutant
 
 
 def _failing(model, system, states, seed, order=None, stop: bool = False) -> list[str]:
@@ -291,14 +301,16 @@ def run_mutation(
     started = time.perf_counter()
     model, system = target.model, target.system
     sm = SymbolicModel.of(type(model))
-    unknown = sorted(set(methods or ()) - set(sm.cls.closed_forms))
+    written = sm.cls.written_closed_forms()
+    unknown = sorted(set(methods or ()) - set(written))
     if unknown:
-        raise UnknownNameError("closed form", ", ".join(unknown), tuple(sm.cls.closed_forms))
+        raise UnknownNameError("closed form", ", ".join(unknown), tuple(written))
     states = sample_states(model, samples, seed)
     first = len(states) - samples + min(FIRST_RANDOM, samples)
     rounds = [r for r in (states[:first], states[first:]) if r]
     controls = _controls(model, system, sm, states, seed)
-    mutants = [m for m in generate(sm) if methods is None or m.method in methods]
+    unseen = unseen_methods(sm.cls)
+    mutants = [m for m in generate(sm) if (methods is None or m.method in methods) and m.method not in unseen]
     outcomes = [classify(model, system, sm, m, rounds, seed, all_checks) for m in mutants]
     return MutationReport(
         target.label,
@@ -309,7 +321,32 @@ def run_mutation(
         controls,
         time.perf_counter() - started,
         all_checks,
+        derived_methods(sm.cls),
+        unseen,
     )
+
+
+def derived_methods(cls) -> list[str]:
+    """The interface's closed forms the model leaves to their derived defaults: nothing to mutate."""
+    written = cls.written_closed_forms()
+    return [
+        m
+        for m in cls.closed_forms
+        if m not in written and not (m == "disturbance_matrix" and not cls.disturbances)
+    ] + ([] if "acceleration" in cls.hand_written() else ["acceleration"])
+
+
+def unseen_methods(cls) -> list[str]:
+    """Hand-written closed forms no Pinocchio check can see: B and W when q̈ is derived.
+
+    The URDF defines no input map, so B and W reach a check only through a
+    hand-written q̈ (the seed's f + g·u); a derived q̈ applies the model's own B
+    and W on both sides of ``aba``.  They are compared by ``pendverify sympy``
+    (the input power) instead, and not mutated here.
+    """
+    if "acceleration" in cls.hand_written():
+        return []
+    return [m for m in ("input_matrix", "disturbance_matrix") if m in cls.written_closed_forms()]
 
 
 def format_report(report: MutationReport) -> str:
@@ -350,6 +387,13 @@ def format_report(report: MutationReport) -> str:
     for o in report.outcomes:
         if o.verdict == SURVIVED:
             out.append(f"SURVIVED: {o.description} — {o.reason}")
+    if report.derived:
+        out.append(f"not mutated (derived, not hand-written): {', '.join(report.derived)}")
+    if report.unseen:
+        out.append(
+            f"not mutated (no Pinocchio check sees them: the URDF has no input map and q̈ is derived; "
+            f"compared by pendverify sympy): {', '.join(report.unseen)}"
+        )
     relevant = len(report.outcomes) - report.count(EQUIVALENT)
     out.append(
         f"detection rate {report.rate:.1%} ({report.count(DETECTED)}/{relevant} non-equivalent mutants), "
