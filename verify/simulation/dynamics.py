@@ -110,8 +110,12 @@ def build_dynamics(scene: Scene, engine: str | None = None, urdf: str | None = N
         terms.append(f"disturbance W·w ({dist.kind})")
     D = None
     if scene.damping is not None:
-        D = np.diag(scene.damping)
-        terms.append(f"friction −D·q̇, D = diag({', '.join(f'{d:g}' for d in scene.damping)})")
+        D = scene.damping_matrix
+        if np.any(D - np.diag(np.diag(D))):
+            rows = "; ".join(", ".join(f"{d:g}" for d in row) for row in D)
+            terms.append(f"friction −D·q̇, D = [{rows}]")
+        else:
+            terms.append(f"friction −D·q̇, D = diag({', '.join(f'{d:g}' for d in scene.damping)})")
 
     zero = np.zeros(model.nv)
 
@@ -151,7 +155,7 @@ def _prepare_lqr(law, model, system, scene) -> None:
         pinocchio_linearisation,
     )
 
-    D = np.diag(scene.damping) if scene.damping is not None else np.zeros((model.nv, model.nv))
+    D = scene.damping_matrix if scene.damping is not None else np.zeros((model.nv, model.nv))
     closed = closed_form_linearisation(model, D, law.q_star)
     pinocchio = pinocchio_linearisation(system, model, D, law.q_star)
     law.spec["linearisation_error"] = linearisation_error(closed, pinocchio)

@@ -27,7 +27,7 @@ A scene is a TOML file::
 
     [effects]                   # every effect is off unless turned on here
     gravity = true              # true (the parameter set's g), false, or a value in m/s²
-    damping = true              # true (the parameter set's), false, or a list per coordinate
+    damping = true              # true (the model's damping_matrix()), false, or a list: diag(D)
     [effects.actuation]         # u: see pendverify.simulation.effects for every type and its keys
     type = "sine"
     amplitude = [0.5, 0.0]
@@ -106,16 +106,21 @@ class Scene:
     sample_rate: float
     integrator: Integrator
     gravity: float | None  # m/s², None when off
-    damping: np.ndarray | None  # D's diagonal, None when off
+    damping: np.ndarray | None  # D's diagonal, None when off (the full D: ``damping_matrix``)
     actuation: Law | None  # u(t, q, q̇), None when off
     disturbance: Law | None  # w(t), None when off
     model_cls: type[ClosedFormModel] | None = None  # None: MODELS[model]
     model_file: str | None = None  # the model file of a plug-in, None when built in
     urdf: str | None = None  # the scene's URDF (path), None: the project writes it (built-in)
+    #: D as a matrix: the model's damping_matrix() (damping = true; a triple pendulum's joint
+    #: friction couples its absolute angles), or diag(damping); None when off
+    damping_matrix: np.ndarray | None = None
 
     def __post_init__(self):
         if self.model_cls is None:
             object.__setattr__(self, "model_cls", MODELS[self.model])
+        if self.damping_matrix is None and self.damping is not None:
+            object.__setattr__(self, "damping_matrix", np.diag(self.damping))
 
     @property
     def conservative(self) -> bool:
@@ -321,8 +326,11 @@ def parse_scene(data: dict, source: str, base: Path | None = None) -> Scene:
     g = effects.boolean_or_number("gravity")
     gravity = params.g if g is True else (None if g is False else g)
     damping_value = effects.get("damping", False)
+    damping_matrix = None
     if isinstance(damping_value, bool):
-        damping = np.diag(model_cls(params).damping_matrix()).copy() if damping_value else None
+        if damping_value:
+            damping_matrix = np.array(model_cls(params).damping_matrix(), dtype=float).reshape(n, n)
+        damping = np.diag(damping_matrix).copy() if damping_value else None
     else:
         damping = effects.vector("damping", n, minimum=0.0)
     actuation = parse_actuation(
@@ -348,6 +356,7 @@ def parse_scene(data: dict, source: str, base: Path | None = None) -> Scene:
         model_cls=model_cls,
         model_file=model_file,
         urdf=urdf,
+        damping_matrix=damping_matrix,
     )
 
 
