@@ -136,7 +136,11 @@ def _system(scene: Scene, params, urdf: str | None, needed_by: str) -> Pinocchio
     if urdf is not None:
         return PinocchioSystem.for_model(scene.model_cls, urdf, params.g)
     if scene.model_file is not None:
-        what = "the lqr actuation linearises with Pinocchio" if needed_by == "lqr" else f"engine {needed_by}"
+        what = (
+            "the lqr actuation linearises with Pinocchio"
+            if needed_by == "lqr"
+            else f"engine {needed_by} integrates ABA"
+        )
         raise SceneError(
             scene.source,
             "urdf",
