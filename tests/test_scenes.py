@@ -253,7 +253,7 @@ method = "RK45"
     [
         (
             ("model =", "colour = 1\nmodel ="),
-            "key 'colour' = 1: unknown key; expected one of name, model, params, parameters, engine, "
+            "key 'colour' = 1: unknown key; expected one of name, model, params, parameters, urdf, engine, "
             "initial, time, integrator, effects",
         ),
         (("duration = 1.0", "duration = 0.0"), "key 'time.duration' = 0.0: expected a number > 0"),
@@ -292,9 +292,12 @@ method = "RK45"
             "key 'effects.disturbance.type' = 'impulse': the double_pendulum model has no disturbance input",
         ),
         (
-            (GOOD, GOOD + '[effects.actuation]\ntype = "lqr"\n'),
-            "key 'effects.actuation.type' = 'lqr': "
-            "LQR is for the cart about upright; double_pendulum takes pd",
+            (
+                GOOD,
+                GOOD + '[effects]\ngravity = true\n[effects.actuation]\ntype = "lqr"\nequilibrium = "zero"\n',
+            ),
+            "key 'effects.actuation.equilibrium' = 'zero': not an equilibrium of double_pendulum: "
+            "H(q*) = [8.1, 1.73] (on theta1: 8.1 > 2.9e-14, the rounding allowance)",
         ),
     ],
 )

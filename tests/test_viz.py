@@ -37,6 +37,9 @@ from .conftest import default_params
 
 REPO = Path(__file__).resolve().parents[1]
 SHIPPED = sorted((REPO / "scenes").glob("*.toml"))
+# scenes on a model file draw that file's URDF, which has none of the project URDFs' colours
+PLUGIN_SCENES = [p for p in SHIPPED if load_scene(p).model_file is not None]
+BUILT_IN_SCENES = [p for p in SHIPPED if p not in PLUGIN_SCENES]
 MAX_HTML_BYTES = 2_000_000  # the issue's goal for a 10 s animation
 SHOT_SIZE = (800, 600)
 CLOCK = "viewer.animator.actions[0].time"  # the animation's clock, in [s]
@@ -296,7 +299,31 @@ def test_browser_leaves_no_process_behind():
 
 
 @needs_chromium
-@pytest.mark.parametrize("path", SHIPPED, ids=[p.stem for p in SHIPPED])
+@pytest.mark.parametrize("path", PLUGIN_SCENES, ids=[p.stem for p in PLUGIN_SCENES])
+def test_rendered_plugin_scene_plays_in_chromium(path, tmp_path, browser):
+    """A model file's URDF (its own visuals, no project colours): drawn, and it moves."""
+    page = tmp_path / f"{path.stem}.html"
+    assert main(["render", str(path), "-o", str(page)]) == 0
+    tab = browser.open(page, SHOT_SIZE)
+    try:
+        tab.evaluate("viewer.animator.reset(), viewer.animator.play(), 0")
+        wait_for_clock(tab, FIRST_SHOT_S)
+        first = tab.screenshot(tmp_path / "first.png")
+        t1 = tab.evaluate(CLOCK)
+        time.sleep(SHOT_GAP_S)
+        second = tab.screenshot(tmp_path / "second.png")
+        t2 = tab.evaluate(CLOCK)
+    finally:
+        tab.close()
+    a, b = (np.asarray(Image.open(x).convert("RGB"), dtype=int) for x in (first, second))
+    drawn = np.abs(a - a[0, 0]).sum(axis=-1) > 30  # pixels unlike the plain background
+    assert drawn.sum() >= MIN_LINK_PIXELS, f"{path.stem}: the model is hardly visible"
+    moved = int((np.abs(a - b).sum(axis=-1) > 30).sum())
+    assert moved >= MIN_MOVED_PIXELS, f"{path.stem}: the model did not move from t = {t1:.2f} to {t2:.2f} s"
+
+
+@needs_chromium
+@pytest.mark.parametrize("path", BUILT_IN_SCENES, ids=[p.stem for p in BUILT_IN_SCENES])
 def test_rendered_scene_plays_in_chromium(path, tmp_path, browser):
     page = tmp_path / f"{path.stem}.html"
     assert main(["render", str(path), "-o", str(page)]) == 0

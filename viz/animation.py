@@ -69,6 +69,10 @@ class Trajectory:
     params: ParameterSet
     title: str
     source: str = "<run>"
+    #: the model class (None: the built-in ``MODELS[params.model]``) and the URDF to draw
+    #: (path or text; None: the one ``urdf_for(params)`` writes, built-in models only)
+    model_cls: type | None = None
+    urdf: str | None = None
 
     def __post_init__(self) -> None:
         if self.t.ndim != 1 or len(self.t) < 2:
@@ -77,7 +81,9 @@ class Trajectory:
             raise TrajectoryError(
                 self.source, "q", self.q.shape, f"expected {len(self.t)} rows, one per time"
             )
-        n = len(MODELS[self.params.model].coordinates)
+        if self.model_cls is None:
+            object.__setattr__(self, "model_cls", MODELS[self.params.model])
+        n = len(self.model_cls.coordinates)
         if self.q.shape[1] != n:
             raise TrajectoryError(
                 self.source, "q", self.q.shape, f"expected {n} columns for {self.params.model}"
@@ -90,7 +96,10 @@ class Trajectory:
     @classmethod
     def from_run(cls, run) -> Trajectory:
         """A ``pendverify.simulation.simulate.Run``."""
-        return cls(np.asarray(run.t), np.asarray(run.q), run.scene.params, run.scene.name, run.scene.source)
+        s = run.scene
+        return cls(
+            np.asarray(run.t), np.asarray(run.q), s.params, s.name, s.source, s.model_cls, run.dynamics.urdf
+        )
 
     @classmethod
     def from_npz(cls, path: str | Path) -> Trajectory:
@@ -184,11 +193,24 @@ def _trace(vis, anim: Animation, tips: np.ndarray, fps: float) -> None:
             clip.set_property(frame, "visible", "boolean", shown)
 
 
+def _visual_system(traj: Trajectory) -> VisualSystem:
+    if traj.urdf is not None:
+        return VisualSystem.for_model(traj.model_cls, traj.urdf, getattr(traj.params, "g", None))
+    if traj.params.model not in MODELS or MODELS[traj.params.model].params_type is not type(traj.params):
+        raise TrajectoryError(
+            traj.source,
+            "urdf",
+            None,
+            f"{traj.params.model} is drawn from its URDF: give urdf = FILE in the scene, or --urdf",
+        )
+    return VisualSystem.from_params(traj.params)
+
+
 def build_scene(traj: Trajectory, trace: bool = False, fps: float = DEFAULT_FPS) -> SceneRecorder:
     """Record the model, the camera and the animation of a trajectory (no server involved)."""
     if not FPS_RANGE[0] <= fps <= FPS_RANGE[1]:
         raise TrajectoryError(traj.source, "fps", fps, f"expected {FPS_RANGE[0]:g} to {FPS_RANGE[1]:g}")
-    visual = VisualSystem.from_params(traj.params)
+    visual = _visual_system(traj)
     recorder = SceneRecorder()
     vis = recorder.visualizer()
     visual.load_into(vis)

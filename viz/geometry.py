@@ -2,7 +2,8 @@
 
 The geometry on screen is the geometry that was verified: the URDF text comes
 from ``pendverify.robot.writer.urdf_for`` (the same writer the checks and the
-simulator use), Pinocchio parses its ``<visual>`` elements into a visual
+simulator use), or is the URDF a scene names (a model file's, ``VisualSystem.for_model``);
+Pinocchio parses its ``<visual>`` elements into a visual
 ``GeometryModel``, and ``pinocchio.visualize.MeshcatVisualizer`` turns every
 ``GeometryObject`` (box, cylinder, sphere, with the URDF material colour) into a
 meshcat object at ``<root>/visuals/<geometry name>``.  Poses come from
@@ -16,6 +17,7 @@ the world (the pendulum's pivot block, the cart's rail) are placed once.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -25,6 +27,12 @@ from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
 
 ROOT = "pendverify"
+
+
+def _is_path(urdf) -> bool:
+    return isinstance(urdf, Path) or "<" not in str(urdf)
+
+
 UP = np.array([0.0, 0.0, 1.0])
 
 
@@ -44,6 +52,17 @@ class VisualSystem:
         system = PinocchioSystem.from_urdf(params.model, urdf, params.g, f"<URDF of {params.model}>")
         visual_model = pin.buildGeomFromUrdfString(system.model, urdf, pin.GeometryType.VISUAL)
         return cls(system, visual_model, visual_model.createData(), urdf)
+
+    @classmethod
+    def for_model(cls, model_cls, urdf: str | Path, g: float | None = None) -> VisualSystem:
+        """A given URDF (path or XML text) with its visuals, seen in ``model_cls``'s coordinates.
+
+        The way a model file (plug-in) is drawn: its URDF is the one the simulation integrated.
+        """
+        text = Path(urdf).read_text() if _is_path(urdf) else str(urdf)
+        system = PinocchioSystem.for_model(model_cls, text, g, str(urdf) if _is_path(urdf) else None)
+        visual_model = pin.buildGeomFromUrdfString(system.model, text, pin.GeometryType.VISUAL)
+        return cls(system, visual_model, visual_model.createData(), text)
 
     @property
     def objects(self) -> list[pin.GeometryObject]:

@@ -21,11 +21,17 @@ def register(sub) -> None:
     p.add_argument("--trajectory", help="render a saved run (npz of `pendverify simulate -o`) instead")
     p.add_argument("--trace", action="store_true", help="draw the path of the tip as it moves")
     p.add_argument("--engine", choices=("aba", "closed_form", "both"), help="override the scene's engine")
+    p.add_argument(
+        "--urdf",
+        help="the URDF ABA integrates (and the animation draws), instead of the scene's urdf "
+        "or the project's URDF of the parameter set",
+    )
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     from pendverify.atomic import write_atomic
+    from pendverify.commands.simulate import urdf_argument
     from pendverify.errors import InputError
     from pendverify.simulation.scene import load_scene
     from pendverify.viz.animation import Trajectory, render_html
@@ -44,7 +50,7 @@ def run(args: argparse.Namespace) -> int:
     else:
         from pendverify.simulation.simulate import simulate
 
-        result = simulate(load_scene(args.scene), args.engine)
+        result = simulate(load_scene(args.scene), args.engine, urdf_argument(args.urdf))
         traj = Trajectory.from_run(result)
         if not result.passed:
             print(f"note: {traj.title}: an invariant FAILS (see `pendverify simulate {args.scene}`)")

@@ -11,6 +11,11 @@ def register(sub) -> None:
     p.add_argument("-o", "--output", help="write the trajectory (npz)")
     p.add_argument("--csv", action="store_true", help="also write a CSV beside the npz")
     p.add_argument("--engine", choices=("aba", "closed_form", "both"), help="override the scene's engine")
+    p.add_argument(
+        "--urdf",
+        help="the URDF ABA integrates (and the animation draws), instead of the scene's urdf "
+        "or the project's URDF of the parameter set",
+    )
     p.add_argument("--html", help="also write a self-contained HTML animation (as `pendverify render`)")
     p.set_defaults(func=run)
 
@@ -20,7 +25,7 @@ def summary(run) -> str:
     engine = "both (ABA integrated; closed form compared)" if run.engine_comparison else run.dynamics.engine
     lines = [
         f"scene       {s.name}  ({s.source})",
-        f"model       {s.model}, parameters {s.params_source}",
+        f"model       {s.model}{f' ({s.model_file})' if s.model_file else ''}, parameters {s.params_source}",
         f"engine      {engine}",
         f"integrator  {s.integrator.describe()}: {len(integ.steps_t) - 1} steps, "
         f"{integ.nfev} right-hand-side evaluations, {s.duration:g} s, {len(run.t)} samples",
@@ -46,7 +51,7 @@ def run(args: argparse.Namespace) -> int:
     from pendverify.simulation.simulate import simulate
 
     scene = load_scene(args.scene)
-    result = simulate(scene, args.engine)
+    result = simulate(scene, args.engine, urdf_argument(args.urdf))
     print(summary(result))
     if args.output:
         write_atomic(args.output, result.to_npz_bytes())
@@ -61,3 +66,14 @@ def run(args: argparse.Namespace) -> int:
         write_atomic(args.html, render_html(Trajectory.from_run(result)))
         print(f"animation written to {args.html}")
     return 0 if result.passed else 1
+
+
+def urdf_argument(path: str | None) -> str | None:
+    """``--urdf``: an existing file, or an InputError naming it."""
+    from pathlib import Path
+
+    from pendverify.errors import InputError
+
+    if path is not None and not Path(path).is_file():
+        raise InputError("<command line>", "--urdf", path, "URDF file not found")
+    return path

@@ -9,7 +9,9 @@ is built with g = 0), with no actuation or disturbance there is no input path.
 
 Engines, both fed the same generalized force τ (model coordinates):
 
-* ``aba``: Pinocchio's ABA on the URDF of the scene's parameter set;
+* ``aba``: Pinocchio's ABA on the scene's URDF (``urdf``, or ``simulate --urdf``), else, for a
+  built-in model, on the URDF the project writes for the scene's parameter set; a model file
+  (plug-in) has no such writer, so it needs a URDF for ``aba`` and ``both``;
 * ``closed_form``: the hand model's control-affine form,
   q̈ = f₀(x) + g(x) τ with f₀ = −M⁻¹ (C q̇ + H) and g(x) = M⁻¹ — the seed's f
   and g, with friction entering τ as −D q̇ only when damping is on.
@@ -26,10 +28,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pendverify.analytic import MODELS, ClosedFormModel
+from pendverify.analytic import MODELS, ClosedFormModel  # noqa: F401  (MODELS: the scenes' built-ins)
 from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
-from pendverify.simulation.scene import Scene
+from pendverify.simulation.scene import Scene, SceneError
 
 
 @dataclass
@@ -42,6 +44,7 @@ class Dynamics:
     u_of: Callable | None
     w_of: Callable | None
     D: np.ndarray | None
+    urdf: str | None = None  # the URDF given (scene or --urdf), None: the project's for the parameter set
 
     @property
     def nv(self) -> int:
@@ -81,12 +84,11 @@ def build_dynamics(scene: Scene, engine: str | None = None, urdf: str | None = N
     engine = engine or scene.engine
     g = scene.gravity if scene.gravity is not None else 0.0
     params = scene.params.replace(g=g)
-    model = MODELS[scene.model](params)
+    model = scene.model_cls(params)
+    urdf = urdf or scene.urdf
     system = None
     if engine in ("aba", "both"):
-        system = PinocchioSystem.from_urdf(
-            scene.model, urdf or urdf_for(params), g, f"<URDF of {scene.name}>"
-        )
+        system = _system(scene, params, urdf, engine)
     terms = ["inertia M(q)q̈", "Coriolis/centrifugal C(q,q̇)q̇"]
     terms.append(f"gravity H(q), g = {g:g} m/s²" if scene.gravity is not None else "gravity: off (H = 0)")
 
@@ -96,7 +98,7 @@ def build_dynamics(scene: Scene, engine: str | None = None, urdf: str | None = N
         law = scene.actuation
         B = model.input_matrix()
         if law.kind == "lqr":
-            _prepare_lqr(law, model, system, scene)
+            _prepare_lqr(law, model, system or _system(scene, params, urdf, "lqr"), scene)
         u_of = law
         parts_in.append(lambda t, q, v: B @ law(t, q, v))
         terms.append(f"actuation B·u ({law.kind}{', feedback' if law.feedback else ''})")
@@ -108,8 +110,12 @@ def build_dynamics(scene: Scene, engine: str | None = None, urdf: str | None = N
         terms.append(f"disturbance W·w ({dist.kind})")
     D = None
     if scene.damping is not None:
-        D = np.diag(scene.damping)
-        terms.append(f"friction −D·q̇, D = diag({', '.join(f'{d:g}' for d in scene.damping)})")
+        D = scene.damping_matrix
+        if np.any(D - np.diag(np.diag(D))):
+            rows = "; ".join(", ".join(f"{d:g}" for d in row) for row in D)
+            terms.append(f"friction −D·q̇, D = [{rows}]")
+        else:
+            terms.append(f"friction −D·q̇, D = diag({', '.join(f'{d:g}' for d in scene.damping)})")
 
     zero = np.zeros(model.nv)
 
@@ -122,7 +128,27 @@ def build_dynamics(scene: Scene, engine: str | None = None, urdf: str | None = N
 
     if engine == "both":
         engine = "aba"
-    return Dynamics(model, system, engine, terms, generalized_force, u_of, w_of, D)
+    return Dynamics(model, system, engine, terms, generalized_force, u_of, w_of, D, urdf)
+
+
+def _system(scene: Scene, params, urdf: str | None, needed_by: str) -> PinocchioSystem:
+    """Pinocchio's side: the given URDF, else the project's URDF of a built-in parameter set."""
+    if urdf is not None:
+        return PinocchioSystem.for_model(scene.model_cls, urdf, params.g)
+    if scene.model_file is not None:
+        what = (
+            "the lqr actuation linearises with Pinocchio"
+            if needed_by == "lqr"
+            else f"engine {needed_by} integrates ABA"
+        )
+        raise SceneError(
+            scene.source,
+            "urdf",
+            None,
+            f"missing key: {what} on a URDF, and the model file {scene.model_file} has none "
+            "the project can write (give urdf = FILE or --urdf)",
+        )
+    return PinocchioSystem.for_model(scene.model_cls, urdf_for(params), params.g, f"<URDF of {scene.name}>")
 
 
 def _prepare_lqr(law, model, system, scene) -> None:
@@ -133,12 +159,19 @@ def _prepare_lqr(law, model, system, scene) -> None:
         pinocchio_linearisation,
     )
 
-    D = np.diag(scene.damping) if scene.damping is not None else np.zeros((model.nv, model.nv))
-    closed = closed_form_linearisation(model, D)
-    if system is None:
-        system = PinocchioSystem.from_urdf(scene.model, urdf_for(model.params), model.params.g)
-    pinocchio = pinocchio_linearisation(system, model, D)
+    D = scene.damping_matrix if scene.damping is not None else np.zeros((model.nv, model.nv))
+    closed = closed_form_linearisation(model, D, law.q_star)
+    pinocchio = pinocchio_linearisation(system, model, D, law.q_star)
     law.spec["linearisation_error"] = linearisation_error(closed, pinocchio)
-    law.K = lqr_gain(closed, np.diag(law.Q), np.diag(law.R))
+    try:
+        law.K = lqr_gain(closed, np.diag(law.Q), np.diag(law.R))
+    except (ValueError, np.linalg.LinAlgError) as exc:
+        raise SceneError(
+            scene.source,
+            "effects.actuation",
+            "lqr",
+            f"no LQR gain about {law.equilibrium!r}: the Riccati equation has no stabilising "
+            f"solution for this Q, R and linearisation ({exc})",
+        ) from None
     closed_loop = np.linalg.eigvals(closed.A - closed.B @ law.K)
     law.spec["closed_loop_max_real"] = float(np.max(closed_loop.real))

@@ -1,7 +1,7 @@
 """Actuation u(t, q, q̇) and disturbance w(t) laws a scene can switch on.
 
-Actuation (``[effects.actuation]``), u in the model's inputs (N·m per joint for
-the double pendulum, N on the cart):
+Actuation (``[effects.actuation]``), u in the model's inputs (``model.inputs``: N·m per
+joint for the double pendulum, N on the cart); any model with inputs takes any type:
 
 =========  =====================================================================
 type       keys
@@ -10,13 +10,18 @@ constant   value = [u…]
 step       time (s), after = [u…], before = [u…] (default zeros)
 sine       amplitude = [u…], frequency (Hz > 0), phase (rad, 0), offset = [u…]
 table      times = [t0 < t1 < …] (s), values = [[u…], …]: piecewise linear, held at the ends
-lqr        cart only: Q = [6 weights ≥ 0] on (q, θ1, θ2, q̇, θ̇1, θ̇2), R = [1 weight > 0],
-           saturation (N, optional).  u = −K x about the upright equilibrium.
-pd         double pendulum only: kp = [2], kd = [2] (≥ 0), target = [θ1, θ2] (rad):
-           u = kp (target − θ) − kd θ̇
+lqr        Q = [2·nv weights ≥ 0] on (q − q*, q̇), R = [one weight > 0 per input],
+           saturation (in u's units, optional), equilibrium (a name in the model's
+           ``special_states()``, default "upright"): u = −K (x − x*) about x* = (q*, 0),
+           which must be an equilibrium (|H(q*)| within rounding, see ``equilibrium``).
+           The cart's scenes: Q on (q, θ1, θ2, q̇, θ̇1, θ̇2), R = [1].
+pd         models whose B is square and invertible: kp = [nv], kd = [nv] (≥ 0), target = [nv]
+           in model coordinates: the joint-space force τ = kp (target − q) − kd q̇ is
+           applied through u = B⁻¹ τ (B = I for the double pendulum: u = τ)
 =========  =====================================================================
 
-Disturbance (``[effects.disturbance]``, cart only), w on (q, θ1, θ2) in N, N·m, N·m:
+Disturbance (``[effects.disturbance]``), w in the model's disturbances (``model.disturbances``,
+entering as W w; the cart's: on (q, θ1, θ2) in N, N·m, N·m); a model without W takes none:
 
 =========  =====================================================================
 impulse    time (s), impulse = [3] (N·s, N·m·s), width (s, 0.01): a rectangular pulse
@@ -35,6 +40,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+
+#: Rounding allowance of the equilibrium test |H_i(q*)| ≤ K·ε·(1 + max|q*|)·Σ|coefficients of H_i|.
+EQUILIBRIUM_K = 16.0
+EPS = float(np.finfo(float).eps)
 
 
 @dataclass
@@ -137,15 +146,18 @@ class Noise(Law):
 
 @dataclass
 class PD(Law):
+    """u = B⁻¹ (kp (target − q) − kd q̇): a joint-space PD force through the inverse input map."""
+
     kp: np.ndarray = None
     kd: np.ndarray = None
     target: np.ndarray = None
+    B_inv: np.ndarray = None
 
     def __post_init__(self):
         self.feedback = True
 
     def __call__(self, t, q, v):
-        return self.kp * (self.target - q) - self.kd * v
+        return self.B_inv @ (self.kp * (self.target - q) - self.kd * v)
 
 
 @dataclass
@@ -156,12 +168,14 @@ class LQR(Law):
     R: np.ndarray = None
     saturation: float | None = None
     K: np.ndarray | None = None
+    equilibrium: str = "upright"
+    q_star: np.ndarray = None
 
     def __post_init__(self):
         self.feedback = True
 
     def __call__(self, t, q, v):
-        u = -self.K @ np.concatenate([q, v])
+        u = -self.K @ np.concatenate([q - self.q_star, v])
         if self.saturation is not None:
             u = np.clip(u, -self.saturation, self.saturation)
         return u
@@ -171,11 +185,17 @@ ACTUATION_TYPES = ("constant", "step", "sine", "table", "lqr", "pd")
 DISTURBANCE_TYPES = ("impulse", "step", "noise")
 
 
-def parse_actuation(r, model_cls) -> Law | None:
-    """An actuation law from the scene table reader ``r`` (None when absent)."""
+def parse_actuation(r, model_cls, params=None) -> Law | None:
+    """An actuation law from the scene table reader ``r`` (None when absent).
+
+    ``params`` (with the scene's g) is the parameter set ``pd`` reads B from and ``lqr``
+    tests its equilibrium with.
+    """
     if r is None:
         return None
     n = len(model_cls.inputs)
+    if n == 0:
+        r.fail("type", r.get("type", None), f"the {model_cls.name} model has no input")
     kind = r.string("type", ACTUATION_TYPES)
     if kind == "constant":
         r.only(("type", "value"))
@@ -213,9 +233,8 @@ def parse_actuation(r, model_cls) -> Law | None:
         values = np.array([_row(r, "values", row, n, i) for i, row in enumerate(rows)])
         return Table(kind, n, times=times, values=values)
     if kind == "lqr":
-        if model_cls.name != "cart_double_pendulum":
-            r.fail("type", kind, f"LQR is for the cart about upright; {model_cls.name} takes pd")
-        r.only(("type", "Q", "R", "saturation"))
+        r.only(("type", "Q", "R", "saturation", "equilibrium"))
+        name, q_star = _equilibrium(r, model_cls(params))
         sat = r.number("saturation", positive=True) if r.has("saturation") else None
         return LQR(
             kind,
@@ -223,19 +242,68 @@ def parse_actuation(r, model_cls) -> Law | None:
             Q=r.vector("Q", 2 * len(model_cls.coordinates), minimum=0.0),
             R=_positive(r, "R", n),
             saturation=sat,
+            equilibrium=name,
+            q_star=q_star,
         )
     # pd
-    if model_cls.name != "double_pendulum":
-        r.fail("type", kind, f"PD acts on the fixed-base pendulum's joints; {model_cls.name} takes lqr")
-    r.only(("type", "kp", "kd", "target"))
     nv = len(model_cls.coordinates)
+    if n != nv:
+        r.fail(
+            "type",
+            kind,
+            f"PD acts through B⁻¹, and B of {model_cls.name} is {nv}×{n}, not square "
+            f"({n} input{'s' if n != 1 else ''} for {nv} coordinates); use lqr or an open-loop type",
+        )
+    B = np.asarray(model_cls(params).input_matrix(), dtype=float)
+    if np.linalg.cond(B) > 1 / (EQUILIBRIUM_K * EPS):
+        r.fail("type", kind, f"PD acts through B⁻¹, and B of {model_cls.name} is singular")
+    r.only(("type", "kp", "kd", "target"))
     return PD(
         kind,
         n,
         kp=r.vector("kp", nv, minimum=0.0),
         kd=r.vector("kd", nv, minimum=0.0),
         target=r.vector("target", nv, default=[0.0] * nv),
+        B_inv=np.linalg.inv(B),
     )
+
+
+def equilibrium_tolerance(model, q_star: np.ndarray) -> np.ndarray:
+    """Per coordinate, how far from zero a computed H_i(q*) may be at an exact equilibrium.
+
+    H_i is a sum of terms c·trig(q…) whose |c| add up to ``gravity_scale()_i``; evaluating it
+    in floating point errs by a few ε per term, and the angle itself carries a rounding
+    error of ε·|q*| (π is not a double: sin(float(π)) ≈ 1.2e-16), so
+    |H_i(q*)| ≤ K·ε·(1 + max|q*|)·gravity_scale_i with K = ``EQUILIBRIUM_K`` = 16, the
+    allowance the engine comparison uses for the same kind of evaluation.
+    """
+    return EQUILIBRIUM_K * EPS * (1.0 + np.max(np.abs(q_star))) * np.abs(model.gravity_scale())
+
+
+def _equilibrium(r, model) -> tuple[str, np.ndarray]:
+    states = model.special_states()
+    names = ", ".join(states)
+    if not r.has("equilibrium") and "upright" not in states:
+        r.fail(
+            "equilibrium",
+            None,
+            f"missing key: {model.name} has no special state 'upright'; name one of {names}",
+        )
+    name = r.string("equilibrium", default="upright")
+    if name not in states:
+        r.fail("equilibrium", name, f"expected a special state of {model.name}: one of {names}")
+    q_star = np.asarray(states[name], dtype=float)
+    H = np.asarray(model.gravity(q_star), dtype=float)
+    tol = equilibrium_tolerance(model, q_star)
+    if np.any(np.abs(H) > tol):
+        i = int(np.argmax(np.abs(H) - tol))
+        r.fail(
+            "equilibrium",
+            name,
+            f"not an equilibrium of {model.name}: H(q*) = [{', '.join(f'{h:.3g}' for h in H)}] "
+            f"(on {model.coordinates[i]}: {abs(H[i]):.3g} > {tol[i]:.2g}, the rounding allowance)",
+        )
+    return name, q_star
 
 
 def _row(r, key, row, n, i):

@@ -1,16 +1,23 @@
-"""LQR for the cart about its upright equilibrium, linearised two ways.
+"""LQR about an equilibrium of any model with inputs, linearised two ways.
 
-State x = (q, θ1, θ2, q̇, θ̇1, θ̇2) (absolute angles, as the seed), input u the
-cart force; x = 0, u = 0 is an equilibrium (both rods upright).  The linear
-model ẋ ≈ A x + B u is computed
+State x = (q − q*, q̇) in the model's coordinates, input u; q* is one of the model's
+``special_states()`` (the scene's ``equilibrium``, default "upright": for the cart
+both rods upright, q* = 0) and must be an equilibrium, H(q*) ≈ 0
+(``pendverify.simulation.effects.equilibrium_tolerance``).  The linear model
+ẋ ≈ A x + B u is computed
 
 * from Pinocchio: ``computeABADerivatives`` at the equilibrium gives ∂q̈/∂q,
   ∂q̈/∂v and ∂q̈/∂τ = M⁻¹ in joint coordinates; with τ_q = T⁻ᵀ (B_u u − D θ̇)
-  the map to the seed's coordinates is
+  the map to the model's coordinates is
       ∂θ̈/∂θ = T⁻¹ (∂q̈/∂q) T,   ∂θ̈/∂θ̇ = T⁻¹ ((∂q̈/∂v) T − M⁻¹ T⁻ᵀ D),   ∂θ̈/∂u = T⁻¹ M⁻¹ T⁻ᵀ B_u;
-* from the closed form: at rest upright the velocity terms of f are quadratic
-  and vanish to first order, so ∂θ̈/∂θ = M(0)⁻¹ G, ∂θ̈/∂θ̇ = −M(0)⁻¹ D and
-  ∂θ̈/∂u = M(0)⁻¹ B_u, with G = ∂f/∂θ = diag(0, g (m1+m2) l1, g m2 l2).
+* from the closed form: at rest the velocity terms C(q, q̇) q̇ are quadratic and
+  vanish to first order, and ∂M⁻¹/∂q multiplies H(q*) ≈ 0, so
+  ∂θ̈/∂θ = −M(q*)⁻¹ ∂H/∂q(q*), ∂θ̈/∂θ̇ = −M(q*)⁻¹ D and ∂θ̈/∂u = M(q*)⁻¹ B_u.
+  ∂H/∂q is the complex-step derivative of the model's own ``gravity`` (exact to
+  rounding: Im H(q + i h e_j) / h with h = 1e-20), evaluated with ``self.math`` set
+  to ``cmath``'s functions; a model whose closed form does not carry complex
+  numbers gets central differences instead (error ≈ ε^(2/3), reported as the
+  linearisation difference).  For the cart, −∂H/∂q = diag(0, g (m1+m2) l1, g m2 l2).
 
 The two must agree to rounding; the gain K = R⁻¹ Bᵀ P solves the continuous
 algebraic Riccati equation (scipy) for the closed-form pair.
@@ -18,13 +25,21 @@ algebraic Riccati equation (scipy) for the closed-form pair.
 
 from __future__ import annotations
 
+import cmath
+import copy
+import types
 from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
 import scipy.linalg
 
-from pendverify.analytic import CartDoublePendulum
+from pendverify.analytic import ClosedFormModel
+
+COMPLEX_STEP = 1e-20
+COMPLEX_MATH = types.SimpleNamespace(
+    cos=cmath.cos, sin=cmath.sin, tan=cmath.tan, sqrt=cmath.sqrt, exp=cmath.exp, pi=cmath.pi
+)
 
 
 @dataclass(frozen=True)
@@ -40,16 +55,42 @@ def _state_space(d_theta: np.ndarray, d_thetadot: np.ndarray, d_u: np.ndarray) -
     return Linearisation(A, B)
 
 
-def closed_form_linearisation(model: CartDoublePendulum, D: np.ndarray) -> Linearisation:
-    p = model.params
-    M0_inv = model.inverse_mass_matrix(np.zeros(3))
-    G = np.diag([0.0, p.g * (p.m1 + p.m2) * p.l1, p.g * p.m2 * p.l2])
-    return _state_space(M0_inv @ G, -M0_inv @ D, M0_inv @ model.input_matrix())
+def gravity_jacobian(model: ClosedFormModel, q_star: np.ndarray) -> np.ndarray:
+    """∂H/∂q at q*: complex step through the model's own ``gravity``, else central differences."""
+    n = model.nv
+    try:
+        shadow = copy.copy(model)
+        shadow.math = COMPLEX_MATH
+        columns = []
+        for j in range(n):
+            z = q_star.astype(complex)
+            z[j] += 1j * COMPLEX_STEP
+            H = np.asarray(shadow.gravity(z))
+            if not np.iscomplexobj(H):
+                raise TypeError("gravity dropped the imaginary part")
+            columns.append(H.imag.astype(float) / COMPLEX_STEP)
+        return np.column_stack(columns)
+    except (TypeError, ValueError, AttributeError):
+        columns = []
+        for j in range(n):
+            h = np.cbrt(np.finfo(float).eps) * (1.0 + abs(q_star[j]))
+            e = np.zeros(n)
+            e[j] = h
+            columns.append((model.gravity(q_star + e) - model.gravity(q_star - e)) / (2 * h))
+        return np.column_stack(columns)
 
 
-def pinocchio_linearisation(system, model: CartDoublePendulum, D: np.ndarray) -> Linearisation:
+def closed_form_linearisation(model: ClosedFormModel, D: np.ndarray, q_star: np.ndarray) -> Linearisation:
+    M_inv = model.inverse_mass_matrix(q_star)
+    G = -gravity_jacobian(model, q_star)
+    return _state_space(M_inv @ G, -M_inv @ D, M_inv @ model.input_matrix())
+
+
+def pinocchio_linearisation(
+    system, model: ClosedFormModel, D: np.ndarray, q_star: np.ndarray
+) -> Linearisation:
     cmap = system.cmap
-    q = cmap.configuration(np.zeros(3))
+    q = cmap.configuration(q_star)
     v = np.zeros(system.model.nv)
     ddq_dq, ddq_dv, Minv = pin.computeABADerivatives(
         system.model, system.data, q, v, np.zeros(system.model.nv)

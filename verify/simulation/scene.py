@@ -3,9 +3,12 @@
 A scene is a TOML file::
 
     name = "Damped double pendulum"
-    model = "double_pendulum"
-    params = "default"          # "default", a parameter file relative to the scene,
-                                # or an inline [parameters] table instead
+    model = "double_pendulum"   # a built-in model, or a model file relative to the scene
+                                # ("../examples/cart_pole.py", see pendverify.analytic.plugin)
+    params = "default"          # "default" (built-in models only), a parameter file relative
+                                # to the scene, or an inline [parameters] table instead
+    # urdf = "cart_pole.urdf"   # relative to the scene: the URDF ABA integrates; required for
+                                # aba/both with a model file, else the project writes the URDF
     engine = "aba"              # aba (Pinocchio, default) | closed_form | both
 
     [initial]
@@ -24,12 +27,12 @@ A scene is a TOML file::
 
     [effects]                   # every effect is off unless turned on here
     gravity = true              # true (the parameter set's g), false, or a value in m/s²
-    damping = true              # true (the parameter set's), false, or a list per coordinate
+    damping = true              # true (the model's damping_matrix()), false, or a list: diag(D)
     [effects.actuation]         # u: see pendverify.simulation.effects for every type and its keys
     type = "sine"
     amplitude = [0.5, 0.0]
     frequency = 0.5
-    [effects.disturbance]       # w, cart model only: impulse | step | noise
+    [effects.disturbance]       # w, models with disturbances (W): impulse | step | noise
     type = "impulse"
     time = 1.0
     impulse = [2.0, 0.0, 0.0]
@@ -46,14 +49,26 @@ from typing import Any
 
 import numpy as np
 
-from pendverify.analytic import MODELS, PARAMETER_TYPES, ParameterSet
+from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
 from pendverify.analytic.params import default_parameter_file, load_parameter_file, read_toml
-from pendverify.errors import InputError
+from pendverify.errors import InputError, PendverifyError
 from pendverify.simulation.effects import Law, parse_actuation, parse_disturbance
 
 ADAPTIVE_METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 FIXED_STEP_METHODS = ("rk4",)
 ENGINES = ("aba", "closed_form", "both")
+TOP_KEYS = (
+    "name",
+    "model",
+    "params",
+    "parameters",
+    "urdf",
+    "engine",
+    "initial",
+    "time",
+    "integrator",
+    "effects",
+)
 
 
 class SceneError(InputError):
@@ -81,7 +96,7 @@ class Integrator:
 class Scene:
     name: str
     source: str
-    model: str
+    model: str  # the model's name (a built-in name, or the plug-in class's ``name``)
     params: ParameterSet
     params_source: str
     engine: str
@@ -91,9 +106,21 @@ class Scene:
     sample_rate: float
     integrator: Integrator
     gravity: float | None  # m/s², None when off
-    damping: np.ndarray | None  # D's diagonal, None when off
+    damping: np.ndarray | None  # D's diagonal, None when off (the full D: ``damping_matrix``)
     actuation: Law | None  # u(t, q, q̇), None when off
     disturbance: Law | None  # w(t), None when off
+    model_cls: type[ClosedFormModel] | None = None  # None: MODELS[model]
+    model_file: str | None = None  # the model file of a plug-in, None when built in
+    urdf: str | None = None  # the scene's URDF (path), None: the project writes it (built-in)
+    #: D as a matrix: the model's damping_matrix() (damping = true; a triple pendulum's joint
+    #: friction couples its absolute angles), or diag(damping); None when off
+    damping_matrix: np.ndarray | None = None
+
+    def __post_init__(self):
+        if self.model_cls is None:
+            object.__setattr__(self, "model_cls", MODELS[self.model])
+        if self.damping_matrix is None and self.damping is not None:
+            object.__setattr__(self, "damping_matrix", np.diag(self.damping))
 
     @property
     def conservative(self) -> bool:
@@ -177,12 +204,27 @@ class _Reader:
         return self.number(key, minimum=0.0)
 
 
-def _parameters(top: _Reader, model: str, scene_path: Path) -> tuple[ParameterSet, str]:
+def _parameters(
+    top: _Reader, model_cls, scene_path: Path, model_file: str | None
+) -> tuple[ParameterSet, str]:
+    model = model_cls.name
     if top.has("parameters"):
         if top.has("params"):
             top.fail("params", top.get("params"), "give either params or [parameters], not both")
         table = top.sub("parameters")
-        return PARAMETER_TYPES[model].from_mapping(table.table, top.source, "parameters."), "inline"
+        return model_cls.params_type.from_mapping(table.table, top.source, "parameters."), "inline"
+    if model_file is not None:
+        ref = top.string("params", default=None) if top.has("params") else None
+        if ref is None or ref == "default":
+            top.fail(
+                "params", ref, "a model file has no default parameter set: give params = FILE or [parameters]"
+            )
+        path = scene_path.parent / ref
+        if not path.is_file():
+            top.fail("params", ref, f"parameter file not found (looked for {path})")
+        from pendverify.checks.targets import plugin_parameters
+
+        return plugin_parameters(model_cls, model_file, str(path)), str(path)
     ref = top.string("params", default="default")
     path = default_parameter_file(model) if ref == "default" else (scene_path.parent / ref)
     if ref != "default" and not path.is_file():
@@ -193,16 +235,63 @@ def _parameters(top: _Reader, model: str, scene_path: Path) -> tuple[ParameterSe
     return params, str(path)
 
 
+def _model(top: _Reader, scene_path: Path) -> tuple[type[ClosedFormModel], str | None]:
+    """(model class, model file or None): a built-in name, or a ``.py`` file relative to the scene."""
+    value = top.get("model")
+    if isinstance(value, str) and value.endswith(".py"):
+        path = scene_path.parent / value
+        if not path.is_file():
+            top.fail("model", value, f"model file not found (looked for {path})")
+        from pendverify.analytic.plugin import load_model_class
+
+        try:
+            return load_model_class(path), str(path)
+        except PendverifyError as exc:
+            top.fail("model", value, f"not a usable model file: {exc}")
+    return MODELS[top.string("model", tuple(MODELS))], None
+
+
+def _urdf(top: _Reader, scene_path: Path) -> str | None:
+    """The scene's URDF (relative to the scene), or None; whether one is needed is decided when
+    the engine is known (``pendverify.simulation.dynamics``: ``simulate --engine`` may override it)."""
+    if not top.has("urdf"):
+        return None
+    ref = top.string("urdf")
+    path = scene_path.parent / ref
+    if not path.is_file():
+        top.fail("urdf", ref, f"URDF file not found (looked for {path})")
+    return str(path)
+
+
 def parse_scene(data: dict, source: str, base: Path | None = None) -> Scene:
     """Validate a scene document (already parsed TOML) into a Scene."""
     top = _Reader(data, source)
-    top.only(("name", "model", "params", "parameters", "engine", "initial", "time", "integrator", "effects"))
-    model = top.string("model", tuple(MODELS))
-    model_cls = MODELS[model]
+    top.only(
+        (
+            "name",
+            "model",
+            "params",
+            "parameters",
+            "urdf",
+            "engine",
+            "initial",
+            "time",
+            "integrator",
+            "effects",
+        )
+    )
+    scene_path = base or Path(source)
+    model_cls, model_file = _model(top, scene_path)
+    model = model_cls.name
     n = len(model_cls.coordinates)
-    params, params_source = _parameters(top, model, base or Path(source))
+    params, params_source = _parameters(top, model_cls, scene_path, model_file)
+    if not hasattr(params, "g"):
+        top.fail(
+            "model", top.get("model"), f"the {model} parameter set has no g; a scene sets gravity through g"
+        )
     name = top.string("name", default=Path(source).stem)
     engine = top.string("engine", ENGINES, default="aba")
+    urdf = _urdf(top, scene_path)
 
     initial = top.sub("initial")
     initial.only(("q", "v"))
@@ -237,11 +326,16 @@ def parse_scene(data: dict, source: str, base: Path | None = None) -> Scene:
     g = effects.boolean_or_number("gravity")
     gravity = params.g if g is True else (None if g is False else g)
     damping_value = effects.get("damping", False)
+    damping_matrix = None
     if isinstance(damping_value, bool):
-        damping = np.diag(model_cls(params).damping_matrix()).copy() if damping_value else None
+        if damping_value:
+            damping_matrix = np.array(model_cls(params).damping_matrix(), dtype=float).reshape(n, n)
+        damping = np.diag(damping_matrix).copy() if damping_value else None
     else:
         damping = effects.vector("damping", n, minimum=0.0)
-    actuation = parse_actuation(effects.sub("actuation", required=False), model_cls)
+    actuation = parse_actuation(
+        effects.sub("actuation", required=False), model_cls, params.replace(g=gravity or 0.0)
+    )
     disturbance = parse_disturbance(effects.sub("disturbance", required=False), model_cls)
     return Scene(
         name=name,
@@ -259,6 +353,10 @@ def parse_scene(data: dict, source: str, base: Path | None = None) -> Scene:
         damping=damping,
         actuation=actuation,
         disturbance=disturbance,
+        model_cls=model_cls,
+        model_file=model_file,
+        urdf=urdf,
+        damping_matrix=damping_matrix,
     )
 
 

@@ -57,6 +57,8 @@ class Run:
             "scene": s.name,
             "scene_file": s.source,
             "model": s.model,
+            **({"model_file": s.model_file} if s.model_file else {}),
+            **({"urdf": self.dynamics.urdf} if self.dynamics.urdf else {}),
             "parameters": s.params.as_dict(),
             "parameters_source": s.params_source,
             "engine": self.dynamics.engine if s.engine != "both" else "both",
