@@ -266,20 +266,7 @@ def _urdf(top: _Reader, scene_path: Path) -> str | None:
 def parse_scene(data: dict, source: str, base: Path | None = None) -> Scene:
     """Validate a scene document (already parsed TOML) into a Scene."""
     top = _Reader(data, source)
-    top.only(
-        (
-            "name",
-            "model",
-            "params",
-            "parameters",
-            "urdf",
-            "engine",
-            "initial",
-            "time",
-            "integrator",
-            "effects",
-        )
-    )
+    top.only(TOP_KEYS)
     scene_path = base or Path(source)
     model_cls, model_file = _model(top, scene_path)
     model = model_cls.name
