@@ -209,6 +209,14 @@ def test_render_draws_a_plugin_scene_from_its_urdf(tmp_path, capsys):
     assert "cart-pole LQR after a push" in page and "cart_pole" in page
 
 
+def test_a_saved_plugin_run_renders_from_its_recorded_model_file_and_urdf(tmp_path, capsys):
+    run = tmp_path / "cart_pole.npz"
+    assert main(["simulate", str(REPO / "scenes" / "cart_pole_lqr_push.toml"), "-o", str(run)]) == 0
+    out = tmp_path / "replay.html"
+    assert main(["render", "--trajectory", str(run), "-o", str(out)]) == 0
+    assert "cart-pole LQR after a push" in out.read_text()
+
+
 def test_simulate_urdf_option_replaces_the_scenes(tmp_path, capsys):
     body = _example("cart_pole", [0.0, 0.3]).replace(f'urdf = "{EXAMPLES / "cart_pole.urdf"}"\n', "")
     path = _scene(tmp_path, str(EXAMPLES / "cart_pole.py"), body)

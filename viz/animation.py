@@ -40,6 +40,7 @@ import numpy as np
 from meshcat.animation import Animation
 
 from pendverify.analytic import MODELS, PARAMETER_TYPES, ParameterSet
+from pendverify.analytic.plugin import load_model_class
 from pendverify.errors import InputError
 from pendverify.viz.geometry import ROOT, UP, VisualSystem
 from pendverify.viz.recorder import SceneRecorder
@@ -116,17 +117,22 @@ class Trajectory:
         except (ValueError, OSError) as exc:
             raise TrajectoryError(source, "<file>", source, f"not a pendverify npz: {exc}") from None
         model = meta.get("model")
-        if model not in PARAMETER_TYPES:
-            raise TrajectoryError(
-                source, "metadata.model", model, f"expected one of {', '.join(PARAMETER_TYPES)}"
-            )
-        params = PARAMETER_TYPES[model].from_mapping(
-            meta.get("parameters", {}), source, "metadata.parameters."
-        )
+        model_file = meta.get("model_file")
+        if model_file is not None:  # a plug-in run: its model file and URDF, as recorded
+            model_cls = load_model_class(str(model_file))
+            param_type, urdf = model_cls.params_type, meta.get("urdf")
+            if urdf is None:
+                raise TrajectoryError(source, "metadata.urdf", None, "a model file's run needs its URDF")
+        elif model in PARAMETER_TYPES:
+            model_cls, param_type, urdf = None, PARAMETER_TYPES[model], meta.get("urdf")
+        else:
+            known = ", ".join(PARAMETER_TYPES)
+            raise TrajectoryError(source, "metadata.model", model, f"expected one of {known} or a model_file")
+        params = param_type.from_mapping(meta.get("parameters", {}), source, "metadata.parameters.")
         t = np.asarray(t, dtype=float)
         q = np.asarray(q, dtype=float)
         q = q.reshape(len(t), -1) if q.ndim == 1 and len(t) else q
-        return cls(t, q, params, str(meta.get("scene", path.stem)), source)
+        return cls(t, q, params, str(meta.get("scene", path.stem)), source, model_cls, urdf)
 
 
 def resample(t: np.ndarray, q: np.ndarray, fps: float) -> tuple[np.ndarray, np.ndarray]:
