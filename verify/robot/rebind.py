@@ -102,6 +102,23 @@ class Binding:
     def bound(self, name: str) -> bool:
         return name in self.sites
 
+    def link_groups(self) -> dict[str, tuple[str, ...]]:
+        """{link: the mass and inertia parameters bound inside its <inertial>} (links with any)."""
+        groups = {}
+        for link in self.root.findall("link"):
+            inside = {id(e) for e in link.iter()}
+            names = tuple(
+                name
+                for name, sites in self.sites.items()
+                if self._kind(name) in ("mass", "inertia") and all(id(e) in inside for e, _ in sites)
+            )
+            if names:
+                groups[link.get("name", "?")] = names
+        return groups
+
+    def _kind(self, name: str) -> str:
+        return next(f.metadata.get("kind") for f in dataclasses.fields(self.params) if f.name == name)
+
     def rewrite(self, params: ParameterSet) -> str:
         """The URDF with every changed parameter's attributes set to its new value."""
         root = copy.deepcopy(self.root)

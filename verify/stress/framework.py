@@ -206,8 +206,9 @@ def compare(name: str, model, system, states: list[State], seed: int) -> _Compar
 
 
 #: What a case expects of the trust rule: no refusal, some states refused (and some
-#: verified), every state refused, or whatever (at least one state verified).
-EXPECT = ("none", "some", "all", "any")
+#: verified), every state refused, whatever (at least one state verified), or not known
+#: beforehand ("allowed": a generic case on a model file; refusals are counted, not failed).
+EXPECT = ("none", "some", "all", "any", "allowed")
 
 
 def _refusals_ok(comp: _Comparison, expect: str) -> bool:
@@ -217,6 +218,7 @@ def _refusals_ok(comp: _Comparison, expect: str) -> bool:
         "some": refused > 0 and kept > 0,
         "all": kept == 0 and refused > 0,
         "any": kept > 0,
+        "allowed": True,
     }[expect]
 
 
