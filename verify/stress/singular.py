@@ -5,10 +5,11 @@
 each parameter (and each link's mass with its inertias) is taken to 1e-16 and to 1e16
 of its value, κ of the Jacobi-scaled M (diagonal scaled to ones) is scanned over the
 sampled states and then maximised from the worst of them by a small Nelder–Mead search.
-The winning direction is then walked from the set's value to 1e∓16 of it, in factors of 100, at the winning state, and every step runs
-the guarded comparison (trust rule, then the core checks) on the URDF rewritten for that
-step.  It passes when every step the rule accepts verifies, the first step is accepted,
-and, if the walk's predicted rounding crosses the refusal limit, the rule refuses there.
+The winning direction is then walked from the set's value to 1e∓16 of it, in factors
+of 100, at the winning state, and every step runs the guarded comparison (trust rule,
+then the core checks) on the URDF rewritten for that step.  It passes when every step
+the rule accepts verifies, the first step is accepted, and, if the walk's predicted
+rounding crosses the refusal limit, the rule refuses there.
 """
 
 from __future__ import annotations
