@@ -11,6 +11,8 @@ import pytest
 from pendverify.certify.certificate import digest_of
 from pendverify.cli import main
 
+from .test_certify import _certs
+
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 FAST = ["--samples", "20"]
 PLUGINS = ("cart_pole", "hanging_double_pendulum", "triple_pendulum", "furuta_pendulum")
@@ -189,22 +191,13 @@ def _plugin_sweep(tmp_path: Path) -> Path:
     return sweep
 
 
-def _bodies(directory: Path) -> dict:
-    out = {}
-    for path in sorted(directory.glob("*.cert.json")):
-        cert = json.loads(path.read_text())
-        cert.pop("date"), cert.pop("digest")
-        out[path.name] = cert
-    return out
-
-
 def test_sweep_over_a_model_file_locally_and_on_dask(tmp_path, capsys):
     distributed = pytest.importorskip("distributed", reason="the dask extra is part of the test extras")
     sweep = _plugin_sweep(tmp_path)
     local = tmp_path / "local"
     assert main(["certify", "--sweep", str(sweep), "-o", str(local), "--workers", "1"]) == 0
     assert "2 passed, 0 failed, 2 sets" in capsys.readouterr().out
-    certs = _bodies(local)
+    certs = _certs(local)
     assert len(certs) == 2
     for name, cert in certs.items():
         assert cert["model_source"]["file"] == "hanging.py"
@@ -216,7 +209,7 @@ def test_sweep_over_a_model_file_locally_and_on_dask(tmp_path, capsys):
         remote = tmp_path / "dask"
         args = ["certify", "--sweep", str(sweep), "-o", str(remote), "--scheduler", cluster.scheduler_address]
         assert main(args) == 0
-    assert _bodies(remote) == certs
+    assert _certs(remote) == certs
 
 
 def test_sweep_over_a_parameter_the_urdf_does_not_show_is_refused(tmp_path, capsys):

@@ -4,18 +4,14 @@ from __future__ import annotations
 
 import argparse
 
-from pendverify.commands import non_negative_int, positive_int
+from pendverify.commands import add_analytic_option, non_negative_int, positive_int
 
 
 def register(sub) -> None:
     p = sub.add_parser("certify", help="run the full battery on a parameter set and certify it")
     p.add_argument("params_file", nargs="?", help="a parameter file (TOML)")
     p.add_argument("--model", help="with --urdf: the model the URDF describes")
-    p.add_argument(
-        "--analytic",
-        metavar="FILE",
-        help="your own closed-form model file (as check --analytic); needs --urdf and --params",
-    )
+    add_analytic_option(p, "certify it on --urdf with --params")
     p.add_argument("--urdf", help="a URDF to certify (or erd:NAME for example-robot-data's)")
     p.add_argument("--params", dest="params_option", help="with --urdf: the parameter set it must match")
     p.add_argument("--sweep", help="a sweep file: certify many sets in parallel")

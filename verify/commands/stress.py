@@ -12,7 +12,7 @@ from __future__ import annotations
 import argparse
 import time
 
-from pendverify.commands import non_negative_int
+from pendverify.commands import add_analytic_option, non_negative_int
 
 
 def register(sub) -> None:
@@ -21,12 +21,7 @@ def register(sub) -> None:
     p.add_argument("--case", action="append", metavar="NAME", help="run only this case (repeatable)")
     p.add_argument("--seed", type=non_negative_int, default=None, help="seed of the state sampler")
     p.add_argument("--json", help="also write the report as JSON to this path")
-    p.add_argument(
-        "--analytic",
-        metavar="FILE",
-        help="your own closed-form model file (as check --analytic): run the generic hard cases "
-        "derived from its parameters and coordinates; needs --urdf and --params",
-    )
+    add_analytic_option(p, "run hard cases derived from its parameters' kinds; needs --urdf, --params")
     p.add_argument("--urdf", help="with --analytic: the model's URDF")
     p.add_argument("--params", help="with --analytic: its parameter file (TOML)")
     p.set_defaults(func=run)
