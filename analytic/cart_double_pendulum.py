@@ -58,7 +58,13 @@ from typing import ClassVar
 
 import numpy as np
 
-from pendverify.analytic.interface import STANDARD_CLOSED_FORMS, ClosedForm, ClosedFormModel, Energies
+from pendverify.analytic.interface import (
+    STANDARD_CLOSED_FORMS,
+    BatteryMotion,
+    ClosedForm,
+    ClosedFormModel,
+    Energies,
+)
 from pendverify.analytic.params import ParameterSet, quantity
 
 
@@ -85,6 +91,15 @@ class CartDoublePendulum(ClosedFormModel):
     coordinates = ("q", "theta1", "theta2")
     angular = (False, True, True)
     inputs = ("u",)
+    battery_motion = BatteryMotion(
+        q=(0.0, 0.15, -0.1),
+        v=(0.1, 0.0, 0.2),
+        input_amplitude=(2.0,),
+        input_frequency=0.5,
+        disturbance_std=(0.5, 0.05, 0.05),
+        disturbance_bandwidth=4.0,
+        damping_floor=0.05,
+    )
     disturbances = ("w1", "w2", "w3")
     # The seed's own right-hand side f is a closed form too.
     closed_forms: ClassVar[dict[str, ClosedForm]] = {

@@ -48,7 +48,13 @@ from typing import ClassVar
 
 import numpy as np
 
-from pendverify.analytic.interface import STANDARD_CLOSED_FORMS, ClosedForm, ClosedFormModel, Energies
+from pendverify.analytic.interface import (
+    STANDARD_CLOSED_FORMS,
+    BatteryMotion,
+    ClosedForm,
+    ClosedFormModel,
+    Energies,
+)
 from pendverify.analytic.params import ParameterSet, quantity
 from pendverify.errors import ParameterError
 
@@ -94,6 +100,9 @@ class DoublePendulum(ClosedFormModel):
     coordinates = ("theta1", "theta2")
     angular = (True, True)
     inputs = ("tau1", "tau2")
+    battery_motion = BatteryMotion(
+        q=(0.4, 1.1), v=(0.5, -0.5), input_amplitude=(1.0, 0.4), input_frequency=0.7, damping_floor=0.05
+    )
     # The seed writes C with the friction on its diagonal: that is the formula to mutate.
     closed_forms: ClassVar[dict[str, ClosedForm]] = {
         **{k: f for k, f in STANDARD_CLOSED_FORMS.items() if k != "coriolis_matrix"},

@@ -95,6 +95,26 @@ class Energies:
 
 
 @dataclass(frozen=True)
+class BatteryMotion:
+    """The motion the certification battery simulates, when a model states its own.
+
+    ``q`` and ``v``: the initial state (model coordinates); ``input_amplitude`` and
+    ``input_frequency`` (Hz): the sine on the inputs; ``disturbance_std`` and
+    ``disturbance_bandwidth`` (Hz): the seeded noise on the disturbances;
+    ``damping_floor``: when > 0, the damping run uses diag(max(D_ii, floor)) rather than D.
+    A model that states none gets one derived from its scales (``pendverify.certify.scenes``).
+    """
+
+    q: tuple[float, ...]
+    v: tuple[float, ...]
+    input_amplitude: tuple[float, ...] = ()
+    input_frequency: float = 0.5
+    disturbance_std: tuple[float, ...] = ()
+    disturbance_bandwidth: float = 4.0
+    damping_floor: float = 0.0
+
+
+@dataclass(frozen=True)
 class ClosedForm:
     """One method that holds a hand-written formula.
 
@@ -148,6 +168,8 @@ class ClosedFormModel(ABC):
     geometry_reader: ClassVar[str] = ""
     #: False for models that give only the force C·q̇ (``BiasOnlyModel``).
     has_coriolis_matrix: ClassVar[bool] = True
+    #: The motion ``pendverify certify`` simulates; None: derived from the model's scales.
+    battery_motion: ClassVar[BatteryMotion | None] = None
 
     def __init__(self, params: ParameterSet):
         if not isinstance(params, self.params_type):

@@ -4,10 +4,13 @@
 2. the stress cases that apply to any set, run on these parameters: large
    angles, high speeds, zero gravity, and the conditioning guard (a set whose
    M is too near singular to compare is refused, not certified);
-3. one simulation invariant per effect: a short run with gravity alone
-   (energy drift), with damping (dissipation balance, energy never rises),
-   with actuation (work–energy balance) and, for the cart, with a seeded noise
-   disturbance (work–energy balance).
+3. one simulation invariant per effect the model has (``pendverify.certify.scenes``):
+   a short run with gravity alone (energy drift), with damping when D is not zero
+   (dissipation balance, energy never rises), with actuation when it has inputs
+   (work–energy balance) and with a seeded noise disturbance when it has
+   disturbances (work–energy balance).
+
+Nothing here depends on which model it is: a plug-in model file runs the same battery.
 
 The battery runs on the URDF being certified, whether the project wrote it or
 the user brought it.  Everything is deterministic in (parameters, URDF, seed,
@@ -20,7 +23,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from pendverify.analytic import MODELS, ParameterSet
+from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
+from pendverify.certify.scenes import effect_scenes
 from pendverify.checks.catalogue import run_checks
 from pendverify.checks.sampling import sample_states
 from pendverify.errors import PendverifyError
@@ -75,43 +79,14 @@ def check_items(model, system, settings: BatterySettings) -> list[BatteryItem]:
     ]
 
 
-def _effect_scenes(model_name: str, params: ParameterSet, settings: BatterySettings) -> dict[str, dict]:
-    """One short scene per effect, as scene documents (see pendverify.simulation.scene)."""
-    if model_name == "double_pendulum":
-        q0, v0 = [0.4, 1.1], [0.5, -0.5]
-        actuation = {"type": "sine", "amplitude": [1.0, 0.4], "frequency": 0.7}
-        disturbance = None
-    else:
-        q0, v0 = [0.0, 0.15, -0.1], [0.1, 0.0, 0.2]
-        actuation = {"type": "sine", "amplitude": [2.0], "frequency": 0.5}
-        disturbance = {"type": "noise", "std": [0.5, 0.05, 0.05], "bandwidth": 4.0, "seed": settings.seed}
-    base = {
-        "model": model_name,
-        "parameters": params.as_dict(),
-        "initial": {"q": q0, "v": v0},
-        "time": {"duration": settings.sim_duration, "sample_rate": 50.0},
-        "integrator": {"method": "DOP853", "rtol": settings.sim_rtol, "atol": settings.sim_rtol},
-    }
-    scenes = {
-        "gravity": {"gravity": True},
-        "damping": {"gravity": True, "damping": [max(d, 0.05) for d in _damping(model_name, params)]},
-        "actuation": {"gravity": True, "actuation": actuation},
-    }
-    if disturbance:
-        scenes["disturbance"] = {"gravity": True, "disturbance": disturbance}
-    return {name: {**base, "name": f"battery:{name}", "effects": effects} for name, effects in scenes.items()}
-
-
-def _damping(model_name: str, params: ParameterSet) -> list[float]:
-    return list(np.diag(MODELS[model_name](params).damping_matrix()))
-
-
-def invariant_items(model_name, params, urdf: str, settings: BatterySettings) -> list[BatteryItem]:
+def invariant_items(model_cls, params, urdf: str, settings: BatterySettings) -> list[BatteryItem]:
+    """One simulation per effect the model has (``pendverify.certify.scenes``), ABA on ``urdf``."""
     from pendverify.simulation.scene import parse_scene
     from pendverify.simulation.simulate import simulate
 
     items = []
-    for effect, doc in _effect_scenes(model_name, params, settings).items():
+    scenes = effect_scenes(model_cls, params, settings.sim_duration, settings.sim_rtol, settings.seed)
+    for effect, doc in scenes.items():
         try:
             with np.errstate(over="ignore", invalid="ignore"):  # a diverging run is judged below
                 run = simulate(parse_scene(doc, f"<battery {effect}>"), "aba", urdf)
@@ -141,7 +116,7 @@ def invariant_items(model_name, params, urdf: str, settings: BatterySettings) ->
     return items
 
 
-def stress_items(model_name, params, settings: BatterySettings, urdf: str | None = None) -> list[BatteryItem]:
+def stress_items(model_cls, params, settings: BatterySettings, urdf: str | None = None) -> list[BatteryItem]:
     """The stress cases that apply to any parameter set, run on this one.
 
     Large angles (|θ| ≈ 1e6 rad, with the θ + 2πk invariance; states beyond the
@@ -154,14 +129,15 @@ def stress_items(model_name, params, settings: BatterySettings, urdf: str | None
     from pendverify.stress import cases, framework
     from pendverify.stress import catalogue as stress
 
-    ctx = framework.Context(framework.FULL, settings.seed, urdf=urdf)
+    cls = model_class(model_cls)
+    ctx = framework.Context(framework.FULL, settings.seed, urdf=urdf, model_cls=cls)
     cases = [
         # at |θ| ≈ 1e6 rad a set with κ̃ in the hundreds is beyond the trust rule: such
         # states are refused and recorded, and every state that is compared must pass
-        cases.large_angle_case("large angles", lambda: params, expect="any"),
-        cases.high_speed_case("high speeds", lambda: params),
-        framework.checks_case("zero gravity", "gravity", lambda: params.replace(g=0.0)),
-        framework.checks_case("conditioning", "conditioning", lambda: params),
+        cases.large_angle_case("large angles", lambda: params, cls, expect="any"),
+        cases.high_speed_case("high speeds", lambda: params, cls),
+        framework.checks_case("zero gravity", "gravity", lambda: params.replace(g=0.0), model_cls=cls),
+        framework.checks_case("conditioning", "conditioning", lambda: params, model_cls=cls),
     ]
     items = []
     for case in cases:
@@ -183,13 +159,17 @@ def stress_items(model_name, params, settings: BatterySettings, urdf: str | None
     return items
 
 
-def run_battery(
-    model_name: str, params: ParameterSet, urdf: str, settings: BatterySettings
-) -> list[BatteryItem]:
-    model = MODELS[model_name](params)
-    system = PinocchioSystem.from_urdf(model_name, urdf, params.g, f"<URDF being certified: {model_name}>")
+def model_class(model) -> type[ClosedFormModel]:
+    """A model class, given itself or a built-in model's name."""
+    return MODELS[model] if isinstance(model, str) else model
+
+
+def run_battery(model, params: ParameterSet, urdf: str, settings: BatterySettings) -> list[BatteryItem]:
+    """The battery for a model (a class, or a built-in model's name), its parameters and URDF."""
+    cls = model_class(model)
+    system = PinocchioSystem.for_model(cls, urdf, params.g, f"<URDF being certified: {cls.name}>")
     return (
-        check_items(model, system, settings)
-        + stress_items(model_name, params, settings, urdf)
-        + invariant_items(model_name, params, urdf, settings)
+        check_items(cls(params), system, settings)
+        + stress_items(cls, params, settings, urdf)
+        + invariant_items(cls, params, urdf, settings)
     )

@@ -7,10 +7,15 @@ key                content
 =================  ===========================================================
 schema             "pendverify-certificate/1"
 name               the set's name (file stem or sweep index)
-model              double_pendulum | cart_double_pendulum
+model              the model's name: double_pendulum | cart_double_pendulum, or a
+                   plug-in's (its class's ``name``)
+model_source       plug-ins only: {"file": the model file's name, "text": its source
+                   verbatim, "sha256": of that text (UTF-8)}; ``recheck`` runs
+                   the battery on this text, never on the file at that path now
 parameters         the physical parameters, SI units (as the parameter file)
-derived            the seed's derived constants: α, β, δ (double pendulum);
-                   m + m1 + m2, l1 (m1 + m2), m2 l2 and det M at upright (cart)
+derived            the model's ``derived_constants()``: α, β, δ (double pendulum);
+                   m + m1 + m2, l1 (m1 + m2), m2 l2 and det M at upright (cart);
+                   whatever a plug-in names (none by default)
 urdf               {"text": the URDF verbatim, "sha256": of that text (UTF-8)}
 settings           the battery's settings: samples, seed, simulation length, rtol
 versions           pendverify, pinocchio, numpy, python
@@ -32,8 +37,9 @@ from __future__ import annotations
 import hashlib
 from datetime import datetime, timezone
 
-from pendverify.analytic import MODELS, ParameterSet
+from pendverify.analytic import ParameterSet
 from pendverify.certify.battery import BatteryItem, BatterySettings
+from pendverify.certify.model_source import ModelSource, source_problem
 from pendverify.errors import PendverifyError
 from pendverify.jsonio import to_json, versions
 
@@ -53,14 +59,14 @@ def digest_of(cert: dict) -> str:
     return hashlib.sha256(canonical_json(body).encode()).hexdigest()
 
 
-def derived_constants(model_name: str, params: ParameterSet) -> dict[str, float]:
+def derived_constants(model: ModelSource, params: ParameterSet) -> dict[str, float]:
     """The model's own derived constants (``ClosedFormModel.derived_constants``)."""
-    return {k: float(v) for k, v in MODELS[model_name](params).derived_constants().items()}
+    return {k: float(v) for k, v in model.load()(params).derived_constants().items()}
 
 
 def build_certificate(
     name: str,
-    model_name: str,
+    model: ModelSource,
     params: ParameterSet,
     urdf: str,
     settings: BatterySettings,
@@ -71,9 +77,10 @@ def build_certificate(
     cert = {
         "schema": SCHEMA,
         "name": name,
-        "model": model_name,
+        "model": model.name,
+        **({} if model.builtin else {"model_source": model.as_record()}),
         "parameters": params.as_dict(),
-        "derived": derived_constants(model_name, params),
+        "derived": derived_constants(model, params),
         "urdf": {"text": urdf, "sha256": hashlib.sha256(urdf.encode()).hexdigest()},
         "settings": settings.as_dict(),
         "versions": versions(),
@@ -95,14 +102,17 @@ def verify_digest(cert: dict, source: str) -> None:
     if not isinstance(recorded, dict) or recorded.get("algorithm") != "sha256" or "value" not in recorded:
         raise CertificateError(f"{source}: no sha256 digest recorded")
     computed = digest_of(cert)
+    model_problem = source_problem(cert["model_source"]) if "model_source" in cert else ""
     if computed != recorded["value"]:
         raise CertificateError(
             f"{source}: digest mismatch: recorded {recorded['value']}, computed {computed}; "
-            "the certificate was edited after it was issued"
+            "the certificate was edited after it was issued" + (f"; {model_problem}" if model_problem else "")
         )
     urdf = cert.get("urdf", {})
     if hashlib.sha256(urdf.get("text", "").encode()).hexdigest() != urdf.get("sha256"):
         raise CertificateError(f"{source}: the embedded URDF does not match its sha256")
+    if model_problem:
+        raise CertificateError(f"{source}: {model_problem}")
 
 
 FIGURE_RTOL = 1e-6  # rounding-level errors may shift in their last digits across library builds
@@ -129,23 +139,34 @@ def compare_items(recorded: list[dict], fresh: list[BatteryItem]) -> list[str]:
 
 
 def bundle_paths(directory, name: str):
+    """NAME.urdf, NAME.params.toml, NAME.cert.json (and, for a plug-in, ``model_path``)."""
     from pathlib import Path
 
     d = Path(directory)
     return d / f"{name}.urdf", d / f"{name}.params.toml", d / f"{name}.cert.json"
 
 
+def model_path(directory, name: str):
+    """Where a plug-in's bundle keeps a copy of the certified model file: NAME.model.py."""
+    from pathlib import Path
+
+    return Path(directory) / f"{name}.model.py"
+
+
 def refuse_existing(directory, name: str, force: bool) -> None:
     """Raise unless ``force`` when any file of the bundle already exists."""
     if force:
         return
-    for path in reversed(bundle_paths(directory, name)):
+    for path in (*reversed(bundle_paths(directory, name)), model_path(directory, name)):
         if path.exists():
             raise CertificateError(f"{path} exists; pass --force to replace it")
 
 
-def write_bundle(directory, name: str, params: ParameterSet, urdf: str, cert: dict, force: bool = False):
-    """Write NAME.urdf, NAME.params.toml and, last, NAME.cert.json, each atomically.
+def write_bundle(
+    directory, name: str, params: ParameterSet, urdf: str, cert: dict, force: bool = False, model=None
+):
+    """Write NAME.urdf, NAME.params.toml (NAME.model.py for a plug-in ``model``) and, last,
+    NAME.cert.json, each atomically.
 
     An existing certificate is never replaced unless ``force``: the refusal names
     the file.  A failure at any point leaves no certificate (the certificate is
@@ -157,5 +178,7 @@ def write_bundle(directory, name: str, params: ParameterSet, urdf: str, cert: di
     urdf_path, params_path, cert_path = bundle_paths(directory, name)
     write_atomic(urdf_path, urdf)
     write_atomic(params_path, params.to_toml(name))
+    if model is not None and not model.builtin:
+        write_atomic(model_path(directory, name), model.text)
     write_atomic(cert_path, certificate_text(cert))
     return cert_path

@@ -2,8 +2,9 @@
 
 A sweep file (TOML)::
 
-    model = "double_pendulum"
+    model = "double_pendulum"  # a built-in model, or a model file relative to the sweep file
     base = "default"       # the set the ranges vary ("default" or a parameter file)
+    # urdf = "arm.urdf"    # a model file's: the URDF of the base set, relative to the sweep file
     mode = "random"        # random (seeded, uniform or log-uniform) | grid
     count = 200            # random only
     seed = 7
@@ -12,6 +13,11 @@ A sweep file (TOML)::
     [ranges]
     m1 = [0.5, 2.0]                                      # linear, [min, max]
     I1 = { min = 0.01, max = 0.05, scale = "log", points = 3 }   # points: grid only
+
+For a model file, each set's URDF is the base URDF with the varied parameters'
+values rewritten where the base set's values sit (``pendverify.robot.rebind``); a
+range over a parameter the URDF does not show is refused, naming it.  Tasks carry
+the model file's source text, not the class, and load it once per worker.
 
 Tasks run on local processes by default, or on a Dask distributed cluster
 (``--scheduler tcp://HOST:PORT``) through its Client's executor; the task is
@@ -27,10 +33,13 @@ from pathlib import Path
 
 import numpy as np
 
-from pendverify.analytic import MODELS, PARAMETER_TYPES
+from pendverify.analytic import MODELS
 from pendverify.analytic.params import default_parameter_file, load_parameter_file, read_toml
 from pendverify.certify.battery import BatterySettings, run_battery
+from pendverify.certify.model_source import ModelSource
+from pendverify.checks.targets import plugin_parameters
 from pendverify.errors import InputError, PendverifyError
+from pendverify.robot.rebind import Binding
 from pendverify.robot.writer import urdf_for
 
 
@@ -40,9 +49,11 @@ class SweepError(InputError):
 
 @dataclass(frozen=True)
 class Sweep:
-    model: str
+    model: ModelSource
     sets: list[tuple[str, dict]]  # (name, parameter values)
     settings: BatterySettings
+    urdf: str | None = None  # a model file's: the URDF of the base set (text)
+    base: dict | None = None  # a model file's: the base set's values
 
 
 def _range(source, key, value):
@@ -80,18 +91,11 @@ def load_sweep(path: str | Path) -> Sweep:
     path = Path(path)
     source = str(path)
     data = read_toml(path)
-    allowed = ("model", "base", "mode", "count", "seed", "samples", "duration", "ranges")
+    allowed = ("model", "base", "urdf", "mode", "count", "seed", "samples", "duration", "ranges")
     for key, value in data.items():
         if key not in allowed:
             raise SweepError(source, key, value, f"unknown key; expected one of {', '.join(allowed)}")
-    model = data.get("model")
-    if model not in MODELS:
-        raise SweepError(source, "model", model, f"expected one of {', '.join(MODELS)}")
-    base_ref = data.get("base", "default")
-    base_path = default_parameter_file(model) if base_ref == "default" else path.parent / base_ref
-    base_model, _, base = load_parameter_file(base_path)
-    if base_model != model:
-        raise SweepError(source, "base", base_ref, f"that parameter file is for {base_model!r}")
+    model, base, urdf = _model_and_base(path, data)
     mode = data.get("mode", "random")
     if mode not in ("random", "grid"):
         raise SweepError(source, "mode", mode, "expected random or grid")
@@ -111,13 +115,16 @@ def load_sweep(path: str | Path) -> Sweep:
     ranges = data.get("ranges")
     if not isinstance(ranges, dict) or not ranges:
         raise SweepError(source, "ranges", ranges, "expected a table of at least one parameter range")
-    known = PARAMETER_TYPES[model].keys()
+    known = base.keys()
+    binding = Binding.of(urdf, base, data["urdf"]) if urdf is not None else None
     specs = {}
     for key, value in ranges.items():
         if key not in known:
             raise SweepError(
-                source, f"ranges.{key}", value, f"unknown parameter; {model} has {', '.join(known)}"
+                source, f"ranges.{key}", value, f"unknown parameter; {model.name} has {', '.join(known)}"
             )
+        if binding is not None and key in binding.reasons:
+            raise SweepError(source, f"ranges.{key}", value, f"cannot be varied: {binding.reasons[key]}")
         specs[key] = _range(source, key, value)
 
     values = []
@@ -141,20 +148,71 @@ def load_sweep(path: str | Path) -> Sweep:
                 )
             values.append(row)
     width = len(str(len(values) - 1))
-    sets = [(f"{model}-{i:0{width}d}", {**base.as_dict(), **row}) for i, row in enumerate(values)]
-    return Sweep(
-        model, sets, BatterySettings(samples=ints["samples"], seed=ints["seed"], sim_duration=float(duration))
-    )
+    sets = [(f"{model.name}-{i:0{width}d}", {**base.as_dict(), **row}) for i, row in enumerate(values)]
+    settings = BatterySettings(samples=ints["samples"], seed=ints["seed"], sim_duration=float(duration))
+    return Sweep(model, sets, settings, urdf, None if urdf is None else base.as_dict())
 
 
-def certify_task(model: str, name: str, values: dict, settings: dict) -> dict:
-    """One set through the battery; a pure function, so it runs anywhere."""
+def _model_and_base(path: Path, data: dict):
+    """(model source, base parameter set, base URDF text or None) of a sweep file."""
+    source = str(path)
+    ref = data.get("model")
+    base_ref = data.get("base", "default")
+    if isinstance(ref, str) and ref.endswith(".py"):
+        model_file = path.parent / ref
+        try:
+            model = ModelSource.of_file(model_file)
+        except PendverifyError as exc:
+            raise SweepError(source, "model", ref, f"not a usable model file: {exc}") from None
+        cls = model.load()
+        if base_ref == "default" or not isinstance(base_ref, str):
+            raise SweepError(
+                source, "base", base_ref, "a model file has no default set: give a parameter file"
+            )
+        base = plugin_parameters(cls, str(model_file), str(path.parent / base_ref))
+        if not hasattr(base, "g"):
+            raise SweepError(source, "model", ref, "certify needs a gravity parameter g in the model's set")
+        urdf_ref = data.get("urdf")
+        if not isinstance(urdf_ref, str) or not (path.parent / urdf_ref).is_file():
+            raise SweepError(source, "urdf", urdf_ref, "a model file needs the URDF of its base set (a file)")
+        return model, base, (path.parent / urdf_ref).read_text()
+    if ref not in MODELS:
+        raise SweepError(source, "model", ref, f"expected a model file (.py) or one of {', '.join(MODELS)}")
+    if "urdf" in data:
+        raise SweepError(
+            source, "urdf", data["urdf"], "a built-in model's sets use the URDF the project writes"
+        )
+    base_path = default_parameter_file(ref) if base_ref == "default" else path.parent / base_ref
+    base_model, _, base = load_parameter_file(base_path)
+    if base_model != ref:
+        raise SweepError(source, "base", base_ref, f"that parameter file is for {base_model!r}")
+    return ModelSource(ref), base, None
+
+
+def set_urdf(model_cls, params, name: str, base_urdf: str | None, base_values: dict | None) -> str:
+    """A set's URDF: the project's for a built-in model, else the base URDF rewritten for the set."""
+    if base_urdf is None:
+        return urdf_for(params, name)
+    base = model_cls.params_type.from_mapping(base_values, "<sweep base>")
+    return Binding.of(base_urdf, base).rewrite(params)
+
+
+def certify_task(
+    model: ModelSource,
+    name: str,
+    values: dict,
+    settings: dict,
+    base_urdf: str | None = None,
+    base_values: dict | None = None,
+) -> dict:
+    """One set through the battery; a pure function of strings and numbers, so it runs anywhere."""
     try:
-        params = PARAMETER_TYPES[model].from_mapping(values, f"<sweep set {name}>")
+        cls = model.load()
+        params = cls.params_type.from_mapping(values, f"<sweep set {name}>")
+        urdf = set_urdf(cls, params, name, base_urdf, base_values)
     except PendverifyError as exc:
         return {"name": name, "values": values, "error": str(exc), "items": []}
-    urdf = urdf_for(params, name)
-    items = run_battery(model, params, urdf, BatterySettings(**settings))
+    items = run_battery(cls, params, urdf, BatterySettings(**settings))
     return {
         "name": name,
         "values": values,
@@ -186,7 +244,8 @@ def run_sweep(sweep: Sweep, executor: Executor, progress: bool = True):
 
     settings = sweep.settings.as_dict()
     futures = [
-        executor.submit(certify_task, sweep.model, name, values, settings) for name, values in sweep.sets
+        executor.submit(certify_task, sweep.model, name, values, settings, sweep.urdf, sweep.base)
+        for name, values in sweep.sets
     ]
     bar = tqdm(total=len(futures), desc="sweep", unit="set", disable=not progress)
     results = []

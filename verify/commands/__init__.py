@@ -40,6 +40,15 @@ def positive_float(text: str) -> float:
     return value
 
 
+def add_analytic_option(parser, what: str) -> None:
+    """``--analytic FILE``: a model file, as ``check --analytic`` takes it; ``what`` says what it does."""
+    parser.add_argument(
+        "--analytic",
+        metavar="FILE",
+        help=f"your own closed-form model file (as check --analytic; see examples/cart_pole.py): {what}",
+    )
+
+
 def builtin_models(model: str | None, analytic: str | None) -> list[str]:
     """The built-in models that --model names (all when omitted; none with --analytic).
 

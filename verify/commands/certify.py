@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import argparse
 
-from pendverify.commands import non_negative_int, positive_int
+from pendverify.commands import add_analytic_option, non_negative_int, positive_int
 
 
 def register(sub) -> None:
     p = sub.add_parser("certify", help="run the full battery on a parameter set and certify it")
     p.add_argument("params_file", nargs="?", help="a parameter file (TOML)")
     p.add_argument("--model", help="with --urdf: the model the URDF describes")
+    add_analytic_option(p, "certify it on --urdf with --params")
     p.add_argument("--urdf", help="a URDF to certify (or erd:NAME for example-robot-data's)")
     p.add_argument("--params", dest="params_option", help="with --urdf: the parameter set it must match")
     p.add_argument("--sweep", help="a sweep file: certify many sets in parallel")
@@ -49,7 +50,7 @@ def run_certify(args: argparse.Namespace) -> int:
         settings = replace(settings, samples=args.samples)
     if args.seed is not None:
         settings = replace(settings, seed=args.seed)
-    target = certification_input(args.params_file, args.urdf, args.model, args.params_option)
+    target = certification_input(args.params_file, args.urdf, args.model, args.params_option, args.analytic)
     issued = issue(target, settings, args.output, args.force)
     _print_items(issued.items)
     if not issued.certified:

@@ -12,7 +12,7 @@ from __future__ import annotations
 import argparse
 import time
 
-from pendverify.commands import non_negative_int
+from pendverify.commands import add_analytic_option, non_negative_int
 
 
 def register(sub) -> None:
@@ -21,6 +21,9 @@ def register(sub) -> None:
     p.add_argument("--case", action="append", metavar="NAME", help="run only this case (repeatable)")
     p.add_argument("--seed", type=non_negative_int, default=None, help="seed of the state sampler")
     p.add_argument("--json", help="also write the report as JSON to this path")
+    add_analytic_option(p, "run hard cases derived from its parameters' kinds; needs --urdf, --params")
+    p.add_argument("--urdf", help="with --analytic: the model's URDF")
+    p.add_argument("--params", help="with --analytic: its parameter file (TOML)")
     p.set_defaults(func=run)
 
 
@@ -31,15 +34,17 @@ def _num(x, fmt=".2e") -> str:
 def format_table(report) -> str:
     from pendverify.checks.report import text_table
 
-    header = ("case", "quantity", "error", "tolerance", "κ(M)", "κ̃(M)", "result")
+    header = ("case", "quantity", "error", "tolerance", "ratio", "κ(M)", "κ̃(M)", "refused", "result")
     rows = [
         (
             r.case,
             r.quantity,
             _num(r.error),
             _num(r.tolerance),
+            _num(_margin(r), ".2g"),
             _num(r.kappa_raw, ".1e"),
             _num(r.kappa_scaled, ".1e"),
+            str(r.refused),
             r.verdict,
         )
         for r in report.results
@@ -60,7 +65,26 @@ def format_table(report) -> str:
         out.append("")
         out.append("notes:")
         out += [f"  {'FAIL ' if not r.passed else ''}{r.case}: {r.note}" for r in notes]
+    if report.notes:
+        out.append("")
+        out.append("not varied:")
+        out += [f"  {note}" for note in report.notes]
+    compared = [r for r in report.results if _margin(r) is not None]
+    if compared:
+        worst = max(compared, key=_margin)
+        out.append("")
+        out.append(
+            f"worst error/tolerance {_margin(worst):.2g} ({worst.case}); largest error "
+            f"{max(r.error for r in compared):.2e}; {sum(r.refused for r in report.results)} state(s) refused"
+        )
     return "\n".join(out)
+
+
+def _margin(r) -> float | None:
+    """error / tolerance of a case that compared something, else None."""
+    if r.error is None or not r.tolerance:
+        return None
+    return r.error / r.tolerance
 
 
 def format_study(study) -> str:
@@ -132,16 +156,26 @@ def report_dict(report) -> dict:
 
 def run(args: argparse.Namespace) -> int:
     from pendverify.atomic import write_atomic
-    from pendverify.errors import UnknownNameError
+    from pendverify.errors import PendverifyError, UnknownNameError
     from pendverify.jsonio import to_json
     from pendverify.stress.catalogue import CASE_NAMES, run_catalogue
     from pendverify.stress.framework import FULL, QUICK, SEED
 
-    for name in args.case or ():
-        if name not in CASE_NAMES:
-            raise UnknownNameError("stress case", name, CASE_NAMES)
     seed = SEED if args.seed is None else args.seed
-    report = run_catalogue(QUICK if args.quick else FULL, names=args.case, seed=seed)
+    settings = QUICK if args.quick else FULL
+    if args.analytic:
+        from pendverify.stress.generic import run_generic
+
+        if not args.urdf or not args.params:
+            raise PendverifyError(f"{args.analytic}: give --urdf and --params with --analytic")
+        report = run_generic(args.analytic, args.urdf, args.params, settings, args.case, seed)
+    else:
+        if args.urdf or args.params:
+            raise PendverifyError("--urdf and --params go with --analytic (a model file)")
+        for name in args.case or ():
+            if name not in CASE_NAMES:
+                raise UnknownNameError("stress case", name, CASE_NAMES)
+        report = run_catalogue(settings, names=args.case, seed=seed)
     print(format_table(report))
     if report.study is not None:
         print()

@@ -236,8 +236,13 @@ def _parameters(
 
 
 def _model(top: _Reader, scene_path: Path) -> tuple[type[ClosedFormModel], str | None]:
-    """(model class, model file or None): a built-in name, or a ``.py`` file relative to the scene."""
+    """(model class, model file or None): a built-in name, or a ``.py`` file relative to the scene.
+
+    A document built in code (the certification battery's) may give the class itself.
+    """
     value = top.get("model")
+    if isinstance(value, type) and issubclass(value, ClosedFormModel):
+        return value, None
     if isinstance(value, str) and value.endswith(".py"):
         path = scene_path.parent / value
         if not path.is_file():

@@ -68,9 +68,9 @@ class ReducedAngleSystem:
         return lambda theta, *rest: attribute(self.reduce(theta), *rest)
 
 
-def shifted_states(model, states: list[State]) -> list[State]:
-    """Each state with its angles moved by ±2πk, |2πk| ≈ ``ANGLE_SHIFT``, alternating sign."""
-    k = round(ANGLE_SHIFT / (2 * math.pi))
+def shifted_states(model, states: list[State], shift: float = ANGLE_SHIFT) -> list[State]:
+    """Each state with its angles moved by ±2πk, |2πk| ≈ ``shift``, alternating sign."""
+    k = round(shift / (2 * math.pi))
     angular = np.array(model.angular)
     out = []
     for i, s in enumerate(states):
@@ -79,14 +79,16 @@ def shifted_states(model, states: list[State]) -> list[State]:
     return out
 
 
-def large_angle_case(name: str, params_fn, model_cls=None, expect: str = "none") -> Case:
-    """|θ| ≈ 1e6 rad; ``expect`` says which refusals by the trust rule are acceptable (see EXPECT)."""
+def large_angle_case(
+    name: str, params_fn, model_cls=None, expect: str = "none", shift: float = ANGLE_SHIFT
+) -> Case:
+    """|θ| ≈ ``shift`` (1e6 rad); ``expect`` says which refusals by the trust rule are acceptable (EXPECT)."""
 
     def run(ctx: Context, name: str) -> StressResult:
         params = params_fn()
         model = _model(params, model_cls)
         system = ctx.system(params)
-        states = shifted_states(model, _states(model, ctx))
+        states = shifted_states(model, _states(model, ctx), shift)
         direct = compare(name, model, system, states, ctx.seed)
         invariance = compare(name, model, ReducedAngleSystem(system, model.angular), states, ctx.seed)
         inv_worst = max(invariance.results, key=_ratio)

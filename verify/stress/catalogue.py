@@ -180,6 +180,8 @@ class StressReport:
     results: list[StressResult] = field(default_factory=list)
     study: StudyResult | None = None
     elapsed_s: float = 0.0
+    #: what the cases did not vary, and why (generic cases on a model file)
+    notes: list[str] = field(default_factory=list)
 
     @property
     def passed(self) -> bool:

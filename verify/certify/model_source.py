@@ -1,0 +1,121 @@
+"""Which model a certificate speaks for: a built-in one by name, or a model file by its source text.
+
+A plug-in model (``--analytic FILE``) is certified *as written*: the certificate
+embeds the file's text and its SHA-256, and ``recheck`` loads the class from that
+text (written to a private temporary file and imported by
+``pendverify.analytic.plugin.load_model_class``, the loader ``check --analytic``
+uses), never from whatever file is at the original path now.  A ``ModelSource`` holds
+only strings, so it crosses process boundaries (sweeps on local processes or Dask)
+and each worker loads the class from the text once.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+from pendverify.analytic import MODELS, ClosedFormModel
+from pendverify.analytic.plugin import load_model_class
+from pendverify.errors import PendverifyError
+
+_LOADED: dict[tuple[str, str], type[ClosedFormModel]] = {}  # (file name, sha256) -> class, per process
+
+
+def sha256_text(text: str) -> str:
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+@dataclass(frozen=True)
+class ModelSource:
+    """A built-in model (``text`` empty) or a model file's name and source text."""
+
+    name: str  # the model's name (the class's ``name``)
+    file: str = ""  # the model file's name, for messages and the bundle
+    text: str = ""  # the model file's source; "" for a built-in model
+
+    @property
+    def builtin(self) -> bool:
+        return not self.text
+
+    @classmethod
+    def of_builtin(cls, name: str) -> ModelSource:
+        if name not in MODELS:
+            raise PendverifyError(f"unknown model {name!r}; built-in models: {', '.join(MODELS)}")
+        return cls(name)
+
+    @classmethod
+    def of_file(cls, path: str | Path) -> ModelSource:
+        """A model file: loaded (and validated) once here, so a bad file fails before any work."""
+        path = Path(path)
+        model_cls = load_model_class(path)
+        text = path.read_text(encoding="utf-8")
+        source = cls(model_cls.name, path.name, text)
+        _LOADED[(source.file, source.sha256)] = model_cls
+        return source
+
+    @property
+    def sha256(self) -> str:
+        return sha256_text(self.text)
+
+    def load(self) -> type[ClosedFormModel]:
+        """The model class: built in, or imported from the embedded text (once per process)."""
+        if self.builtin:
+            return MODELS[self.name]
+        key = (self.file, self.sha256)
+        if key not in _LOADED:
+            _LOADED[key] = load_from_text(self.text, self.file)
+        model_cls = _LOADED[key]
+        if model_cls.name != self.name:
+            raise PendverifyError(
+                f"{self.file}: the embedded source defines model {model_cls.name!r}, not {self.name!r}"
+            )
+        return model_cls
+
+    def as_record(self) -> dict:
+        """The certificate's ``model_source`` field (plug-ins only)."""
+        return {"file": self.file, "text": self.text, "sha256": self.sha256}
+
+    @classmethod
+    def from_certificate(cls, cert: dict, source: str) -> ModelSource:
+        """The model a certificate names; a plug-in's embedded source must match its recorded SHA-256."""
+        record = cert.get("model_source")
+        name = cert.get("model")
+        if record is None:
+            if name not in MODELS:
+                raise PendverifyError(
+                    f"{source}: key 'model' = {name!r}: not a built-in model, and no model_source is embedded"
+                )
+            return cls(name)
+        problem = source_problem(record)
+        if problem:
+            raise PendverifyError(f"{source}: {problem}")
+        return cls(name, record["file"], record["text"])
+
+
+def source_problem(record) -> str:
+    """Why an embedded ``model_source`` record does not hold, or ""."""
+    if not isinstance(record, dict) or not all(
+        isinstance(record.get(k), str) for k in ("file", "text", "sha256")
+    ):
+        return "key 'model_source': expected a table of strings file, text and sha256"
+    computed = sha256_text(record["text"])
+    if computed != record["sha256"]:
+        return (
+            f"key 'model_source.text': the embedded model source does not match its sha256 "
+            f"(recorded {record['sha256']}, computed {computed}): the model was edited after it was certified"
+        )
+    return ""
+
+
+def load_from_text(text: str, file_name: str) -> type[ClosedFormModel]:
+    """Import a model file's source through the plug-in loader, from a private temporary copy."""
+    name = Path(file_name).name or "model.py"
+    with tempfile.TemporaryDirectory(prefix="pendverify-model-") as tmp:
+        path = Path(tmp) / name
+        path.write_text(text, encoding="utf-8")
+        try:
+            return load_model_class(path)
+        except PendverifyError as exc:
+            raise PendverifyError(f"{name} (the embedded model source): {exc}") from None
