@@ -19,13 +19,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from pendverify.checks.catalogue import (
-    CheckResult,
-    applicable_checks,
-    derived_notes,
-    run_checks,
-    skipped_notes,
-)
+from pendverify.checks.applicability import derived_notes
+from pendverify.checks.catalogue import CheckResult, applicable_checks, run_checks, skipped_notes
 from pendverify.checks.diagnose import diagnose
 from pendverify.checks.report import Report
 from pendverify.checks.sampling import sample_states
