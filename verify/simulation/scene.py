@@ -52,7 +52,8 @@ import numpy as np
 from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
 from pendverify.analytic.params import default_parameter_file, load_parameter_file, read_toml
 from pendverify.errors import InputError, PendverifyError
-from pendverify.simulation.effects import Law, parse_actuation, parse_disturbance
+from pendverify.simulation.effects import parse_actuation, parse_disturbance
+from pendverify.simulation.laws import Law
 
 ADAPTIVE_METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 FIXED_STEP_METHODS = ("rk4",)
