@@ -24,8 +24,9 @@ from pendverify.checks.catalogue import CheckResult, applicable_checks, run_chec
 from pendverify.checks.diagnose import diagnose
 from pendverify.checks.report import Report
 from pendverify.checks.sampling import sample_states
-from pendverify.checks.trust import IllConditionedError, check_conditioning
+from pendverify.checks.trust import check_conditioning
 from pendverify.checks.verdict import FAIL, REFUSED, apply_strict, non_christoffel_c
+from pendverify.errors import IllConditionedError
 from pendverify.robot.geometry import MODEL_FORM_RTOL
 
 

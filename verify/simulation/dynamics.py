@@ -29,9 +29,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from pendverify.analytic import MODELS, ClosedFormModel  # noqa: F401  (MODELS: the scenes' built-ins)
+from pendverify.errors import SceneError
 from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
-from pendverify.simulation.scene import Scene, SceneError
+from pendverify.simulation.scene import Scene
 
 
 @dataclass

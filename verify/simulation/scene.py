@@ -51,7 +51,7 @@ import numpy as np
 
 from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
 from pendverify.analytic.params import default_parameter_file, load_parameter_file, read_toml
-from pendverify.errors import InputError, PendverifyError
+from pendverify.errors import InputError, PendverifyError, SceneError
 from pendverify.simulation.effects import parse_actuation, parse_disturbance
 from pendverify.simulation.laws import Law
 
@@ -70,10 +70,6 @@ TOP_KEYS = (
     "integrator",
     "effects",
 )
-
-
-class SceneError(InputError):
-    """A scene file breaks a rule."""
 
 
 @dataclass(frozen=True)
