@@ -51,7 +51,7 @@ DISTURBANCE_TYPES = ("impulse", "step", "noise")
 
 
 def parse_actuation(r, model_cls, params=None) -> Law | None:
-    """An actuation law from the scene table reader ``r`` (None when absent).
+    """An actuation law from the scene table reader ``r`` (a ``scene_reader.TableReader``; None when absent).
 
     ``params`` (with the scene's g) is the parameter set ``pd`` reads B from and ``lqr``
     tests its equilibrium with.
