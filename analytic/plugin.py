@@ -29,7 +29,8 @@ import traceback
 from pathlib import Path
 
 from pendverify.analytic import ClosedFormModel, ParameterSet
-from pendverify.errors import PendverifyError
+from pendverify.analytic.params import parse_parameter_document, read_toml
+from pendverify.errors import ParameterError, PendverifyError
 
 
 def where(cls: type) -> str:
@@ -125,3 +126,16 @@ def load_model_class(path: str | Path) -> type[ClosedFormModel]:
         )
     _validate(found[0], path)
     return found[0]
+
+
+def plugin_parameters(cls: type[ClosedFormModel], model_file: str, params_file: str) -> ParameterSet:
+    """A parameter file for a plug-in: its ``model`` key must be the plug-in's name."""
+    data = read_toml(Path(params_file))
+    if data.get("model") != cls.name:
+        raise ParameterError(
+            params_file,
+            "model",
+            data.get("model"),
+            f"must be {cls.name!r}, the model defined in {model_file}",
+        )
+    return parse_parameter_document(data, params_file, {cls.name: cls.params_type})[2]

@@ -31,10 +31,10 @@ from typing import TYPE_CHECKING, Any
 
 from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
 from pendverify.analytic.params import check_value
-from pendverify.analytic.plugin import _validate, load_model_class, where
+from pendverify.analytic.plugin import _validate, load_model_class, plugin_parameters, where
 from pendverify.checks.report import Report, format_table
 from pendverify.checks.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
-from pendverify.checks.targets import Target, default_target, model_target, plugin_parameters, user_target
+from pendverify.checks.targets import Target, default_target, model_target, user_target
 from pendverify.checks.verification import build_report
 from pendverify.errors import InputError, PendverifyError, UnknownNameError
 from pendverify.robot.geometry import MODEL_FORM_RTOL

@@ -19,14 +19,9 @@ from importlib.resources import files
 from pathlib import Path
 
 from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
-from pendverify.analytic.params import (
-    default_parameter_file,
-    load_parameter_file,
-    parse_parameter_document,
-    read_toml,
-)
-from pendverify.analytic.plugin import load_model_class
-from pendverify.errors import ParameterError, PendverifyError, UnknownNameError
+from pendverify.analytic.params import default_parameter_file, load_parameter_file
+from pendverify.analytic.plugin import load_model_class, plugin_parameters
+from pendverify.errors import PendverifyError, UnknownNameError
 from pendverify.robot.erd import MODEL as ERD_MODEL
 from pendverify.robot.erd import double_pendulum_urdfs
 from pendverify.robot.seed_geometry import DEFAULT_G
@@ -125,19 +120,6 @@ def user_target(model_name: str | None, urdf: str | None, params_file: str | Non
         system = PinocchioSystem.for_model(cls, urdf_for(params), params.g, f"<URDF of {params_file}>")
         return Target(f"{model_name}:{Path(params_file).stem}", cls(params), system, system.source)
     return model_target(cls, urdf, params)
-
-
-def plugin_parameters(cls: type[ClosedFormModel], model_file: str, params_file: str) -> ParameterSet:
-    """A parameter file for a plug-in: its ``model`` key must be the plug-in's name."""
-    data = read_toml(Path(params_file))
-    if data.get("model") != cls.name:
-        raise ParameterError(
-            params_file,
-            "model",
-            data.get("model"),
-            f"must be {cls.name!r}, the model defined in {model_file}",
-        )
-    return parse_parameter_document(data, params_file, {cls.name: cls.params_type})[2]
 
 
 def plugin_target(model_file: str, urdf: str | None, params_file: str | None) -> Target:

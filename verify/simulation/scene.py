@@ -49,6 +49,7 @@ import numpy as np
 
 from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
 from pendverify.analytic.params import default_parameter_file, load_parameter_file, read_toml
+from pendverify.analytic.plugin import load_model_class, plugin_parameters
 from pendverify.errors import InputError, PendverifyError, SceneError
 from pendverify.simulation.effects import parse_actuation, parse_disturbance
 from pendverify.simulation.laws import Law
@@ -141,8 +142,6 @@ def _parameters(
         path = scene_path.parent / ref
         if not path.is_file():
             top.fail("params", ref, f"parameter file not found (looked for {path})")
-        from pendverify.checks.targets import plugin_parameters
-
         return plugin_parameters(model_cls, model_file, str(path)), str(path)
     ref = top.string("params", default="default")
     path = default_parameter_file(model) if ref == "default" else (scene_path.parent / ref)
@@ -161,8 +160,6 @@ def _model(top: TableReader, scene_path: Path) -> tuple[type[ClosedFormModel], s
         path = scene_path.parent / value
         if not path.is_file():
             top.fail("model", value, f"model file not found (looked for {path})")
-        from pendverify.analytic.plugin import load_model_class
-
         try:
             return load_model_class(path), str(path)
         except PendverifyError as exc:
