@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from pendverify.analytic import DoublePendulum
-from pendverify.analytic.interface import ClosedForm
+from pendverify.analytic.forms import ClosedForm
 from pendverify.checks.targets import Target
 from pendverify.checks.verdict import CHRISTOFFEL_CONSISTENT, NON_CHRISTOFFEL
 from pendverify.cli import main
