@@ -34,7 +34,7 @@ from pendverify.analytic.params import check_value
 from pendverify.analytic.plugin import load_model_class, plugin_parameters, validate_model_class, where
 from pendverify.certify.battery import BatterySettings
 from pendverify.certify.issue import certification_input, issue
-from pendverify.checks.report import Report, format_table
+from pendverify.checks.report import CheckReport
 from pendverify.checks.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
 from pendverify.checks.targets import Target, default_target, model_target, params_target
 from pendverify.checks.verification import build_report
@@ -59,45 +59,16 @@ OPTIONS_SOURCE = "<pendverify API arguments>"
 INLINE = "<inline>"
 
 __all__ = [
-    "CheckReport",
     "ModelLike",
     "ParamsLike",
     "UrdfLike",
+    "certify_set",
     "check",
     "load_model",
     "load_params",
     "load_urdf",
     "simulate",
 ]
-
-
-class CheckReport(Report):
-    """The report of ``check``: a ``pendverify.checks.report.Report`` that prints as the CLI's table.
-
-    The evidence is in the fields of ``Report``: ``results`` (one ``CheckResult`` per model and
-    check: ``max_error``, ``tolerance``, ``max_abs_error``, ``worst_state``, ``status``, ``notes``),
-    ``notes``, ``warnings`` and ``diagnoses`` (per model label), ``states``, ``sources``, ``seed``,
-    ``strict``, ``elapsed_s``; ``passed``, ``status``, ``failures()``, ``refusals()``, ``as_dict()``
-    and ``to_json()`` (the document ``check --json`` writes).
-    """
-
-    def table(self) -> str:
-        """The text ``pendverify check`` prints: the table, notes, warnings, diagnoses, the verdict."""
-        return format_table(self)
-
-    def __str__(self) -> str:
-        return self.table()
-
-    def __repr__(self) -> str:
-        models = ", ".join(self.states)
-        return f"<CheckReport {self.status}: {len(self.results)} checks on {models}, seed {self.seed}>"
-
-    def _repr_pretty_(self, printer, cycle: bool) -> None:  # IPython / Jupyter: show the table
-        printer.text(repr(self) if cycle else self.table())
-
-    @classmethod
-    def from_report(cls, report: Report) -> CheckReport:
-        return cls(**{f.name: getattr(report, f.name) for f in dataclasses.fields(Report)})
 
 
 # --- loading ----------------------------------------------------------------------------------------
