@@ -224,6 +224,8 @@ class ClosedFormModel(ABC):
         """The scales derived from M and H (``pendverify.symbolic.scales``), cached on the instance."""
         scales = self.__dict__.get("_derived_scales_cache")
         if scales is None:
+            # deferred on purpose: SymPy (symbolic.scales) loads only for a model that leaves a scale
+            # to be derived, so `pendverify check` on the built-in models does not import it
             from pendverify.symbolic.scales import DerivedScales
 
             scales = self.__dict__["_derived_scales_cache"] = DerivedScales.of(self)

@@ -32,6 +32,12 @@ from pendverify.analytic import MODELS, ClosedFormModel  # noqa: F401  (MODELS: 
 from pendverify.errors import SceneError
 from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
+from pendverify.simulation.lqr import (
+    closed_form_linearisation,
+    linearisation_error,
+    lqr_gain,
+    pinocchio_linearisation,
+)
 from pendverify.simulation.scene import Scene
 
 
@@ -153,13 +159,6 @@ def _system(scene: Scene, params, urdf: str | None, needed_by: str) -> Pinocchio
 
 
 def _prepare_lqr(law, model, system, scene) -> None:
-    from pendverify.simulation.lqr import (
-        closed_form_linearisation,
-        linearisation_error,
-        lqr_gain,
-        pinocchio_linearisation,
-    )
-
     D = scene.damping_matrix if scene.damping is not None else np.zeros((model.nv, model.nv))
     closed = closed_form_linearisation(model, D, law.q_star)
     pinocchio = pinocchio_linearisation(system, model, D, law.q_star)
