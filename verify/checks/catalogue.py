@@ -42,15 +42,14 @@ from pendverify.checks import quantities
 from pendverify.checks.applicability import hand_written, needs_matrix_c, needs_urdf_damping
 from pendverify.checks.quantities import Sample
 from pendverify.checks.sampling import State
-from pendverify.checks.scaling import EPS, world_lever
-from pendverify.checks.trust import REFUSE_REL
+from pendverify.checks.scaling import world_lever
+from pendverify.checks.trust import EPS, REFUSE_REL
 from pendverify.checks.verdict import FAIL, PASS, REFUSED
 from pendverify.robot.system import PinocchioSystem
 
 __all__ = [
     "CHECKS",
     "CHECK_NAMES",
-    "EPS",
     "Check",
     "CheckResult",
     "applicable_checks",

@@ -19,8 +19,6 @@ import numpy as np
 
 from pendverify.checks.trust import term_amplification
 
-EPS = float(np.finfo(float).eps)
-
 
 def weights(model, q):
     return 1.0 / np.sqrt(model.diagonal_scale(q))

@@ -14,7 +14,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from pendverify.checks.scaling import EPS, norm2, rate_scale, scaled_matrix, weights
+from pendverify.checks.scaling import norm2, rate_scale, scaled_matrix, weights
+from pendverify.checks.trust import EPS
 from pendverify.jsonio import to_json, versions
 from pendverify.simulation.dynamics import Dynamics, build_dynamics
 from pendverify.simulation.integrate import Integration, integrate
