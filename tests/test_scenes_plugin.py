@@ -200,6 +200,9 @@ def test_shipped_plugin_scenes_pass():
     damped = simulate(load_scene(REPO / "scenes" / "damped_triple_pendulum.toml"))
     assert damped.passed and damped.engine_comparison.passed
     assert damped.energy[-1] < damped.energy[0]
+    furuta = simulate(load_scene(REPO / "scenes" / "furuta_arm_turning.toml"))  # not planar
+    assert furuta.passed and furuta.engine_comparison.passed
+    assert np.ptp(furuta.q[:, 0]) > 0.1 and np.ptp(furuta.q[:, 1]) > 1.0, "arm turned, pendulum fell"
 
 
 def test_render_draws_a_plugin_scene_from_its_urdf(tmp_path, capsys):

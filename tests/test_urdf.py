@@ -129,3 +129,17 @@ def test_non_finite_states_are_refused_not_propagated(call, key):
         InputError, match=rf"dp\.urdf: key '{re.escape(key)}' = .*: a state entry must be a finite number"
     ):
         call(system)
+
+
+def test_a_model_without_a_urdf_writer_is_a_clear_error():
+    from pendverify.analytic.plugin import load_model_class
+    from pendverify.checks.targets import plugin_parameters
+    from pendverify.errors import PendverifyError
+    from pendverify.robot.writer import WRITERS, urdf_for
+
+    examples = Path(__file__).resolve().parents[1] / "examples"
+    cls = load_model_class(examples / "cart_pole.py")
+    params = plugin_parameters(cls, "cart_pole.py", str(examples / "cart_pole.toml"))
+    assert set(WRITERS) == {"double_pendulum", "cart_double_pendulum"}
+    with pytest.raises(PendverifyError, match="no URDF writer for model 'cart_pole': give the URDF"):
+        urdf_for(params)

@@ -20,7 +20,24 @@ written with ``repr`` so that the URDF round-trips every parameter exactly.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from pendverify.analytic import CartDoublePendulumParams, DoublePendulumParams, ParameterSet
+from pendverify.errors import PendverifyError
+
+#: model name → the function writing the URDF of one of its parameter sets (``register_writer``)
+WRITERS: dict[str, Callable[[ParameterSet, str], str]] = {}
+
+
+def register_writer(model: str):
+    """Decorator: the URDF writer of model ``model``'s parameter sets (``urdf_for`` finds it)."""
+
+    def register(writer):
+        WRITERS[model] = writer
+        return writer
+
+    return register
+
 
 ROD_RADIUS = 0.012
 BOB_RADIUS = 0.03
@@ -74,6 +91,7 @@ def _joint(name, kind, parent, child, xyz, axis, damping=None, limit=None) -> st
     )
 
 
+@register_writer("double_pendulum")
 def double_pendulum_urdf(p: DoublePendulumParams, name: str = "double_pendulum") -> str:
     rod_y = "-1.5707963267948966 0 0"  # a URDF cylinder runs along z; this turns it onto +y
     links = []
@@ -111,6 +129,7 @@ def double_pendulum_urdf(p: DoublePendulumParams, name: str = "double_pendulum")
     )
 
 
+@register_writer("cart_double_pendulum")
 def cart_double_pendulum_urdf(p: CartDoublePendulumParams, name: str = "cart_double_pendulum") -> str:
     rail_length = max(4.0, 4 * (p.l1 + p.l2))
     cart_size = (0.3, 0.15, 0.1)
@@ -161,9 +180,8 @@ def cart_double_pendulum_urdf(p: CartDoublePendulumParams, name: str = "cart_dou
 
 
 def urdf_for(params: ParameterSet, name: str | None = None) -> str:
-    """The URDF text of any parameter set."""
-    if isinstance(params, DoublePendulumParams):
-        return double_pendulum_urdf(params, name or params.model)
-    if isinstance(params, CartDoublePendulumParams):
-        return cart_double_pendulum_urdf(params, name or params.model)
-    raise TypeError(f"no URDF writer for {type(params).__name__}")
+    """The URDF text of a parameter set whose model has a writer (the seeds); the robot is ``name``."""
+    model = getattr(params, "model", type(params).__name__)
+    if model not in WRITERS:
+        raise PendverifyError(f"no URDF writer for model {model!r}: give the URDF that describes it")
+    return WRITERS[model](params, name or model)

@@ -1,0 +1,134 @@
+"""The review folder: check every model a set of scenes simulates, run the scenes, write the page.
+
+``write_review(scene_paths, out, ...)`` loads the scenes first (a bad scene is an
+error before any work), then builds one check target per distinct model, URDF
+and parameter set among them (``scene_targets``):
+
+* a built-in model with the project's URDF: the URDF the project writes for the
+  scene's parameter set (for the default set, exactly ``pendverify check``'s target);
+* a scene that names a URDF (plug-in or built-in): that URDF, in the model's
+  coordinates, with the scene's parameter set;
+* a plug-in scene without a URDF can be neither checked nor drawn: an error,
+  before any work.
+
+example-robot-data's double pendulums join the table when ``erd`` is on and a
+scene simulates their model.  The folder holds ``index.html``, ``report.json``,
+``scenes/<stem>.html`` and ``plots/<stem>.svg``.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from pendverify.analytic.params import default_parameter_file, load_parameter_file
+from pendverify.atomic import write_atomic
+from pendverify.checks.targets import Target, default_target, erd_targets, model_target
+from pendverify.checks.verification import build_report
+from pendverify.robot.erd import MODEL as ERD_MODEL
+from pendverify.robot.system import PinocchioSystem
+from pendverify.simulation.scene import Scene, SceneError, load_scene
+from pendverify.simulation.simulate import simulate
+from pendverify.viz.animation import Trajectory, render_html
+from pendverify.viz.plots import energy_plot_svg
+from pendverify.viz.review import SceneReview, review_page
+
+
+@dataclass
+class ReviewFolder:
+    """What ``write_review`` wrote and found."""
+
+    report: object  # pendverify.checks.verification.CheckReport
+    reviews: list[SceneReview]
+    index: Path
+
+    @property
+    def passed(self) -> bool:
+        return self.report.passed and all(r.passed for r in self.reviews)
+
+
+def _is_default(scene: Scene) -> bool:
+    return scene.params == load_parameter_file(default_parameter_file(scene.model))[2]
+
+
+def _target(scene: Scene) -> Target:
+    if scene.urdf is not None:
+        return model_target(scene.model_cls, scene.urdf, scene.params)
+    if _is_default(scene):
+        return default_target(scene.model)
+    system = PinocchioSystem.for_params(scene.params, f"<URDF of {scene.params_source}>")
+    return Target(
+        f"{scene.model}:{Path(scene.params_source).stem}",
+        scene.model_cls(scene.params),
+        system,
+        system.source,
+    )
+
+
+def scene_targets(scenes: list[Scene], erd: bool = True) -> list[Target]:
+    """One target per distinct (model, URDF, parameters) the scenes use."""
+    targets, seen = [], set()
+    for scene in scenes:
+        key = (scene.model, scene.model_file, scene.urdf, repr(scene.params))
+        if key in seen:
+            continue
+        seen.add(key)
+        if scene.model_file is not None and scene.urdf is None:
+            raise SceneError(
+                scene.source,
+                "urdf",
+                None,
+                f"a review checks and draws {scene.model} against its URDF: give one",
+            )
+        targets.append(_target(scene))
+    if erd and any(s.model == ERD_MODEL and s.model_file is None for s in scenes):
+        targets += erd_targets()
+    return targets
+
+
+def _shown(path: Path) -> str:
+    """A scene's path relative to the working directory when it is below it."""
+    try:
+        return str(path.resolve().relative_to(Path.cwd().resolve()))
+    except ValueError:
+        return str(path)
+
+
+def _review(path: Path, scene: Scene, out: Path, trace: bool) -> SceneReview:
+    result = simulate(scene)
+    animation, plot = f"scenes/{path.stem}.html", f"plots/{path.stem}.svg"
+    write_atomic(out / animation, render_html(Trajectory.from_run(result), trace=trace))
+    write_atomic(out / plot, energy_plot_svg(result))
+    return SceneReview(
+        name=scene.name,
+        source=_shown(path),
+        animation=animation,
+        plot=plot,
+        invariants=[*result.invariants, *([result.engine_comparison] if result.engine_comparison else [])],
+        passed=result.passed,
+        model=scene.model,
+        duration_s=scene.duration,
+        notes=list(result.notes),
+    )
+
+
+def write_review(
+    scene_paths: list[Path], out: Path, samples: int, seed: int, erd: bool, trace: bool, log=print
+) -> ReviewFolder:
+    """Check the scenes' models, run and draw every scene, and write ``out/index.html`` (docstring)."""
+    out = Path(out)
+    scenes = [load_scene(path) for path in scene_paths]
+    targets = scene_targets(scenes, erd)
+    start = time.perf_counter()
+    report = build_report(targets, samples, seed)
+    report.elapsed_s = time.perf_counter() - start
+    write_atomic(out / "report.json", report.to_json())
+    verdict = "pass" if report.passed else "FAIL"
+    log(f"checks: {len(report.results)} on {len(report.states)} model(s): {verdict}")
+    reviews = []
+    for path, scene in zip(scene_paths, scenes, strict=True):
+        reviews.append(_review(path, scene, out, trace))
+        log(f"scene {scene.name}: invariants {'pass' if reviews[-1].passed else 'FAIL'}")
+    index = write_atomic(out / "index.html", review_page(report, reviews))
+    return ReviewFolder(report, reviews, index)
