@@ -120,14 +120,20 @@ def model_target(
     return Target(f"{cls.name}:{name}", model, system, system.source, notes)
 
 
-def params_target(params: ParameterSet, name: str = "inline", origin: str | None = None) -> Target:
-    """A built-in model's parameter set against the URDF the project writes for it.
+def params_target(
+    params: ParameterSet,
+    name: str = "inline",
+    origin: str | None = None,
+    model_cls: type[ClosedFormModel] | None = None,
+) -> Target:
+    """A parameter set against the URDF the project writes for it (``pendverify.robot.writer``).
 
-    The model is the set's own (``params.model``).  The target is labelled ``{model}:{name}``
-    (the CLI passes the parameter file's stem); ``origin`` says where the set came from in
-    the URDF's source, ``<URDF of {origin}>`` (default: the inline parameters).
+    The model is ``model_cls``, by default the built-in model of the set (``params.model``).
+    The target is labelled ``{model}:{name}`` (the CLI passes the parameter file's stem);
+    ``origin`` says where the set came from in the URDF's source, ``<URDF of {origin}>``
+    (default: the inline parameters).
     """
-    cls = _model_class(params.model)
+    cls = model_cls or _model_class(params.model)
     origin = origin or f"the inline {cls.name} parameters"
     system = PinocchioSystem.for_model(cls, urdf_for(params), params.g, f"<URDF of {origin}>")
     return Target(f"{cls.name}:{name}", cls(params), system, system.source)
