@@ -48,13 +48,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from pendverify.analytic.interface import (
-    STANDARD_CLOSED_FORMS,
-    BatteryMotion,
-    ClosedForm,
-    ClosedFormModel,
-    Energies,
-)
+from pendverify.analytic.forms import STANDARD_CLOSED_FORMS, BatteryMotion, ClosedForm, Energies
+from pendverify.analytic.interface import ClosedFormModel
 from pendverify.analytic.params import ParameterSet, quantity
 from pendverify.errors import ParameterError
 

@@ -49,6 +49,7 @@ the abstract methods below it declares:
 * optionally ``closed_forms``: which methods hold hand-written formulas (the ones
   ``pendverify mutate`` mutates); extra methods name what they equal in terms of
   the Lagrangian quantities, e.g. ``ClosedForm("qvuw", "-C*v - H - D*v + B*u + W*w")``.
+  (``Energies``, ``ClosedForm`` and ``STANDARD_CLOSED_FORMS`` are in ``pendverify.analytic.forms``.)
 
 A model that has no matrix C, only the force C(q, q̇)·q̇, subclasses ``BiasOnlyModel``
 and writes ``coriolis_force`` instead; the checks that need a matrix C (``coriolis``,
@@ -63,83 +64,14 @@ too) and keep ``__init__`` free of arithmetic on the parameters.
 
 from __future__ import annotations
 
-import math
 import types
 from abc import ABC, abstractmethod
-from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
 
+from pendverify.analytic.forms import NUMERIC_MATH, STANDARD_CLOSED_FORMS, BatteryMotion, ClosedForm, Energies
 from pendverify.analytic.params import ParameterSet
-
-#: The scalar functions closed forms call through ``self.math``: Python's own, numerically.
-NUMERIC_MATH = types.SimpleNamespace(
-    cos=math.cos, sin=math.sin, tan=math.tan, sqrt=math.sqrt, exp=math.exp, atan2=math.atan2, pi=math.pi
-)
-
-
-@dataclass(frozen=True)
-class Energies:
-    """The Lagrangian data of a model, as SymPy expressions in (q, q̇, u, w).
-
-    ``kinetic`` T(q, q̇) = ½ q̇ᵀ M q̇; ``potential`` V(q); ``dissipation`` the Rayleigh
-    function R(q̇) = ½ q̇ᵀ D q̇ (the friction force is −∂R/∂q̇); ``power`` the power of
-    the inputs and disturbances, P = (B u + W w)ᵀ q̇.
-    """
-
-    kinetic: Any
-    potential: Any
-    dissipation: Any = 0
-    power: Any = 0
-
-
-@dataclass(frozen=True)
-class BatteryMotion:
-    """The motion the certification battery simulates, when a model states its own.
-
-    ``q`` and ``v``: the initial state (model coordinates); ``input_amplitude`` and
-    ``input_frequency`` (Hz): the sine on the inputs; ``disturbance_std`` and
-    ``disturbance_bandwidth`` (Hz): the seeded noise on the disturbances;
-    ``damping_floor``: when > 0, the damping run uses diag(max(D_ii, floor)) rather than D.
-    A model that states none gets one derived from its scales (``pendverify.certify.scenes``).
-    """
-
-    q: tuple[float, ...]
-    v: tuple[float, ...]
-    input_amplitude: tuple[float, ...] = ()
-    input_frequency: float = 0.5
-    disturbance_std: tuple[float, ...] = ()
-    disturbance_bandwidth: float = 4.0
-    damping_floor: float = 0.0
-
-
-@dataclass(frozen=True)
-class ClosedForm:
-    """One method that holds a hand-written formula.
-
-    ``args`` names its arguments in order from "q", "v", "u", "w" (``""``: none).
-    ``equals`` is empty for the methods of the interface; for any other method it
-    says what the method equals in terms of the Lagrangian quantities M, C, H, D, B,
-    W and the column vectors q, v, u, w, e.g. ``"-C*v - H - D*v + B*u + W*w"``.
-    """
-
-    args: str
-    equals: str = ""
-
-
-#: The interface's own closed forms, in the order the tools report them.
-STANDARD_CLOSED_FORMS: dict[str, ClosedForm] = {
-    "mass_matrix": ClosedForm("q"),
-    "coriolis_matrix": ClosedForm("qv"),
-    "gravity": ClosedForm("q"),
-    "potential_energy": ClosedForm("q"),
-    "damping_matrix": ClosedForm(""),
-    "input_matrix": ClosedForm(""),
-    "disturbance_matrix": ClosedForm(""),
-    "det_mass_matrix": ClosedForm("q"),
-    "inverse_mass_matrix": ClosedForm("q"),
-}
 
 
 class ClosedFormModel(ABC):
@@ -294,6 +226,8 @@ class ClosedFormModel(ABC):
         """The scales derived from M and H (``pendverify.symbolic.scales``), cached on the instance."""
         scales = self.__dict__.get("_derived_scales_cache")
         if scales is None:
+            # deferred on purpose: SymPy (symbolic.scales) loads only for a model that leaves a scale
+            # to be derived, so `pendverify check` on the built-in models does not import it
             from pendverify.symbolic.scales import DerivedScales
 
             scales = self.__dict__["_derived_scales_cache"] = DerivedScales.of(self)

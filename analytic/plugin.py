@@ -13,10 +13,12 @@ exactly one concrete subclass of ``pendverify.analytic.ClosedFormModel``
   too when it declares ``inputs``), and the coordinate map
   (``urdf_joints``, ``joint_transform``, ``joint_offset``; see ``pendverify.robot.joint_map``).
 
-``examples/cart_pole.py`` is a complete plug-in.  The built-in models are
-plug-ins of the same kind: ``--analytic analytic/double_pendulum.py`` loads the
-seed through this same path.  Every problem is a ``PendverifyError`` naming the
-file (and the line, for an exception raised while importing it).
+``validate_model_class`` checks these rules on any class (the Python API applies it to a
+class written in the caller's own code).  ``examples/cart_pole.py`` is a complete
+plug-in.  The built-in models are plug-ins of the same kind: ``--analytic
+analytic/double_pendulum.py`` loads the seed through this same path.  Every problem is
+a ``PendverifyError`` naming the file (and the line, for an exception raised while
+importing it).
 """
 
 from __future__ import annotations
@@ -29,7 +31,8 @@ import traceback
 from pathlib import Path
 
 from pendverify.analytic import ClosedFormModel, ParameterSet
-from pendverify.errors import PendverifyError
+from pendverify.analytic.params import parse_parameter_document, read_toml
+from pendverify.errors import ParameterError, PendverifyError
 
 
 def where(cls: type) -> str:
@@ -60,7 +63,19 @@ def _import(path: Path):
     return module
 
 
-def _validate(cls: type[ClosedFormModel], path: Path) -> None:
+def validate_model_class(cls: type[ClosedFormModel], path: str | Path | None = None) -> None:
+    """Check that ``cls`` is a usable closed-form model class, as a model file's class must be.
+
+    The rules are the module docstring's: ``name``, a ``params_type`` dataclass of
+    ``quantity()`` fields whose ``model`` is that name, ``coordinates`` and ``angular``,
+    ``inputs`` and ``disturbances``, every abstract method, and ``input_matrix`` when it
+    declares inputs.  ``path`` names the file in messages (default: the file defining
+    ``cls``).  Raises ``PendverifyError`` naming the file, the class and the rule broken;
+    returns None when ``cls`` passes.  ``load_model_class`` applies it to the class a
+    model file defines; ``pendverify.api.load_model`` to a class given in Python.
+    """
+    path = Path(where(cls)) if path is None else Path(path)
+
     def fail(problem: str):
         raise PendverifyError(f"{path}: {cls.__name__}: {problem}")
 
@@ -123,5 +138,18 @@ def load_model_class(path: str | Path) -> type[ClosedFormModel]:
             f"{path}: defines {len(found)} ClosedFormModel subclasses "
             f"({', '.join(c.__name__ for c in found)}); a model file defines exactly one"
         )
-    _validate(found[0], path)
+    validate_model_class(found[0], path)
     return found[0]
+
+
+def plugin_parameters(cls: type[ClosedFormModel], model_file: str, params_file: str) -> ParameterSet:
+    """A parameter file for a plug-in: its ``model`` key must be the plug-in's name."""
+    data = read_toml(Path(params_file))
+    if data.get("model") != cls.name:
+        raise ParameterError(
+            params_file,
+            "model",
+            data.get("model"),
+            f"must be {cls.name!r}, the model defined in {model_file}",
+        )
+    return parse_parameter_document(data, params_file, {cls.name: cls.params_type})[2]

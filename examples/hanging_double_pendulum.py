@@ -45,7 +45,7 @@ from typing import ClassVar
 import numpy as np
 
 from pendverify.analytic import ClosedFormModel, DoublePendulumParams
-from pendverify.analytic.interface import STANDARD_CLOSED_FORMS, ClosedForm, Energies
+from pendverify.analytic.forms import STANDARD_CLOSED_FORMS, ClosedForm, Energies
 from pendverify.analytic.params import ParameterSet, quantity
 
 

@@ -25,7 +25,7 @@ import dataclasses
 import numpy as np
 
 from pendverify.analytic import ClosedFormModel
-from pendverify.analytic.interface import Energies
+from pendverify.analytic.forms import Energies
 from pendverify.analytic.params import ParameterSet, quantity
 
 

@@ -19,8 +19,9 @@ import pytest
 import pendverify
 from pendverify.analytic import DoublePendulum, DoublePendulumParams
 from pendverify.analytic.params import default_parameter_file, load_parameter_file, read_toml
+from pendverify.analytic.plugin import validate_model_class
 from pendverify.checks.report import Report
-from pendverify.checks.targets import committed_urdf
+from pendverify.checks.targets import committed_urdf, model_target, params_target
 from pendverify.cli import main
 from pendverify.errors import PendverifyError
 from pendverify.robot.system import PinocchioSystem
@@ -103,6 +104,49 @@ def test_builtin_with_parameters_from_a_file_a_mapping_or_urdf_text():
     by_text = pendverify.check(DoublePendulum, urdf_for(params), params, samples=FEW)
     assert by_text.passed and list(by_text.states) == ["double_pendulum:urdf-text"]
     assert [r.max_error for r in by_mapping.results] == [r.max_error for r in by_file.results]
+
+
+def test_targets_are_labelled_by_file_stem_by_urdf_text_or_by_the_callers_name():
+    params = load_parameter_file(default_parameter_file("double_pendulum"))[2]
+    urdf = committed_urdf("double_pendulum")
+    assert model_target(DoublePendulum, str(urdf), params).label == "double_pendulum:double_pendulum"
+    by_text = model_target(DoublePendulum, urdf.read_text(), params)
+    assert by_text.label == "double_pendulum:urdf-text" and by_text.source == "<urdf text>"
+    assert (
+        model_target(DoublePendulum, urdf.read_text(), params, "bench arm").label
+        == "double_pendulum:bench arm"
+    )
+    inline = params_target(params)
+    assert inline.label == "double_pendulum:inline"
+    assert inline.source == "<URDF of the inline double_pendulum parameters>"
+    from_file = params_target(params, "set 7", "sweeps/set7.toml")
+    assert (from_file.label, from_file.source) == ("double_pendulum:set 7", "<URDF of sweeps/set7.toml>")
+
+
+def test_a_missing_parameter_set_is_asked_for_in_words_that_fit_the_api():
+    """The library's message names both ways to give it, and the URDF text is not repeated."""
+    urdf = committed_urdf("cart_double_pendulum").read_text()
+    with pytest.raises(PendverifyError) as caught:
+        pendverify.check("cart_double_pendulum", urdf)
+    message = str(caught.value)
+    assert message == (
+        "<urdf text>: give the parameter set (--params on the command line, params= in the Python API): "
+        "a cart_double_pendulum URDF alone does not fix the closed form"
+    )
+    assert pendverify.check(
+        "cart_double_pendulum", urdf, default_values("cart_double_pendulum"), samples=10
+    ).passed
+
+
+def test_validate_model_class_is_public_and_names_the_rule():
+    class Nameless(DoublePendulum):
+        name = ""
+
+    validate_model_class(DoublePendulum)  # a usable class: nothing to say
+    with pytest.raises(PendverifyError, match=r"test_api\.py: Nameless: needs a class attribute name"):
+        validate_model_class(Nameless)
+    with pytest.raises(PendverifyError, match=r"^models/arm\.py: Nameless: "):
+        validate_model_class(Nameless, "models/arm.py")
 
 
 def test_load_urdf_gives_pinocchio_in_the_models_coordinates():
@@ -244,6 +288,12 @@ BAD_INPUTS = {
     "another model's parameter set": (
         lambda tmp: pendverify.load_params(SignFlip, DoublePendulumParams(**default_values())),
         "sign_flip needs SignFlipParams",
+    ),
+    "another built-in model's parameter file": (
+        lambda tmp: pendverify.check(
+            "double_pendulum", params=default_parameter_file("cart_double_pendulum")
+        ),
+        "key 'model' = 'cart_double_pendulum': must be 'double_pendulum'",
     ),
     "missing URDF": (
         lambda tmp: pendverify.load_urdf("double_pendulum", tmp / "none.urdf"),

@@ -51,7 +51,7 @@ def test_cart_urdf_alone_needs_params(capsys):
 
     urdf = str(files("pendverify.urdf") / "cart_double_pendulum.urdf")
     assert main(["check", "--model", "cart_double_pendulum", "--urdf", urdf]) == 2
-    assert "give --params" in capsys.readouterr().err
+    assert "give the parameter set (--params on the command line" in capsys.readouterr().err
 
 
 def test_not_a_planar_chain_is_exit_2(capsys):

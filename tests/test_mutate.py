@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from pendverify.analytic import DoublePendulum
-from pendverify.analytic.interface import ClosedForm
+from pendverify.analytic.forms import ClosedForm
 from pendverify.checks.targets import Target
 from pendverify.checks.verdict import CHRISTOFFEL_CONSISTENT, NON_CHRISTOFFEL
 from pendverify.cli import main
@@ -22,7 +22,8 @@ from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
 from pendverify.symbolic.model import SymbolicModel
 from pendverify.symbolic.mutants import OPERATORS, generate
-from pendverify.symbolic.mutate import DETECTED, EQUIVALENT, SURVIVED, numeric_model, run_mutation
+from pendverify.symbolic.mutate import numeric_model, run_mutation
+from pendverify.symbolic.mutation_report import DETECTED, EQUIVALENT, SURVIVED
 
 from .conftest import default_params
 

@@ -233,8 +233,8 @@ def _bias_only_source() -> str:
         .replace("(ClosedFormModel):", "(BiasOnlyModel):")
         .replace("**STANDARD_CLOSED_FORMS,", "**BiasOnlyModel.closed_forms,")
         .replace(
-            "from pendverify.analytic.interface import",
-            "from pendverify.analytic.interface import BiasOnlyModel,",
+            "from pendverify.analytic.forms import",
+            "from pendverify.analytic.interface import BiasOnlyModel\nfrom pendverify.analytic.forms import",
         )
     )
     assert "coriolis_matrix" not in text

@@ -11,8 +11,9 @@ import pytest
 
 from pendverify.analytic import CartDoublePendulum, DoublePendulum
 from pendverify.cli import main
+from pendverify.errors import SceneError
 from pendverify.simulation.dynamics import build_dynamics
-from pendverify.simulation.scene import SceneError, load_scene, parse_scene
+from pendverify.simulation.scene import load_scene, parse_scene
 from pendverify.simulation.simulate import simulate
 
 REPO = Path(__file__).resolve().parents[1]

@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from pendverify.cli import main
-from pendverify.simulation.scene import SceneError, load_scene
+from pendverify.errors import SceneError
+from pendverify.simulation.scene import load_scene
 from pendverify.simulation.simulate import simulate
 
 REPO = Path(__file__).resolve().parents[1]

@@ -14,7 +14,7 @@ import pytest
 import sympy as sp
 
 from pendverify.analytic import MODELS, CartDoublePendulum, DoublePendulum
-from pendverify.analytic.interface import Energies
+from pendverify.analytic.forms import Energies
 from pendverify.checks.catalogue import run_checks
 from pendverify.checks.sampling import sample_states
 from pendverify.checks.verdict import CHRISTOFFEL_CONSISTENT, NON_CHRISTOFFEL

@@ -11,13 +11,8 @@ import pytest
 
 from pendverify.errors import UrdfShapeError
 from pendverify.robot.erd import double_pendulum_urdfs
-from pendverify.robot.strict import (
-    JointDynamics,
-    UrdfFacts,
-    inertia_tolerance,
-    read_urdf_strictly,
-    resolution,
-)
+from pendverify.robot.inertia_rounding import inertia_tolerance, resolution
+from pendverify.robot.strict import JointDynamics, UrdfFacts, read_urdf_strictly
 from pendverify.robot.urdfdom import build_pinocchio_model
 
 REPO = Path(__file__).resolve().parents[1]

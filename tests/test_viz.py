@@ -23,10 +23,11 @@ import umsgpack
 from PIL import Image
 
 from pendverify.cli import main
+from pendverify.errors import TrajectoryError
 from pendverify.robot.writer import COLOURS
 from pendverify.simulation.scene import load_scene, parse_scene
 from pendverify.simulation.simulate import simulate
-from pendverify.viz.animation import DEFAULT_FPS, Trajectory, TrajectoryError, build_scene, render_html
+from pendverify.viz.animation import DEFAULT_FPS, Trajectory, build_scene, render_html
 from pendverify.viz.browser import Chromium, find_chromium
 from pendverify.viz.geometry import VisualSystem
 from pendverify.viz.plots import energy_plot_svg

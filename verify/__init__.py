@@ -26,7 +26,7 @@ _LAZY = {
     "load_urdf": "pendverify.api",
     "simulate": "pendverify.api",
     "certify_set": "pendverify.api",
-    "CheckReport": "pendverify.api",
+    "CheckReport": "pendverify.checks.report",
     "assert_verified": "pendverify.testing",
     "PendverifyError": "pendverify.errors",
 }
@@ -45,7 +45,8 @@ __all__ = [
 ]
 
 if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
-    from pendverify.api import CheckReport, certify_set, check, load_model, load_params, load_urdf, simulate
+    from pendverify.api import certify_set, check, load_model, load_params, load_urdf, simulate
+    from pendverify.checks.report import CheckReport
     from pendverify.errors import PendverifyError
     from pendverify.testing import assert_verified
 

@@ -31,10 +31,12 @@ from typing import TYPE_CHECKING, Any
 
 from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
 from pendverify.analytic.params import check_value
-from pendverify.analytic.plugin import _validate, load_model_class, where
-from pendverify.checks.report import Report, format_table
+from pendverify.analytic.plugin import load_model_class, plugin_parameters, validate_model_class, where
+from pendverify.certify.battery import BatterySettings
+from pendverify.certify.issue import certification_input, issue
+from pendverify.checks.report import CheckReport
 from pendverify.checks.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
-from pendverify.checks.targets import Target, default_target, model_target, plugin_parameters, user_target
+from pendverify.checks.targets import Target, default_target, model_target, params_target
 from pendverify.checks.verification import build_report
 from pendverify.errors import InputError, PendverifyError, UnknownNameError
 from pendverify.robot.geometry import MODEL_FORM_RTOL
@@ -57,45 +59,16 @@ OPTIONS_SOURCE = "<pendverify API arguments>"
 INLINE = "<inline>"
 
 __all__ = [
-    "CheckReport",
     "ModelLike",
     "ParamsLike",
     "UrdfLike",
+    "certify_set",
     "check",
     "load_model",
     "load_params",
     "load_urdf",
     "simulate",
 ]
-
-
-class CheckReport(Report):
-    """The report of ``check``: a ``pendverify.checks.report.Report`` that prints as the CLI's table.
-
-    The evidence is in the fields of ``Report``: ``results`` (one ``CheckResult`` per model and
-    check: ``max_error``, ``tolerance``, ``max_abs_error``, ``worst_state``, ``status``, ``notes``),
-    ``notes``, ``warnings`` and ``diagnoses`` (per model label), ``states``, ``sources``, ``seed``,
-    ``strict``, ``elapsed_s``; ``passed``, ``status``, ``failures()``, ``refusals()``, ``as_dict()``
-    and ``to_json()`` (the document ``check --json`` writes).
-    """
-
-    def table(self) -> str:
-        """The text ``pendverify check`` prints: the table, notes, warnings, diagnoses, the verdict."""
-        return format_table(self)
-
-    def __str__(self) -> str:
-        return self.table()
-
-    def __repr__(self) -> str:
-        models = ", ".join(self.states)
-        return f"<CheckReport {self.status}: {len(self.results)} checks on {models}, seed {self.seed}>"
-
-    def _repr_pretty_(self, printer, cycle: bool) -> None:  # IPython / Jupyter: show the table
-        printer.text(repr(self) if cycle else self.table())
-
-    @classmethod
-    def from_report(cls, report: Report) -> CheckReport:
-        return cls(**{f.name: getattr(report, f.name) for f in dataclasses.fields(Report)})
 
 
 # --- loading ----------------------------------------------------------------------------------------
@@ -117,7 +90,7 @@ def load_model(source: ModelLike) -> type[ClosedFormModel]:
                 f"{source.__name__} is not a subclass of pendverify.analytic.ClosedFormModel"
             )
         if not _is_builtin(source):
-            _validate(source, Path(where(source)))
+            validate_model_class(source)
         return source
     if isinstance(source, (str, Path)):
         text = str(source)
@@ -183,10 +156,6 @@ def load_urdf(model_cls: ModelLike, urdf: UrdfLike, g: float | None = None) -> P
 
 
 # --- check -----------------------------------------------------------------------------------------
-def _is_urdf_text(urdf: UrdfLike) -> bool:
-    return isinstance(urdf, str) and urdf.lstrip().startswith("<")
-
-
 def _urdf_arg(urdf: UrdfLike) -> str:
     if not isinstance(urdf, (str, Path)):
         raise PendverifyError(f"a URDF is a file path or its XML text; got a {type(urdf).__name__}")
@@ -200,26 +169,17 @@ def _count(key: str, value: Any) -> int:
 
 
 def _target(cls: type[ClosedFormModel], urdf: UrdfLike | None, params: ParamsLike | None) -> Target:
-    """The one target ``check`` verifies, built by the functions the CLI uses."""
-    builtin = _is_builtin(cls)
-    if urdf is None:
-        if not builtin:
-            raise PendverifyError(f"{where(cls)}: give urdf: the URDF to verify {cls.name} against")
-        if params is None:  # pendverify check --model NAME
-            return default_target(cls.name)
-        if isinstance(params, (str, Path)):  # pendverify check --params P
-            return user_target(cls.name, None, str(params))
-        # an in-memory set against the URDF the project writes for it
-        # (what user_target does for a file; it takes only a file)
-        values = load_params(cls, params)
-        system = PinocchioSystem.for_params(values, f"<URDF of the inline {cls.name} parameters>")
-        return Target(f"{cls.name}:inline", cls(values), system, system.source)
-    # --model/--analytic with --urdf [--params]
+    """The one target ``check`` verifies: the parameters loaded once, then the CLI's target functions."""
+    if urdf is None and not _is_builtin(cls):
+        raise PendverifyError(f"{where(cls)}: give urdf: the URDF to verify {cls.name} against")
     values = None if params is None else load_params(cls, params)
-    target = model_target(cls, _urdf_arg(urdf), values)
-    if _is_urdf_text(urdf):  # model_target names the target after the URDF file's stem
-        target.label = f"{cls.name}:urdf-text"
-    return target
+    if urdf is not None:  # --model/--analytic with --urdf [--params]
+        return model_target(cls, _urdf_arg(urdf), values)
+    if values is None:  # pendverify check --model NAME
+        return default_target(cls.name)
+    if isinstance(params, (str, Path)):  # pendverify check --params P
+        return params_target(values, Path(params).stem, str(params))
+    return params_target(values)  # a mapping or a set: against the URDF the project writes for it
 
 
 def check(
@@ -283,6 +243,7 @@ def simulate(
     ``energy``; ``invariants`` (name, error, tolerance, passed, detail); ``engine_comparison``
     (engine ``both``); ``passed``; ``notes``; ``metadata()``, ``to_npz_bytes()``, ``to_csv()``.
     """
+    # deferred on purpose: the simulator brings SciPy (0.7 s), which check() does not need
     from pendverify.simulation.scene import ENGINES, Scene, load_scene, parse_scene
     from pendverify.simulation.simulate import simulate as run_scene
 
@@ -322,9 +283,6 @@ def certify_set(
     ``certified``, ``certificate``, ``path``).  (Not ``certify``: that name is the
     ``pendverify.certify`` sub-package.)
     """
-    from pendverify.certify.battery import BatterySettings
-    from pendverify.certify.issue import certification_input, issue
-
     settings = BatterySettings()
     if samples is not None:
         settings = dataclasses.replace(settings, samples=_count("samples", samples))

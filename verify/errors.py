@@ -7,7 +7,7 @@ prints ``str(error)`` and exits with status 2; no traceback reaches the user.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 
 class PendverifyError(Exception):
@@ -56,3 +56,57 @@ class UnknownNameError(PendverifyError):
 
     def __str__(self) -> str:
         return f"unknown {self.kind} {self.name!r}; known: {', '.join(self.known)}"
+
+
+class SceneError(InputError):
+    """A scene file breaks a rule (``pendverify.simulation.scene``)."""
+
+
+class TrajectoryError(InputError):
+    """A saved trajectory cannot be rendered (``pendverify.viz.animation``)."""
+
+
+@dataclass
+class IllConditionedError(PendverifyError):
+    """M(q) is too close to singular (or Pinocchio's terms too large) for a comparison to mean something.
+
+    Raised by ``pendverify.checks.trust.check_conditioning``; ``limit`` is the trust limit
+    (``pendverify.checks.trust.REFUSE_REL``) the rounding bound exceeded.
+    """
+
+    what: str
+    q: list
+    kappa_scaled: float
+    bound: float
+    amplification: float = 1.0
+    spread: float = 1.0
+    #: the bound comes from the scale spread, not from κ̃ and A
+    by_spread: bool = False
+    limit: float = field(kw_only=True)
+
+    def __str__(self) -> str:
+        q = ", ".join(f"{x:.6g}" for x in self.q)
+        terms = (
+            f" and Pinocchio's terms are {self.amplification:.2g}× the result"
+            if self.amplification >= 10
+            else ""
+        )
+        if self.by_spread:
+            return (
+                f"{self.what} at q = ({q}): cannot be verified: M's diagonal scales span a factor "
+                f"{self.spread**2:.3g}, so an error of a relative {self.bound:.2g} in the smaller ones would "
+                f"not show against rounding ({self.bound:.2g} > {self.limit:g}, the trust limit); refused"
+            )
+        return (
+            f"{self.what} at q = ({q}): too ill-conditioned to verify: κ̃(M) = {self.kappa_scaled:.3g} "
+            f"after diagonal scaling{terms}, so rounding alone can cause a relative error of "
+            f"{self.bound:.2g} > {self.limit:g} (the trust limit); refused"
+        )
+
+
+class BrowserError(RuntimeError):
+    """Chromium is missing, failed, or did not answer in time (``pendverify.viz.browser``).
+
+    Not a ``PendverifyError``: nothing the user gave is wrong; the callers that drive a
+    browser catch it and carry on without one.
+    """

@@ -17,7 +17,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from pendverify.api import CheckReport, ModelLike, ParamsLike, UrdfLike, check
+from pendverify.api import ModelLike, ParamsLike, UrdfLike, check
+from pendverify.checks.report import CheckReport
 
 __all__ = ["assert_verified"]
 

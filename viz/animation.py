@@ -41,7 +41,7 @@ from meshcat.animation import Animation
 
 from pendverify.analytic import MODELS, PARAMETER_TYPES, ParameterSet
 from pendverify.analytic.plugin import load_model_class
-from pendverify.errors import InputError
+from pendverify.errors import TrajectoryError
 from pendverify.viz.geometry import ROOT, UP, VisualSystem
 from pendverify.viz.recorder import SceneRecorder
 
@@ -55,10 +55,6 @@ TRACE_COLOUR = 0x5B2C83  # dark purple: unlike every URDF material
 TRACE_CHUNK_S = 0.05  # s of motion per trace segment (at most MAX_TRACE_CHUNKS)
 MAX_TRACE_CHUNKS = 200
 REPETITIONS = 1_000_000  # loop for as long as anyone watches
-
-
-class TrajectoryError(InputError):
-    """A saved trajectory cannot be rendered."""
 
 
 @dataclass(frozen=True)

@@ -32,6 +32,7 @@ import time
 from pathlib import Path
 
 from pendverify.atomic import write_atomic
+from pendverify.errors import BrowserError
 
 CANDIDATES = ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable")
 FLAGS = (
@@ -49,10 +50,6 @@ FLAGS = (
 )
 URL_SCHEMES = ("file:", "http:", "https:", "about:", "data:")
 TIMEOUT_S = 60.0  # for any one protocol reply or page load
-
-
-class BrowserError(RuntimeError):
-    """Chromium is missing, failed, or did not answer in time."""
 
 
 def find_chromium() -> str | None:

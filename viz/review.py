@@ -12,14 +12,10 @@ through ``html.escape``; link targets are also percent-encoded.
 from __future__ import annotations
 
 import html
-import platform
 from dataclasses import dataclass, field
 from urllib.parse import quote
 
-import numpy as np
-import pinocchio
-
-from pendverify import __version__
+from pendverify.jsonio import versions
 
 _STYLE = """
 body { font-family: sans-serif; margin: 24px auto; max-width: 1200px; color: #222; padding: 0 16px; }
@@ -156,9 +152,10 @@ def scene_section(scene: SceneReview) -> str:
 def review_page(report, scenes: list[SceneReview], title: str = "pendverify review") -> str:
     """The whole ``index.html``."""
     passed = report.passed and all(s.passed for s in scenes)
-    versions = (
-        f"pendverify {__version__} · Pinocchio {pinocchio.__version__} · numpy {np.__version__} · "
-        f"Python {platform.python_version()}"
+    v = versions()
+    versions_line = (
+        f"pendverify {v['pendverify']} · Pinocchio {v['pinocchio']} · numpy {v['numpy']} · "
+        f"Python {v['python']}"
     )
     summary = (
         f"{len(report.results)} checks {_verdict(report.passed)} · "
@@ -172,7 +169,7 @@ def review_page(report, scenes: list[SceneReview], title: str = "pendverify revi
         '<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8">\n'
         f"<title>{_e(title)}</title>\n<style>{_STYLE}</style>\n</head>\n<body>\n"
         f"<h1>{_e(title)} {_verdict(passed)}</h1>\n"
-        f'<p class="meta">{_e(versions)}</p>\n<p>{summary}</p>\n'
+        f'<p class="meta">{_e(versions_line)}</p>\n<p>{summary}</p>\n'
         f"<h2>Pinocchio against the closed forms</h2>\n{check_table(report)}"
         f"<h2>Scenes</h2>\n<ol>{contents}</ol>\n{sections}"
         "</body>\n</html>\n"

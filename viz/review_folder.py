@@ -24,11 +24,11 @@ from pathlib import Path
 
 from pendverify.analytic.params import default_parameter_file, load_parameter_file
 from pendverify.atomic import write_atomic
-from pendverify.checks.targets import Target, default_target, erd_targets, model_target
+from pendverify.checks.targets import Target, default_target, erd_targets, model_target, params_target
 from pendverify.checks.verification import build_report
+from pendverify.errors import SceneError
 from pendverify.robot.erd import MODEL as ERD_MODEL
-from pendverify.robot.system import PinocchioSystem
-from pendverify.simulation.scene import Scene, SceneError, load_scene
+from pendverify.simulation.scene import Scene, load_scene
 from pendverify.simulation.simulate import simulate
 from pendverify.viz.animation import Trajectory, render_html
 from pendverify.viz.plots import energy_plot_svg
@@ -57,13 +57,7 @@ def _target(scene: Scene) -> Target:
         return model_target(scene.model_cls, scene.urdf, scene.params)
     if _is_default(scene):
         return default_target(scene.model)
-    system = PinocchioSystem.for_params(scene.params, f"<URDF of {scene.params_source}>")
-    return Target(
-        f"{scene.model}:{Path(scene.params_source).stem}",
-        scene.model_cls(scene.params),
-        system,
-        system.source,
-    )
+    return params_target(scene.params, Path(scene.params_source).stem, scene.params_source, scene.model_cls)
 
 
 def scene_targets(scenes: list[Scene], erd: bool = True) -> list[Target]:

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from pendverify.analytic import ClosedFormModel, ParameterSet
-from pendverify.analytic.interface import BatteryMotion
+from pendverify.analytic.forms import BatteryMotion
 
 ANGLE_STEP = 0.3  # rad: the start is this far from the model's first special state, per angle
 ANGULAR_RATE = 0.5  # rad/s

@@ -1,7 +1,12 @@
-"""The verification report: one table for people, one JSON document for machines."""
+"""The verification report: one table for people, one JSON document for machines.
+
+``Report`` is what ``build_report`` returns; ``CheckReport``, what ``pendverify.check``
+returns, is the same report printing as the CLI's table (``format_table``).
+"""
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 from pendverify.checks.catalogue import CheckResult
@@ -132,3 +137,32 @@ def verdict_sentence(report: Report) -> str:
             return f"FAIL: {warned} warning(s), which --strict counts as failures"
         return f"pass with {warned} warning(s)"
     return "all checks pass"
+
+
+class CheckReport(Report):
+    """The report of ``check``: a ``pendverify.checks.report.Report`` that prints as the CLI's table.
+
+    The evidence is in the fields of ``Report``: ``results`` (one ``CheckResult`` per model and
+    check: ``max_error``, ``tolerance``, ``max_abs_error``, ``worst_state``, ``status``, ``notes``),
+    ``notes``, ``warnings`` and ``diagnoses`` (per model label), ``states``, ``sources``, ``seed``,
+    ``strict``, ``elapsed_s``; ``passed``, ``status``, ``failures()``, ``refusals()``, ``as_dict()``
+    and ``to_json()`` (the document ``check --json`` writes).
+    """
+
+    def table(self) -> str:
+        """The text ``pendverify check`` prints: the table, notes, warnings, diagnoses, the verdict."""
+        return format_table(self)
+
+    def __str__(self) -> str:
+        return self.table()
+
+    def __repr__(self) -> str:
+        models = ", ".join(self.states)
+        return f"<CheckReport {self.status}: {len(self.results)} checks on {models}, seed {self.seed}>"
+
+    def _repr_pretty_(self, printer, cycle: bool) -> None:  # IPython / Jupyter: show the table
+        printer.text(repr(self) if cycle else self.table())
+
+    @classmethod
+    def from_report(cls, report: Report) -> CheckReport:
+        return cls(**{f.name: getattr(report, f.name) for f in dataclasses.fields(Report)})

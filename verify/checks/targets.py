@@ -9,7 +9,11 @@
 
 Built-in and plug-in models take one path: the URDF is loaded, the model class's
 geometry reader (or declared map) gives the coordinate map (the seeds read it off the
-geometry, a plug-in declares it), and ``model_target`` pairs the two.
+geometry, a plug-in declares it), and ``model_target`` pairs the two.  A parameter set
+with no URDF is checked against the URDF the project writes for it (``params_target``).
+``user_target`` and ``plugin_target`` read the CLI's options into these; the Python API
+(``pendverify.api``) calls ``default_target``, ``params_target`` and ``model_target``
+directly.
 """
 
 from __future__ import annotations
@@ -19,21 +23,19 @@ from importlib.resources import files
 from pathlib import Path
 
 from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
-from pendverify.analytic.params import (
-    default_parameter_file,
-    load_parameter_file,
-    parse_parameter_document,
-    read_toml,
-)
-from pendverify.analytic.plugin import load_model_class
-from pendverify.errors import ParameterError, PendverifyError, UnknownNameError
+from pendverify.analytic.params import default_parameter_file, load_parameter_file
+from pendverify.analytic.plugin import load_model_class, plugin_parameters
+from pendverify.errors import PendverifyError, UnknownNameError
 from pendverify.robot.erd import MODEL as ERD_MODEL
 from pendverify.robot.erd import double_pendulum_urdfs
 from pendverify.robot.seed_geometry import DEFAULT_G
 from pendverify.robot.system import PinocchioSystem
+from pendverify.robot.urdf import is_urdf_text
 from pendverify.robot.writer import urdf_for
 
 PARAMETER_MATCH_RTOL = 1e-9
+#: How a library error asks for the parameter set: it may reach a user of the CLI or of the Python API.
+PARAMS_HINT = "--params on the command line, params= in the Python API"
 
 
 @dataclass
@@ -85,8 +87,14 @@ def parameter_differences(urdf_params: ParameterSet, given: ParameterSet) -> lis
     return notes
 
 
-def model_target(cls: type[ClosedFormModel], urdf: str, params: ParameterSet | None) -> Target:
-    """A model class, a URDF file and (unless the URDF fixes them) its parameters: built-in or plug-in."""
+def model_target(
+    cls: type[ClosedFormModel], urdf: str | Path, params: ParameterSet | None, name: str | None = None
+) -> Target:
+    """A model class, a URDF and (unless the URDF fixes them) its parameters: built-in or plug-in.
+
+    ``urdf`` is a file path or the XML text itself.  The target is labelled
+    ``{model}:{name}``; ``name`` defaults to the URDF file's stem, or ``urdf-text`` for text.
+    """
     g = getattr(params, "g", None)
     system = PinocchioSystem.for_model(cls, urdf, g)
     notes = []
@@ -94,7 +102,8 @@ def model_target(cls: type[ClosedFormModel], urdf: str, params: ParameterSet | N
     if params is None:
         if read is None:
             raise PendverifyError(
-                f"{urdf}: give --params: a {cls.name} URDF alone does not fix the closed form"
+                f"{system.source}: give the parameter set ({PARAMS_HINT}): a {cls.name} URDF alone "
+                "does not fix the closed form"
             )
         params = read if isinstance(read, cls.params_type) else cls.params_type(**read.as_dict())
         notes.append("parameters read off the URDF")
@@ -106,7 +115,28 @@ def model_target(cls: type[ClosedFormModel], urdf: str, params: ParameterSet | N
         model = cls(params)
     except Exception as exc:
         raise PendverifyError(f"{cls.name}: building the model failed: {type(exc).__name__}: {exc}") from None
-    return Target(f"{cls.name}:{Path(urdf).stem}", model, system, system.source, notes)
+    if name is None:
+        name = "urdf-text" if is_urdf_text(urdf) else Path(urdf).stem
+    return Target(f"{cls.name}:{name}", model, system, system.source, notes)
+
+
+def params_target(
+    params: ParameterSet,
+    name: str = "inline",
+    origin: str | None = None,
+    model_cls: type[ClosedFormModel] | None = None,
+) -> Target:
+    """A parameter set against the URDF the project writes for it (``pendverify.robot.writer``).
+
+    The model is ``model_cls``, by default the built-in model of the set (``params.model``).
+    The target is labelled ``{model}:{name}`` (the CLI passes the parameter file's stem);
+    ``origin`` says where the set came from in the URDF's source, ``<URDF of {origin}>``
+    (default: the inline parameters).
+    """
+    cls = model_cls or _model_class(params.model)
+    origin = origin or f"the inline {cls.name} parameters"
+    system = PinocchioSystem.for_model(cls, urdf_for(params), params.g, f"<URDF of {origin}>")
+    return Target(f"{cls.name}:{name}", cls(params), system, system.source)
 
 
 def user_target(model_name: str | None, urdf: str | None, params_file: str | None) -> Target:
@@ -119,25 +149,9 @@ def user_target(model_name: str | None, urdf: str | None, params_file: str | Non
         model_name = file_model
     if model_name is None:
         raise PendverifyError("name the model with --model, or give --params")
-    cls = _model_class(model_name)
-    if urdf is None:
-        # the URDF of this parameter set, as the project writes it
-        system = PinocchioSystem.for_model(cls, urdf_for(params), params.g, f"<URDF of {params_file}>")
-        return Target(f"{model_name}:{Path(params_file).stem}", cls(params), system, system.source)
-    return model_target(cls, urdf, params)
-
-
-def plugin_parameters(cls: type[ClosedFormModel], model_file: str, params_file: str) -> ParameterSet:
-    """A parameter file for a plug-in: its ``model`` key must be the plug-in's name."""
-    data = read_toml(Path(params_file))
-    if data.get("model") != cls.name:
-        raise ParameterError(
-            params_file,
-            "model",
-            data.get("model"),
-            f"must be {cls.name!r}, the model defined in {model_file}",
-        )
-    return parse_parameter_document(data, params_file, {cls.name: cls.params_type})[2]
+    if urdf is None:  # the URDF of this parameter set, as the project writes it
+        return params_target(params, Path(params_file).stem, params_file)
+    return model_target(_model_class(model_name), urdf, params)
 
 
 def plugin_target(model_file: str, urdf: str | None, params_file: str | None) -> Target:

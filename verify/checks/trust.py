@@ -79,46 +79,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pendverify.errors import PendverifyError
+from pendverify.errors import IllConditionedError
 
 EPS = float(np.finfo(float).eps)
 KAPPA_K = 16  # the K of the checks that solve with M (aba, minverse)
 WARN_REL = 1e-10  # predicted relative error above which results carry a warning
 REFUSE_REL = 1e-6  # predicted relative error above which results are refused
 AMPLIFICATION_CACHE = 4096  # states whose term amplification a system remembers
-
-
-@dataclass
-class IllConditionedError(PendverifyError):
-    """M(q) is too close to singular (or Pinocchio's terms too large) for a comparison to mean something."""
-
-    what: str
-    q: list
-    kappa_scaled: float
-    bound: float
-    amplification: float = 1.0
-    spread: float = 1.0
-    #: the bound comes from the scale spread, not from κ̃ and A
-    by_spread: bool = False
-
-    def __str__(self) -> str:
-        q = ", ".join(f"{x:.6g}" for x in self.q)
-        terms = (
-            f" and Pinocchio's terms are {self.amplification:.2g}× the result"
-            if self.amplification >= 10
-            else ""
-        )
-        if self.by_spread:
-            return (
-                f"{self.what} at q = ({q}): cannot be verified: M's diagonal scales span a factor "
-                f"{self.spread**2:.3g}, so an error of a relative {self.bound:.2g} in the smaller ones would "
-                f"not show against rounding ({self.bound:.2g} > {REFUSE_REL:g}, the trust limit); refused"
-            )
-        return (
-            f"{self.what} at q = ({q}): too ill-conditioned to verify: κ̃(M) = {self.kappa_scaled:.3g} "
-            f"after diagonal scaling{terms}, so rounding alone can cause a relative error of "
-            f"{self.bound:.2g} > {REFUSE_REL:g} (the trust limit); refused"
-        )
 
 
 @dataclass(frozen=True)
@@ -242,5 +209,6 @@ def check_conditioning(model, q, system=None, what: str | None = None) -> Condit
             verdict.amplification,
             verdict.spread,
             verdict.by_spread,
+            limit=REFUSE_REL,
         )
     return verdict

@@ -19,18 +19,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from pendverify.checks.catalogue import (
-    CheckResult,
-    applicable_checks,
-    derived_notes,
-    run_checks,
-    skipped_notes,
-)
+from pendverify.checks.applicability import derived_notes
+from pendverify.checks.catalogue import CheckResult, applicable_checks, run_checks, skipped_notes
 from pendverify.checks.diagnose import diagnose
 from pendverify.checks.report import Report
 from pendverify.checks.sampling import sample_states
-from pendverify.checks.trust import IllConditionedError, check_conditioning
+from pendverify.checks.trust import check_conditioning
 from pendverify.checks.verdict import FAIL, REFUSED, apply_strict, non_christoffel_c
+from pendverify.errors import IllConditionedError
 from pendverify.robot.geometry import MODEL_FORM_RTOL
 
 

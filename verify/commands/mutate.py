@@ -42,7 +42,8 @@ def run(args: argparse.Namespace) -> int:
     from pendverify.checks.targets import default_target, plugin_target
     from pendverify.errors import PendverifyError
     from pendverify.jsonio import to_json
-    from pendverify.symbolic.mutate import DEFAULT_MUTATION_STATES, format_report, run_mutation
+    from pendverify.symbolic.mutate import DEFAULT_MUTATION_STATES, run_mutation
+    from pendverify.symbolic.mutation_report import format_report
 
     names = builtin_models(args.model, args.analytic)
     if args.analytic:

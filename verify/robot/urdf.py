@@ -55,16 +55,25 @@ class LoadedUrdf:
         return out
 
 
+#: ``source`` of a URDF given as XML text rather than a file.
+URDF_TEXT_SOURCE = "<urdf text>"
+
+
+def is_urdf_text(urdf: str | Path) -> bool:
+    """Whether ``urdf`` is the XML itself (a string starting with "<") rather than a file path."""
+    return isinstance(urdf, str) and urdf.lstrip().startswith("<")
+
+
 def load_urdf(urdf: str | Path, source: str | None = None) -> LoadedUrdf:
     """Read a URDF file (or XML text) strictly, parse it with Pinocchio and anchor its base at the origin."""
-    if isinstance(urdf, Path) or (isinstance(urdf, str) and not urdf.lstrip().startswith("<")):
+    if not is_urdf_text(urdf):
         path = Path(urdf)
         source = source or str(path)
         if not path.is_file():
             raise UrdfShapeError(source, "file not found")
         text = read_text_file(path, source)
     else:
-        text, source = urdf, source or "<urdf text>"
+        text, source = urdf, source or URDF_TEXT_SOURCE
     model, facts, log = build_pinocchio_model(text, source)
     offset = _anchor_base(model)
     return LoadedUrdf(model, source, text, facts, offset, log)

@@ -29,9 +29,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from pendverify.analytic import MODELS, ClosedFormModel  # noqa: F401  (MODELS: the scenes' built-ins)
+from pendverify.errors import SceneError
 from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
-from pendverify.simulation.scene import Scene, SceneError
+from pendverify.simulation.lqr import (
+    closed_form_linearisation,
+    linearisation_error,
+    lqr_gain,
+    pinocchio_linearisation,
+)
+from pendverify.simulation.scene import Scene
 
 
 @dataclass
@@ -152,13 +159,6 @@ def _system(scene: Scene, params, urdf: str | None, needed_by: str) -> Pinocchio
 
 
 def _prepare_lqr(law, model, system, scene) -> None:
-    from pendverify.simulation.lqr import (
-        closed_form_linearisation,
-        linearisation_error,
-        lqr_gain,
-        pinocchio_linearisation,
-    )
-
     D = scene.damping_matrix if scene.damping is not None else np.zeros((model.nv, model.nv))
     closed = closed_form_linearisation(model, D, law.q_star)
     pinocchio = pinocchio_linearisation(system, model, D, law.q_star)

@@ -1,4 +1,4 @@
-"""Actuation u(t, q, q̇) and disturbance w(t) laws a scene can switch on.
+"""The scene keys of the actuation u(t, q, q̇) and disturbance w(t) laws a scene can switch on.
 
 Actuation (``[effects.actuation]``), u in the model's inputs (``model.inputs``: N·m per
 joint for the double pendulum, N on the cart); any model with inputs takes any type:
@@ -31,154 +31,19 @@ noise      std = [3], bandwidth (Hz > 0), seed (integer), components (32): band-
            phases; smooth, so the integrator needs no breakpoints
 =========  =====================================================================
 
-Every law lists its breakpoints (times where it jumps or kinks) so that the
-integrator can stop there rather than step over a discontinuity.
+The laws themselves, and their breakpoints (times where they jump or kink, which the
+integrator stops at), are in ``pendverify.simulation.laws``.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import numpy as np
+
+from pendverify.simulation.laws import LQR, PD, Constant, Law, Noise, Pulse, Sine, Step, Table
 
 #: Rounding allowance of the equilibrium test |H_i(q*)| ≤ K·ε·(1 + max|q*|)·Σ|coefficients of H_i|.
 EQUILIBRIUM_K = 16.0
 EPS = float(np.finfo(float).eps)
-
-
-@dataclass
-class Law:
-    """u(t, q, q̇) or w(t): ``kind`` names the type; ``feedback`` laws read the state."""
-
-    kind: str
-    size: int
-    spec: dict = field(default_factory=dict)
-    feedback: bool = False
-
-    def breakpoints(self) -> list[float]:
-        return []
-
-    def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:  # pragma: no cover
-        raise NotImplementedError
-
-    def describe(self) -> str:
-        return self.kind
-
-
-@dataclass
-class Constant(Law):
-    value: np.ndarray = None
-
-    def __call__(self, t, q, v):
-        return self.value
-
-
-@dataclass
-class Step(Law):
-    time: float = 0.0
-    before: np.ndarray = None
-    after: np.ndarray = None
-
-    def breakpoints(self):
-        return [self.time]
-
-    def __call__(self, t, q, v):
-        return self.after if t >= self.time else self.before
-
-
-@dataclass
-class Sine(Law):
-    amplitude: np.ndarray = None
-    frequency: float = 1.0
-    phase: float = 0.0
-    offset: np.ndarray = None
-
-    def __call__(self, t, q, v):
-        return self.offset + self.amplitude * np.sin(2 * np.pi * self.frequency * t + self.phase)
-
-
-@dataclass
-class Table(Law):
-    times: np.ndarray = None
-    values: np.ndarray = None
-
-    def breakpoints(self):
-        return list(self.times)
-
-    def __call__(self, t, q, v):
-        return np.array([np.interp(t, self.times, col) for col in self.values.T])
-
-
-@dataclass
-class Pulse(Law):
-    time: float = 0.0
-    width: float = 0.01
-    impulse: np.ndarray = None
-
-    def breakpoints(self):
-        return [self.time, self.time + self.width]
-
-    def __call__(self, t, q, v):
-        inside = self.time <= t < self.time + self.width
-        return self.impulse / self.width if inside else np.zeros(self.size)
-
-
-@dataclass
-class Noise(Law):
-    std: np.ndarray = None
-    bandwidth: float = 1.0
-    seed: int = 0
-    components: int = 32
-    _freq: np.ndarray = None
-    _phase: np.ndarray = None
-
-    def __post_init__(self):
-        rng = np.random.default_rng(self.seed)
-        self._freq = rng.uniform(0.0, self.bandwidth, (self.size, self.components))
-        self._freq = np.where(self._freq == 0.0, self.bandwidth, self._freq)
-        self._phase = rng.uniform(0.0, 2 * np.pi, (self.size, self.components))
-
-    def __call__(self, t, q, v):
-        # each component has variance a²/2; N of them give std² when a = std·√(2/N)
-        a = self.std * np.sqrt(2.0 / self.components)
-        return a * np.sum(np.sin(2 * np.pi * self._freq * t + self._phase), axis=1)
-
-
-@dataclass
-class PD(Law):
-    """u = B⁻¹ (kp (target − q) − kd q̇): a joint-space PD force through the inverse input map."""
-
-    kp: np.ndarray = None
-    kd: np.ndarray = None
-    target: np.ndarray = None
-    B_inv: np.ndarray = None
-
-    def __post_init__(self):
-        self.feedback = True
-
-    def __call__(self, t, q, v):
-        return self.B_inv @ (self.kp * (self.target - q) - self.kd * v)
-
-
-@dataclass
-class LQR(Law):
-    """u = −K x; K is set by the simulator from the linearisation (pendverify.simulation.lqr)."""
-
-    Q: np.ndarray = None
-    R: np.ndarray = None
-    saturation: float | None = None
-    K: np.ndarray | None = None
-    equilibrium: str = "upright"
-    q_star: np.ndarray = None
-
-    def __post_init__(self):
-        self.feedback = True
-
-    def __call__(self, t, q, v):
-        u = -self.K @ np.concatenate([q - self.q_star, v])
-        if self.saturation is not None:
-            u = np.clip(u, -self.saturation, self.saturation)
-        return u
 
 
 ACTUATION_TYPES = ("constant", "step", "sine", "table", "lqr", "pd")
@@ -186,7 +51,7 @@ DISTURBANCE_TYPES = ("impulse", "step", "noise")
 
 
 def parse_actuation(r, model_cls, params=None) -> Law | None:
-    """An actuation law from the scene table reader ``r`` (None when absent).
+    """An actuation law from the scene table reader ``r`` (a ``scene_reader.TableReader``; None when absent).
 
     ``params`` (with the scene's g) is the parameter set ``pd`` reads B from and ``lqr``
     tests its equilibrium with.

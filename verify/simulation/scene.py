@@ -42,17 +42,18 @@ Every error names the file, the key, the value and the expected type or range.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
 from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
 from pendverify.analytic.params import default_parameter_file, load_parameter_file, read_toml
-from pendverify.errors import InputError, PendverifyError
-from pendverify.simulation.effects import Law, parse_actuation, parse_disturbance
+from pendverify.analytic.plugin import load_model_class, plugin_parameters
+from pendverify.errors import InputError, PendverifyError, SceneError
+from pendverify.simulation.effects import parse_actuation, parse_disturbance
+from pendverify.simulation.laws import Law
+from pendverify.simulation.scene_reader import TableReader
 
 ADAPTIVE_METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 FIXED_STEP_METHODS = ("rk4",)
@@ -69,10 +70,6 @@ TOP_KEYS = (
     "integrator",
     "effects",
 )
-
-
-class SceneError(InputError):
-    """A scene file breaks a rule."""
 
 
 @dataclass(frozen=True)
@@ -127,85 +124,8 @@ class Scene:
         return self.damping is None and self.actuation is None and self.disturbance is None
 
 
-class _Reader:
-    """Typed access to one table of a scene, with errors that name the key."""
-
-    def __init__(self, table: dict, source: str, prefix: str = ""):
-        self.table, self.source, self.prefix = table, source, prefix
-
-    def fail(self, key: str, value: object, rule: str):
-        raise SceneError(self.source, self.prefix + key, value, rule)
-
-    def only(self, allowed: tuple[str, ...]) -> None:
-        for key, value in self.table.items():
-            if key not in allowed:
-                self.fail(key, value, f"unknown key; expected one of {', '.join(allowed)}")
-
-    def has(self, key: str) -> bool:
-        return key in self.table
-
-    def get(self, key: str, default: Any = ...):
-        if key not in self.table:
-            if default is ...:
-                self.fail(key, None, "missing key")
-            return default
-        return self.table[key]
-
-    def sub(self, key: str, required: bool = True) -> _Reader | None:
-        value = self.get(key, ... if required else None)
-        if value is None:
-            return None
-        if not isinstance(value, dict):
-            self.fail(key, value, "expected a table")
-        return _Reader(value, self.source, f"{self.prefix}{key}.")
-
-    def string(self, key: str, choices: tuple[str, ...] | None = None, default: Any = ...) -> str:
-        value = self.get(key, default)
-        if not isinstance(value, str):
-            self.fail(key, value, "expected a string" + (f": one of {', '.join(choices)}" if choices else ""))
-        if choices and value not in choices:
-            self.fail(key, value, f"expected one of {', '.join(choices)}")
-        return value
-
-    def number(self, key: str, default: Any = ..., positive: bool = False, minimum: float | None = None):
-        value = self.get(key, default)
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            self.fail(key, value, "expected a number")
-        x = float(value)
-        if not math.isfinite(x):
-            self.fail(key, value, "expected a finite number")
-        if positive and not x > 0:
-            self.fail(key, value, "expected a number > 0")
-        if minimum is not None and x < minimum:
-            self.fail(key, value, f"expected a number >= {minimum:g}")
-        return x
-
-    def vector(self, key: str, length: int, default: Any = ..., minimum: float | None = None) -> np.ndarray:
-        value = self.get(key, default)
-        if isinstance(value, (int, float)) and not isinstance(value, bool) and length == 1:
-            value = [value]
-        if not isinstance(value, list) or any(
-            isinstance(x, bool) or not isinstance(x, (int, float)) for x in value
-        ):
-            self.fail(key, value, f"expected a list of {length} numbers")
-        if len(value) != length:
-            self.fail(key, value, f"expected a list of {length} numbers, got {len(value)}")
-        arr = np.array(value, dtype=float)
-        if not np.all(np.isfinite(arr)):
-            self.fail(key, value, "expected finite numbers")
-        if minimum is not None and np.any(arr < minimum):
-            self.fail(key, value, f"expected numbers >= {minimum:g}")
-        return arr
-
-    def boolean_or_number(self, key: str, default: Any = False):
-        value = self.get(key, default)
-        if isinstance(value, bool):
-            return value
-        return self.number(key, minimum=0.0)
-
-
 def _parameters(
-    top: _Reader, model_cls, scene_path: Path, model_file: str | None
+    top: TableReader, model_cls, scene_path: Path, model_file: str | None
 ) -> tuple[ParameterSet, str]:
     model = model_cls.name
     if top.has("parameters"):
@@ -222,8 +142,6 @@ def _parameters(
         path = scene_path.parent / ref
         if not path.is_file():
             top.fail("params", ref, f"parameter file not found (looked for {path})")
-        from pendverify.checks.targets import plugin_parameters
-
         return plugin_parameters(model_cls, model_file, str(path)), str(path)
     ref = top.string("params", default="default")
     path = default_parameter_file(model) if ref == "default" else (scene_path.parent / ref)
@@ -235,7 +153,7 @@ def _parameters(
     return params, str(path)
 
 
-def _model(top: _Reader, scene_path: Path) -> tuple[type[ClosedFormModel], str | None]:
+def _model(top: TableReader, scene_path: Path) -> tuple[type[ClosedFormModel], str | None]:
     """(model class, model file or None): a built-in name, or a ``.py`` file relative to the scene.
 
     A document built in code (the certification battery's) may give the class itself.
@@ -247,8 +165,6 @@ def _model(top: _Reader, scene_path: Path) -> tuple[type[ClosedFormModel], str |
         path = scene_path.parent / value
         if not path.is_file():
             top.fail("model", value, f"model file not found (looked for {path})")
-        from pendverify.analytic.plugin import load_model_class
-
         try:
             return load_model_class(path), str(path)
         except PendverifyError as exc:
@@ -256,7 +172,7 @@ def _model(top: _Reader, scene_path: Path) -> tuple[type[ClosedFormModel], str |
     return MODELS[top.string("model", tuple(MODELS))], None
 
 
-def _urdf(top: _Reader, scene_path: Path) -> str | None:
+def _urdf(top: TableReader, scene_path: Path) -> str | None:
     """The scene's URDF (relative to the scene), or None; whether one is needed is decided when
     the engine is known (``pendverify.simulation.dynamics``: ``simulate --engine`` may override it)."""
     if not top.has("urdf"):
@@ -270,7 +186,7 @@ def _urdf(top: _Reader, scene_path: Path) -> str | None:
 
 def parse_scene(data: dict, source: str, base: Path | None = None) -> Scene:
     """Validate a scene document (already parsed TOML) into a Scene."""
-    top = _Reader(data, source)
+    top = TableReader(data, source)
     top.only(TOP_KEYS)
     scene_path = base or Path(source)
     model_cls, model_file = _model(top, scene_path)
@@ -313,7 +229,7 @@ def parse_scene(data: dict, source: str, base: Path | None = None) -> Scene:
             integ.fail("step", step, f"expected a step <= the duration ({duration:g} s)")
         integrator = Integrator(method, step=step)
 
-    effects = top.sub("effects", required=False) or _Reader({}, source, "effects.")
+    effects = top.sub("effects", required=False) or TableReader({}, source, "effects.")
     effects.only(("gravity", "damping", "actuation", "disturbance"))
     g = effects.boolean_or_number("gravity")
     gravity = params.g if g is True else (None if g is False else g)

@@ -14,7 +14,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from pendverify.checks.catalogue import EPS, norm2, rate_scale, scaled_matrix, weights
+from pendverify.checks.scaling import norm2, rate_scale, scaled_matrix, weights
+from pendverify.checks.trust import EPS
 from pendverify.jsonio import to_json, versions
 from pendverify.simulation.dynamics import Dynamics, build_dynamics
 from pendverify.simulation.integrate import Integration, integrate
@@ -23,6 +24,7 @@ from pendverify.simulation.invariants import (
     adaptive_bound,
     energy_scale,
     evaluate,
+    residual,
     richardson_bound,
 )
 from pendverify.simulation.scene import Integrator, Scene
@@ -149,8 +151,8 @@ def simulate(scene: Scene, engine: str | None = None, urdf: str | None = None) -
     else:
         half = Integrator(scene.integrator.method, step=scene.integrator.step / 2)
         fine = integrate(dyn.rhs, x0, scene.duration, half, run.steps_t, bps, label=f"{scene.name} (h/2)")
-        _, r_h = _residual(dyn, run.steps_x)
-        _, r_half = _residual(dyn, fine.samples_x)
+        _, r_h = residual(dyn, run.steps_x)
+        _, r_half = residual(dyn, fine.samples_x)
         bound = richardson_bound(r_h, r_half, scale)
     invariants = evaluate(dyn, scene, run.steps_t, run.steps_x, bound, scale)
     comparison = _engine_comparison(dyn, run.steps_t, run.steps_x) if engine == "both" else None
@@ -170,9 +172,3 @@ def simulate(scene: Scene, engine: str | None = None, urdf: str | None = None) -
             f"{spec['closed_loop_max_real']:.3g} 1/s"
         )
     return result
-
-
-def _residual(dyn, xs):
-    from pendverify.simulation.invariants import residual
-
-    return residual(dyn, xs)

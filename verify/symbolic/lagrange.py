@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from pendverify.analytic.interface import Energies
+from pendverify.analytic.forms import Energies
 from pendverify.analytic.plugin import where
 from pendverify.errors import PendverifyError
 from pendverify.symbolic.model import SymbolicModel, canonical, is_zero

@@ -15,7 +15,7 @@ detected
     mutant, for the full profile of which checks see what).
 equivalent
     the mutant does not change the dynamics, proved symbolically
-    (``pendverify.symbolic.model.is_zero``): the expression is identical, or
+    (``pendverify.symbolic.equivalence``): the expression is identical, or
     simplifies to the original, or V changes by a constant, or — for a
     Coriolis-type form — C·q̇ is unchanged (a different factorisation of C; the
     report says whether Ṁ − 2C stays skew, i.e. whether the factorisation is
@@ -28,26 +28,25 @@ survived
 Detection rate = detected / (all − equivalent); the target is 100 %.  Before
 any mutant runs, the untouched model and one *control* per method (every
 entry replaced by its own lambdified expression) must pass every check, so that
-a detection is never caused by the lambdified rounding itself.
+a detection is never caused by the lambdified rounding itself.  The verdicts and the
+printed report are in ``pendverify.symbolic.mutation_report``.
 """
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
 
 import numpy as np
 import sympy as sp
 
-from pendverify.checks.catalogue import CHECK_NAMES, CHECKS, applicable_checks, run_check
+from pendverify.checks.catalogue import CHECKS, applicable_checks, run_check
 from pendverify.checks.sampling import sample_states
-from pendverify.checks.verdict import CHRISTOFFEL_CONSISTENT, NON_CHRISTOFFEL
 from pendverify.errors import PendverifyError, UnknownNameError
-from pendverify.symbolic.lagrange import mass_matrix_rate
-from pendverify.symbolic.model import SymbolicModel, entries, is_zero, probe, show
+from pendverify.symbolic.equivalence import coriolis_equivalence, differences, equivalence
+from pendverify.symbolic.model import SymbolicModel, entries, show
 from pendverify.symbolic.mutants import Mutant, generate, is_coriolis_form
+from pendverify.symbolic.mutation_report import DETECTED, EQUIVALENT, SURVIVED, MutationReport, Outcome
 
-DETECTED, EQUIVALENT, SURVIVED = "detected", "equivalent", "survived"
 FIRST_RANDOM = 4  # random states in the first round, after the special ones
 #: |mutant − original| / (|original| + 1) above this at a sampled state cannot be rounding
 DIFFERENT_RTOL = 1e-9
@@ -61,66 +60,6 @@ AIMED_AT = {
     "coriolis_force": "rnea",
 }
 DEFAULT_MUTATION_STATES = 40
-
-
-@dataclass
-class Outcome:
-    method: str
-    operator: str
-    description: str
-    verdict: str
-    reason: str = ""
-    checks: list[str] = field(default_factory=list)
-
-    def as_dict(self) -> dict:
-        return dict(self.__dict__)
-
-
-@dataclass
-class MutationReport:
-    model: str
-    source: str
-    seed: int
-    states: int
-    outcomes: list[Outcome]
-    controls: list[str]
-    elapsed_s: float = 0.0
-    all_checks: bool = False
-    #: interface methods the model does not write (derived by default): not mutated
-    derived: list[str] = field(default_factory=list)
-    #: hand-written methods no Pinocchio check sees (B, W with a derived q̈): not mutated
-    unseen: list[str] = field(default_factory=list)
-
-    def count(self, verdict: str, method: str | None = None) -> int:
-        return sum(o.verdict == verdict and (method is None or o.method == method) for o in self.outcomes)
-
-    @property
-    def rate(self) -> float:
-        relevant = len(self.outcomes) - self.count(EQUIVALENT)
-        return self.count(DETECTED) / relevant if relevant else 1.0
-
-    @property
-    def passed(self) -> bool:
-        return self.count(SURVIVED) == 0
-
-    def as_dict(self) -> dict:
-        return {
-            "model": self.model,
-            "source": self.source,
-            "seed": self.seed,
-            "states": self.states,
-            "mutants": len(self.outcomes),
-            "detected": self.count(DETECTED),
-            "equivalent": self.count(EQUIVALENT),
-            "survived": self.count(SURVIVED),
-            "detection_rate": self.rate,
-            "controls": self.controls,
-            "all_checks": self.all_checks,
-            "derived": self.derived,
-            "unseen": self.unseen,
-            "elapsed_s": round(self.elapsed_s, 3),
-            "outcomes": [o.as_dict() for o in self.outcomes],
-        }
 
 
 # --- numeric mutants ------------------------------------------------------------------------
@@ -192,51 +131,13 @@ def _numerically_different(model, mutated, method, args, states) -> bool:
     return False
 
 
-# --- equivalence ----------------------------------------------------------------------------
-def _coriolis_equivalence(sm: SymbolicModel, mutant: Mutant) -> str | None:
-    """The reason text if the mutant keeps C·q̇ (a different factorisation of C), else None."""
-    n = len(sm.symbols["q"])
-    delta = sp.zeros(n, n)
-    for index, old, new in mutant.changes:
-        delta[index // n, index % n] = new - old
-    bias = delta * sm.column("v")
-    if any(probe(e) for e in bias) or not all(is_zero(e, sm.angles) for e in bias):
-        return None
-    C = sm.evaluate("coriolis_matrix", "qv") + delta
-    N = mass_matrix_rate(sm.evaluate("mass_matrix", "q"), sm.symbols["q"], sm.symbols["v"]) - 2 * C
-    if all(is_zero(e, sm.angles) for e in N + N.T):
-        return CHRISTOFFEL_CONSISTENT
-    return NON_CHRISTOFFEL
-
-
-def _differences(sm: SymbolicModel, mutant: Mutant) -> list:
-    diffs = [new - old for _, old, new in mutant.changes]
-    if mutant.method == "potential_energy":  # V matters up to a constant
-        return [d.diff(x) for d in diffs for x in sm.symbols["q"]]
-    return diffs
-
-
-def _equivalence(sm: SymbolicModel, mutant: Mutant, params) -> str | None:
-    """Why the mutant is equivalent, if it is (symbolic proof); None otherwise."""
-    diffs = _differences(sm, mutant)
-    if all(is_zero(d, sm.angles) for d in diffs):
-        if mutant.method == "potential_energy":
-            return "V changes by a constant only, which no equation of motion sees"
-        return "simplifies to the original expression"
-    values = {s: sp.Rational(repr(getattr(params, n))) for n, s in sm.parameters.items()}
-    if all(is_zero(d.xreplace(values), sm.angles) for d in diffs):
-        used = sorted({s.name for d in diffs for s in d.free_symbols if s in values.keys()})
-        return f"equivalent for this parameter set only (the change vanishes at {', '.join(used)} as given)"
-    return None
-
-
 def classify(model, system, sm, mutant: Mutant, rounds, seed, all_checks: bool = False) -> Outcome:
     out = Outcome(mutant.method, mutant.operator, mutant.description, SURVIVED)
     if mutant.identical:
         out.verdict, out.reason = EQUIVALENT, "identical expression after SymPy's canonical ordering"
         return out
     value = sm.closed_forms[mutant.method]
-    coriolis = is_coriolis_form(sm, mutant.method, value) and _coriolis_equivalence(sm, mutant)
+    coriolis = is_coriolis_form(sm, mutant.method, value) and coriolis_equivalence(sm, mutant)
     form = sm.cls.closed_forms[mutant.method]
     mutated = numeric_model(model, sm, mutant.method, mutant.changes)
     order = _order(mutant.method, form)
@@ -252,7 +153,7 @@ def classify(model, system, sm, mutant: Mutant, rounds, seed, all_checks: bool =
         out.verdict = DETECTED
     else:
         # not detected, or detected although no difference shows at 50 digits: prove or report
-        reason = _equivalence(sm, mutant, model.params)
+        reason = equivalence(sm, mutant, model.params)
         if reason and out.checks:
             reason += (
                 f"; yet {', '.join(out.checks)} failed: rounding of the lambdified form exceeds a tolerance"
@@ -262,7 +163,7 @@ def classify(model, system, sm, mutant: Mutant, rounds, seed, all_checks: bool =
         elif out.checks:
             out.verdict = DETECTED
         else:
-            diff = show(_differences(sm, mutant)[0], sm.angles, 100)
+            diff = show(differences(sm, mutant)[0], sm.angles, 100)
             out.reason = f"no check fails, and the change {diff} is not zero: a gap in the checks"
     return out
 
@@ -347,57 +248,3 @@ def unseen_methods(cls) -> list[str]:
     if "acceleration" in cls.hand_written():
         return []
     return [m for m in ("input_matrix", "disturbance_matrix") if m in cls.written_closed_forms()]
-
-
-def format_report(report: MutationReport) -> str:
-    methods = list(dict.fromkeys(o.method for o in report.outcomes))
-    header = ("method", "mutants", "detected", "equivalent", "survived")
-    rows = [
-        (
-            m,
-            str(sum(o.method == m for o in report.outcomes)),
-            str(report.count(DETECTED, m)),
-            str(report.count(EQUIVALENT, m)),
-            str(report.count(SURVIVED, m)),
-        )
-        for m in methods
-    ]
-    rows.append(
-        (
-            "all",
-            str(len(report.outcomes)),
-            str(report.count(DETECTED)),
-            str(report.count(EQUIVALENT)),
-            str(report.count(SURVIVED)),
-        )
-    )
-    widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(header)]
-    line = "  ".join(h.ljust(w) for h, w in zip(header, widths, strict=True))
-    out = [f"mutate [{report.model}] ({report.source})", line, "-" * len(line)]
-    out += ["  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True)).rstrip() for r in rows]
-    by_check = {
-        c: sum(any(k.split()[0] == c for k in o.checks) for o in report.outcomes if o.verdict == DETECTED)
-        for c in CHECK_NAMES
-    }
-    what = "failing" if report.all_checks else "first failing (aimed check first)"
-    out.append(f"detections per {what} check: " + ", ".join(f"{c} {n}" for c, n in by_check.items()))
-    for o in report.outcomes:
-        if o.verdict == EQUIVALENT:
-            out.append(f"equivalent: {o.description} — {o.reason}")
-    for o in report.outcomes:
-        if o.verdict == SURVIVED:
-            out.append(f"SURVIVED: {o.description} — {o.reason}")
-    if report.derived:
-        out.append(f"not mutated (derived, not hand-written): {', '.join(report.derived)}")
-    if report.unseen:
-        out.append(
-            f"not mutated (no Pinocchio check sees them: the URDF has no input map and q̈ is derived; "
-            f"compared by pendverify sympy): {', '.join(report.unseen)}"
-        )
-    relevant = len(report.outcomes) - report.count(EQUIVALENT)
-    out.append(
-        f"detection rate {report.rate:.1%} ({report.count(DETECTED)}/{relevant} non-equivalent mutants), "
-        f"{report.count(EQUIVALENT)} equivalent, {report.states} states (seed {report.seed}), "
-        f"controls pass for {len(report.controls)} methods, {report.elapsed_s:.1f} s"
-    )
-    return "\n".join(out)

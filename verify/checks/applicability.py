@@ -1,0 +1,82 @@
+"""Which checks apply to a model (and its URDF), and what a derived closed form means for the evidence.
+
+A check is not run when there is nothing to compare: ``coriolis`` and ``skew`` need a
+matrix C (a ``BiasOnlyModel`` gives only C·q̇); ``det`` and ``minverse`` need a
+hand-written det M and M⁻¹ (the interface's defaults derive them from M, by LU and by
+solving); ``damping`` needs a URDF that declares ``<dynamics damping>``.  Each
+``requires`` function returns "" when its check applies, else the reason, which the
+report prints.  ``derived_notes`` says what the model left to the interface's defaults.
+"""
+
+from __future__ import annotations
+
+
+def needs_matrix_c(model, system) -> str:
+    if model.has_coriolis_matrix:
+        return ""
+    name = model.__name__ if isinstance(model, type) else type(model).__name__
+    return (
+        f"not run: {name} gives the force C·q̇ (coriolis_force), not a matrix C; "
+        "C·q̇ is checked by rnea and aba"
+    )
+
+
+def _class(model) -> type:
+    return model if isinstance(model, type) else type(model)
+
+
+#: The quantities a model may leave to the interface's defaults: (method, name, how it is derived).
+DERIVED = {
+    "det_mass_matrix": ("det M", "from M (LU)"),
+    "inverse_mass_matrix": ("M⁻¹", "from M (solving with M)"),
+    "acceleration": ("q̈", "from M, C, H, D, B, W (M⁻¹(B u + W w − D q̇ − C q̇ − H))"),
+    "gravity_scale": ("the gravity scale", "from H (Σ|terms|)"),
+    "diagonal_scale": ("the inertia scale", "from M (Σ|terms| of M_ii)"),
+    "special_states": ("the special states", "(the zero state only)"),
+}
+
+
+def hand_written(method: str):
+    """A ``requires``: the check compares a hand-written closed form, so a derived one is not run."""
+
+    def requires(model, system) -> str:
+        if method in _class(model).hand_written():
+            return ""
+        what, how = DERIVED[method]
+        return f"not run: {what} is derived {how}, not hand-written: nothing to check"
+
+    return requires
+
+
+def derived_notes(model) -> list[str]:
+    """What the model left to the interface's defaults and what that means for the evidence.
+
+    ``aba`` runs on a derived q̈ too, but it is then weaker evidence: the derived
+    M⁻¹(B u + W w − D q̇ − C q̇ − H) and Pinocchio's ABA of the same τ = B u + W w − D q̇
+    see B, W and D alike, so aba checks only M and C·q̇ + H (which crba and rnea
+    check directly) composed by the solve the simulator uses — not B or W, which the
+    URDF does not define (``pendverify sympy`` compares them with the input power),
+    and D only through ``damping`` (the URDF's <dynamics damping>).
+    """
+    written = set(_class(model).hand_written())
+    notes = []
+    if "acceleration" not in written:
+        notes.append(
+            "aba: q̈ is derived from the model's M, C, H, D, B, W, not hand-written: aba checks M and "
+            "C·q̇ + H composed (the same τ = B u + W w − D q̇ enters both sides), not B or W, and no "
+            "closed form of q̈; B and W are compared only by pendverify sympy"
+        )
+    derived = [
+        f"{what} {how}"
+        for method, (what, how) in DERIVED.items()
+        if method not in written and method in ("gravity_scale", "diagonal_scale", "special_states")
+    ]
+    if derived:
+        notes.append("derived, not hand-written: " + "; ".join(derived))
+    return notes
+
+
+def needs_urdf_damping(model, system) -> str:
+    if system is None or system.urdf_damping() is not None:
+        return ""
+    return "not run: the URDF declares no <dynamics damping>, so there is nothing to compare D with"
