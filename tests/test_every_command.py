@@ -52,22 +52,27 @@ class Model:
         return path
 
 
+def _certify(m: Model) -> list[list[str]]:
+    out = m.tmp / "certificates"
+    name = m.params.stem  # the parameter file's name names the certificate
+    certify = ["certify", *m.files(), "-o", str(out), "--samples", "100"]
+    return [certify, ["recheck", str(out / f"{name}.cert.json")]]
+
+
+#: command → the command lines it takes to run it (each must exit 0)
 COMMANDS = {
-    "check": lambda m: ["check", *m.files(), "--samples", "50"],
-    "sympy": lambda m: ["sympy", "--analytic", str(m.model)],
-    "mutate": lambda m: ["mutate", *m.files(), "--samples", "10", "--method", "mass_matrix"],
-    "simulate": lambda m: ["simulate", str(m.scene())],
-    "render": lambda m: ["render", str(m.scene()), "-o", str(m.tmp / "out.html")],
+    "check": lambda m: [["check", *m.files(), "--samples", "50"]],
+    "sympy": lambda m: [["sympy", "--analytic", str(m.model)]],
+    "mutate": lambda m: [["mutate", *m.files(), "--samples", "10", "--method", "mass_matrix"]],
+    "simulate": lambda m: [["simulate", str(m.scene())]],
+    "render": lambda m: [["render", str(m.scene()), "-o", str(m.tmp / "out.html")]],
     "report": lambda m: [
-        "report",
-        "-o",
-        str(m.tmp / "review"),
-        "--scenes",
-        str(m.scene().parent),
-        "--samples",
-        "20",
+        ["report", "-o", str(m.tmp / "review"), "--scenes", str(m.scene().parent), "--samples", "20"]
     ],
+    "stress": lambda m: [["stress", *m.files(), "--quick"]],
+    "certify+recheck": _certify,
 }
+
 
 WRITTEN_HERE = '''"""The cart-pole, written again in a file of this test: a user's own model."""
 
@@ -91,15 +96,15 @@ def _written_here(tmp_path: Path) -> Path:
 @pytest.mark.parametrize("stem", list(STEMS))
 def test_each_command_on_each_example(command, stem, tmp_path, capsys):
     model = Model(EXAMPLES / f"{stem}.py", stem, tmp_path)
-    status = main(COMMANDS[command](model))
-    assert status == 0, capsys.readouterr()
+    for argv in COMMANDS[command](model):
+        assert main(argv) == 0, (argv, capsys.readouterr())
 
 
 @pytest.mark.parametrize("command", list(COMMANDS))
 def test_each_command_on_a_model_written_here(command, tmp_path, capsys):
     model = Model(_written_here(tmp_path), "cart_pole", tmp_path)
-    status = main(COMMANDS[command](model))
-    assert status == 0, capsys.readouterr()
+    for argv in COMMANDS[command](model):
+        assert main(argv) == 0, (argv, capsys.readouterr())
 
 
 def test_a_planted_error_in_the_model_written_here_fails_check(tmp_path, capsys):
@@ -111,4 +116,5 @@ def test_a_planted_error_in_the_model_written_here_fails_check(tmp_path, capsys)
         + "        M[0, 0] *= 1.001\n"
         + "        return M\n"
     )
-    assert main(COMMANDS["check"](Model(path, "cart_pole", tmp_path))) == 1
+    (argv,) = COMMANDS["check"](Model(path, "cart_pole", tmp_path))
+    assert main(argv) == 1

@@ -5,12 +5,14 @@ Every check result, and so every target and report, has one of four levels:
 ``pass``
     the error is within its tolerance on every state.
 ``warn``
-    right where it matters, with something the user must know.  Two cases:
+    right where it matters, with something the user must know.  Three cases:
     a matrix C whose product C·q̇ is right (``rnea``, ``aba``, ``energy`` and
     every other check pass) but which is not the Christoffel C, so that
     ``coriolis`` and, when Ṁ − 2C is not skew-symmetric, ``skew`` differ from
-    Pinocchio's; and a URDF that carries what the hand model has no term for
-    (Coulomb ``<dynamics friction>``).  ``--strict`` turns warnings into failures.
+    Pinocchio's; a URDF that carries what the hand model has no term for
+    (Coulomb ``<dynamics friction>``); and closed forms that agree with Pinocchio
+    only when evaluated in high precision (``pendverify.checks.precision``).
+    ``--strict`` turns warnings into failures.
 ``fail``
     the error exceeds its tolerance: the hand model and the URDF disagree.
 ``refused``

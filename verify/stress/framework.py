@@ -21,7 +21,9 @@ from pendverify.analytic import MODELS, CartDoublePendulumParams, DoublePendulum
 from pendverify.analytic.params import default_parameter_file, load_parameter_file
 from pendverify.checks.catalogue import CHECKS, applicable_checks, run_check
 from pendverify.checks.sampling import DEFAULT_SEED, State, sample_states
-from pendverify.checks.trust import IllConditionedError, check_conditioning
+from pendverify.checks.trust import check_conditioning
+from pendverify.checks.verdict import WARN
+from pendverify.errors import IllConditionedError
 from pendverify.robot.system import PinocchioSystem
 from pendverify.stress.trust_study import StudyResult, trust_study
 from pendverify.validate import model_state
@@ -237,9 +239,14 @@ def _result_from(name, comp: _Comparison, expect: str = "none", invariant=None, 
                     for r in failed
                 )
             )
+        warned = [r for r in comp.results if r.status == WARN]
+        if warned:
+            first = next((r.notes[0] for r in warned if r.notes), "")
+            notes.append(f"warn {', '.join(r.check for r in warned)}: {first}")
     else:
         error = tolerance = None
         quantity = "no state verified"
+        warned = []
     if comp.refused:
         notes.append(
             f"refused {len(comp.refused)} of {len(comp.refused) + comp.kept} states, e.g. {comp.refused[0]}"
@@ -259,7 +266,7 @@ def _result_from(name, comp: _Comparison, expect: str = "none", invariant=None, 
         invariant=invariant,
         passed=not failed and refusals_ok and extra_ok,
         note="; ".join(notes),
-        level="refuse" if comp.kept == 0 else comp.level,
+        level="refuse" if comp.kept == 0 else ("warn" if warned else comp.level),
         refused=len(comp.refused),
     )
 
