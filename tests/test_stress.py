@@ -17,7 +17,7 @@ from pendverify.checks import trust as near_singular
 from pendverify.checks.trust import Conditioning, IllConditionedError, check_conditioning
 from pendverify.cli import main
 from pendverify.errors import InputError
-from pendverify.stress import cases, framework, sim_cases, trust_study
+from pendverify.stress import cases, framework, seed_params, sim_cases, trust_study
 from pendverify.stress import catalogue as stress
 from pendverify.stress import integrators as si
 from pendverify.validate import finite_state, model_state
@@ -156,21 +156,23 @@ class CartPushed(CartDoublePendulum):
     "case",
     [
         framework.checks_case(
-            "planted β", "mass ratio", lambda: framework.dp_link_mass_ratio(1e-6), model_cls=BetaOff
+            "planted β", "mass ratio", lambda: seed_params.dp_link_mass_ratio(1e-6), model_cls=BetaOff
         ),
         framework.checks_case(
-            "planted C", "length", lambda: framework.cart(l1=1e3, l2=1e3), model_cls=CartCoriolisSignFlip
+            "planted C", "length", lambda: seed_params.cart(l1=1e3, l2=1e3), model_cls=CartCoriolisSignFlip
         ),
-        framework.checks_case("planted β km", "length", lambda: framework.dp_scaled(1e3), model_cls=BetaOff),
+        framework.checks_case(
+            "planted β km", "length", lambda: seed_params.dp_scaled(1e3), model_cls=BetaOff
+        ),
         cases.large_angle_case("planted period", lambda: default_params("double_pendulum"), NotPeriodic),
         cases.high_speed_case("planted NaN", lambda: default_params("double_pendulum"), NaNAtHighSpeed),
         sim_cases.stiff_sim_case(
-            "planted pump", lambda: framework.cart(d1=1e4, d2=1e4, d3=1e4), (0.0, 3.0, 3.4), EnergyPump
+            "planted pump", lambda: seed_params.cart(d1=1e4, d2=1e4, d3=1e4), (0.0, 3.0, 3.4), EnergyPump
         ),
         sim_cases.long_horizon_case("planted C long", model_cls=WrongCoriolis),
         sim_cases.zero_gravity_sim_case(
             "planted push",
-            lambda: framework.cart(g=0.0, d1=0.0, d2=0.0, d3=0.0),
+            lambda: seed_params.cart(g=0.0, d1=0.0, d2=0.0, d3=0.0),
             (0, 0.3, -0.4),
             (0.5, 1, -2),
             0,

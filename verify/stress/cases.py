@@ -1,4 +1,7 @@
-"""Stress cases on states and parameters: large angles, high speeds, the near-singular cart, bad input."""
+"""The seeds' stress cases on states and parameters.
+
+Large angles, high speeds, the near-singular cart and the trust study, bad input.
+"""
 
 from __future__ import annotations
 
@@ -26,8 +29,8 @@ from pendverify.stress.framework import (
     _result_from,
     _states,
     compare,
-    default,
 )
+from pendverify.stress.seed_params import default
 from pendverify.stress.trust_study import study_states
 from pendverify.validate import model_state
 

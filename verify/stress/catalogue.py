@@ -1,4 +1,7 @@
-"""The stress catalogue: hard cases that must stay numerically stable, or be refused.
+"""The seeds' stress catalogue: hard cases that must stay numerically stable, or be refused.
+
+These cases are about the two seed models (``pendverify stress`` without ``--analytic``);
+any model file gets the generic cases of ``pendverify.stress.generic``.
 
 Each case is a named function returning a ``StressResult``: the achieved
 relative error next to the tolerance used, κ(M) raw and after diagonal scaling
@@ -69,13 +72,9 @@ from pendverify.stress.framework import (
     Context,
     Settings,
     StressResult,
-    cart,
     checks_case,
-    default,
-    dp_link_lengths,
-    dp_link_mass_ratio,
-    dp_scaled,
 )
+from pendverify.stress.seed_params import cart, default, dp_link_lengths, dp_link_mass_ratio, dp_scaled
 from pendverify.stress.sim_cases import long_horizon_case, stiff_sim_case, zero_gravity_sim_case
 from pendverify.stress.trust_study import StudyResult
 

@@ -17,15 +17,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pendverify.analytic import MODELS, CartDoublePendulumParams, DoublePendulumParams
-from pendverify.analytic.params import default_parameter_file, load_parameter_file
+from pendverify.analytic import MODELS
 from pendverify.checks.catalogue import CHECKS, applicable_checks, run_check
 from pendverify.checks.sampling import DEFAULT_SEED, State, sample_states
 from pendverify.checks.trust import check_conditioning
 from pendverify.checks.verdict import WARN
 from pendverify.errors import IllConditionedError
 from pendverify.robot.system import PinocchioSystem
-from pendverify.stress.trust_study import StudyResult, trust_study
+from pendverify.stress.trust_study import StudyResult, cart_study
 from pendverify.validate import model_state
 
 SEED = DEFAULT_SEED
@@ -124,8 +123,9 @@ class Context:
         return PinocchioSystem.for_model(cls, self.urdf, getattr(params, "g", None), "<URDF being compared>")
 
     def trust_study(self) -> StudyResult:
+        """The cart seed's m1 → 0 study (``pendverify.stress.trust_study``), run once per context."""
         if self.study is None:
-            self.study = trust_study(default("cart_double_pendulum"), self.settings.study_masses)
+            self.study = cart_study(self.settings.study_masses)
         return self.study
 
 
@@ -134,34 +134,6 @@ class Case:
     name: str
     group: str
     run: Callable[[Context, str], StressResult]
-
-
-# --- parameter sets --------------------------------------------------------------------------
-def default(model: str):
-    return load_parameter_file(default_parameter_file(model))[2]
-
-
-def dp_scaled(length: float = 1.0, **changes) -> DoublePendulumParams:
-    """The default double pendulum with every length × ``length`` (inertias × length²)."""
-    p = default("double_pendulum")
-    s = length
-    p = p.replace(l1=p.l1 * s, l2=p.l2 * s, r1=p.r1 * s, r2=p.r2 * s, I1=p.I1 * s * s, I2=p.I2 * s * s)
-    return p.replace(**changes)
-
-
-def dp_link_mass_ratio(ratio: float) -> DoublePendulumParams:
-    """m1/m2 = ratio (m2 kept); link 1's inertia scales with its mass."""
-    p = default("double_pendulum")
-    return p.replace(m1=ratio * p.m2, I1=p.I1 * ratio * p.m2 / p.m1)
-
-
-def dp_link_lengths(s1: float, s2: float) -> DoublePendulumParams:
-    p = default("double_pendulum")
-    return p.replace(l1=p.l1 * s1, r1=p.r1 * s1, I1=p.I1 * s1**2, l2=p.l2 * s2, r2=p.r2 * s2, I2=p.I2 * s2**2)
-
-
-def cart(**changes) -> CartDoublePendulumParams:
-    return default("cart_double_pendulum").replace(**changes)
 
 
 # --- comparing closed form and Pinocchio --------------------------------------------------------

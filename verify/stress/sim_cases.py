@@ -1,4 +1,4 @@
-"""Stress cases that simulate: stiff damping, a 1e4 s horizon, zero gravity (on the closed form)."""
+"""The seeds' stress cases that simulate: stiff damping, a 1e4 s horizon, zero gravity (closed form)."""
 
 from __future__ import annotations
 
@@ -20,9 +20,8 @@ from pendverify.stress.framework import (
     Context,
     StressResult,
     _model,
-    default,
-    dp_scaled,
 )
+from pendverify.stress.seed_params import default, dp_scaled
 
 
 # --- simulations --------------------------------------------------------------------------------
