@@ -387,3 +387,24 @@ def test_certify_set_writes_a_bundle_that_recheck_accepts(tmp_path):
     assert recheck(str(issued.path)).passed
     with pytest.raises(pendverify.PendverifyError, match="exists"):
         pendverify.certify_set(tmp_path, default_parameter_file("double_pendulum"), samples=40)
+
+
+def test_certify_set_takes_a_model_file_and_a_missing_urdf_is_named_in_api_words(tmp_path):
+    from pendverify.certify.issue import recheck
+
+    examples = Path(__file__).resolve().parents[1] / "examples"
+    issued = pendverify.certify_set(
+        tmp_path,
+        analytic=examples / "cart_pole.py",
+        urdf=examples / "cart_pole.urdf",
+        urdf_params=examples / "cart_pole.toml",
+        samples=40,
+    )
+    assert issued.certified and issued.certificate["model_source"]["text"].startswith('"""')
+    assert recheck(str(issued.path)).passed
+    with pytest.raises(
+        pendverify.PendverifyError, match=r"give the URDF to certify cart_pole against \(--urdf, urdf=\)"
+    ):
+        pendverify.certify_set(
+            tmp_path / "b", analytic=examples / "cart_pole.py", urdf_params=examples / "cart_pole.toml"
+        )

@@ -271,6 +271,7 @@ def certify_set(
     urdf: str | Path | None = None,
     model: str | None = None,
     urdf_params: str | Path | None = None,
+    analytic: str | Path | None = None,
     samples: int | None = None,
     seed: int | None = None,
     force: bool = False,
@@ -279,9 +280,10 @@ def certify_set(
 
     As ``pendverify certify``: a parameter file ``params``; or a ``urdf`` (a path or
     ``erd:NAME``) with ``urdf_params`` (the set it must match) or a built-in ``model``
-    whose parameters are read off the URDF.  Returns the issued result (``items``,
-    ``certified``, ``certificate``, ``path``).  (Not ``certify``: that name is the
-    ``pendverify.certify`` sub-package.)
+    whose parameters are read off the URDF; or a model file ``analytic`` with its
+    ``urdf`` and ``urdf_params`` (the certificate then embeds the file's text).
+    Returns the issued result (``items``, ``certified``, ``certificate``, ``path``).
+    (Not ``certify``: that name is the ``pendverify.certify`` sub-package.)
     """
     settings = BatterySettings()
     if samples is not None:
@@ -293,5 +295,6 @@ def certify_set(
         None if urdf is None else str(urdf),
         model,
         None if urdf_params is None else str(urdf_params),
+        None if analytic is None else str(analytic),
     )
     return issue(target, settings, str(output), force)

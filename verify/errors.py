@@ -104,6 +104,18 @@ class IllConditionedError(PendverifyError):
         )
 
 
+class CertificateError(PendverifyError):
+    """A certificate is malformed, tampered with, or no longer holds."""
+
+
+class SweepError(InputError):
+    """A sweep file breaks a rule."""
+
+
+class RebindError(PendverifyError):
+    """A parameter cannot be changed in the URDF."""
+
+
 class BrowserError(RuntimeError):
     """Chromium is missing, failed, or did not answer in time (``pendverify.viz.browser``).
 

@@ -40,14 +40,10 @@ from datetime import datetime, timezone
 from pendverify.analytic import ParameterSet
 from pendverify.certify.battery import BatteryItem, BatterySettings
 from pendverify.certify.model_source import ModelSource, source_problem
-from pendverify.errors import PendverifyError
+from pendverify.errors import CertificateError
 from pendverify.jsonio import to_json, versions
 
 SCHEMA = "pendverify-certificate/1"
-
-
-class CertificateError(PendverifyError):
-    """A certificate is malformed, tampered with, or no longer holds."""
 
 
 def canonical_json(obj: dict) -> str:

@@ -17,9 +17,9 @@ from pathlib import Path
 
 from pendverify.analytic import ParameterSet
 from pendverify.analytic.params import load_parameter_file
+from pendverify.analytic.plugin import plugin_parameters
 from pendverify.certify.battery import BatteryItem, BatterySettings, run_battery
 from pendverify.certify.certificate import (
-    CertificateError,
     build_certificate,
     compare_items,
     refuse_existing,
@@ -27,8 +27,8 @@ from pendverify.certify.certificate import (
     write_bundle,
 )
 from pendverify.certify.model_source import ModelSource
-from pendverify.checks.targets import plugin_parameters
-from pendverify.errors import ParameterError, PendverifyError
+from pendverify.checks.targets import PARAMS_HINT
+from pendverify.errors import CertificateError, ParameterError, PendverifyError
 from pendverify.robot.erd import resolve_urdf
 from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
@@ -55,7 +55,7 @@ def certification_input(
         analytic, model = model, None
     if analytic is not None:
         if model is not None:
-            raise PendverifyError(f"{analytic}: give --analytic or --model, not both")
+            raise PendverifyError(f"{analytic}: give a model file or a built-in model name, not both")
         return _plugin_input(analytic, urdf, urdf_params or params_file)
     if urdf:
         path, name = resolve_urdf(urdf)
@@ -63,18 +63,23 @@ def certification_input(
         if urdf_params:
             model_name, _, params = load_parameter_file(urdf_params)
             if model and model != model_name:
-                raise PendverifyError(f"{urdf_params}: model is {model_name!r}, --model says {model!r}")
+                raise ParameterError(
+                    urdf_params, "model", model_name, f"must be {model!r}, the model named with it"
+                )
             return CertificationInput(name, ModelSource.of_builtin(model_name), params, text)
         if not model:
-            raise PendverifyError("with --urdf, name the model (--model) or give --params")
+            raise PendverifyError(f"with a URDF, name the model or give the parameter set ({PARAMS_HINT})")
         params = PinocchioSystem.from_urdf(model, text, source=str(path)).geometry.params
         if params is None:
-            raise PendverifyError(f"{path}: give --params: a {model} URDF alone does not fix the closed form")
+            raise PendverifyError(
+                f"{path}: give the parameter set ({PARAMS_HINT}): "
+                f"a {model} URDF alone does not fix the closed form"
+            )
         return CertificationInput(name, ModelSource.of_builtin(model), params, text)
     if params_file:
         model_name, name, params = load_parameter_file(params_file)
         return CertificationInput(name, ModelSource.of_builtin(model_name), params, urdf_for(params, name))
-    raise PendverifyError("give a parameter file, --urdf, --analytic, or --sweep")
+    raise PendverifyError("give a parameter file, a URDF, a model file (--analytic), or a sweep")
 
 
 def _plugin_input(model_file: str, urdf: str | None, params_file: str | None) -> CertificationInput:
@@ -82,9 +87,11 @@ def _plugin_input(model_file: str, urdf: str | None, params_file: str | None) ->
     source = ModelSource.of_file(model_file)
     cls = source.load()
     if urdf is None:
-        raise PendverifyError(f"{model_file}: give --urdf: the URDF to certify {cls.name} against")
+        raise PendverifyError(f"{model_file}: give the URDF to certify {cls.name} against (--urdf, urdf=)")
     if params_file is None:
-        raise PendverifyError(f"{model_file}: give --params: a model file has no parameters of its own")
+        raise PendverifyError(
+            f"{model_file}: give the parameter set ({PARAMS_HINT}): a model file has no parameters of its own"
+        )
     params = plugin_parameters(cls, model_file, params_file)
     if not hasattr(params, "g"):
         raise ParameterError(

@@ -35,16 +35,12 @@ import numpy as np
 
 from pendverify.analytic import MODELS
 from pendverify.analytic.params import default_parameter_file, load_parameter_file, read_toml
+from pendverify.analytic.plugin import plugin_parameters
 from pendverify.certify.battery import BatterySettings, run_battery
 from pendverify.certify.model_source import ModelSource
-from pendverify.checks.targets import plugin_parameters
-from pendverify.errors import InputError, PendverifyError
+from pendverify.errors import PendverifyError, SweepError
 from pendverify.robot.rebind import Binding
 from pendverify.robot.writer import urdf_for
-
-
-class SweepError(InputError):
-    """A sweep file breaks a rule."""
 
 
 @dataclass(frozen=True)

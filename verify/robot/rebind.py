@@ -31,7 +31,7 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 
 from pendverify.analytic import ParameterSet
-from pendverify.errors import PendverifyError
+from pendverify.errors import PendverifyError, RebindError
 
 MATCH_RTOL = 1e-12
 _INERTIA = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
@@ -44,10 +44,6 @@ SITES: dict[str, tuple[tuple[str, tuple[str, ...]], ...]] = {
     "damping": (("joint/dynamics", ("damping",)),),
 }
 IN_PINOCCHIO = ("gravity",)  # kinds that are not in the URDF at all
-
-
-class RebindError(PendverifyError):
-    """A parameter cannot be changed in the URDF."""
 
 
 @dataclass(frozen=True)
