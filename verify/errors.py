@@ -56,3 +56,7 @@ class UnknownNameError(PendverifyError):
 
     def __str__(self) -> str:
         return f"unknown {self.kind} {self.name!r}; known: {', '.join(self.known)}"
+
+
+class FastPathError(InputError):
+    """A scene uses an effect the compiled back ends do not compile (time-varying, non-diagonal D...)."""
