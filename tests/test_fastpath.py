@@ -52,7 +52,7 @@ def test_compiled_rhs_is_the_closed_form(name, forced):
     for _ in range(50):
         x = rng.uniform(-3, 3, 2 * model.nv)
         q, v = x[: model.nv], x[model.nv :]
-        tau = system.B @ (system.u0 - system.K @ x) - system.D * v
+        tau = system.B @ (system.u0 - system.K @ x) - system.D @ v
         expected = model.inverse_mass_matrix(q) @ (tau - model.bias(q, v))
         assert_close(system.rhs(x)[model.nv :], expected, RHS_RTOL, f"{name=} {forced=} {x=}")
         generic = taylor.field(taylor.float_system(system), list(x))

@@ -12,7 +12,8 @@ componentwise (Higham, Accuracy and Stability of Numerical Algorithms, 2nd ed.,
   (``_magnitude``: sums and products of |terms|; a sin/cos of a computed argument
   counts 1 + |argument|, for the argument's own rounding).  k = the largest
   operation count of an entry (``count_ops``: a bound on the roundings along any
-  path of any evaluation order, CSE included) + 4n + 2nu + 8 for τ and f = τ − b;
+  path of any evaluation order, CSE included) + 6n + 2nu + 8 for τ (D q̇: n products,
+  n − 1 sums) and f = τ − b;
 * the solve (root-free Cholesky M = L diag(d) Lᵀ, no pivoting: M is SPD) is
   backward stable: (M + ΔM) â = f with |ΔM| ≤ γ_{3n+1} |L||D||Lᵀ| = γ_{3n+1} |C||Cᵀ|,
   C the Cholesky factor.
@@ -128,7 +129,7 @@ class Reference:
         n = self.ex.n
         mass, _, mass_abs, bias_abs = (np.array(v, float) for v in self._float(*x[: 2 * n]))
         chol = np.abs(np.linalg.cholesky(mass))  # |L||D||Lᵀ| = |L D^½||D^½ Lᵀ|
-        k = self.ops + 4 * n + 2 * nu + 8
+        k = self.ops + 6 * n + 2 * nu + 8
         perturbation = _gamma(k) * (mass_abs @ np.abs(a) + tau_abs + bias_abs.ravel()) + _gamma(3 * n + 1) * (
             chol @ chol.T @ np.abs(a)
         )
@@ -164,11 +165,11 @@ def _check_model(model, forced: bool, work: bool, tag: str = ""):
         q, v = state.q, state.v
         xs = x[: 2 * n]
         u = system.u0 - system.K @ xs
-        tau_in, tau_diss = system.B @ u, -system.D * v
+        tau_in, tau_diss = system.B @ u, -system.D @ v
         tau = tau_in + tau_diss
         tau_abs = np.abs(system.B) @ (np.abs(system.u0) + np.abs(system.K) @ np.abs(xs)) + np.abs(
-            system.D * v
-        )
+            system.D
+        ) @ np.abs(v)
         got = system.rhs(x)
         context = f"{tag} {state.label} {x=}"
         assert np.all(np.isfinite(got)), context
@@ -192,11 +193,11 @@ def _check_model(model, forced: bool, work: bool, tag: str = ""):
         rel = np.max(np.abs(got[n : 2 * n] - own)) / max(1.0, np.max(np.abs(own)))
         _note(f"{tag} generated vs model, relative to max(1, |a|)", rel / U)
         if work:
-            # v·τ_in and v·(D v): ≤ 2n + nu + 4 roundings of terms bounded by |v|·|τ|
-            k = _gamma(2 * n + 2 * nu + 8)
-            w_in, w_diss = v @ tau_in, v @ (system.D * v)
+            # v·τ_in and v·(D v): ≤ 4n + nu + 4 roundings of terms bounded by |v|·|τ|
+            k = _gamma(4 * n + 2 * nu + 8)
+            w_in, w_diss = v @ tau_in, v @ (system.D @ v)
             assert abs(got[2 * n] - w_in) <= 2 * k * (np.abs(v) @ tau_abs), context
-            assert abs(got[2 * n + 1] - w_diss) <= 2 * k * (np.abs(v) @ np.abs(system.D * v)), context
+            assert abs(got[2 * n + 1] - w_diss) <= 2 * k * (np.abs(v) @ np.abs(system.D) @ np.abs(v)), context
     return system
 
 
@@ -431,7 +432,7 @@ def test_digest_does_not_depend_on_parameter_values():
     assert a.kernel.digest == b.kernel.digest
     assert not np.array_equal(a.packed(), b.packed())
     n, nu = 2, 0
-    assert a.packed().shape == (2 + len(a.kernel.parameters) + n + 3 * n * nu + nu,)
+    assert a.packed().shape == (2 + len(a.kernel.parameters) + n * n + 3 * n * nu + nu,)
 
 
 # --- integration -------------------------------------------------------------------------------------

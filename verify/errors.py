@@ -59,4 +59,4 @@ class UnknownNameError(PendverifyError):
 
 
 class FastPathError(InputError):
-    """A scene uses an effect the compiled back ends do not compile (time-varying, non-diagonal D...)."""
+    """A scene uses an effect the compiled back ends do not compile (time-varying, saturated)."""

@@ -30,10 +30,10 @@ nu inputs of the force law::
 
     P[0] = n,  P[1] = nu,
     P[2 : 2 + n_p]            the parameter values, in the field order of the model's params_type,
-    then D (n), B (n × nu, row-major), K (nu × 2n, row-major), u0 (nu).
+    then D (n × n), B (n × nu), K (nu × 2n), u0 (nu), matrices row-major.
 
-The force law τ = B (u0 − K x) − D q̇ (D diagonal) covers every time-invariant scene:
-conservative (K = 0, D = 0), joint friction, PD control (B = I, K = [kp kd],
+The force law τ = B (u0 − K x) − D q̇ covers every time-invariant scene: conservative
+(K = 0, D = 0), joint friction (any D: a plug-in's absolute angles couple it), PD control (B = I, K = [kp kd],
 u0 = kp·target), LQR about upright (B = e_q, K the gain), a constant input (K = 0).
 """
 
@@ -80,7 +80,7 @@ class GeneratedSystem:
 
     kernel: GeneratedKernel
     params: np.ndarray  # parameter values in the field order of the model's params_type
-    D: np.ndarray  # (n,) viscous friction per coordinate
+    D: np.ndarray  # (n, n) viscous friction
     B: np.ndarray  # (n, nu) input map
     K: np.ndarray  # (nu, 2n) state feedback
     u0: np.ndarray  # (nu,) feed-forward input
@@ -105,11 +105,13 @@ class GeneratedSystem:
     def packed(self) -> np.ndarray:
         """The one array the generated functions take (layout in the module docstring)."""
         head = np.array([self.nv, self.B.shape[1]], dtype=float)
-        return np.concatenate([head, self.params, self.D, self.B.ravel(), self.K.ravel(), self.u0])
+        return np.concatenate([head, self.params, self.D.ravel(), self.B.ravel(), self.K.ravel(), self.u0])
 
     @classmethod
     def from_model(cls, model, D=None, B=None, K=None, u0=None, fresh: bool = False) -> GeneratedSystem:
-        """Pack a ``ClosedFormModel`` instance with its parameter values; no forces unless given."""
+        """Pack a ``ClosedFormModel`` instance with its parameter values; no forces unless given.
+
+        ``D``: the friction matrix, or its diagonal as a vector."""
         k = kernel(type(model), fresh=fresh)
         n = model.nv
         names = tuple(f.name for f in dataclasses.fields(model.params_type))
@@ -120,7 +122,8 @@ class GeneratedSystem:
         nu = B.shape[1]
         K = np.zeros((nu, 2 * n)) if K is None else np.asarray(K, float).reshape(nu, 2 * n)
         u0 = np.zeros(nu) if u0 is None else np.asarray(u0, float).reshape(nu)
-        D = np.zeros(n) if D is None else np.asarray(D, float).reshape(n)
+        D = np.zeros((n, n)) if D is None else np.asarray(D, float)
+        D = np.ascontiguousarray(np.diag(D) if D.ndim == 1 else D.reshape(n, n))
         anchors = np.array([np.asarray(q, float).reshape(n) for q in model.special_states().values()])
         return cls(k, params, D, np.ascontiguousarray(B), np.ascontiguousarray(K), u0, anchors.reshape(-1, n))
 
@@ -130,11 +133,7 @@ class GeneratedSystem:
         n = dyn.nv
         if dyn.w_of is not None:
             raise FastPathError(source, "effects.disturbance", dyn.w_of.kind, "not compiled: time-varying")
-        D = None
-        if dyn.D is not None:
-            D = np.diag(dyn.D)
-            if np.any(dyn.D - np.diag(D)):
-                raise FastPathError(source, "effects.damping", dyn.D.tolist(), "a diagonal D")
+        D = dyn.D
         B = K = u0 = None
         law = dyn.u_of
         if law is not None:
@@ -177,7 +176,7 @@ class GeneratedSystem:
         """The system's numbers as the generic functions take them, in floats."""
         return {
             "params": [float(v) for v in self.params],
-            "D": [float(v) for v in self.D],
+            "D": self.D.tolist(),
             "B": self.B.tolist(),
             "K": self.K.tolist(),
             "u0": self.u0.tolist(),

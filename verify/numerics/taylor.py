@@ -177,7 +177,7 @@ def _numbers(fast, number) -> dict:
         "module": fast.module,
         "N": number,
         "params": conv(fast.params),
-        "D": conv(fast.D),
+        "D": [conv(row) for row in fast.D],
         "B": [conv(row) for row in fast.B],
         "K": [conv(row) for row in fast.K],
         "u0": conv(fast.u0),

@@ -40,16 +40,18 @@ def _reads(ex: Expressions, state: str, rates: bool) -> list[str]:
 
 
 def _tau(ex: Expressions) -> list[str]:
-    """ti = B (u0 − K x), td = −D v, from q0…, v0… (v must be known)."""
+    """ti = B (u0 − K x), td = −D v (D n × n), from q0…, v0… (v must be known)."""
     n, od = ex.n, HEADER + len(ex.parameters)
-    lines = ["nu = int(P[1])", f"ob = {od + n}", f"ok = ob + {n}*nu", f"ou = ok + {2 * n}*nu"]
+    lines = ["nu = int(P[1])", f"ob = {od + n * n}", f"ok = ob + {n}*nu", f"ou = ok + {2 * n}*nu"]
     lines += ["# tau = B (u0 - K x) - D v"]
     lines += [f"ti{i} = 0.0" for i in range(n)]
     lines += ["for j in range(nu):", f"    k = ok + {2 * n}*j"]
     kx = " + ".join([f"P[k + {k}]*q{k}" for k in range(n)] + [f"P[k + {n + k}]*v{k}" for k in range(n)])
     lines += [f"    u = P[ou + j] - ({kx})"]
     lines += [f"    ti{i} += P[ob + {i}*nu + j]*u" for i in range(n)]
-    lines += [f"td{i} = -P[{od + i}]*v{i}" for i in range(n)]
+    lines += [
+        f"td{i} = -(" + " + ".join(f"P[{od + n * i + j}]*v{j}" for j in range(n)) + ")" for i in range(n)
+    ]
     return lines
 
 

@@ -37,7 +37,7 @@ from pendverify.numerics.codegen.printers import Unsupported, generic_printer
 
 
 def _force(p, x, n):
-    """τ = B (u0 − K x) − D q̇ with zero entries skipped (exact constants, any number type)."""
+    """τ = B (u0 − K x) − D q̇ with zero entries skipped (exact constants, any number type, D n × n)."""
     B, K, u0, D = p["B"], p["K"], p["u0"], p["D"]
     tau = [0] * n
     for j in range(len(u0)):
@@ -49,8 +49,9 @@ def _force(p, x, n):
             if B[i][j] != 0:
                 tau[i] = tau[i] + B[i][j] * u
     for i in range(n):
-        if D[i] != 0:
-            tau[i] = tau[i] - D[i] * x[n + i]
+        for j in range(n):
+            if D[i][j] != 0:
+                tau[i] = tau[i] - D[i][j] * x[n + j]
     return tau
 
 
