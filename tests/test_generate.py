@@ -407,14 +407,19 @@ def test_a_fresh_process_neither_generates_nor_compiles(fresh_cache):
         assert second[name]["out"] == first[name]["out"]
 
 
-def test_planted_change_in_mass_matrix_changes_digest_and_result(tmp_path):
+def planted_cart_pole(folder: Path):
+    """examples/cart_pole.py with M_11 = I + 2 m_p r² instead of I + m_p r² (written to ``folder``)."""
     source = (REPO / "examples" / "cart_pole.py").read_text()
     old = "return np.array([[p.mc + p.mp, k], [k, p.I + p.mp * p.r**2]])"
     assert source.count(old) == 1
-    planted = tmp_path / "cart_pole.py"
+    planted = folder / "cart_pole.py"
     planted.write_text(source.replace(old, old.replace("p.I + p.mp * p.r**2", "p.I + 2 * p.mp * p.r**2")))
-    shutil.copy(REPO / "examples" / "cart_pole.toml", tmp_path / "cart_pole.toml")
-    original, mutant = _example(REPO / "examples" / "cart_pole.py"), _example(planted)
+    shutil.copy(REPO / "examples" / "cart_pole.toml", folder / "cart_pole.toml")
+    return _example(planted)
+
+
+def test_planted_change_in_mass_matrix_changes_digest_and_result(tmp_path):
+    original, mutant = _example(REPO / "examples" / "cart_pole.py"), planted_cart_pole(tmp_path)
     a, b = GeneratedSystem.from_model(original), GeneratedSystem.from_model(mutant)
     assert a.kernel.digest != b.kernel.digest and a.kernel.path != b.kernel.path
     x = np.array([0.1, 0.7, 0.4, -1.2])

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import shutil
 from pathlib import Path
 
 import mpmath
@@ -29,7 +28,19 @@ from pendverify.numerics.codegen.expressions import momentum_rate
 from pendverify.numerics.generate import GeneratedSystem
 from pendverify.simulation.scene import load_scene
 
-from .test_generate import SEED, WHEEL, Reference, WheelPole, _example, _forces, _gamma, _magnitude, _seed
+from .test_generate import (
+    SEED,
+    WHEEL,
+    Reference,
+    WheelPole,
+    _cache,  # noqa: F401 - the module-scoped cache fixture (autouse), shared
+    _example,
+    _forces,
+    _gamma,
+    _magnitude,
+    _seed,
+    planted_cart_pole,
+)
 
 REPO = Path(__file__).resolve().parents[1]
 EPS = np.finfo(float).eps
@@ -37,28 +48,8 @@ STATES = 12
 CASES = ["double_pendulum", "cart_double_pendulum", "cart_pole", "triple_pendulum"]
 
 
-@pytest.fixture(scope="module", autouse=True)
-def _cache(tmp_path_factory):
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setenv("PENDVERIFY_CACHE", str(tmp_path_factory.mktemp("cache")))
-        generate.forget()
-        yield
-    generate.forget()
-
-
 def _model(case: str):
     return _seed(case) if case in MODELS else _example(REPO / "examples" / f"{case}.py")
-
-
-def _planted_cart_pole(tmp_path):
-    """examples/cart_pole.py with M_11 = I + 2 m_p r² instead of I + m_p r²."""
-    source = (REPO / "examples" / "cart_pole.py").read_text()
-    old = "return np.array([[p.mc + p.mp, k], [k, p.I + p.mp * p.r**2]])"
-    assert source.count(old) == 1
-    planted = tmp_path / "cart_pole.py"
-    planted.write_text(source.replace(old, old.replace("p.I + p.mp * p.r**2", "p.I + 2 * p.mp * p.r**2")))
-    shutil.copy(REPO / "examples" / "cart_pole.toml", tmp_path / "cart_pole.toml")
-    return _example(planted)
 
 
 def _with_g(system: GeneratedSystem, factor: float) -> GeneratedSystem:
@@ -138,7 +129,7 @@ def test_hamiltonian_checks_catch_planted_errors(tmp_path):
     """A planted M (momentum from the mutant, velocity from the original) and g off by 1e-9."""
     model = _model("cart_pole")
     system = GeneratedSystem.from_model(model)
-    planted = GeneratedSystem.from_model(_planted_cart_pole(tmp_path))
+    planted = GeneratedSystem.from_model(planted_cart_pole(tmp_path))
     canonical = _Canonical(model, system)
     x = np.array([0.1, 0.7, 0.4, -1.2])
     ev, _ = _Canonical(model, planted).errors(x, hamilton_system=system)
@@ -181,7 +172,7 @@ def test_fixed_step_methods_follow_the_models_flow(case, method):
 @pytest.mark.parametrize("method", tuple(STEPS))
 def test_planted_mass_matrix_changes_the_fixed_step_result(tmp_path, method):
     original = GeneratedSystem.from_model(_model("cart_pole"))
-    planted = GeneratedSystem.from_model(_planted_cart_pole(tmp_path))
+    planted = GeneratedSystem.from_model(planted_cart_pole(tmp_path))
     assert planted.kernel.digest != original.kernel.digest
     x0 = np.array([0.1, 0.7, 0.4, -1.2])
     err, bound = _fixed_errors(planted, original, method, x0, 0.5)
