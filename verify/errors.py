@@ -116,6 +116,10 @@ class RebindError(PendverifyError):
     """A parameter cannot be changed in the URDF."""
 
 
+class FastPathError(InputError):
+    """A scene uses an effect the compiled back ends do not compile (time-varying, saturated)."""
+
+
 class BrowserError(RuntimeError):
     """Chromium is missing, failed, or did not answer in time (``pendverify.viz.browser``).
 

@@ -1,13 +1,20 @@
-"""The generated right-hand side against the hand kernels: cost per call, and generation/compilation times.
+"""The generated back ends' costs against same-run baselines, and generation/compilation times.
 
-Per call.  ``_calls`` runs ``calls`` evaluations of one compiled right-hand side
-inside a numba loop (the state moves by 1e-12 each call, so nothing is hoisted
-out of the loop); the right-hand side is a dispatcher argument, so the loop is
-specialised, and compiled, for each one alike.  The loops of the hand kernel and
-of the generated one alternate (a busy machine slows both alike); the cost per
-call is the minimum over ``repeats`` loops divided by ``calls``, and the ratio
-generated / hand is formed from the same run.  The scipy wrapper (``scipy_rhs``: one Python call, an
-allocation and the kernel) is timed the same way with fewer calls.
+The hand-written kernels these replaced are gone; what they cost against the
+generated code (before deletion, same process) is recorded in
+``docs/generated-backends.md``.  What stays measurable:
+
+Per call.  ``_calls`` runs ``calls`` evaluations of the generated right-hand side
+inside a numba loop (the state moves by 1e-12 each call, so nothing is hoisted out
+of the loop); the cost per call is the minimum over ``repeats`` loops divided by
+``calls``.  The scipy wrapper (``scipy_rhs``: one Python call, an allocation and the
+kernel) is timed against Pinocchio's ``aba`` right-hand side
+(``pendverify.simulation.engines``), both called from Python, alternating, so the
+ratio wrapper / aba comes from the same run.
+
+One integration.  The fast path's compiled DOP853 (``fastpath.integrate``) against
+scipy's DOP853 on the same generated right-hand side (``solve_ivp`` on
+``scipy_rhs``: the same steps, scipy's bookkeeping in Python), alternating.
 
 Generation and compilation.  ``cache_timings`` runs a fresh Python process twice
 on one empty cache directory: the first generates the module (SymPy), imports
@@ -32,7 +39,9 @@ from numba import njit
 
 from pendverify.analytic import MODELS
 from pendverify.analytic.params import default_parameter_file, load_parameter_file
-from pendverify.numerics import generate, kernels
+from pendverify.numerics import fastpath
+from pendverify.numerics.generate import GeneratedSystem
+from pendverify.simulation import engines
 
 
 @njit(error_model="numpy")
@@ -45,33 +54,30 @@ def _calls(rhs, P, x, out, calls):
     return acc
 
 
-def _per_call(pairs, x, calls: int, repeats: int) -> list[float]:
-    """Seconds per call of each (rhs, P) in ``pairs``: the loops interleaved, the minimum of each."""
+def _per_call(rhs, P, x, calls: int, repeats: int) -> float:
+    """Seconds per call of the compiled ``rhs`` in a numba loop (the minimum of ``repeats`` loops)."""
     x, out = x.copy(), np.empty_like(x)
-    for rhs, P in pairs:
-        _calls(rhs, P, x, out, 10)  # compile
-    best = [np.inf] * len(pairs)
+    _calls(rhs, P, x, out, 10)  # compile
+    best = np.inf
     for _ in range(repeats):
-        for i, (rhs, P) in enumerate(pairs):
-            start = time.perf_counter()
-            _calls(rhs, P, x, out, calls)
-            best[i] = min(best[i], time.perf_counter() - start)
-    return [b / calls for b in best]
+        start = time.perf_counter()
+        _calls(rhs, P, x, out, calls)
+        best = min(best, time.perf_counter() - start)
+    return best / calls
 
 
-def _per_scipy_call(funs, x, calls: int, repeats: int) -> list[float]:
-    best = [np.inf] * len(funs)
+def _alternating(runs, repeats: int) -> list[float]:
+    """The minimum wall time of each callable in ``runs``, the runs interleaved."""
+    best = [np.inf] * len(runs)
     for _ in range(repeats):
-        for i, fun in enumerate(funs):
-            fun(0.0, x)
+        for i, run in enumerate(runs):
             start = time.perf_counter()
-            for _ in range(calls):
-                fun(0.0, x)
+            run()
             best[i] = min(best[i], time.perf_counter() - start)
-    return [b / calls for b in best]
+    return best
 
 
-def _systems(name: str, forced: bool):
+def _system(name: str, forced: bool):
     model = MODELS[name](load_parameter_file(default_parameter_file(name))[2])
     kw = {}
     if forced:  # friction and a state feedback on every input
@@ -83,51 +89,57 @@ def _systems(name: str, forced: bool):
             K=rng.normal(size=(B.shape[1], 2 * model.nv)),
             u0=rng.normal(size=B.shape[1]),
         )
-    return model, kernels.FastSystem.from_model(model, **kw), generate.GeneratedSystem.from_model(model, **kw)
+    return model, GeneratedSystem.from_model(model, **kw)
 
 
-def per_call(calls: int = 100_000, repeats: int = 7, scipy_calls: int = 20_000) -> list[dict]:
-    """Cost per call of the generated and the hand right-hand side, per seed and force law."""
+def per_call(calls: int = 100_000, repeats: int = 7, scipy_calls: int = 2_000) -> list[dict]:
+    """Cost per call of the generated right-hand side, and of its scipy wrapper against Pinocchio's aba."""
     rows = []
     for name in MODELS:
         for forced in (False, True):
-            model, hand, gen = _systems(name, forced)
-            x = np.append(np.linspace(0.3, 1.2, 2 * model.nv), [0.0, 0.0])
-            pairs = [(kernels._rhs, hand.packed()), (gen.kernel.rhs, gen.packed())]
-            t_hand, t_gen = _per_call(pairs, x, calls, repeats)
-            s_hand, s_gen = _per_scipy_call([hand.scipy_rhs(), gen.scipy_rhs()], x, scipy_calls, repeats)
+            model, gen = _system(name, forced)
+            x = np.linspace(0.3, 1.2, 2 * model.nv)
+            t_gen = _per_call(gen.kernel.rhs, gen.packed(), np.append(x, [0.0, 0.0]), calls, repeats)
+            wrapper, aba = gen.scipy_rhs(), engines.build("aba", model, gen)
+            xa = aba.to_engine(x)
+            wrapper(0.0, x), aba.fun(0.0, xa)
+
+            def batch(fun, y):
+                return lambda: [fun(0.0, y) for _ in range(scipy_calls)]
+
+            s_gen, s_aba = _alternating([batch(wrapper, x), batch(aba.fun, xa)], repeats)
             rows.append(
                 dict(
                     model=name,
                     forces="friction + feedback" if forced else "none",
-                    hand_ns=t_hand * 1e9,
                     generated_ns=t_gen * 1e9,
-                    ratio=t_gen / t_hand,
-                    scipy_hand_us=s_hand * 1e6,
-                    scipy_generated_us=s_gen * 1e6,
-                    scipy_ratio=s_gen / s_hand,
+                    scipy_generated_us=s_gen / scipy_calls * 1e6,
+                    scipy_aba_us=s_aba / scipy_calls * 1e6,
+                    scipy_ratio=s_gen / s_aba,
                 )
             )
     return rows
 
 
 def integration(t_end: float = 1.0, tol: float = 1e-10, repeats: int = 15) -> list[dict]:
-    """One DOP853 run (fastpath's hand kernels vs the generated module's stepper), friction and feedback."""
-    from pendverify.numerics import fastpath
+    """One DOP853 run: the compiled stepper against scipy's on the same generated rhs (friction, feedback)."""
+    from scipy.integrate import solve_ivp
 
     rows = []
     for name in MODELS:
-        model, hand, gen = _systems(name, True)
+        model, gen = _system(name, True)
         x0 = np.append(np.full(2 * model.nv, 0.4), [0.0, 0.0])
-        runs = [(fastpath.integrate, hand), (generate.integrate, gen)]
-        nfev = [run(system, x0, t_end, tol, tol).nfev for run, system in runs]  # compile
-        best = [np.inf, np.inf]
-        for _ in range(repeats):
-            for i, (run, system) in enumerate(runs):
-                start = time.perf_counter()
-                run(system, x0, t_end, tol, tol)
-                best[i] = min(best[i], time.perf_counter() - start)
-        rows.append(dict(model=name, nfev=nfev, hand_s=best[0], generated_s=best[1], ratio=best[1] / best[0]))
+        fun = gen.scipy_rhs()
+
+        def ours(gen=gen, x0=x0):
+            return fastpath.integrate(gen, x0, t_end, tol, tol)
+
+        def scipy(fun=fun, x0=x0):
+            return solve_ivp(fun, (0.0, t_end), x0, method="DOP853", rtol=tol, atol=tol)
+
+        nfev = [ours().nfev, int(scipy().nfev)]  # compile
+        fast, slow = _alternating([ours, scipy], repeats)
+        rows.append(dict(model=name, nfev=nfev, generated_s=fast, scipy_s=slow, ratio=fast / slow))
     return rows
 
 
@@ -137,7 +149,7 @@ start = time.perf_counter()
 import numpy as np
 from pendverify.analytic import MODELS
 from pendverify.analytic.params import default_parameter_file, load_parameter_file
-from pendverify.numerics import generate
+from pendverify.numerics import fastpath, generate
 result = {}
 for name in MODELS:
     model = MODELS[name](load_parameter_file(default_parameter_file(name))[2])
@@ -149,7 +161,7 @@ for name in MODELS:
     t2 = time.perf_counter()
     entry = dict(origin=system.kernel.origin, kernel_s=t1 - t0, rhs_first_call_s=t2 - t1)
     if STEPPER:
-        generate.integrate(system, x, 0.01, 1e-6, 1e-6)
+        fastpath.integrate(system, x, 0.01, 1e-6, 1e-6)
         entry["stepper_first_call_s"] = time.perf_counter() - t2
     result[name] = entry
 result["process_s"] = time.perf_counter() - start
@@ -175,18 +187,19 @@ def cache_timings(stepper: bool = True, cache: str | None = None) -> list[dict]:
 
 
 def report(calls: int = 100_000, repeats: int = 7, stepper: bool = True) -> str:
-    lines = [f"per call (numba loop of {calls} calls, min of {repeats}):"]
+    lines = [f"per call (numba loop of {calls} calls, min of {repeats}; scipy wrappers against aba):"]
     for r in per_call(calls, repeats):
         lines.append(
-            f"  {r['model']:22s} {r['forces']:20s} hand {r['hand_ns']:6.1f} ns  generated "
-            f"{r['generated_ns']:6.1f} ns  ratio {r['ratio']:.2f}   scipy wrapper {r['scipy_hand_us']:.2f} / "
-            f"{r['scipy_generated_us']:.2f} µs (ratio {r['scipy_ratio']:.2f})"
+            f"  {r['model']:22s} {r['forces']:20s} generated {r['generated_ns']:6.1f} ns   scipy wrapper "
+            f"{r['scipy_generated_us']:.2f} µs, Pinocchio aba {r['scipy_aba_us']:.2f} µs "
+            f"(ratio {r['scipy_ratio']:.2f})"
         )
     lines.append("one DOP853 run, 1 s at rtol = atol = 1e-10, friction + feedback (min of 15):")
     for r in integration():
         lines.append(
-            f"  {r['model']:22s} nfev {r['nfev'][0]}/{r['nfev'][1]}  hand {r['hand_s'] * 1e6:7.1f} µs  "
-            f"generated {r['generated_s'] * 1e6:7.1f} µs  ratio {r['ratio']:.2f}"
+            f"  {r['model']:22s} nfev {r['nfev'][0]}/{r['nfev'][1]}  compiled "
+            f"{r['generated_s'] * 1e6:7.1f} µs  scipy on the generated rhs {r['scipy_s'] * 1e6:7.1f} µs  "
+            f"ratio {r['ratio']:.3f}"
         )
     first, second = cache_timings(stepper)
     for label, run in (("first process (empty cache)", first), ("second process (cached)", second)):

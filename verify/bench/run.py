@@ -2,7 +2,8 @@
 
 1. the references of every state problem (and of the checked ensemble members),
    from the cache or computed in parallel processes — before any timing;
-2. compilation (or cache load) of the numba kernels, timed apart;
+2. generation (or cache load) of the models' modules and compilation of their numba
+   functions, timed apart;
 3. the sweeps (``pendverify.bench.workprecision``), the observed orders;
 4. the fast path against scipy: the single-trajectory ratio from the sweeps,
    the engine costs and the ensemble at the tolerance where scipy DOP853 first
@@ -115,7 +116,7 @@ def run_benchmark(
     )
     results.reference_seconds = time.perf_counter() - t0
     results.compile_seconds = fastpath.warm_up() + fixedstep.warm_up()
-    log(f"kernels compiled or loaded in {results.compile_seconds:.1f} s; sweeping")
+    log(f"generated back ends compiled or loaded in {results.compile_seconds:.1f} s; sweeping")
     results.points = run_sweeps(problems, results.references, config, log)
     results.orders = order_fits(results.points)
     if chaotic is not None:

@@ -27,12 +27,13 @@ sample, as ``timeit`` does).  Dense output comes from that
 untimed run; dense output does not change the steps.
 
 References (``pendverify.numerics.reference``) are Taylor-series solutions in high
-precision of the closed form, checked at a second precision; their own error
+precision of the model's generated field, checked at a second precision; their own error
 bound is reported next to the smallest error plotted.
 
 Methods.  Adaptive: scipy's RK45, DOP853, Radau and LSODA with ``rtol = atol``,
-on Pinocchio's ``aba`` (the usual choice), and the fast path (compiled DOP853,
-``pendverify.numerics.fastpath``).  Fixed step, compiled (``pendverify.numerics.fixedstep``):
+on Pinocchio's ``aba`` (the usual choice), and the fast path (compiled DOP853 on
+the right-hand side generated from the model, ``pendverify.numerics.fastpath``).
+Fixed step, compiled from the model too (``pendverify.numerics.fixedstep``):
 explicit Euler, symplectic Euler, implicit midpoint and RK4 with halving steps;
 their observed order is the least-squares slope of log error against log h over
 the points whose error lies in the asymptotic window [1e-11, 1e-2].  A scipy
@@ -53,8 +54,8 @@ import numpy as np
 
 from pendverify.bench.timing import measure
 from pendverify.numerics import fixedstep
-from pendverify.numerics.fastpath import FastSystem
 from pendverify.numerics.fastpath import integrate as fast_integrate
+from pendverify.numerics.generate import GeneratedSystem
 
 PI = math.pi
 ORDER_WINDOW = (1e-11, 1e-2)
@@ -173,7 +174,7 @@ class Problem:
     title: str
     scene: object  # pendverify.simulation.scene.Scene
     dynamics: object  # pendverify.simulation.dynamics.Dynamics (closed form)
-    fast: FastSystem
+    fast: GeneratedSystem  # the model's generated back ends and the scene's force law
     x0: np.ndarray
     duration: float
     grid: np.ndarray
@@ -193,7 +194,7 @@ def make_problem(key: str, duration: float, grid_intervals: int = 64) -> Problem
     doc["integrator"] = {"method": "DOP853", "rtol": 1e-10, "atol": 1e-10}
     scene = parse_scene(doc, f"<benchmark {key}>")
     dyn = build_dynamics(scene, "closed_form")
-    fast = FastSystem.from_dynamics(dyn)
+    fast = GeneratedSystem.from_dynamics(dyn)
     x0 = np.concatenate([scene.q0, scene.v0])
     grid = np.linspace(0.0, duration, grid_intervals + 1)
     return Problem(

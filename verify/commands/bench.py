@@ -70,7 +70,8 @@ def run(args: argparse.Namespace) -> int:
     for name, (r, rm, met) in ratios(results).items():
         target = "1/8" if name == "single" else "1/50"
         print(
-            f"fast path / scipy DOP853, {name}: {fraction(r)} (min), {fraction(rm)} (median); "
+            f"generated fast path / scipy DOP853 + Pinocchio aba (same run), {name}: {fraction(r)} (min), "
+            f"{fraction(rm)} (median); "
             f"target ≤ {target}: {'met' if met else 'NOT met'}"
         )
     print(f"written: {out}/work_precision.png, .csv, .md")

@@ -1,32 +1,37 @@
-"""The fast integration path: compiled closed-form right-hand sides and a compiled DOP853.
+"""The fast path: a compiled DOP853 on the right-hand side generated from the model.
 
 Why.  ``scipy.integrate.solve_ivp`` with a Pinocchio right-hand side spends most
 of its time outside the dynamics: each evaluation costs a Python call, array
 allocations and scipy's stage bookkeeping (≈ 15–30 µs), against ≈ 1–5 µs for
-``pinocchio.aba`` itself.  Here the closed-form right-hand side of each model
-*and* the stepper are compiled together by numba, so one evaluation costs about
-0.1–0.3 µs, stage arithmetic included.  The kernels take one packed float array
-(``FastSystem.packed``): a tuple of arrays costs reference counting on every
+``pinocchio.aba`` itself.  Here the model's right-hand side *and* the stepper are
+compiled together by numba, so one evaluation costs about 0.05–0.3 µs, stage
+arithmetic included.  They take one packed float array
+(``GeneratedSystem.packed``): a tuple of arrays costs reference counting on every
 call, several times the dynamics.
 
 What is compiled.
 
-* the closed-form right-hand sides of both models (``pendverify.numerics.kernels``),
-  under any time-invariant force law τ = B (u0 − K x) − D q̇;
+* the right-hand side generated from the model's closed forms
+  (``pendverify.numerics.generate``: any ``ClosedFormModel``, seeds and plug-ins
+  alike), under any time-invariant force law τ = B (u0 − K x) − D q̇;
 * ``_dop853``: scipy's DOP853 reproduced step for step — same Butcher tableau
   (read from scipy), same initial step (Hairer's rule), same error norm (the 5th-
   and 3rd-order estimates combined as in scipy), SAFETY 0.9, factors in
   [0.2, 10] — with scipy's 7th-order dense output when output times are asked
   for (3 extra evaluations per step that contains one, as scipy counts them).
+  The functions below are *templates* (``pendverify.numerics.codegen.templates``):
+  they are copied into each model's generated module, where they call that
+  model's ``_rhs`` inlined and are compiled and cached with it; ``integrate``
+  runs the generated module's copy.
 * ``integrate_ensemble``: many initial states at once, one compiled DOP853 per
   state with its own step control; the kernel releases the GIL, so a pool of
   threads runs them in parallel (numba's ``parallel=True`` took ≈ 20 s more to
   compile, for no measurable gain on 2 cores).
 
-Accuracy.  The kernels take the steps scipy's DOP853 takes at the same rtol and
-atol: the same nfev and step count, each step equal to scipy's step from the same
-state within the rounding of its stage sums (computed in another order), step
-sizes within the jitter that rounding of the error estimate explains (up to
+Accuracy.  The compiled stepper takes the steps scipy's DOP853 takes at the same
+rtol and atol: the same nfev and step count, each step equal to scipy's step from
+the same state within the rounding of its stage sums (computed in another order),
+step sizes within the jitter that rounding of the error estimate explains (up to
 ≈ 1e-7 relative; on a chaotic trajectory the final states of the two then differ
 by a change of truncation error, ≈ 1e-10 at rtol 1e-5); ``tests/test_fastpath.py``
 derives each bound.  So the fast path is as accurate as scipy's DOP853.
@@ -35,15 +40,17 @@ check a final-state error ≤ 100 · rtol · (1 + ‖x‖∞) for rtol ≤ 1e-8 
 T ≤ 2 s on the benchmark problems, and ≤ 1e-10 at rtol = atol = 1e-11 on the
 chaotic pendulum over 2 s.
 
-The fast path is the closed form; that the closed form agrees with Pinocchio is
-what ``pendverify check`` establishes (ε-level, every check).  ``simulate``
-runs a scene on the fast path and evaluates the *same* invariants as
-``pendverify.simulation.simulate`` (``pendverify.simulation.invariants``), on the fast path's own
-steps, with the same adaptive bound.
+The fast path is the model's closed form; that the closed form agrees with
+Pinocchio is what ``pendverify check`` establishes (ε-level, every check).
+``simulate`` runs a scene — a seed's or a plug-in model's — on the fast path and
+evaluates the *same* invariants as ``pendverify.simulation.simulate``
+(``pendverify.simulation.invariants``), on the fast path's own steps, with the same
+adaptive bound.
 
-JIT.  Kernels are compiled on first use and cached on disk (numba
-``cache=True``); ``warm_up()`` triggers compilation and returns the seconds it
-took, so that benchmarks report it separately from per-run timings.
+JIT.  The generated functions are compiled on first use and cached on disk (numba
+``cache=True``, beside the generated module); ``warm_up()`` triggers compilation
+and returns the seconds it took, so that benchmarks report it separately from
+per-run timings.
 """
 
 from __future__ import annotations
@@ -55,14 +62,15 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 from scipy.integrate._ivp import dop853_coefficients as _coef
 
-from pendverify.numerics.kernels import FastPathError, FastSystem, _rhs, cache_allowed
+from pendverify.errors import FastPathError
+from pendverify.numerics.codegen.templates import placeholder, template
+from pendverify.numerics.generate import GeneratedSystem
 
-#: pendverify.numerics.kernels.source_stamp() of the kernels inlined here (see cache_allowed).
-KERNELS_STAMP = "03b2c66be689d7fd"
-CACHE = cache_allowed(KERNELS_STAMP, __name__)
+__all__ = ["FastPathError", "FastResult", "FastRun", "integrate", "integrate_ensemble", "simulate", "warm_up"]
+
+_rhs = placeholder("_rhs")  # each generated module defines its model's
 
 # --- DOP853 tableau, as scipy has it ----------------------------------------------------
 _NS = _coef.N_STAGES  # 12 stages, then f(t + h, y_new) as the 13th row of K
@@ -75,12 +83,12 @@ _DD = np.ascontiguousarray(_coef.D)
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
 ERROR_EXPONENT = -1.0 / 8.0  # error estimator of order 7
 
-# status codes of the kernels
+# status codes of the stepper
 OK, STEP_TOO_SMALL, NOT_FINITE = 0, -1, -2
 
 
 # --- DOP853 ------------------------------------------------------------------------------
-@njit(cache=CACHE, error_model="numpy")
+@template()
 def _rms(x):
     s = 0.0
     for i in range(x.shape[0]):
@@ -88,7 +96,7 @@ def _rms(x):
     return math.sqrt(s / x.shape[0])
 
 
-@njit(cache=CACHE, error_model="numpy")
+@template()
 def _initial_step(P, t0, y0, f0, t_end, rtol, atol, tmp, f1):
     """scipy's ``select_initial_step`` for an error estimator of order 7."""
     n = y0.shape[0]
@@ -108,7 +116,7 @@ def _initial_step(P, t0, y0, f0, t_end, rtol, atol, tmp, f1):
     return min(100.0 * h0, h1, length)
 
 
-@njit(cache=CACHE, error_model="numpy")
+@template()
 def _stages(P, y, h, K, first, last, x, f):
     """K[s] = f(y + h Σ_j A[s, j] K[j]) for s in [first, last).
 
@@ -126,7 +134,7 @@ def _stages(P, y, h, K, first, last, x, f):
             K[s, i] = f[i]
 
 
-@njit(cache=CACHE, error_model="numpy")
+@template()
 def _dense(P, y_old, y_new, h, K, x, f, F):
     """scipy's DOP853 interpolant coefficients F (7 × n) for the step just taken."""
     n = y_old.shape[0]
@@ -143,7 +151,7 @@ def _dense(P, y_old, y_new, h, K, x, f, F):
             F[3 + r, i] = h * acc
 
 
-@njit(cache=CACHE, error_model="numpy")
+@template()
 def _interpolate(F, y_old, xi, out):
     for i in range(y_old.shape[0]):
         y = 0.0
@@ -153,7 +161,7 @@ def _interpolate(F, y_old, xi, out):
         out[i] = y + y_old[i]
 
 
-@njit(cache=CACHE, error_model="numpy")
+@template()
 def _error_norm(y, y_new, K, h_abs, rtol, atol):
     """scipy's DOP853 error norm: the 5th-order estimate, damped by the 3rd-order one."""
     n = y.shape[0]
@@ -171,7 +179,7 @@ def _error_norm(y, y_new, K, h_abs, rtol, atol):
     return h_abs * e5 / math.sqrt((e5 + 0.01 * e3) * n)
 
 
-@njit(cache=CACHE, nogil=True, error_model="numpy")
+@template(nogil=True)
 def _dop853(P, y, t_end, rtol, atol, t_out, out, st, sx):
     """Integrate y (in place) from t = 0 to t_end.
 
@@ -268,8 +276,8 @@ class FastResult:
     rejected: int
 
 
-def integrate(system: FastSystem, x0, t_end, rtol, atol, t_out=None, record=False) -> FastResult:
-    """DOP853 from t = 0 to t_end on the compiled right-hand side.
+def integrate(system: GeneratedSystem, x0, t_end, rtol, atol, t_out=None, record=False) -> FastResult:
+    """DOP853 from t = 0 to t_end on the model's generated right-hand side (its module's ``_dop853``).
 
     ``t_out``: sorted times in [0, t_end] for dense output; ``record``: keep
     every accepted step (for the invariant checks).
@@ -279,9 +287,10 @@ def integrate(system: FastSystem, x0, t_end, rtol, atol, t_out=None, record=Fals
     n = x0.shape[0]
     out = np.empty((t_out.shape[0], n))
     cap = 4096 if record else 0
+    dop853 = system.kernel.module._dop853
     while True:
         y, st, sx = x0.copy(), np.empty(cap), np.empty((cap, n))
-        nfev, steps, rejected, status, rows = _dop853(
+        nfev, steps, rejected, status, rows = dop853(
             system.packed(), y, float(t_end), float(rtol), float(atol), t_out, out, st, sx
         )
         if rows <= cap or not record:
@@ -295,7 +304,7 @@ def integrate(system: FastSystem, x0, t_end, rtol, atol, t_out=None, record=Fals
     return FastResult(y, out, st, sx, int(nfev), int(steps), int(rejected))
 
 
-def integrate_ensemble(system: FastSystem, X0, t_end, rtol, atol, threads: int | None = None):
+def integrate_ensemble(system: GeneratedSystem, X0, t_end, rtol, atol, threads: int | None = None):
     """Final states and nfev of one DOP853 per row of X0, on ``threads`` threads (default: all cores).
 
     Each row is an independent run of the compiled kernel, with its own step
@@ -309,11 +318,12 @@ def integrate_ensemble(system: FastSystem, X0, t_end, rtol, atol, threads: int |
     X, nfev, status = np.empty_like(X0), np.zeros(m, dtype=np.int64), np.zeros(m, dtype=np.int64)
     P, t_end, rtol, atol = system.packed(), float(t_end), float(rtol), float(atol)
     none, no_rows, no_states = np.zeros(0), np.zeros((0, X0.shape[1])), np.zeros((0, X0.shape[1]))
+    dop853 = system.kernel.module._dop853
 
     def work(k):
         for r in range(k, m, threads):
             y = X0[r].copy()
-            res = _dop853(P, y, t_end, rtol, atol, none, no_rows, none, no_states)
+            res = dop853(P, y, t_end, rtol, atol, none, no_rows, none, no_states)
             X[r], nfev[r], status[r] = y, res[0], res[3]
 
     if threads == 1:
@@ -327,14 +337,15 @@ def integrate_ensemble(system: FastSystem, X0, t_end, rtol, atol, threads: int |
 
 
 def warm_up() -> float:
-    """Compile (or load from numba's cache) every kernel; the seconds it took."""
+    """Generate (or load) the seeds' modules and compile (or load from numba's cache) their stepper;
+    the seconds it took."""
     from pendverify.analytic import CartDoublePendulum, DoublePendulum
     from pendverify.analytic.params import default_parameter_file, load_parameter_file
 
     start = time.perf_counter()
     for cls in (DoublePendulum, CartDoublePendulum):
         model = cls(load_parameter_file(default_parameter_file(cls.name))[2])
-        system = FastSystem.from_model(model)
+        system = GeneratedSystem.from_model(model)
         x0 = np.full(2 * model.nv, 0.1)
         integrate(system, x0, 0.01, 1e-6, 1e-6, t_out=np.array([0.005]), record=True)
         integrate(system, np.append(x0, [0.0, 0.0]), 0.01, 1e-6, 1e-6)
@@ -349,7 +360,7 @@ class FastRun:
 
     scene: object
     dynamics: object
-    system: FastSystem
+    system: GeneratedSystem
     result: FastResult
     t: np.ndarray
     x: np.ndarray  # samples (q, q̇, W_in, W_diss)
@@ -362,6 +373,8 @@ class FastRun:
 
 def simulate(scene) -> FastRun:
     """Run a scene with the compiled DOP853 (at the scene's rtol, atol) and check its invariants.
+
+    Any model a scene names, seed or plug-in file: its module is generated on first use.
 
     The invariants are ``pendverify.simulation.invariants``' — the energy drift, dissipation
     or work–energy balance with the bound an adaptive method's tolerance implies —
@@ -376,7 +389,7 @@ def simulate(scene) -> FastRun:
             scene.source, "integrator.method", scene.integrator.method, "an adaptive method (rtol, atol)"
         )
     dyn = build_dynamics(scene, "closed_form")
-    system = FastSystem.from_dynamics(dyn, scene.source)
+    system = GeneratedSystem.from_dynamics(dyn, scene.source)
     x0 = np.concatenate([scene.q0, scene.v0, [0.0, 0.0]])
     n_samples = int(np.floor(scene.duration * scene.sample_rate + 1e-9)) + 1
     t = np.arange(n_samples) / scene.sample_rate

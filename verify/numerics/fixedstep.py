@@ -1,8 +1,11 @@
 """Compiled fixed-step integrators, for the work-precision study (orders 1, 1, 2 and 4).
 
-All run on the compiled closed forms of ``pendverify.numerics.kernels`` (same constants, same
-force law τ = B (u0 − K x) − D q̇), compiled with numba so that a million
-Euler steps cost milliseconds and the methods are compared on equal terms.
+All run on the functions generated from the model (``pendverify.numerics.generate``:
+same parameters, same force law τ = B (u0 − K x) − D q̇), compiled with numba so
+that a million Euler steps cost milliseconds and the methods are compared on
+equal terms.  The functions below are templates (``numerics.codegen.templates``),
+copied into each model's generated module, where ``_run`` calls that model's
+``_rhs`` and ``_hamilton`` inlined; ``integrate_fixed`` runs the module's copy.
 
 =====================  =====  ===========================================================
 method                 order  one step, h
@@ -16,14 +19,13 @@ method                 order  one step, h
 The two implicit methods work in canonical coordinates y = (q, p), p = M(q) q̇,
 where they are symplectic for the conservative problems (so the energy error
 stays bounded instead of drifting); with friction or feedback they remain
-consistent methods of the same order.  The Hamiltonian vector field with forces
-is
+consistent methods of the same order.  The vector field in these coordinates is
+the generated ``_hamilton`` (``pendverify.numerics.codegen.compiled``, which derives it):
 
-    q̇ = M(q)⁻¹ p,     ṗ = ½ q̇ᵀ (∂M/∂q) q̇ − ∂V/∂q + τ(q, q̇),
+    q̇ = M(q)⁻¹ p,     ṗ = Ṁ(q, q̇) q̇ − (C(q, q̇) q̇ + H(q)) + τ(q, q̇),
 
-    double pendulum:  ½ q̇ᵀ ∂M/∂θ2 q̇ = −β sin θ2 (θ̇1² + θ̇1 θ̇2),  ∂M/∂θ1 = 0;
-    cart:             ½ ẏᵀ ∂M/∂θ1 ẏ = −l1 (m1+m2) sin θ1 q̇ θ̇1 − l1 l2 m2 sin(θ1−θ2) θ̇1 θ̇2,
-                      ½ ẏᵀ ∂M/∂θ2 ẏ = −m2 l2 sin θ2 q̇ θ̇2 + l1 l2 m2 sin(θ1−θ2) θ̇1 θ̇2.
+with Ṁ q̇ = Σ_k q̇_k (∂M/∂q_k) q̇, which is ½ q̇ᵀ (∂M/∂q) q̇ − ∂V/∂q + τ when the
+model's C is Christoffel-consistent and H = ∂V/∂q.
 
 Their implicit equations are solved by fixed-point iteration to rounding level
 (|Δ| ≤ 4ε (1 + |y|)), at most ``MAX_ITERATIONS``; a step that does not converge
@@ -35,77 +37,20 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
-from pendverify.numerics.kernels import (
-    C0,
-    FastSystem,
-    _cart_mass,
-    _cart_solve,
-    _cart_tau,
-    _dp_tau,
-    _rhs,
-    cache_allowed,
-)
-
-#: pendverify.numerics.kernels.source_stamp() of the kernels inlined here (see cache_allowed).
-KERNELS_STAMP = "03b2c66be689d7fd"
-CACHE = cache_allowed(KERNELS_STAMP, __name__)
+from pendverify.numerics.codegen.templates import placeholder, template
+from pendverify.numerics.generate import GeneratedSystem
 
 METHODS = {"euler": 1, "symplectic_euler": 1, "implicit_midpoint": 2, "rk4": 4}
 MAX_ITERATIONS = 200
 EPS = float(np.finfo(float).eps)
 OK, NOT_CONVERGED, NOT_FINITE = 0, -3, -2
 
-
-# --- canonical coordinates ------------------------------------------------------------------
-@njit(cache=CACHE, error_model="numpy")
-def _hamilton(P, y, out):
-    """(q̇, ṗ) at y = (q, p); returns nothing, writes ``out``."""
-    if P[0] == 0.0:
-        a, b, d, g1, g2 = P[C0], P[C0 + 1], P[C0 + 2], P[C0 + 3], P[C0 + 4]
-        s2, c2 = math.sin(y[1]), math.cos(y[1])
-        c1, c12 = math.cos(y[0]), math.cos(y[0] + y[1])
-        m00, m01 = a + 2.0 * b * c2, d + b * c2
-        det = a * d - d * d - (b * c2) * (b * c2)
-        v0 = (d * y[2] - m01 * y[3]) / det
-        v1 = (-m01 * y[2] + m00 * y[3]) / det
-        ti0, ti1, td0, td1 = _dp_tau(P, y[0], y[1], v0, v1)
-        out[0], out[1] = v0, v1
-        out[2] = -(g1 * c1 + g2 * c12) + ti0 + td0
-        out[3] = -b * s2 * (v0 * v0 + v0 * v1) - g2 * c12 + ti1 + td1
-    else:
-        m1, m2, l1, l2, g = P[C0 + 1], P[C0 + 2], P[C0 + 3], P[C0 + 4], P[C0 + 5]
-        m12, k = m1 + m2, l1 * l2 * m2
-        s1, c1 = math.sin(y[1]), math.cos(y[1])
-        s2, c2 = math.sin(y[2]), math.cos(y[2])
-        s12, c12 = math.sin(y[1] - y[2]), math.cos(y[1] - y[2])
-        v0, v1, v2 = _cart_solve(P, s1, c1, c2, s12, c12, y[3], y[4], y[5])
-        ti0, ti1, ti2, td0, td1, td2 = _cart_tau(P, y[0], y[1], y[2], v0, v1, v2)
-        out[0], out[1], out[2] = v0, v1, v2
-        out[3] = ti0 + td0
-        out[4] = -l1 * m12 * s1 * v0 * v1 - k * s12 * v1 * v2 + g * m12 * l1 * s1 + ti1 + td1
-        out[5] = -m2 * l2 * s2 * v0 * v2 + k * s12 * v1 * v2 + g * m2 * l2 * s2 + ti2 + td2
+# each generated module defines its model's
+_rhs, _hamilton, _to_momentum = placeholder("_rhs"), placeholder("_hamilton"), placeholder("_to_momentum")
 
 
-@njit(cache=CACHE, error_model="numpy")
-def _to_momentum(P, x, y):
-    """y = (q, M(q) q̇) from x = (q, q̇)."""
-    if P[0] == 0.0:
-        a, b, d = P[C0], P[C0 + 1], P[C0 + 2]
-        c2 = math.cos(x[1])
-        y[0], y[1] = x[0], x[1]
-        y[2] = (a + 2.0 * b * c2) * x[2] + (d + b * c2) * x[3]
-        y[3] = (d + b * c2) * x[2] + d * x[3]
-    else:
-        p00, p01, p02, p11, p12, p22 = _cart_mass(P, math.cos(x[1]), math.cos(x[2]), math.cos(x[1] - x[2]))
-        y[0], y[1], y[2] = x[0], x[1], x[2]
-        y[3] = p00 * x[3] + p01 * x[4] + p02 * x[5]
-        y[4] = p01 * x[3] + p11 * x[4] + p12 * x[5]
-        y[5] = p02 * x[3] + p12 * x[4] + p22 * x[5]
-
-
-@njit(cache=CACHE, error_model="numpy")
+@template()
 def _to_velocity(P, y, x, tmp):
     """x = (q, M(q)⁻¹ p) from y = (q, p)."""
     n = y.shape[0] // 2
@@ -115,7 +60,7 @@ def _to_velocity(P, y, x, tmp):
         x[n + i] = tmp[i]
 
 
-@njit(cache=CACHE, error_model="numpy")
+@template()
 def _converged(delta, y):
     big = 0.0
     for i in range(y.shape[0]):
@@ -124,7 +69,7 @@ def _converged(delta, y):
 
 
 # --- the methods --------------------------------------------------------------------------------
-@njit(cache=CACHE, error_model="numpy")
+@template()
 def _run(method, P, x0, h, steps, every):
     """Integrate ``steps`` steps of size h; states (q, q̇) every ``every`` steps, nfev, status."""
     nx = x0.shape[0]
@@ -207,7 +152,7 @@ def _run(method, P, x0, h, steps, every):
 _IDS = {"euler": 0, "symplectic_euler": 1, "implicit_midpoint": 2, "rk4": 3}
 
 
-def integrate_fixed(method: str, system: FastSystem, x0, duration: float, steps: int, every: int = 1):
+def integrate_fixed(method: str, system: GeneratedSystem, x0, duration: float, steps: int, every: int = 1):
     """States (q, q̇) at t = k·every·h, h = duration / steps; plus nfev and whether it succeeded.
 
     ``steps`` must be a multiple of ``every``.  A failed run (an implicit step
@@ -218,18 +163,20 @@ def integrate_fixed(method: str, system: FastSystem, x0, duration: float, steps:
     if steps % every:
         raise ValueError(f"steps ({steps}) must be a multiple of every ({every})")
     x0 = np.ascontiguousarray(x0, dtype=float)
-    out, nfev, status = _run(_IDS[method], system.packed(), x0, duration / steps, steps, every)
+    run = system.kernel.module._run
+    out, nfev, status = run(_IDS[method], system.packed(), x0, duration / steps, steps, every)
     return out, int(nfev), status == OK
 
 
 def warm_up() -> float:
-    """Compile (or load from numba's cache) the fixed-step kernel; the seconds it took."""
+    """Compile (or load from numba's cache) the seeds' fixed-step methods; the seconds it took."""
     import time
 
-    from pendverify.analytic import DoublePendulum
+    from pendverify.analytic import CartDoublePendulum, DoublePendulum
     from pendverify.analytic.params import default_parameter_file, load_parameter_file
 
     start = time.perf_counter()
-    model = DoublePendulum(load_parameter_file(default_parameter_file(DoublePendulum.name))[2])
-    integrate_fixed("rk4", FastSystem.from_model(model), np.array([0.1, 0.2, 0.0, 0.0]), 0.01, 2)
+    for cls in (DoublePendulum, CartDoublePendulum):
+        model = cls(load_parameter_file(default_parameter_file(cls.name))[2])
+        integrate_fixed("rk4", GeneratedSystem.from_model(model), np.full(2 * model.nv, 0.1), 0.01, 2)
     return time.perf_counter() - start

@@ -1,9 +1,10 @@
 """High-precision reference solutions: Taylor series at two precisions, bounded, cached.
 
-Method.  ``pendverify.numerics.taylor`` integrates the compiled closed form's ODE (same
-constants, same force law, initial state converted exactly) by a Taylor series
-method with automatic differentiation, in decimal arithmetic, with the order
-and step rule of Jorba & Zou.
+Method.  ``pendverify.numerics.taylor`` integrates the ODE of the model's generated
+``field`` (the model's own closed forms, same parameters, same force law as the
+compiled back ends, initial state converted exactly) by a Taylor series method
+with automatic differentiation, in decimal arithmetic, with the order and step
+rule of Jorba & Zou.
 
 How its error is bounded.  The same problem is solved twice: at ε = 10^-30
 with 38 working digits (the reference) and at ε = 10^-40 with 48 digits (the
@@ -16,10 +17,11 @@ The reference is stored as a double-double (hi + lo, ≈ 32 digits), and errors
 of a double-precision run are formed as (x − hi) − lo, exact to ≈ 1e-32.
 
 Cache.  Results go to ``$PENDVERIFY_CACHE`` or ``~/.cache/pendverify``, one
-``.npz`` per problem, named by the SHA-256 of a canonical description (model,
-constants, force law and initial state as exact float hex, horizon, dense grid,
-precisions, method version), so a cached reference is reused only for the
-identical problem.
+``.npz`` per problem, named by the SHA-256 of a canonical description (the
+digest of the model's generated generic code ``FIELD_DIGEST`` — the equations the
+reference integrates —, the packed parameters and force law and the initial
+state as exact float hex, horizon, dense grid, precisions, method version), so a
+cached reference is reused only for the identical problem.
 """
 
 from __future__ import annotations
@@ -46,7 +48,7 @@ from pendverify.numerics.taylor import (
     taylor_solve,
 )
 
-VERSION = "taylor-jz-1"
+VERSION = "taylor-jz-2"
 DIGITS, CHECK_DIGITS = 30, 40
 
 
@@ -97,11 +99,8 @@ def problem_key(fast, x0, duration, grid, digits=DIGITS, check_digits=CHECK_DIGI
     description = {
         "version": VERSION,
         "model": fast.model,
-        "constants": hexes(fast.constants),
-        "D": hexes(fast.D),
-        "B": [list(fast.B.shape), hexes(fast.B)],
-        "K": [list(fast.K.shape), hexes(fast.K)],
-        "u0": hexes(fast.u0),
+        "equations": fast.module.FIELD_DIGEST,
+        "packed": hexes(fast.packed()),
         "x0": hexes(x0),
         "duration": float(duration).hex(),
         "grid": hexes(grid),

@@ -1,8 +1,9 @@
-"""Taylor-series integration in high precision of the compiled closed forms' equations.
+"""Taylor-series integration in high precision of the model's equations.
 
-The ODE ẋ = f(x) of ``pendverify.numerics.kernels`` (same constants, same force law
-τ = B (u0 − K x) − D q̇) is written once, generically (``field``): it runs on
-floats, numpy arrays, mpmath numbers and on ``Series``.  On ``Series`` it
+The ODE ẋ = f(x) is the model's generated ``field`` (``pendverify.numerics.codegen.generic``:
+same parameters, same force law τ = B (u0 − K x) − D q̇, written once from the
+model's closed forms, generic over the number type): it runs on floats, numpy
+arrays, mpmath numbers, Decimals and on ``Series``.  On ``Series`` it
 records a tape of elementary operations on truncated power series (+, −, ×, ÷
 and the sin/cos pair, each with its O(k) recurrence for the k-th coefficient),
 replayed order by order: x_{k+1} = f_k / (k + 1).  Arithmetic is Python's
@@ -24,6 +25,8 @@ from operator import mul
 
 import mpmath
 import numpy as np
+
+from pendverify.errors import PendverifyError
 
 GUARD_DIGITS = 8
 SAFETY = 0.9
@@ -144,7 +147,7 @@ class Series:
 
 
 def series_sincos(u):
-    """(sin u, cos u) for a Series, a float, a numpy array or an mpf."""
+    """(sin u, cos u) for a Series, a float, a numpy array, a Decimal or an mpf."""
     if isinstance(u, Series):
         s = u._new("sin", u)
         c = u._new("cos", u)
@@ -154,125 +157,57 @@ def series_sincos(u):
         return math.sin(u), math.cos(u)
     if isinstance(u, np.ndarray):
         return np.sin(u), np.cos(u)
+    if isinstance(u, Decimal):
+        return _sincos0(u)
     return mpmath.sin(u), mpmath.cos(u)
 
 
-# --- the closed forms, generic over float, mpf and Series --------------------------------
-def _tau(system, x, n):
-    """τ = B (u0 − K x) − D q̇ with zero entries skipped (exact constants, any number type)."""
-    B, K, u0, D = system["B"], system["K"], system["u0"], system["D"]
-    tau = [0] * n
-    for j in range(len(u0)):
-        u = u0[j]
-        for k in range(2 * n):
-            if K[j][k] != 0:
-                u = u - K[j][k] * x[k]
-        for i in range(n):
-            if B[i][j] != 0:
-                tau[i] = tau[i] + B[i][j] * u
-    for i in range(n):
-        if D[i] != 0:
-            tau[i] = tau[i] - D[i] * x[n + i]
-    return tau
-
-
-def field(system, x):
-    """ẋ = (q̇, q̈) of ``pendverify.numerics.fastpath``'s equations, for any number type."""
-    c = system["constants"]
-    if system["model"] == "double_pendulum":
-        n = 2
-        t0, t1 = _tau(system, x, n)
-        a, b, d, g1, g2 = c
-        w1, w2 = x[2], x[3]
-        s2, c2 = series_sincos(x[1])
-        _, c1 = series_sincos(x[0])
-        _, c12 = series_sincos(x[0] + x[1])
-        r1 = t0 + b * s2 * (2 * w1 * w2 + w2 * w2) - (g1 * c1 + g2 * c12)
-        r2 = t1 - b * s2 * w1 * w1 - g2 * c12
-        m12 = d + b * c2
-        bc2 = b * c2
-        inv_det = 1 / (a * d - d * d - bc2 * bc2)
-        return [w1, w2, (d * r1 - m12 * r2) * inv_det, ((a + 2 * bc2) * r2 - m12 * r1) * inv_det]
-    n = 3
-    t0, t1, t2 = _tau(system, x, n)
-    m, m1, m2, l1, l2, g = c
-    m12, k = m1 + m2, l1 * l2 * m2
-    w0, w1, w2 = x[3], x[4], x[5]
-    s1, c1 = series_sincos(x[1])
-    s2, c2 = series_sincos(x[2])
-    s12, c12 = series_sincos(x[1] - x[2])
-    w1sq, w2sq = w1 * w1, w2 * w2
-    f0 = l1 * m12 * w1sq * s1 + m2 * l2 * w2sq * s2 + t0
-    f1 = -k * w2sq * s12 + g * m12 * l1 * s1 + t1
-    f2 = k * w1sq * s12 + g * m2 * l2 * s2 + t2
-    p00, p01, p02 = m + m12, l1 * m12 * c1, m2 * l2 * c2
-    p11, p12, p22 = l1 * l1 * m12, k * c12, l2 * l2 * m2
-    a00, a01, a02 = p11 * p22 - p12 * p12, p02 * p12 - p01 * p22, p01 * p12 - p02 * p11
-    a11, a12, a22 = p00 * p22 - p02 * p02, p01 * p02 - p00 * p12, p00 * p11 - p01 * p01
-    inv_det = 1 / (l1 * l1 * l2 * l2 * m2 * (m * m1 + m1 * m12 * s1 * s1 + m * m2 * s12 * s12))
-    return [
-        w0,
-        w1,
-        w2,
-        (a00 * f0 + a01 * f1 + a02 * f2) * inv_det,
-        (a01 * f0 + a11 * f1 + a12 * f2) * inv_det,
-        (a02 * f0 + a12 * f1 + a22 * f2) * inv_det,
-    ]
-
-
-def energy_above_minimum(system, x):
-    """E(x) − V_min = ½ q̇ᵀ M q̇ + V(q) − min V, for float or mpf."""
-    c = system["constants"]
-    if system["model"] == "double_pendulum":
-        a, b, d, g1, g2 = c
-        s1, _ = series_sincos(x[0])
-        s12, _ = series_sincos(x[0] + x[1])
-        _, c2 = series_sincos(x[1])
-        w1, w2 = x[2], x[3]
-        kinetic = (a + 2 * b * c2) * w1 * w1 / 2 + (d + b * c2) * w1 * w2 + d * w2 * w2 / 2
-        return kinetic + g1 * s1 + g2 * s12 + abs(g1) + abs(g2)
-    m, m1, m2, l1, l2, g = c
-    m12 = m1 + m2
-    _, c1 = series_sincos(x[1])
-    _, c2 = series_sincos(x[2])
-    _, c12 = series_sincos(x[1] - x[2])
-    w0, w1, w2 = x[3], x[4], x[5]
-    kinetic = (
-        (m + m12) * w0 * w0 / 2
-        + l1 * l1 * m12 * w1 * w1 / 2
-        + m2 * l2 * l2 * w2 * w2 / 2
-        + l1 * m12 * c1 * w0 * w1
-        + m2 * l2 * c2 * w0 * w2
-        + l1 * l2 * m2 * c12 * w1 * w2
-    )
-    return kinetic + g * (m12 * l1 * c1 + m2 * l2 * c2) + g * (m12 * l1 + m2 * l2)
-
-
-def exact_system(fast, number=mpmath.mpf) -> dict:
-    """A ``FastSystem`` as nested lists of exact ``number`` values (Decimal or mpf: exact for doubles)."""
+# --- the model's generated functions, generic over float, numpy, mpf, Decimal and Series -------
+def _numbers(fast, number) -> dict:
+    """A ``GeneratedSystem``'s numbers as the generated generic functions take them (``number`` each)."""
+    error = fast.module.FIELD_ERROR
+    if error:
+        raise PendverifyError(f"{fast.model}: no Taylor reference: {error}")
 
     def conv(values):
         return [number(float(v)) for v in values]
 
     return {
-        "model": fast.model,
-        "constants": conv(fast.constants),
-        "D": conv(fast.D),
+        "system": fast,
+        "module": fast.module,
+        "N": number,
+        "params": conv(fast.params),
+        "D": [conv(row) for row in fast.D],
         "B": [conv(row) for row in fast.B],
         "K": [conv(row) for row in fast.K],
         "u0": conv(fast.u0),
     }
 
 
+def exact_system(fast, number=mpmath.mpf) -> dict:
+    """A ``GeneratedSystem`` in exact ``number`` values (Decimal or mpf: exact for doubles)."""
+    return _numbers(fast, number)
+
+
 def float_system(fast) -> dict:
-    return {
-        "model": fast.model,
-        "constants": [float(v) for v in fast.constants],
-        "D": [float(v) for v in fast.D],
-        "B": fast.B.tolist(),
-        "K": fast.K.tolist(),
-        "u0": fast.u0.tolist(),
-    }
+    return _numbers(fast, float)
+
+
+def field(system, x):
+    """ẋ = f(x): the model's generated ``field`` in the system's number type (or on Series)."""
+    return system["module"].field(system, x, system["N"], series_sincos)
+
+
+def energy_above_minimum(system, x):
+    """E(x) − V_min = ½ q̇ᵀ M q̇ + V(q) − min V, generated from the model (float, numpy or mpf).
+
+    V_min is ``GeneratedSystem.potential_minimum`` (how it is found: there), as an
+    exact ``number``: it only normalises relative energy errors."""
+    fast, N = system["system"], system["N"]
+    error = fast.module.ENERGY_ERROR
+    if error:
+        raise PendverifyError(f"{fast.model}: no energy for the Taylor path: {error}")
+    return system["module"].energy(system, x, N, series_sincos) - N(fast.potential_minimum)
 
 
 # --- the integrator ------------------------------------------------------------------------

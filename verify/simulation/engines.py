@@ -59,7 +59,7 @@ def closed_form_rhs(model, fast) -> EngineRhs:
 
     def fun(t, x):
         q, v = x[:n], x[n:]
-        tau = (B @ (u0 - K @ x) - D * v) if forced else np.zeros(n)
+        tau = (B @ (u0 - K @ x) - D @ v) if forced else np.zeros(n)
         return np.concatenate([v, model.inverse_mass_matrix(q) @ (tau - model.bias(q, v))])
 
     return EngineRhs("closed_form", fun, _identity, _identity)
@@ -84,7 +84,7 @@ def pinocchio_rhs(engine: str, system, fast) -> EngineRhs:
     n = m.nv
     T, T_inv = cmap.T, np.linalg.inv(cmap.T)
     K_q, K_v = fast.K[:, :n], fast.K[:, n:]
-    G = T_inv.T @ np.hstack([-fast.B @ K_q @ T_inv, -(fast.B @ K_v + np.diag(fast.D)) @ T_inv])
+    G = T_inv.T @ np.hstack([-fast.B @ K_q @ T_inv, -(fast.B @ K_v + fast.D) @ T_inv])
     c = T_inv.T @ fast.B @ (fast.u0 - K_q @ cmap.theta0)
     forced = not fast.conservative
     zero = np.zeros(n)

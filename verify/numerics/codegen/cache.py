@@ -1,0 +1,190 @@
+"""The on-disk cache of generated modules.
+
+A generated module is written to ``$PENDVERIFY_CACHE/generated`` (or
+``~/.cache/pendverify/generated``) as ``rhs_<model>_<digest>.py``, the digest the
+SHA-256 of its source: it depends on the model's expressions (and on the copied
+templates), never on parameter values.  It is imported with importlib; its numba
+functions are ``@njit(cache=True)``, so their machine code lands in ``__pycache__``
+beside it.  An index file maps a *model key* — the SHA-256 of the source files that
+define the model class, its bases and its parameter set (and of the modules they
+use from outside the standard library and site-packages), of the generator package,
+of the symbolic reader and of the template modules — to that digest, so that a
+second process neither reads the model with SymPy nor compiles again.  A model
+whose formulas depend on code the key does not see may pass ``fresh=True``.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import importlib.metadata
+import importlib.util
+import inspect
+import pkgutil
+import sys
+import sysconfig
+import time
+import types
+from dataclasses import dataclass
+from pathlib import Path
+
+from pendverify.atomic import write_atomic
+from pendverify.numerics.codegen import expressions as _expressions
+from pendverify.numerics.codegen import module as _module
+
+#: the modules the generated source depends on besides the model's own
+SOURCES = ("pendverify.symbolic.model", "pendverify.numerics.fastpath", "pendverify.numerics.fixedstep")
+
+
+def cache_dir() -> Path:
+    """Where generated modules (and numba's cache of them) live."""
+    from pendverify.numerics.reference import cache_dir as base
+
+    return base() / "generated"
+
+
+def _file_digest(path: str) -> str:
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+@functools.cache
+def _environment_roots() -> tuple[Path, ...]:
+    return tuple(
+        {Path(sysconfig.get_paths()[k]).resolve() for k in ("stdlib", "platstdlib", "purelib", "platlib")}
+    )
+
+
+def _outside_environment(path: str) -> bool:
+    """True for a source file that is not in the standard library or site-packages."""
+    return not any(Path(path).resolve().is_relative_to(root) for root in _environment_roots())
+
+
+def _origin(module: str) -> str:
+    """A module's source file, without importing it (fastpath would import scipy.integrate)."""
+    return importlib.util.find_spec(module).origin
+
+
+def _generator_files() -> set[str]:
+    package = Path(__file__).parent
+    names = [m.name for m in pkgutil.iter_modules([str(package)])]
+    return {str(package / f"{n}.py") for n in names} | {_origin(m) for m in SOURCES}
+
+
+def model_key(model_cls) -> str | None:
+    """SHA-256 of everything the generated source depends on, without reading the model (docstring).
+
+    None when a class has no source file (the generator then always runs)."""
+    files: set[str] = set()
+    try:
+        classes = [
+            c for c in (*model_cls.__mro__, *model_cls.params_type.__mro__) if c.__module__ != "builtins"
+        ]
+        for c in classes:
+            files.add(inspect.getfile(c))
+            module = sys.modules.get(c.__module__)
+            for obj in vars(module).values() if module else ():
+                target = (
+                    obj
+                    if isinstance(obj, types.ModuleType)
+                    else sys.modules.get(getattr(obj, "__module__", ""))
+                )
+                path = getattr(target, "__file__", None)
+                if path and path.endswith(".py") and _outside_environment(path):
+                    files.add(path)
+        files |= _generator_files()
+    except (TypeError, OSError):
+        return None
+    # not the module's name: a plug-in's is salted per process (pendverify.analytic.plugin)
+    version = importlib.metadata.version("sympy")
+    h = hashlib.sha256(f"{_module.GENERATOR}|{version}|{model_cls.__qualname__}".encode())
+    for path in sorted(files):
+        h.update(f"|{Path(path).name}:{_file_digest(path)}".encode())
+    return h.hexdigest()
+
+
+@dataclass(frozen=True)
+class GeneratedKernel:
+    """A generated module and where it came from."""
+
+    module: types.ModuleType
+    digest: str  # SHA-256 of the source
+    path: Path
+    origin: str  # "generated" (this call ran SymPy), "disk" (read from the cache), "memory"
+    seconds: float  # time of this call (generation + import; compilation happens on first use)
+
+    @property
+    def rhs(self):
+        return self.module._rhs
+
+    def __reduce__(self):  # pickled by path and digest (process pools): the module is re-imported
+        return _restore, (self.path, self.digest, self.origin, self.seconds)
+
+    @property
+    def n(self) -> int:
+        return self.module.N
+
+    @property
+    def parameters(self) -> tuple[str, ...]:
+        return self.module.PARAMETERS
+
+
+_MEMORY: dict[str, types.ModuleType] = {}  # digest → module
+_KEYS: dict[str, str] = {}  # model key → digest
+
+
+def forget() -> None:
+    """Forget the modules this process loaded: the next ``kernel`` call reads the disk (tests)."""
+    _MEMORY.clear()
+    _KEYS.clear()
+
+
+def _import(path: Path, digest: str) -> types.ModuleType:
+    if digest in _MEMORY:
+        return _MEMORY[digest]
+    name = f"pendverify_generated_{digest[:16]}"
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    _MEMORY[digest] = module
+    return module
+
+
+def _restore(path: Path, digest: str, origin: str, seconds: float) -> GeneratedKernel:
+    return GeneratedKernel(_import(path, digest), digest, path, origin, seconds)
+
+
+def _module_path(name: str, digest: str) -> Path:
+    safe = "".join(c if c.isalnum() else "_" for c in name)[:40]
+    return cache_dir() / f"rhs_{safe}_{digest[:24]}.py"
+
+
+def kernel(model_cls, fresh: bool = False) -> GeneratedKernel:
+    """The generated module of ``model_cls``: from memory, from the on-disk cache, or generated.
+
+    ``fresh``: skip the model-key index (and memory) and read the model with SymPy again;
+    the module itself is still reused when its digest is unchanged."""
+    start = time.perf_counter()
+    key = None if fresh else model_key(model_cls)
+    index = cache_dir() / f"index_{key[:24]}.txt" if key else None
+    if key and key in _KEYS:
+        digest = _KEYS[key]
+        module = _MEMORY[digest]
+        return GeneratedKernel(module, digest, Path(module.__file__), "memory", time.perf_counter() - start)
+    if index is not None and index.is_file():
+        digest = index.read_text().strip()
+        path = _module_path(model_cls.name, digest)
+        if path.is_file() and hashlib.sha256(path.read_bytes()).hexdigest() == digest:
+            module = _import(path, digest)
+            _KEYS[key] = digest
+            return GeneratedKernel(module, digest, path, "disk", time.perf_counter() - start)
+    source = _module.render(_expressions.expressions(model_cls))
+    digest = hashlib.sha256(source.encode()).hexdigest()
+    path = _module_path(model_cls.name, digest)
+    if not (path.is_file() and path.read_text() == source):
+        write_atomic(path, source)  # never rewritten otherwise: numba's cache keys on the file's mtime
+    module = _import(path, digest)
+    if key:
+        write_atomic(index, digest + "\n")
+        _KEYS[key] = digest
+    return GeneratedKernel(module, digest, path, "generated", time.perf_counter() - start)
