@@ -10,7 +10,8 @@
 * ``BatteryMotion``: the motion the certification battery simulates, for a model
   that states its own (``pendverify.certify.scenes`` derives one otherwise).
 * ``NUMERIC_MATH``: what ``self.math`` is numerically (Python's ``math``); the SymPy
-  tools swap in SymPy's functions to read the formulas as expressions.
+  tools swap in SymPy's functions to read the formulas as expressions, and the
+  high-precision judge mpmath's (``math_namespace``).
 
 The model interface that uses them is ``pendverify.analytic.interface.ClosedFormModel``.
 """
@@ -23,9 +24,16 @@ from dataclasses import dataclass
 from typing import Any
 
 #: The scalar functions closed forms call through ``self.math``: Python's own, numerically.
-NUMERIC_MATH = types.SimpleNamespace(
-    cos=math.cos, sin=math.sin, tan=math.tan, sqrt=math.sqrt, exp=math.exp, atan2=math.atan2, pi=math.pi
-)
+#: the functions (and π) a closed form may call through ``self.math``
+MATH_NAMES = ("cos", "sin", "tan", "sqrt", "exp", "atan2", "pi")
+
+
+def math_namespace(module) -> types.SimpleNamespace:
+    """A ``self.math`` made of ``module``'s functions of those names (``math``, ``sympy``, ``mpmath``)."""
+    return types.SimpleNamespace(**{name: getattr(module, name) for name in MATH_NAMES})
+
+
+NUMERIC_MATH = math_namespace(math)
 
 
 @dataclass(frozen=True)

@@ -38,22 +38,15 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-import types
 
 import mpmath
 import numpy as np
 
+from pendverify.analytic.forms import math_namespace
+
 DIGITS = 40  # far beyond the 16 of double: the rounded result is the correctly rounded value
 #: what ``self.math`` is on the high-precision twin (``mpmath.pi`` evaluates at the working precision)
-MP_MATH = types.SimpleNamespace(
-    cos=mpmath.cos,
-    sin=mpmath.sin,
-    tan=mpmath.tan,
-    sqrt=mpmath.sqrt,
-    exp=mpmath.exp,
-    atan2=mpmath.atan2,
-    pi=mpmath.pi,
-)
+MP_MATH = math_namespace(mpmath)
 #: the finding, in one sentence shared by every report
 UNSTABLE = (
     "the closed forms lose digits in double: evaluated in high precision they agree with Pinocchio "

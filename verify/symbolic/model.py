@@ -36,7 +36,6 @@ from __future__ import annotations
 
 import dataclasses
 import random
-import types
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -44,12 +43,11 @@ import numpy as np
 import sympy as sp
 
 from pendverify.analytic import ClosedFormModel
+from pendverify.analytic.forms import math_namespace
 from pendverify.analytic.plugin import where
 from pendverify.errors import PendverifyError
 
-SYMBOLIC_MATH = types.SimpleNamespace(
-    cos=sp.cos, sin=sp.sin, tan=sp.tan, sqrt=sp.sqrt, exp=sp.exp, atan2=sp.atan2, pi=sp.pi
-)
+SYMBOLIC_MATH = math_namespace(sp)
 _POSITIVE_KINDS = {"mass", "length"}
 PROBE_DIGITS = 50
 PROBE_ZERO = sp.Float(10) ** -30  # |e| below this at 50 digits: numerically zero
