@@ -30,9 +30,11 @@ import sys
 import traceback
 from pathlib import Path
 
+import numpy as np
+
 from pendverify.analytic import ClosedFormModel, ParameterSet
 from pendverify.analytic.params import parse_parameter_document, read_toml
-from pendverify.errors import ParameterError, PendverifyError
+from pendverify.errors import FileAccessError, ParameterError, PendverifyError, UserCodeError
 
 
 def where(cls: type) -> str:
@@ -43,8 +45,41 @@ def where(cls: type) -> str:
         return cls.__module__
 
 
+#: the model files imported so far (resolved paths): an exception raised in one is the user's
+_LOADED: set[str] = set()
+
+
+def _described(exc: BaseException) -> str:
+    if isinstance(exc, SystemExit):
+        return f"SystemExit({exc.code!r}): a model file must not exit"
+    return f"{type(exc).__name__}: {exc}"
+
+
+def user_code_error(exc: BaseException) -> UserCodeError | None:
+    """A UserCodeError naming the model file and line when ``exc`` was raised in a loaded model file.
+
+    The innermost frame of the traceback that lies in a model file names the place;
+    None when no frame does (the exception is pendverify's own).
+    """
+    frames = [f for f in traceback.extract_tb(exc.__traceback__) if _resolved(f.filename) in _LOADED]
+    if not frames:
+        return None
+    f = frames[-1]
+    return UserCodeError(
+        f"{f.filename}, line {f.lineno}", f"the model raised {_described(exc)} (in {f.name})"
+    )
+
+
+def _resolved(filename: str) -> str:
+    try:
+        return str(Path(filename).resolve())
+    except (OSError, ValueError):  # pragma: no cover - a frame of a file that is gone
+        return filename
+
+
 def _import(path: Path):
-    name = f"pendverify_plugin_{abs(hash(str(path.resolve())))}"
+    resolved = str(path.resolve())
+    name = f"pendverify_plugin_{abs(hash(resolved))}"
     spec = importlib.util.spec_from_file_location(name, path)
     if spec is None or spec.loader is None:
         raise PendverifyError(f"{path}: not a Python file that can be imported")
@@ -52,14 +87,21 @@ def _import(path: Path):
     sys.modules[name] = module  # dataclasses look their module up while the file runs
     try:
         spec.loader.exec_module(module)
-    except Exception as exc:
+    except KeyboardInterrupt:
+        del sys.modules[name]
+        raise
+    except OSError as exc:
+        del sys.modules[name]
+        raise FileAccessError(str(path), "read", exc.strerror or str(exc)) from None
+    except BaseException as exc:  # SystemExit too: a model file that exits must not end the run
         del sys.modules[name]
         if isinstance(exc, SyntaxError) and exc.lineno:
-            line, text = f", line {exc.lineno}", exc.msg
+            line, text = f", line {exc.lineno}", f"{type(exc).__name__}: {exc.msg}"
         else:
-            frames = [f for f in traceback.extract_tb(exc.__traceback__) if Path(f.filename) == path]
-            line, text = (f", line {frames[-1].lineno}" if frames else ""), str(exc)
-        raise PendverifyError(f"{path}{line}: importing it failed: {type(exc).__name__}: {text}") from None
+            frames = [f for f in traceback.extract_tb(exc.__traceback__) if _resolved(f.filename) == resolved]
+            line, text = (f", line {frames[-1].lineno}" if frames else ""), _described(exc)
+        raise UserCodeError(f"{path}{line}", f"importing it failed: {text}") from None
+    _LOADED.add(resolved)
     return module
 
 
@@ -153,3 +195,51 @@ def plugin_parameters(cls: type[ClosedFormModel], model_file: str, params_file: 
             f"must be {cls.name!r}, the model defined in {model_file}",
         )
     return parse_parameter_document(data, params_file, {cls.name: cls.params_type})[2]
+
+
+def _expected_shapes(model: ClosedFormModel) -> dict[str, tuple[tuple, tuple[int, ...]]]:
+    """method → (arguments at the zero state, the shape of its result)."""
+    n, nu, nw = model.nv, len(model.inputs), len(model.disturbances)
+    q, v, u, w = np.zeros(n), np.zeros(n), np.zeros(nu), np.zeros(nw)
+    return {
+        "mass_matrix": ((q,), (n, n)),
+        "coriolis_matrix": ((q, v), (n, n)),
+        "coriolis_force": ((q, v), (n,)),
+        "gravity": ((q,), (n,)),
+        "potential_energy": ((q,), ()),
+        "damping_matrix": ((), (n, n)),
+        "input_matrix": ((), (n, nu)),
+        "disturbance_matrix": ((), (n, nw)),
+        "det_mass_matrix": ((q,), ()),
+        "inverse_mass_matrix": ((q,), (n, n)),
+        "acceleration": ((q, v, u, w), (n,)),
+    }
+
+
+def check_model_outputs(model: ClosedFormModel) -> None:
+    """Evaluate the model's hand-written methods at the zero state: each returns numbers of its shape.
+
+    Raises ``UserCodeError`` naming the file defining the class, the method and what it
+    returned (or raised), so that a wrong shape is not met later as a broadcasting error.
+    """
+    cls = type(model)
+    unused = {"input_matrix": not model.inputs, "disturbance_matrix": not model.disturbances}
+    for method, (args, shape) in _expected_shapes(model).items():
+        if method not in cls.hand_written() or unused.get(method):
+            continue
+        place = f"{where(cls)}: {cls.__name__}.{method}"
+        try:
+            value = np.asarray(getattr(model, method)(*args), dtype=float)
+        except KeyboardInterrupt:
+            raise
+        except (TypeError, ValueError) as exc:
+            user = user_code_error(exc)
+            if user is not None:
+                raise user from None
+            raise UserCodeError(place, f"must return numbers; at the zero state: {exc}") from None
+        except BaseException as exc:
+            raise (user_code_error(exc) or UserCodeError(place, f"raised {_described(exc)}")) from None
+        if value.shape != shape:
+            raise UserCodeError(
+                place, f"returned an array of shape {value.shape} at the zero state; expected {shape}"
+            )

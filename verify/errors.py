@@ -126,3 +126,38 @@ class BrowserError(RuntimeError):
     Not a ``PendverifyError``: nothing the user gave is wrong; the callers that drive a
     browser catch it and carry on without one.
     """
+
+
+@dataclass
+class FileAccessError(PendverifyError):
+    """A user's file cannot be read, or an output cannot be written: the path and the OS's reason."""
+
+    path: str
+    action: str  # "read" or "write"
+    reason: str
+
+    def __str__(self) -> str:
+        return f"{self.path}: cannot {self.action} it: {self.reason}"
+
+
+@dataclass
+class UserCodeError(PendverifyError):
+    """A user's model file raised (or called sys.exit) while pendverify ran it."""
+
+    source: str  # "FILE" or "FILE, line N"
+    problem: str
+
+    def __str__(self) -> str:
+        return f"{self.source}: {self.problem}"
+
+
+@dataclass
+class OptionConflictError(PendverifyError):
+    """Two options (or an option and an argument) that cannot go together on the command line."""
+
+    first: str
+    second: str
+    rule: str
+
+    def __str__(self) -> str:
+        return f"{self.first} with {self.second}: {self.rule}"

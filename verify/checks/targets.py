@@ -24,7 +24,7 @@ from pathlib import Path
 
 from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
 from pendverify.analytic.params import default_parameter_file, load_parameter_file
-from pendverify.analytic.plugin import load_model_class, plugin_parameters
+from pendverify.analytic.plugin import check_model_outputs, load_model_class, plugin_parameters
 from pendverify.errors import PendverifyError, UnknownNameError
 from pendverify.robot.erd import MODEL as ERD_MODEL
 from pendverify.robot.erd import double_pendulum_urdfs
@@ -115,6 +115,7 @@ def model_target(
         model = cls(params)
     except Exception as exc:
         raise PendverifyError(f"{cls.name}: building the model failed: {type(exc).__name__}: {exc}") from None
+    check_model_outputs(model)
     if name is None:
         name = "urdf-text" if is_urdf_text(urdf) else Path(urdf).stem
     return Target(f"{cls.name}:{name}", model, system, system.source, notes)
