@@ -49,6 +49,13 @@ def add_analytic_option(parser, what: str) -> None:
     )
 
 
+def refuse_together(first: str, second: str, rule: str):
+    """Refuse two options given together (exit status 2), naming both and the rule."""
+    from pendverify.errors import OptionConflictError
+
+    raise OptionConflictError(first, second, rule)
+
+
 def builtin_models(model: str | None, analytic: str | None) -> list[str]:
     """The built-in models that --model names (all when omitted; none with --analytic).
 

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import argparse
 
+from pendverify.atomic import check_output
+
 BLAS_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
 
@@ -46,6 +48,7 @@ def limit_blas() -> tuple[object, str]:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_output(args.output, folder=True)
     guard, blas = limit_blas()
     with guard:
         from pathlib import Path

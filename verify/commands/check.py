@@ -40,7 +40,7 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from pendverify.atomic import write_atomic
+    from pendverify.atomic import check_output, write_atomic
     from pendverify.checks.report import format_table
     from pendverify.checks.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
     from pendverify.checks.targets import default_target, erd_targets, plugin_target, user_target
@@ -48,6 +48,7 @@ def run(args: argparse.Namespace) -> int:
     from pendverify.robot.erd import MODEL as ERD_MODEL
     from pendverify.robot.geometry import MODEL_FORM_RTOL
 
+    check_output(args.json)
     samples = DEFAULT_RANDOM_STATES if args.samples is None else args.samples
     seed = DEFAULT_SEED if args.seed is None else args.seed
     names = builtin_models(args.model, args.analytic)

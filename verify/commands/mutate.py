@@ -37,7 +37,7 @@ def register(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
 
-    from pendverify.atomic import write_atomic
+    from pendverify.atomic import check_output, write_atomic
     from pendverify.checks.sampling import DEFAULT_SEED
     from pendverify.checks.targets import default_target, plugin_target
     from pendverify.errors import PendverifyError
@@ -45,6 +45,7 @@ def run(args: argparse.Namespace) -> int:
     from pendverify.symbolic.mutate import DEFAULT_MUTATION_STATES, run_mutation
     from pendverify.symbolic.mutation_report import format_report
 
+    check_output(args.json)
     names = builtin_models(args.model, args.analytic)
     if args.analytic:
         targets = [plugin_target(args.analytic, args.urdf, args.params)]

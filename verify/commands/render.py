@@ -30,7 +30,8 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from pendverify.atomic import write_atomic
+    from pendverify.atomic import check_output, write_atomic
+    from pendverify.commands import refuse_together
     from pendverify.commands.simulate import urdf_argument
     from pendverify.errors import InputError
     from pendverify.simulation.scene import load_scene
@@ -38,15 +39,14 @@ def run(args: argparse.Namespace) -> int:
 
     if args.scene is None and args.trajectory is None:
         raise InputError("<command line>", "scene", None, "give a scene file, or --trajectory FILE.npz")
+    if args.trajectory:
+        for given, option in ((args.scene, "a scene file"), (args.engine, "--engine"), (args.urdf, "--urdf")):
+            if given is not None:
+                refuse_together("--trajectory", option, "give one: a saved run is drawn as it was simulated")
+    check_output(args.output)
     status = 0
     if args.trajectory:
         traj = Trajectory.from_npz(args.trajectory)
-        if args.scene is not None:
-            scene = load_scene(args.scene)
-            if scene.model != traj.params.model:
-                raise InputError(
-                    args.trajectory, "metadata.model", traj.params.model, f"the scene is {scene.model!r}"
-                )
     else:
         from pendverify.simulation.simulate import simulate
 

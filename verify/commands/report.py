@@ -50,8 +50,11 @@ def shipped_scenes(folder: str | None) -> list[Path]:
 
 
 def run(args: argparse.Namespace) -> int:
+    from pendverify.atomic import check_output
     from pendverify.checks.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
     from pendverify.viz.review_folder import write_review
+
+    check_output(args.output, folder=True)
 
     folder = write_review(
         shipped_scenes(args.scenes),

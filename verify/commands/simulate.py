@@ -46,18 +46,25 @@ def summary(run) -> str:
 def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from pendverify.atomic import write_atomic
+    from pendverify.atomic import check_output, write_atomic
+    from pendverify.commands import refuse_together
     from pendverify.simulation.scene import load_scene
     from pendverify.simulation.simulate import simulate
 
+    if args.csv and not args.output:
+        refuse_together(
+            "--csv", "no -o/--output", "the CSV is written beside the npz of -o; give -o FILE.npz"
+        )
+    csv = Path(args.output).with_suffix(".csv") if args.csv else None
+    for path in (args.output, csv, args.html):
+        check_output(path)
     scene = load_scene(args.scene)
     result = simulate(scene, args.engine, urdf_argument(args.urdf))
     print(summary(result))
     if args.output:
         write_atomic(args.output, result.to_npz_bytes())
         print(f"trajectory written to {args.output}")
-        if args.csv:
-            csv = Path(args.output).with_suffix(".csv")
+        if csv is not None:
             write_atomic(csv, result.to_csv())
             print(f"CSV written to {csv}")
     if args.html:

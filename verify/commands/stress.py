@@ -155,12 +155,13 @@ def report_dict(report) -> dict:
 
 
 def run(args: argparse.Namespace) -> int:
-    from pendverify.atomic import write_atomic
+    from pendverify.atomic import check_output, write_atomic
     from pendverify.errors import PendverifyError, UnknownNameError
     from pendverify.jsonio import to_json
     from pendverify.stress.catalogue import CASE_NAMES, run_catalogue
     from pendverify.stress.framework import FULL, QUICK, SEED
 
+    check_output(args.json)
     seed = SEED if args.seed is None else args.seed
     settings = QUICK if args.quick else FULL
     if args.analytic:

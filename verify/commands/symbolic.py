@@ -23,10 +23,11 @@ def run(args: argparse.Namespace) -> int:
 
     from pendverify.analytic import MODELS
     from pendverify.analytic.plugin import load_model_class
-    from pendverify.atomic import write_atomic
+    from pendverify.atomic import check_output, write_atomic
     from pendverify.jsonio import to_json
     from pendverify.symbolic.compare import compare, format_report
 
+    check_output(args.json)
     names = builtin_models(args.model, args.analytic)
     classes = [load_model_class(args.analytic)] if args.analytic else [MODELS[n] for n in names]
     reports = [compare(cls) for cls in classes]
