@@ -49,10 +49,11 @@ import numpy as np
 
 from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
 from pendverify.analytic.params import default_parameter_file, load_parameter_file, read_toml
-from pendverify.analytic.plugin import load_model_class, plugin_parameters
+from pendverify.analytic.plugin import check_model_outputs, load_model_class, plugin_parameters
 from pendverify.errors import InputError, PendverifyError, SceneError
 from pendverify.simulation.effects import parse_actuation, parse_disturbance
 from pendverify.simulation.laws import Law
+from pendverify.simulation.limits import check_scene_work
 from pendverify.simulation.scene_reader import TableReader
 
 ADAPTIVE_METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
@@ -228,6 +229,7 @@ def parse_scene(data: dict, source: str, base: Path | None = None) -> Scene:
         if step > duration:
             integ.fail("step", step, f"expected a step <= the duration ({duration:g} s)")
         integrator = Integrator(method, step=step)
+    check_scene_work(source, duration, sample_rate, integrator.step, 2 * n)
 
     effects = top.sub("effects", required=False) or TableReader({}, source, "effects.")
     effects.only(("gravity", "damping", "actuation", "disturbance"))
@@ -245,6 +247,8 @@ def parse_scene(data: dict, source: str, base: Path | None = None) -> Scene:
         effects.sub("actuation", required=False), model_cls, params.replace(g=gravity or 0.0)
     )
     disturbance = parse_disturbance(effects.sub("disturbance", required=False), model_cls)
+    if model_file is not None:
+        check_model_outputs(model_cls(params))
     return Scene(
         name=name,
         source=source,
