@@ -34,7 +34,7 @@ import sys
 from pathlib import Path
 from typing import Any, ClassVar, TypeVar
 
-from pendverify.errors import ParameterError
+from pendverify.errors import FileAccessError, ParameterError
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -70,7 +70,10 @@ def check_value(source: str, key: str, value: object, kind: str) -> float:
     rule = _rule_text(kind)
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ParameterError(source, key, value, rule + f"; got a {type(value).__name__}")
-    x = float(value)
+    try:
+        x = float(value)
+    except OverflowError:  # a TOML integer beyond a double
+        x = math.inf
     if not math.isfinite(x):
         raise ParameterError(source, key, value, rule)
     strict = _RULES[kind][0] == "> 0"
@@ -143,11 +146,25 @@ def read_toml(path: Path) -> dict[str, Any]:
     """Parse a TOML file, turning syntax errors into a ParameterError that names the file."""
     try:
         with open(path, "rb") as fh:
-            return tomllib.load(fh)
+            raw = fh.read()
     except FileNotFoundError:
         raise ParameterError(str(path), "<file>", str(path), "file not found") from None
+    except IsADirectoryError:
+        raise ParameterError(str(path), "<file>", str(path), "is a directory, not a TOML file") from None
+    except OSError as exc:
+        raise FileAccessError(str(path), "read", exc.strerror or str(exc)) from None
+    try:
+        text = raw.decode("utf-8-sig")  # a byte-order mark is allowed, as in URDFs
+    except UnicodeDecodeError as exc:
+        raise ParameterError(
+            str(path), "<file>", str(path), f"not UTF-8 text (byte {exc.start}: {exc.reason}); TOML is UTF-8"
+        ) from None
+    try:
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError(str(path), "<file>", str(path), f"not valid TOML: {exc}") from None
+    except RecursionError:
+        raise ParameterError(str(path), "<file>", str(path), "not valid TOML: nested too deeply") from None
 
 
 def parse_parameter_document(data: dict[str, Any], source: str, registry: dict[str, type[ParameterSet]]):

@@ -112,6 +112,8 @@ class Trajectory:
             raise TrajectoryError(source, str(exc).strip("'"), None, "missing array in the npz") from None
         except (ValueError, OSError) as exc:
             raise TrajectoryError(source, "<file>", source, f"not a pendverify npz: {exc}") from None
+        if not isinstance(meta, dict):
+            raise TrajectoryError(source, "metadata", type(meta).__name__, "must be a JSON object")
         model = meta.get("model")
         model_file = meta.get("model_file")
         if model_file is not None:  # a plug-in run: its model file and URDF, as recorded
@@ -124,11 +126,26 @@ class Trajectory:
         else:
             known = ", ".join(PARAMETER_TYPES)
             raise TrajectoryError(source, "metadata.model", model, f"expected one of {known} or a model_file")
-        params = param_type.from_mapping(meta.get("parameters", {}), source, "metadata.parameters.")
-        t = np.asarray(t, dtype=float)
-        q = np.asarray(q, dtype=float)
-        q = q.reshape(len(t), -1) if q.ndim == 1 and len(t) else q
+        parameters = meta.get("parameters", {})
+        if not isinstance(parameters, dict):
+            raise TrajectoryError(source, "metadata.parameters", parameters, "must be a JSON object")
+        params = param_type.from_mapping(parameters, source, "metadata.parameters.")
+        t, q = _samples(source, t, q)
         return cls(t, q, params, str(meta.get("scene", path.stem)), source, model_cls, urdf)
+
+
+def _samples(source: str, t, q) -> tuple[np.ndarray, np.ndarray]:
+    """A saved run's t (finite, increasing) and q (one finite row per time), or a TrajectoryError."""
+    try:
+        t, q = np.asarray(t, dtype=float), np.asarray(q, dtype=float)
+    except (TypeError, ValueError):
+        raise TrajectoryError(source, "t, q", None, "must be arrays of numbers") from None
+    if t.ndim != 1 or t.size == 0 or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
+        raise TrajectoryError(source, "t", t.shape, "must be a non-empty vector of finite, increasing times")
+    q = q.reshape(len(t), -1) if q.ndim == 1 and q.size % t.size == 0 else q
+    if q.ndim != 2 or q.shape[0] != t.size or q.shape[1] == 0 or not np.all(np.isfinite(q)):
+        raise TrajectoryError(source, "q", q.shape, f"must be {t.size} rows of finite coordinates, one per t")
+    return t, q
 
 
 def resample(t: np.ndarray, q: np.ndarray, fps: float) -> tuple[np.ndarray, np.ndarray]:

@@ -60,7 +60,10 @@ class TableReader:
         value = self.get(key, default)
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             self.fail(key, value, "expected a number")
-        x = float(value)
+        try:
+            x = float(value)
+        except OverflowError:  # a TOML integer beyond a double
+            x = math.inf
         if not math.isfinite(x):
             self.fail(key, value, "expected a finite number")
         if positive and not x > 0:
@@ -79,7 +82,10 @@ class TableReader:
             self.fail(key, value, f"expected a list of {length} numbers")
         if len(value) != length:
             self.fail(key, value, f"expected a list of {length} numbers, got {len(value)}")
-        arr = np.array(value, dtype=float)
+        try:
+            arr = np.array(value, dtype=float)
+        except OverflowError:  # a TOML integer beyond a double
+            self.fail(key, value, "expected finite numbers")
         if not np.all(np.isfinite(arr)):
             self.fail(key, value, "expected finite numbers")
         if minimum is not None and np.any(arr < minimum):
