@@ -157,6 +157,8 @@ def validate_model_class(cls: type[ClosedFormModel], path: str | Path | None = N
 def load_model_class(path: str | Path) -> type[ClosedFormModel]:
     """The one ClosedFormModel subclass a model file defines, validated."""
     path = Path(path)
+    if path.is_dir():
+        raise PendverifyError(f"{path}: is a directory, not a model file")
     if not path.is_file():
         raise PendverifyError(f"{path}: model file not found")
     if path.suffix != ".py":
@@ -232,6 +234,8 @@ def check_model_outputs(model: ClosedFormModel) -> None:
             value = np.asarray(getattr(model, method)(*args), dtype=float)
         except KeyboardInterrupt:
             raise
+        except ArithmeticError:  # the parameters' size, not the code: the checks refuse such states
+            continue
         except (TypeError, ValueError) as exc:
             user = user_code_error(exc)
             if user is not None:

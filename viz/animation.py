@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import json
 import math
+import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -110,8 +111,9 @@ class Trajectory:
                 t, q, meta = npz["t"], npz["q"], json.loads(str(npz["metadata"]))
         except KeyError as exc:
             raise TrajectoryError(source, str(exc).strip("'"), None, "missing array in the npz") from None
-        except (ValueError, OSError) as exc:
-            raise TrajectoryError(source, "<file>", source, f"not a pendverify npz: {exc}") from None
+        except (ValueError, OSError, EOFError, zipfile.BadZipFile) as exc:  # JSON's errors are ValueErrors
+            reason = str(exc) or type(exc).__name__
+            raise TrajectoryError(source, "<file>", source, f"not a pendverify npz: {reason}") from None
         if not isinstance(meta, dict):
             raise TrajectoryError(source, "metadata", type(meta).__name__, "must be a JSON object")
         model = meta.get("model")

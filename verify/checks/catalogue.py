@@ -152,6 +152,10 @@ class _Judged:
         return self.rel_err / self.rel_tol if np.isfinite(self.rel_err) else np.inf
 
 
+#: what evaluating a state raises when its numbers leave double's range (parameters of 1e200)
+OUT_OF_RANGE = (OverflowError, FloatingPointError, np.linalg.LinAlgError)
+
+
 def _judge(check: Check, model, system, state: State, rounding: float) -> _Judged:
     sample = check.evaluate(model, system, state)
     if sample.scale > 0:
@@ -207,7 +211,12 @@ def run_check(check: Check, label: str, model, system, states, seed: int) -> Che
         if not rounding <= REFUSE_REL:
             refused.append((state, rounding))
             continue
-        j = _judge(check, model, system, state, rounding)
+        try:
+            j = _judge(check, model, system, state, rounding)
+        except OUT_OF_RANGE as exc:  # terms beyond double's range: nothing can be verified there
+            refused.append((state, np.inf))
+            notes.append(f"{state.label}: refused: its terms overflow double ({type(exc).__name__}: {exc})")
+            continue
         if j.note and len(notes) < 3:
             notes.append(f"{state.label}: {j.note}")
         judged.append((i, state, rounding, j))

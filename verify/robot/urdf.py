@@ -70,7 +70,7 @@ def load_urdf(urdf: str | Path, source: str | None = None) -> LoadedUrdf:
         path = Path(urdf)
         source = source or str(path)
         if not path.is_file():
-            raise UrdfShapeError(source, "file not found")
+            raise UrdfShapeError(source, "is a directory, not a file" if path.is_dir() else "file not found")
         text = read_text_file(path, source)
     else:
         text, source = urdf, source or URDF_TEXT_SOURCE

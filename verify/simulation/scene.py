@@ -275,7 +275,8 @@ def parse_scene(data: dict, source: str, base: Path | None = None) -> Scene:
 def load_scene(path: str | Path) -> Scene:
     path = Path(path)
     if not path.is_file():
-        raise SceneError(str(path), "<file>", str(path), "scene file not found")
+        what = "is a directory, not a scene file" if path.is_dir() else "scene file not found"
+        raise SceneError(str(path), "<file>", str(path), what)
     try:
         data = read_toml(path)
     except InputError as exc:
