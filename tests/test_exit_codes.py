@@ -300,12 +300,25 @@ def test_ctrl_c_in_a_real_process(tmp_path):
     assert done.returncode == 130 and done.stderr.decode() == "pendverify: interrupted\n"
 
 
+#: the POSIX locale without Python's automatic UTF-8 mode (PEP 540), as a minimal container runs it
+POSIX = {"LC_ALL": "POSIX", "PYTHONUTF8": "0"}
+
+
 def test_utf8_output_under_the_posix_locale(tmp_path):
+    # a URDF with a non-ASCII comment, read and reported under the POSIX locale: UTF-8 in and out
+    urdf = tmp_path / "θ.urdf"
+    urdf.write_bytes(URDF.read_bytes().replace(b"<robot", "<!-- θ₁, κ̃ · m -->\n<robot".encode(), 1))
     out = tmp_path / "r.json"
-    done = _run(["check", "--params", str(PARAMS), "--samples", "0", "--json", str(out)], LC_ALL="POSIX")
+    argv = ["check", "--params", str(PARAMS), "--urdf", str(urdf), "--samples", "0", "--json", str(out)]
+    done = _run(argv, **POSIX)
     assert done.returncode == 0, done.stderr.decode()
-    assert "κ̃" in done.stdout.decode("utf-8") or "θ" in done.stdout.decode("utf-8")
-    out.read_bytes().decode("utf-8")
+    stdout = done.stdout.decode("utf-8")
+    assert "θ" in stdout and "·" in stdout
+    assert "θ.urdf" in out.read_bytes().decode("utf-8")
+    html = tmp_path / "a.html"
+    done = _run(["simulate", str(SCENE), "--html", str(html)], **POSIX)
+    assert done.returncode == 0, done.stderr.decode()
+    html.read_bytes().decode("utf-8")
 
 
 def test_usage_errors_stay_2(capsys):

@@ -43,9 +43,7 @@ def check_output(path: str | Path | None, folder: bool = False) -> None:
     """
     if path is None:
         return
-    path = Path(path)
-    if str(path) == "":
-        raise FileAccessError("''", "write", "an empty path")
+    path = Path(path)  # "" is "."
     if path.is_dir() and not folder:
         raise FileAccessError(str(path), "write", "it is a directory, not a file")
     if path.exists() and folder and not path.is_dir():
@@ -61,6 +59,24 @@ def check_output(path: str | Path | None, folder: bool = False) -> None:
     os.unlink(probe)
 
 
+def utf8_bytes(text: str) -> bytes:
+    """``text`` as UTF-8, always valid UTF-8.
+
+    A path the OS gave in bytes the locale could not decode holds lone surrogates: they
+    become the original bytes again when those are UTF-8 (``θ.urdf`` under
+    ``LC_ALL=POSIX``), else a visible ``\\udcXX`` escape — never a silent '?'.
+    """
+    try:
+        return text.encode("utf-8")
+    except UnicodeEncodeError:
+        raw = text.encode("utf-8", "surrogateescape")
+        try:
+            raw.decode("utf-8")
+        except UnicodeDecodeError:
+            return text.encode("utf-8", "backslashreplace")
+        return raw
+
+
 def write_atomic(path: str | Path, data: str | bytes) -> Path:
     """Write ``data`` (text as UTF-8) to a temporary file beside ``path``, fsync it, rename it into place."""
     path = Path(path)
@@ -69,7 +85,7 @@ def write_atomic(path: str | Path, data: str | bytes) -> Path:
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     except OSError as exc:
         raise FileAccessError(str(path), "write", _reason(exc)) from None
-    payload = data if isinstance(data, bytes) else data.encode("utf-8")
+    payload = data if isinstance(data, bytes) else utf8_bytes(data)
     try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(payload)

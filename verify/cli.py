@@ -37,11 +37,17 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def utf8_streams() -> None:
-    """Write stdout and stderr as UTF-8 (the reports hold θ, κ̃, ·) whatever the locale says."""
+    """Write stdout and stderr as UTF-8 (the reports hold θ, κ̃, ·) whatever the locale says.
+
+    A path the OS gave in bytes the locale cannot decode (``θ.urdf`` under ``LC_ALL=POSIX``)
+    is written back as those same bytes (surrogateescape), not as an error.
+    """
     for stream in (sys.stdout, sys.stderr):
         reconfigure = getattr(stream, "reconfigure", None)
-        if reconfigure is not None and (stream.encoding or "").lower().replace("-", "") != "utf8":
-            reconfigure(encoding="utf-8")
+        utf8 = (stream.encoding or "").lower().replace("-", "") == "utf8"
+        if reconfigure is not None and not (utf8 and stream.errors == "surrogateescape"):
+            stream.flush()
+            reconfigure(encoding="utf-8", errors="surrogateescape")
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -24,6 +24,7 @@ import pinocchio as pin
 
 from pendverify.analytic import ParameterSet
 from pendverify.robot.system import PinocchioSystem
+from pendverify.robot.urdf import read_text_file
 from pendverify.robot.writer import urdf_for
 
 ROOT = "pendverify"
@@ -59,7 +60,7 @@ class VisualSystem:
 
         The way a model file (plug-in) is drawn: its URDF is the one the simulation integrated.
         """
-        text = Path(urdf).read_text() if _is_path(urdf) else str(urdf)
+        text = read_text_file(Path(urdf), str(urdf)) if _is_path(urdf) else str(urdf)
         system = PinocchioSystem.for_model(model_cls, text, g, str(urdf) if _is_path(urdf) else None)
         visual_model = pin.buildGeomFromUrdfString(system.model, text, pin.GeometryType.VISUAL)
         return cls(system, visual_model, visual_model.createData(), text)

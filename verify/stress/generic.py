@@ -29,6 +29,7 @@ from pathlib import Path
 from pendverify.checks.targets import plugin_target
 from pendverify.errors import PendverifyError, UnknownNameError
 from pendverify.robot.rebind import Binding
+from pendverify.robot.urdf import read_text_file
 from pendverify.stress.cases import high_speed_case, large_angle_case
 from pendverify.stress.catalogue import StressReport, run_case
 from pendverify.stress.framework import SEED, Case, Context, Settings, StressResult, checks_case
@@ -111,7 +112,7 @@ def run_generic(
     """``pendverify stress --analytic FILE --urdf URDF --params PARAMS``: the generic cases, run."""
     started = time.perf_counter()
     target = plugin_target(model_file, urdf, params_file)  # validates the three files, as check does
-    text = Path(urdf).read_text()
+    text = read_text_file(Path(urdf), urdf)  # UTF-8 (a BOM allowed) whatever the locale
     cases, notes = generic_cases(type(target.model), target.model.params, text, urdf)
     known = tuple(c.name for c in cases)
     for name in names or ():

@@ -172,7 +172,7 @@ def kernel(model_cls, fresh: bool = False) -> GeneratedKernel:
         module = _MEMORY[digest]
         return GeneratedKernel(module, digest, Path(module.__file__), "memory", time.perf_counter() - start)
     if index is not None and index.is_file():
-        digest = index.read_text().strip()
+        digest = index.read_text(encoding="utf-8").strip()
         path = _module_path(model_cls.name, digest)
         if path.is_file() and hashlib.sha256(path.read_bytes()).hexdigest() == digest:
             module = _import(path, digest)
@@ -181,7 +181,7 @@ def kernel(model_cls, fresh: bool = False) -> GeneratedKernel:
     source = _module.render(_expressions.expressions(model_cls))
     digest = hashlib.sha256(source.encode()).hexdigest()
     path = _module_path(model_cls.name, digest)
-    if not (path.is_file() and path.read_text() == source):
+    if not (path.is_file() and path.read_text(encoding="utf-8") == source):
         write_atomic(path, source)  # never rewritten otherwise: numba's cache keys on the file's mtime
     module = _import(path, digest)
     if key:
