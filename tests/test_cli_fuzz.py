@@ -236,49 +236,70 @@ def sample_limit(limit: str):
             os.environ["PENDVERIFY_MAX_SAMPLES"] = old
 
 
-@seed(FUZZ_SEED)
-@FUZZ
-@given(params=PARAM_FILES, as_dir=AS_DIRECTORY, output=OUTPUTS)
+def fuzz(**strategies):
+    """A seeded (``FUZZ_SEED``), bounded hypothesis test over ``strategies``."""
+
+    def wrap(test):
+        return seed(FUZZ_SEED)(FUZZ(given(**strategies)(test)))
+
+    return wrap
+
+
+def contract_with_file(name: str, content: bytes, as_directory: bool, argv) -> None:
+    """Write the input ``name`` (or make it a directory); assert the contract on ``argv(path, folder)``."""
+    with workdir() as folder:
+        assert_contract(argv(_input(folder, name, content, as_directory), folder))
+
+
+@fuzz(params=PARAM_FILES, as_dir=AS_DIRECTORY, output=OUTPUTS)
 def test_fuzz_check_params(params, as_dir, output):
-    with workdir() as folder:
-        path = _input(folder, "p.toml", params, as_dir)
-        assert_contract(
-            ["check", "--params", path, "--samples", "2", "--json", _output(folder, output, "r.json")]
-        )
+    def argv(path, folder):
+        return ["check", "--params", path, "--samples", "2", "--json", _output(folder, output, "r.json")]
+
+    contract_with_file("p.toml", params, as_dir, argv)
 
 
-@seed(FUZZ_SEED)
-@FUZZ
-@given(urdf=urdf_files(), as_dir=AS_DIRECTORY, with_params=st.booleans())
+@fuzz(urdf=urdf_files(), as_dir=AS_DIRECTORY, with_params=st.booleans())
 def test_fuzz_check_urdf(urdf, as_dir, with_params):
-    with workdir() as folder:
-        path = _input(folder, "u.urdf", urdf, as_dir)
-        given_params = (
-            ["--params", str(REPO / "analytic" / "params" / "double_pendulum.toml")] if with_params else []
-        )
-        assert_contract(
-            ["check", "--model", "double_pendulum", "--urdf", path, "--samples", "2", *given_params]
-        )
+    given_params = (
+        ["--params", str(REPO / "analytic" / "params" / "double_pendulum.toml")] if with_params else []
+    )
+    contract_with_file(
+        "u.urdf",
+        urdf,
+        as_dir,
+        lambda path, _: [
+            "check",
+            "--model",
+            "double_pendulum",
+            "--urdf",
+            path,
+            "--samples",
+            "2",
+            *given_params,
+        ],
+    )
 
 
-@seed(FUZZ_SEED)
-@FUZZ
-@given(model=model_files(), as_dir=AS_DIRECTORY)
+@fuzz(model=model_files(), as_dir=AS_DIRECTORY)
 def test_fuzz_check_model_file(model, as_dir):
-    with workdir() as folder:
-        path = _input(folder, "mine.py", model, as_dir)
-        argv = ["check", "--analytic", path, "--urdf", str(REPO / "urdf" / "double_pendulum.urdf")]
-        assert_contract([*argv, "--params", str(MINIMAL_PARAMS), "--samples", "2"])
+    urdf = str(REPO / "urdf" / "double_pendulum.urdf")
+    rest = ["--urdf", urdf, "--params", str(MINIMAL_PARAMS), "--samples", "2"]
+    contract_with_file("mine.py", model, as_dir, lambda path, _: ["check", "--analytic", path, *rest])
 
 
-@seed(FUZZ_SEED)
-@FUZZ
-@given(scene=SCENE_FILES, output=OUTPUTS, html=st.booleans())
+@fuzz(scene=SCENE_FILES, output=OUTPUTS, html=st.booleans())
 def test_fuzz_simulate(scene, output, html):
-    with workdir() as folder, sample_limit("3000"):
-        path = _input(folder, "s.toml", scene, False)
-        target = ["--html" if html else "-o", _output(folder, output, "run.html" if html else "run.npz")]
-        assert_contract(["simulate", path, *target])
+    def argv(path, folder):
+        return [
+            "simulate",
+            path,
+            "--html" if html else "-o",
+            _output(folder, output, "run.html" if html else "run.npz"),
+        ]
+
+    with sample_limit("3000"):
+        contract_with_file("s.toml", scene, False, argv)
 
 
 @st.composite
@@ -312,10 +333,11 @@ def trajectories(draw) -> bytes:
     return buffer.getvalue()
 
 
-@seed(FUZZ_SEED)
-@FUZZ
-@given(npz=trajectories(), output=OUTPUTS)
+@fuzz(npz=trajectories(), output=OUTPUTS)
 def test_fuzz_render_trajectory(npz, output):
-    with workdir() as folder:
-        path = _input(folder, "run.npz", npz, False)
-        assert_contract(["render", "--trajectory", path, "-o", _output(folder, output, "x.html")])
+    contract_with_file(
+        "run.npz",
+        npz,
+        False,
+        lambda path, folder: ["render", "--trajectory", path, "-o", _output(folder, output, "x.html")],
+    )

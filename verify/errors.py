@@ -36,14 +36,18 @@ class ParameterError(InputError):
 
 
 @dataclass
-class UrdfShapeError(PendverifyError):
-    """A URDF does not have the structure a model needs."""
+class PlaceError(PendverifyError):
+    """A problem at a place: ``source`` names the file (", line N" where known)."""
 
     source: str
     problem: str
 
     def __str__(self) -> str:
         return f"{self.source}: {self.problem}"
+
+
+class UrdfShapeError(PlaceError):
+    """A URDF does not have the structure a model needs."""
 
 
 @dataclass
@@ -128,36 +132,16 @@ class BrowserError(RuntimeError):
     """
 
 
-@dataclass
-class FileAccessError(PendverifyError):
+class FileAccessError(PlaceError):
     """A user's file cannot be read, or an output cannot be written: the path and the OS's reason."""
 
-    path: str
-    action: str  # "read" or "write"
-    reason: str
-
-    def __str__(self) -> str:
-        return f"{self.path}: cannot {self.action} it: {self.reason}"
+    def __init__(self, path: str, action: str, reason: str):
+        super().__init__(path, f"cannot {action} it: {reason}")  # action: "read" or "write"
 
 
-@dataclass
-class UserCodeError(PendverifyError):
+class UserCodeError(PlaceError):
     """A user's model file raised (or called sys.exit) while pendverify ran it."""
 
-    source: str  # "FILE" or "FILE, line N"
-    problem: str
 
-    def __str__(self) -> str:
-        return f"{self.source}: {self.problem}"
-
-
-@dataclass
 class OptionConflictError(PendverifyError):
     """Two options (or an option and an argument) that cannot go together on the command line."""
-
-    first: str
-    second: str
-    rule: str
-
-    def __str__(self) -> str:
-        return f"{self.first} with {self.second}: {self.rule}"

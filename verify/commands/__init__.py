@@ -53,7 +53,7 @@ def refuse_together(first: str, second: str, rule: str):
     """Refuse two options given together (exit status 2), naming both and the rule."""
     from pendverify.errors import OptionConflictError
 
-    raise OptionConflictError(first, second, rule)
+    raise OptionConflictError(f"{first} with {second}: {rule}")
 
 
 def builtin_models(model: str | None, analytic: str | None) -> list[str]:
