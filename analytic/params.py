@@ -123,6 +123,14 @@ class ParameterSet:
             return cls(**values)
         except ParameterError as exc:  # a rule across fields: name the file
             raise ParameterError(source, prefix + exc.key, exc.value, exc.rule) from None
+        except OverflowError:  # a rule across fields computed x**2 beyond a double
+            key = max(values, key=lambda k: abs(values[k]))
+            raise ParameterError(
+                source,
+                prefix + key,
+                values[key],
+                f"too large: the {cls.model} terms built from it overflow a double",
+            ) from None
 
     def as_dict(self) -> dict[str, float]:
         return dataclasses.asdict(self)

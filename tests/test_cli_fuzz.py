@@ -7,7 +7,7 @@ and runs ``main([...])`` in-process.  Every run must end with status 0, 1 or 2 (
 a bug to fix), no traceback, and at most one error line (exactly one for status 2).
 
 Seeded (``FUZZ_SEED``) and without an example database, so every run tries the same
-inputs; 40 examples per command keep the file well under a minute.  The scenes run
+inputs; 80 examples per command keep the file well under a minute.  The scenes run
 with ``PENDVERIFY_MAX_SAMPLES`` lowered to 3000 so that no example integrates for long.
 """
 
@@ -38,7 +38,7 @@ DEFAULT_PARAMETERS = load_parameter_file(REPO / "analytic" / "params" / "double_
 
 FUZZ_SEED = 20261129
 FUZZ = settings(
-    max_examples=40,
+    max_examples=80,
     deadline=20_000,  # ms per example: a hang is a failure too
     database=None,
     suppress_health_check=[HealthCheck.too_slow],

@@ -96,6 +96,16 @@ def test_huge_masses_are_refused_not_a_crash(tmp_path, capsys):
         assert "refused" in capsys.readouterr().out
 
 
+def test_a_length_whose_square_overflows(tmp_path, capsys):
+    path = tmp_path / "p.toml"
+    path.write_text(PARAMS.read_text().replace("l1 = 0.5", "l1 = 1e300"))
+    assert main(["check", "--params", str(path)]) == 2
+    assert error_line(capsys) == (
+        f"pendverify: error: {path}: key 'parameters.l1' = 1e+300: too large: the double_pendulum terms "
+        "built from it overflow a double"
+    )
+
+
 def test_toml_integer_beyond_a_double(tmp_path, capsys):
     path = tmp_path / "p.toml"
     path.write_text(PARAMS.read_text().replace("m1 = 1.0", "m1 = " + "9" * 400))
@@ -245,6 +255,25 @@ def test_scene_work_is_bounded(tmp_path, capsys, old, new, key, estimate):
     line = error_line(capsys)
     assert f"{path}: {key}" in line and f"≈ {estimate}" in line and "limit of 1e+06" in line
     assert "PENDVERIFY_MAX_SAMPLES" in line
+
+
+@pytest.mark.parametrize(
+    "integrator, expected",
+    [
+        (
+            'method = "DOP853"',
+            "DOP853 failed at t = 0 s: Required step size is less than spacing between numbers",
+        ),
+        ('method = "rk4"\nstep = 0.01', "rk4 left double's range at t = 0.005 s (the state overflowed)"),
+    ],
+)
+def test_a_scene_beyond_double_precision(tmp_path, capsys, integrator, expected):
+    text = SCENE.read_text().replace("gravity = true", "gravity = 1e300")
+    path = tmp_path / "s.toml"
+    path.write_text(text.replace('method = "DOP853"\nrtol = 1e-10\natol = 1e-10', integrator))
+    assert main(["simulate", str(path)]) == 2
+    line = error_line(capsys)
+    assert line.startswith(f"pendverify: error: {path}: {expected}")
 
 
 def test_the_work_limit_is_overridable(tmp_path, monkeypatch, capsys):

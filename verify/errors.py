@@ -143,5 +143,9 @@ class UserCodeError(PlaceError):
     """A user's model file raised (or called sys.exit) while pendverify ran it."""
 
 
+class IntegrationError(PlaceError):
+    """The integrator cannot follow a scene's dynamics (``source`` names the scene)."""
+
+
 class OptionConflictError(PendverifyError):
     """Two options (or an option and an argument) that cannot go together on the command line."""

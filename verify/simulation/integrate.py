@@ -16,6 +16,8 @@ from itertools import pairwise
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from pendverify.errors import IntegrationError
+
 PROGRESS_CHUNKS = 20
 
 
@@ -42,6 +44,21 @@ def _progress(total: int, label: str):
     except ImportError:  # pragma: no cover - tqdm is a dependency
         return None
     return tqdm(total=total, desc=label, unit="seg", disable=quiet, leave=False)
+
+
+def _finite(rhs, label: str):
+    """``rhs`` refusing a state that left double's range: a fixed step has no step-size control to stop it."""
+
+    def guarded(t, x):
+        if not np.all(np.isfinite(x)):
+            raise IntegrationError(
+                label,
+                f"rk4 left double's range at t = {t:.6g} s (the state overflowed); the scene's values "
+                "(gravity, damping, initial state) ask for a smaller step or are beyond double precision",
+            )
+        return rhs(t, x)
+
+    return guarded
 
 
 def _rk4_segment(rhs, t0, t1, x0, h):
@@ -92,13 +109,18 @@ def integrate(rhs, x0, duration, integrator, sample_times, breakpoints=(), label
                 dense_output=True,
             )
             if sol.status != 0:
-                raise RuntimeError(f"{integrator.method} failed at t = {sol.t[-1]:.6g} s: {sol.message}")
+                raise IntegrationError(
+                    label,
+                    f"{integrator.method} failed at t = {sol.t[-1]:.6g} s: {sol.message.rstrip('.')}; the "
+                    "scene's values (gravity, damping, initial state, rtol/atol) ask for more than the "
+                    "integrator can follow in double precision",
+                )
             ts, xs = sol.t, sol.y.T
             nfev += sol.nfev
             if inside.size:
                 samples_x.append(sol.sol(inside).T)
         else:
-            ts, xs, fs, n = _rk4_segment(rhs, a, b, x, integrator.step)
+            ts, xs, fs, n = _rk4_segment(_finite(rhs, label), a, b, x, integrator.step)
             nfev += n
             if inside.size:
                 samples_x.append(_hermite(ts, xs, fs, inside))

@@ -16,6 +16,7 @@ import numpy as np
 
 from pendverify.checks.scaling import norm2, rate_scale, scaled_matrix, weights
 from pendverify.checks.trust import EPS
+from pendverify.errors import IntegrationError
 from pendverify.jsonio import to_json, versions
 from pendverify.simulation.dynamics import Dynamics, build_dynamics
 from pendverify.simulation.integrate import Integration, integrate
@@ -144,7 +145,10 @@ def simulate(scene: Scene, engine: str | None = None, urdf: str | None = None) -
     n_samples = int(np.floor(scene.duration * scene.sample_rate + 1e-9)) + 1
     sample_times = np.arange(n_samples) / scene.sample_rate
     bps = _breakpoints(scene)
-    run = integrate(dyn.rhs, x0, scene.duration, scene.integrator, sample_times, bps, label=scene.name)
+    try:
+        run = integrate(dyn.rhs, x0, scene.duration, scene.integrator, sample_times, bps, label=scene.name)
+    except IntegrationError as exc:  # name the scene's file
+        raise IntegrationError(scene.source, exc.problem) from None
     scale = energy_scale(dyn, run.steps_x)
     if scene.integrator.adaptive:
         bound = adaptive_bound(dyn, run.steps_x, scene.integrator, scale)
