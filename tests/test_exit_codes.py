@@ -210,6 +210,26 @@ def test_a_model_file_that_exits_or_raises(tmp_path, capsys, text, expected):
     assert str(tmp_path / "mine.py") in line and expected in line, line
 
 
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["sympy", "--analytic", "{m}"],
+        ["mutate", "--analytic", "{m}", "--urdf", str(URDF), "--params", str(MINIMAL_PARAMS)],
+        ["stress", "--analytic", "{m}", "--urdf", str(URDF), "--params", str(MINIMAL_PARAMS)],
+        ["simulate", "{scene}"],
+    ],
+    ids=["sympy", "mutate", "stress", "simulate"],
+)
+def test_every_command_loading_a_model_file_turns_its_exit_into_status_2(tmp_path, capsys, argv):
+    model = tmp_path / "mine.py"
+    model.write_text("import sys\nsys.exit(0)\n")
+    scene = tmp_path / "s.toml"
+    scene.write_text(SCENE.read_text().replace('model = "double_pendulum"', 'model = "mine.py"'))
+    assert main([a.format(m=model, scene=scene) for a in argv]) == 2
+    line = error_line(capsys)
+    assert f"{model}, line 2: importing it failed: SystemExit(0)" in line, line
+
+
 def test_a_model_raising_at_some_states_names_its_line(tmp_path, capsys):
     body = (
         "        if abs(q[0]) > 1:\n"
