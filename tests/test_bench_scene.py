@@ -12,10 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pendverify.bench import run as benchrun
 from pendverify.bench import seed_problems, workprecision
 from pendverify.bench.problems import build_problem, engine_rhs, scene_problems
 from pendverify.cli import main
+from tests.test_bench import SMALL, run_quick
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 REFERENCE_MARGIN = 1000.0
@@ -60,25 +60,12 @@ impulse = [0.05]
 )
 
 TINY = replace(
-    workprecision.QUICK,
-    name="test",
-    tolerances=(1e-4, 1e-7, 1e-10),
-    other_tolerances=(1e-4, 1e-7),
-    fixed={
-        "euler": (2.0**-7, 3),
-        "symplectic_euler": (2.0**-7, 3),
-        "implicit_midpoint": (2.0**-5, 3),
-        "rk4": (2.0**-4, 3),
-    },
-    long_fixed={"symplectic_euler": (2.0**-4, 2), "implicit_midpoint": (2.0**-4, 2), "rk4": (2.0**-3, 2)},
-    repeats=1,
-    run_budget=0.5,
-    grid_intervals=16,
-    digits=(20, 26),
+    SMALL,
+    name="test scene",
     ensemble_size=8,
-    ensemble_checked=2,
-    scene_horizon=1.0,
-    scene_long=20.0,
+    ensemble_variants=("threads",),
+    scene_horizon=1.0,  # s: the scene's state problem (its duration is 5 s)
+    scene_long=20.0,  # s: its energy-only run
 )
 
 
@@ -93,18 +80,8 @@ def bench(tmp_path_factory):
     """The CLI once on a conservative cart-pole scene, --quick with the tiny configuration."""
     folder = tmp_path_factory.mktemp("bench_scene")
     scene = write_scene(folder, "cart_pole_swing")
-    captured = {}
-    real = benchrun.run_benchmark
-
-    def keep(*args, **kwargs):
-        captured["results"] = real(*args, **kwargs)
-        return captured["results"]
-
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(workprecision, "QUICK", TINY)
-        mp.setattr(benchrun, "run_benchmark", keep)
-        status = main(["bench", "accuracy", "--scene", str(scene), "--quick", "-o", str(folder / "out")])
-    return status, folder / "out", captured["results"]
+    status, results = run_quick(["--scene", str(scene), "-o", str(folder / "out")], TINY)
+    return status, folder / "out", results
 
 
 def test_scene_run_writes_its_problems(bench):
