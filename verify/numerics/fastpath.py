@@ -48,7 +48,7 @@ evaluates the *same* invariants as ``pendverify.simulation.simulate``
 adaptive bound.
 
 JIT.  The generated functions are compiled on first use and cached on disk (numba
-``cache=True``, beside the generated module); ``warm_up()`` triggers compilation
+``cache=True``, beside the generated module); ``warm_up(systems)`` triggers compilation
 and returns the seconds it took, so that benchmarks report it separately from
 per-run timings.
 """
@@ -336,21 +336,24 @@ def integrate_ensemble(system: GeneratedSystem, X0, t_end, rtol, atol, threads: 
     return X, nfev
 
 
-def warm_up() -> float:
-    """Generate (or load) the seeds' modules and compile (or load from numba's cache) their stepper;
-    the seconds it took."""
-    from pendverify.analytic import CartDoublePendulum, DoublePendulum
-    from pendverify.analytic.params import default_parameter_file, load_parameter_file
-
+def warm_up(systems) -> float:
+    """Compile (or load from numba's cache) the stepper of each distinct generated module among
+    ``systems`` (``GeneratedSystem``s: a benchmark passes its problems'); the seconds it took."""
     start = time.perf_counter()
-    for cls in (DoublePendulum, CartDoublePendulum):
-        model = cls(load_parameter_file(default_parameter_file(cls.name))[2])
-        system = GeneratedSystem.from_model(model)
-        x0 = np.full(2 * model.nv, 0.1)
+    for system in distinct_modules(systems):
+        x0 = np.full(2 * system.nv, 0.1)
         integrate(system, x0, 0.01, 1e-6, 1e-6, t_out=np.array([0.005]), record=True)
         integrate(system, np.append(x0, [0.0, 0.0]), 0.01, 1e-6, 1e-6)
         integrate_ensemble(system, np.tile(x0, (2, 1)), 0.01, 1e-6, 1e-6)
     return time.perf_counter() - start
+
+
+def distinct_modules(systems) -> list[GeneratedSystem]:
+    """The first of ``systems`` for each generated module (compilation is per module)."""
+    seen = {}
+    for system in systems:
+        seen.setdefault(id(system.module), system)
+    return list(seen.values())
 
 
 # --- scenes on the fast path ----------------------------------------------------------------
