@@ -36,6 +36,7 @@ import numpy as np
 from pendverify.bench.problems import Problem, engine_rhs
 from pendverify.bench.timing import measure
 from pendverify.bench.workprecision import Config, Point
+from pendverify.numerics.fast_scene import simulate
 from pendverify.numerics.fastpath import integrate, integrate_ensemble
 from pendverify.simulation import engines
 
@@ -219,8 +220,7 @@ def ensemble_study(problem: Problem, tol: float, config: Config, member_refs: li
 
 
 def fast_invariants(problems: list[Problem]) -> list[tuple[str, list]]:
-    """The scene invariants of each state problem, run on the fast path (``numerics.fastpath.simulate``)."""
-    from pendverify.numerics.fastpath import simulate
+    """The scene invariants of each state problem, run on the fast path (``numerics.fast_scene.simulate``)."""
 
     out = []
     for problem in problems:
