@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from pendverify.bench import fast as fastbench
 from pendverify.bench.problems import engine_rhs
 from pendverify.bench.timing import machine_info
 from pendverify.bench.workprecision import (
@@ -32,7 +33,8 @@ from pendverify.bench.workprecision import (
     order_fits,
     scipy_sweep,
 )
-from pendverify.numerics import fixedstep
+from pendverify.numerics import fastpath, fixedstep
+from pendverify.numerics.reference import references
 
 
 @dataclass
@@ -105,9 +107,6 @@ def run_benchmark(
     ``specs``: the problems by key (``problems.ProblemSpec``; default: the seeds' table);
     ``config.horizons`` says which run and for how long, ``config.anchor`` which one anchors
     the single-trajectory ratio, the engine study and the ensemble."""
-    from pendverify.bench import fast as fastbench
-    from pendverify.numerics import fastpath
-    from pendverify.numerics.reference import references
 
     start = time.perf_counter()
     problems = make_problems(config, specs)

@@ -48,6 +48,7 @@ from pendverify.bench.problems import Problem, ProblemSpec, build_problem
 from pendverify.bench.timing import measure
 from pendverify.numerics import fixedstep
 from pendverify.numerics.fastpath import integrate as fast_integrate
+from pendverify.numerics.reference import energy_errors
 
 ORDER_WINDOW = (1e-11, 1e-2)
 SCIPY_METHODS = ("RK45", "DOP853", "Radau", "LSODA")
@@ -190,8 +191,6 @@ def _errors(point: Point, problem: Problem, ref, final_state, grid_states) -> No
         point.final_error = ref.final_error(final_state)
         point.max_error = float(np.max(ref.errors(grid_states)))
     if problem.conservative:
-        from pendverify.numerics.reference import energy_errors
-
         point.energy_final, point.energy_max = energy_errors(
             problem.fast, problem.x0, grid_states, final_state
         )
