@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from pendverify.analytic.params import default_parameter_file
-from pendverify.certify.certificate import SCHEMA, digest_of
+from pendverify.certify.certificate import SCHEMA, digest_of, summary_of
 from pendverify.cli import main
 
 from .conftest import default_params
@@ -46,8 +46,20 @@ def test_certificate_has_every_field(certified):
     kinds = {c["kind"] for c in cert["checks"]}
     assert {"check", "invariant"} <= kinds
     for c in cert["checks"]:
-        assert {"name", "max_error", "tolerance", "samples", "seed", "passed"} <= set(c)
-        assert c["passed"] and c["max_error"] <= c["tolerance"]
+        assert {
+            "name",
+            "error",
+            "tolerance",
+            "at",
+            "max_error",
+            "max_error_at",
+            "samples",
+            "seed",
+            "passed",
+        } <= set(c)
+        assert c["passed"] and c["error"] <= c["tolerance"]
+        assert (c["max_error"] is None) == (c["kind"] != "invariant")
+    assert cert["summary"] == summary_of(cert["checks"]) and cert["summary"]["result"] == "PASSED"
     assert cert["digest"] == {"algorithm": "sha256", "value": digest_of(cert)}
     assert (
         (certified.parent / "double_pendulum.params.toml").read_text().startswith('model = "double_pendulum"')
@@ -71,14 +83,15 @@ def test_edited_field_is_rejected_by_digest(certified, tmp_path, capsys):
 
 def test_resigned_edit_names_the_differing_fields(certified, tmp_path, capsys):
     cert = json.loads(certified.read_text())
-    cert["checks"][0]["max_error"] *= 3
+    cert["checks"][0]["error"] *= 3
     cert["checks"][1]["samples"] += 1
+    cert["summary"] = summary_of(cert["checks"])  # the forger derives the summary again too
     cert["digest"]["value"] = digest_of(cert)
     forged = tmp_path / "forged.cert.json"
     forged.write_text(json.dumps(cert))
     assert main(["recheck", str(forged)]) == 1
     out = capsys.readouterr().out
-    assert f"differs: {cert['checks'][0]['name']}.max_error: recorded" in out
+    assert f"differs: {cert['checks'][0]['name']}.error: recorded" in out
     assert f"differs: {cert['checks'][1]['name']}.samples: recorded" in out
 
 

@@ -126,3 +126,11 @@ class BrowserError(RuntimeError):
     Not a ``PendverifyError``: nothing the user gave is wrong; the callers that drive a
     browser catch it and carry on without one.
     """
+
+
+class BundleNameError(InputError):
+    """A set's name cannot name files: it must be a plain file name inside the output folder."""
+
+
+class SigningError(PendverifyError):
+    """A key cannot be read or written, or a signature does not hold (``pendverify.certify.signing``)."""

@@ -44,14 +44,25 @@ class BatterySettings:
 
 @dataclass(frozen=True)
 class BatteryItem:
+    """One battery item's evidence: the worst error/tolerance ratio and, apart, the largest error.
+
+    ``error`` and ``tolerance`` are relative (as in the tables) and belong to the same
+    state or step, ``at``: the one with the worst ratio, which decides ``passed``.
+    ``max_error`` is the largest error over the item, at ``max_error_at``; the core
+    checks and stress cases keep only their worst ratio, so it is None there.
+    """
+
     name: str
     kind: str  # check | stress | invariant
-    max_error: float
+    error: float
     tolerance: float
     samples: int
     seed: int
     passed: bool
     detail: str = ""
+    at: str = ""
+    max_error: float | None = None
+    max_error_at: str = ""
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -59,7 +70,7 @@ class BatteryItem:
     @property
     def margin(self) -> float:
         """error / tolerance: below 1 passes."""
-        return self.max_error / self.tolerance if self.tolerance > 0 else float("inf")
+        return self.error / self.tolerance if self.tolerance > 0 else float("inf")
 
 
 def check_items(model, system, settings: BatterySettings) -> list[BatteryItem]:
@@ -74,6 +85,7 @@ def check_items(model, system, settings: BatterySettings) -> list[BatteryItem]:
             r.seed,
             r.passed,
             r.worst_state["label"],
+            at=r.worst_state["label"],
         )
         for r in run_checks(model.name, model, system, states, settings.seed)
     ]
@@ -94,7 +106,15 @@ def invariant_items(model_cls, params, urdf: str, settings: BatterySettings) -> 
             # a run that diverges or dies is a failed item, not a crash of the battery
             items.append(
                 BatteryItem(
-                    f"invariant:{effect}", "invariant", np.inf, 0.0, 0, settings.seed, False, str(exc)
+                    f"invariant:{effect}",
+                    "invariant",
+                    np.inf,
+                    0.0,
+                    0,
+                    settings.seed,
+                    False,
+                    str(exc),
+                    max_error=np.inf,
                 )
             )
             continue
@@ -111,6 +131,9 @@ def invariant_items(model_cls, params, urdf: str, settings: BatterySettings) -> 
                     settings.seed,
                     inv.passed,
                     inv.name,
+                    at=f"t = {inv.worst_t:.6g} s",
+                    max_error=inv.max_error,
+                    max_error_at=f"t = {inv.max_error_t:.6g} s",
                 )
             )
     return items

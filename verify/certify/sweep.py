@@ -257,7 +257,7 @@ def summary_table(results: list[dict]) -> str:
     worst: dict[str, tuple[float, str]] = {}
     for r in results:
         for item in r["items"]:
-            margin = item["max_error"] / item["tolerance"] if item["tolerance"] > 0 else float("inf")
+            margin = item["error"] / item["tolerance"] if item["tolerance"] > 0 else float("inf")
             if margin > worst.get(item["name"], (-1.0, ""))[0]:
                 worst[item["name"]] = (margin, r["name"])
     lines = [f"{len(passed)} passed, {len(results) - len(passed)} failed, {len(results)} sets"]
