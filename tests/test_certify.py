@@ -58,7 +58,9 @@ def test_certificate_has_every_field(certified):
             "passed",
         } <= set(c)
         assert c["passed"] and c["error"] <= c["tolerance"]
-        assert (c["max_error"] is None) == (c["kind"] != "invariant")
+        assert (c["max_error"] is None) == (c["kind"] == "stress")
+        if c["kind"] == "check":  # the largest error is at least the error at the worst ratio
+            assert c["max_error"] >= c["error"] and c["max_error_at"]
     assert cert["summary"] == summary_of(cert["checks"]) and cert["summary"]["result"] == "PASSED"
     assert cert["digest"] == {"algorithm": "sha256", "value": digest_of(cert)}
     assert (

@@ -48,8 +48,8 @@ class BatteryItem:
 
     ``error`` and ``tolerance`` are relative (as in the tables) and belong to the same
     state or step, ``at``: the one with the worst ratio, which decides ``passed``.
-    ``max_error`` is the largest error over the item, at ``max_error_at``; the core
-    checks and stress cases keep only their worst ratio, so it is None there.
+    ``max_error`` is the largest error over the item, at ``max_error_at`` (checks and
+    invariants); the stress cases keep only their worst ratio, so it is None there.
     """
 
     name: str
@@ -86,6 +86,8 @@ def check_items(model, system, settings: BatterySettings) -> list[BatteryItem]:
             r.passed,
             r.worst_state["label"],
             at=r.worst_state["label"],
+            max_error=None if np.isnan(r.largest_error) else r.largest_error,  # nan: nothing judged
+            max_error_at=r.largest_state.get("label", ""),
         )
         for r in run_checks(model.name, model, system, states, settings.seed)
     ]

@@ -22,7 +22,7 @@ versions           pendverify, pinocchio, numpy, python
 checks             every battery item: name, kind (check | stress | invariant);
                    error, tolerance, at: the worst error/tolerance ratio (the
                    figures at that state or step, and where it is); max_error,
-                   max_error_at: the largest error and where (invariants; null
+                   max_error_at: the largest error and where (checks and invariants; null
                    for checks and stress cases, which keep only the worst ratio);
                    samples, seed, passed, detail
 summary            derived from ``checks``: items, passed, failed (names),

@@ -25,7 +25,7 @@ from pendverify.checks.diagnose import diagnose
 from pendverify.checks.report import Report
 from pendverify.checks.sampling import sample_states
 from pendverify.checks.trust import check_conditioning
-from pendverify.checks.verdict import FAIL, REFUSED, apply_strict, non_christoffel_c
+from pendverify.checks.verdict import FAIL, REFUSED, WARN, apply_strict, non_christoffel_c
 from pendverify.errors import IllConditionedError
 from pendverify.robot.geometry import MODEL_FORM_RTOL
 
@@ -60,6 +60,8 @@ def model_form_result(target, seed: int) -> CheckResult | None:
         samples=1,
         seed=seed,
         worst_state={"label": "URDF geometry", "q": []},
+        largest_error=form.relative,
+        largest_state={"label": "URDF geometry", "q": []},
         passed=form.within(rtol),
         notes=[form.sentence(rtol)],
     )
@@ -112,6 +114,8 @@ def verify_target(report: Report, target, samples: int, seed: int) -> None:
     if form is not None:
         results.append(form)
     warnings = coulomb_warnings(target)
+    # a closed form right in high precision but not in double (pendverify.checks.precision)
+    warnings += [f"{r.check}: {r.notes[0]}" for r in results if r.status == WARN and r.notes]
     sentence = non_christoffel_c(results)
     if sentence:
         warnings.append(sentence)
