@@ -416,7 +416,7 @@ def test_certify_set_signs_with_a_key_and_recheck_trusts_only_that_key(tmp_path)
     from pendverify.certify.signing import generate_keys
 
     private, public, _ = generate_keys(tmp_path / "keys")
-    other_private, other_public, _ = generate_keys(tmp_path / "other")
+    _, other_public, _ = generate_keys(tmp_path / "other")
     params = default_parameter_file("double_pendulum")
     issued = pendverify.certify_set(tmp_path / "out", params, key=private, samples=40)
     assert issued.certified and issued.certificate["signature"]
