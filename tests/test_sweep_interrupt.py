@@ -71,8 +71,8 @@ def _session_processes(sid: int) -> list[int]:
     return alive
 
 
-def _interrupt_after_first_bundle(sweep: Path, out: Path, signals: int = 1):
-    proc = _pendverify("certify", "--sweep", str(sweep), "-o", str(out), "--workers", "2")
+def _interrupt_after_first_bundle(sweep: Path, out: Path, signals: int = 1, where=("--workers", "2")):
+    proc = _pendverify("certify", "--sweep", str(sweep), "-o", str(out), *where)
     deadline = time.monotonic() + 120
     while not list(out.glob("*.cert.json")):
         assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
@@ -121,6 +121,24 @@ def test_a_second_ctrl_c_exits_at_once(tmp_path):
     assert "Traceback" not in err, err
     time.sleep(0.5)
     assert not _session_processes(proc.pid), "workers outlived the sweep"
+
+
+def test_ctrl_c_on_a_dask_sweep_cancels_its_tasks(tmp_path):
+    distributed = pytest.importorskip("distributed", reason="the dask extra is part of the test extras")
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, host="127.0.0.1", dashboard_address=None, processes=True
+    ) as cluster:
+        where = ("--scheduler", cluster.scheduler_address)
+        proc, elapsed, err = _interrupt_after_first_bundle(_sweep(tmp_path), tmp_path / "out", where=where)
+        assert proc.returncode == 130 and elapsed < EXIT_WITHIN_S, (proc.returncode, elapsed, err)
+        assert "Traceback" not in err, err
+        with distributed.Client(cluster.scheduler_address) as client:
+            for _ in range(30):  # the scheduler forgets a closed client's tasks within moments
+                left = client.run_on_scheduler(lambda dask_scheduler: len(dask_scheduler.tasks))
+                if not left:
+                    break
+                time.sleep(0.1)
+        assert left == 0, f"{left} task(s) of the sweep still on the cluster"
 
 
 def test_resume_refuses_an_edited_certificate(tmp_path, uninterrupted, capsys, monkeypatch):
