@@ -28,6 +28,7 @@ from pendverify.certify.scenes import effect_scenes
 from pendverify.checks.catalogue import run_checks
 from pendverify.checks.sampling import sample_states
 from pendverify.errors import PendverifyError
+from pendverify.progress import bar
 from pendverify.robot.system import PinocchioSystem
 
 
@@ -193,8 +194,14 @@ def run_battery(model, params: ParameterSet, urdf: str, settings: BatterySetting
     """The battery for a model (a class, or a built-in model's name), its parameters and URDF."""
     cls = model_class(model)
     system = PinocchioSystem.for_model(cls, urdf, params.g, f"<URDF being certified: {cls.name}>")
-    return (
-        check_items(cls(params), system, settings)
-        + stress_items(cls, params, settings, urdf)
-        + invariant_items(cls, params, urdf, settings)
+    parts = (
+        lambda: check_items(cls(params), system, settings),
+        lambda: stress_items(cls, params, settings, urdf),
+        lambda: invariant_items(cls, params, urdf, settings),
     )
+    items = []
+    with bar(len(parts), "battery", "part") as progress:  # checks, stress cases, simulations
+        for part in parts:
+            items += part()
+            progress.update(1)
+    return items

@@ -27,6 +27,7 @@ from pendverify.checks.sampling import sample_states
 from pendverify.checks.trust import check_conditioning
 from pendverify.checks.verdict import FAIL, REFUSED, WARN, apply_strict, non_christoffel_c
 from pendverify.errors import IllConditionedError
+from pendverify.progress import bar
 from pendverify.robot.geometry import MODEL_FORM_RTOL
 
 
@@ -138,7 +139,9 @@ def build_report(
 ) -> Report:
     """Every applicable check on every target, judged and diagnosed: one Report."""
     report = Report(seed=seed, states={}, results=[], strict=strict)
-    for target in targets:
-        target.system.model_form_rtol = model_form_rtol
-        verify_target(report, target, samples, seed)
+    with bar(len(targets), "check", "model") as progress:
+        for target in targets:
+            target.system.model_form_rtol = model_form_rtol
+            verify_target(report, target, samples, seed)
+            progress.update(1)
     return report

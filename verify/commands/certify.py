@@ -6,6 +6,8 @@ import argparse
 
 from pendverify.commands import add_analytic_option, non_negative_int, positive_int
 
+DEFAULT_MAX_SETS = 100_000  # pendverify.certify.sweep.DEFAULT_MAX_SETS, without importing NumPy here
+
 
 def register(sub) -> None:
     p = sub.add_parser("certify", help="run the full battery on a parameter set and certify it")
@@ -17,6 +19,17 @@ def register(sub) -> None:
     p.add_argument("--sweep", help="a sweep file: certify many sets in parallel")
     p.add_argument("--scheduler", help="with --sweep: a Dask scheduler address, tcp://HOST:PORT")
     p.add_argument("--workers", type=positive_int, help="with --sweep: local worker processes")
+    p.add_argument(
+        "--resume",
+        action="store_true",
+        help="with --sweep: keep the sets certified in -o already (digests checked), compute the rest",
+    )
+    p.add_argument(
+        "--max-sets",
+        type=positive_int,
+        default=DEFAULT_MAX_SETS,
+        help=f"with --sweep: refuse a sweep of more sets than this (default {DEFAULT_MAX_SETS:,})",
+    )
     p.add_argument("-o", "--output", required=True, help="directory for the certificate, URDF and parameters")
     p.add_argument("--samples", type=positive_int, help="random states for the core checks (default 2000)")
     p.add_argument("--seed", type=non_negative_int, help="seed of the state sampler")
@@ -78,21 +91,32 @@ def _run_sweep(args) -> int:
     import sys
 
     from pendverify.certify.issue import check_sweep_names, write_sweep_certificates
-    from pendverify.certify.sweep import executor_for, load_sweep, run_sweep, summary_table
+    from pendverify.certify.sweep import load_sweep, summary_table
+    from pendverify.certify.sweep_output import prepare_output
+    from pendverify.certify.sweep_run import INTERRUPTED, Workers, run_sweep
 
-    sweep = load_sweep(args.sweep)
+    sweep = load_sweep(args.sweep, args.max_sets)
     check_sweep_names(sweep, args.sweep)
-    key = _key(args)
-    executor, resource = executor_for(args.scheduler, args.workers)
-    try:
-        results = run_sweep(sweep, executor, progress=sys.stderr.isatty())
-    finally:
-        close = getattr(resource, "shutdown", None) or resource.close
-        close()
-    print(summary_table(results))
-    written = write_sweep_certificates(sweep, results, args.output, args.force, key)
-    print(f"{written} certificate(s) written to {args.output}")
-    return 0 if written == len(results) else 1
+    key = _key(args)  # a bad key fails before any work
+    state = prepare_output(sweep, args.output, args.force, args.resume)
+
+    def write(result: dict, replace: bool) -> int:
+        return write_sweep_certificates(sweep, [result], args.output, args.force or replace, key)
+
+    run = run_sweep(sweep, Workers(args.scheduler, args.workers), write, state.done, state.partial)
+    certified = run.written + run.skipped
+    if run.interrupted:
+        print(
+            f"pendverify: interrupted: {certified} of {run.total} set(s) certified in {args.output}; "
+            "continue with --resume",
+            file=sys.stderr,
+        )
+        return INTERRUPTED
+    print(summary_table(run.results))
+    if run.skipped:
+        print(f"{run.skipped} set(s) already certified in {args.output} (--resume): not recomputed")
+    print(f"{run.written} certificate(s) written to {args.output}")
+    return 0 if certified == run.total else 1
 
 
 def run_recheck(args: argparse.Namespace) -> int:
