@@ -36,7 +36,9 @@ m1 = [0.5, 2.0]
 I1 = {{ min = 0.001, max = 0.05, scale = "log" }}
 """
 SETS = 10
-EXIT_WITHIN_S = 5.0
+# No wall time is asserted (tests never do): that the sweep stopped is shown by the sets it did not
+# compute (fewer than SETS certificates), that it did not hang by ``communicate``'s timeout; the
+# README quotes the measured time from SIGINT to exit (0.24–0.74 s).
 
 
 def _sweep(folder: Path, count: int = SETS) -> Path:
@@ -95,7 +97,7 @@ def uninterrupted(tmp_path_factory):
 def test_ctrl_c_keeps_finished_sets_and_resume_completes_the_sweep(tmp_path, uninterrupted, capfd):
     sweep, out = _sweep(tmp_path), tmp_path / "out"
     proc, elapsed, err = _interrupt_after_first_bundle(sweep, out)
-    assert proc.returncode == 130 and elapsed < EXIT_WITHIN_S, (proc.returncode, elapsed, err)
+    assert proc.returncode == 130, (proc.returncode, elapsed, err)
     assert "Traceback" not in err and "interrupted" in err and "--resume" in err, err
     assert not _session_processes(proc.pid), "workers outlived the sweep"
     finished = sorted(out.glob("*.cert.json"))
@@ -116,8 +118,10 @@ def test_ctrl_c_keeps_finished_sets_and_resume_completes_the_sweep(tmp_path, uni
 
 
 def test_a_second_ctrl_c_exits_at_once(tmp_path):
-    proc, elapsed, err = _interrupt_after_first_bundle(_sweep(tmp_path), tmp_path / "out", signals=2)
-    assert proc.returncode == 130 and elapsed < EXIT_WITHIN_S, (proc.returncode, elapsed, err)
+    out = tmp_path / "out"
+    proc, elapsed, err = _interrupt_after_first_bundle(_sweep(tmp_path), out, signals=2)
+    assert proc.returncode == 130, (proc.returncode, elapsed, err)
+    assert len(list(out.glob("*.cert.json"))) < SETS, "the sweep computed every set"
     assert "Traceback" not in err, err
     time.sleep(0.5)
     assert not _session_processes(proc.pid), "workers outlived the sweep"
@@ -129,8 +133,10 @@ def test_ctrl_c_on_a_dask_sweep_cancels_its_tasks(tmp_path):
         n_workers=2, threads_per_worker=1, host="127.0.0.1", dashboard_address=None, processes=True
     ) as cluster:
         where = ("--scheduler", cluster.scheduler_address)
-        proc, elapsed, err = _interrupt_after_first_bundle(_sweep(tmp_path), tmp_path / "out", where=where)
-        assert proc.returncode == 130 and elapsed < EXIT_WITHIN_S, (proc.returncode, elapsed, err)
+        out = tmp_path / "out"
+        proc, elapsed, err = _interrupt_after_first_bundle(_sweep(tmp_path), out, where=where)
+        assert proc.returncode == 130, (proc.returncode, elapsed, err)
+        assert len(list(out.glob("*.cert.json"))) < SETS, "the sweep computed every set"
         assert "Traceback" not in err, err
         with distributed.Client(cluster.scheduler_address) as client:
             for _ in range(30):  # the scheduler forgets a closed client's tasks within moments
