@@ -200,7 +200,7 @@ def parse_parameter_document(data: dict[str, Any], source: str, registry: dict[s
 
 def load_parameter_file(path: str | Path, registry: dict[str, type[ParameterSet]] | None = None):
     """Read a parameter file: returns (model name, set name, validated parameter set)."""
-    if registry is None:
+    if registry is None:  # the built-in models' registry; pendverify.analytic imports this module
         from pendverify.analytic import PARAMETER_TYPES as registry
     path = Path(path)
     return parse_parameter_document(read_toml(path), str(path), registry)

@@ -408,3 +408,20 @@ def test_certify_set_takes_a_model_file_and_a_missing_urdf_is_named_in_api_words
         pendverify.certify_set(
             tmp_path / "b", analytic=examples / "cart_pole.py", urdf_params=examples / "cart_pole.toml"
         )
+
+
+def test_certify_set_signs_with_a_key_and_recheck_trusts_only_that_key(tmp_path):
+    from pendverify.analytic.params import default_parameter_file
+    from pendverify.certify.issue import recheck
+    from pendverify.certify.signing import generate_keys
+
+    private, public, _ = generate_keys(tmp_path / "keys")
+    _, other_public, _ = generate_keys(tmp_path / "other")
+    params = default_parameter_file("double_pendulum")
+    issued = pendverify.certify_set(tmp_path / "out", params, key=private, samples=40)
+    assert issued.certified and issued.certificate["signature"]
+    assert recheck(str(issued.path), trust=str(public)).passed
+    with pytest.raises(pendverify.PendverifyError, match="not by the trusted key"):
+        recheck(str(issued.path), trust=str(other_public))
+    with pytest.raises(pendverify.PendverifyError, match="key"):
+        pendverify.certify_set(tmp_path / "bad", params, key=tmp_path / "no-such.pem", samples=40)

@@ -47,10 +47,9 @@ SMALL = replace(
 )
 
 
-@pytest.fixture(scope="module")
-def bench(tmp_path_factory):
-    """Run the CLI once in --quick mode, with the small configuration; keep what it measured."""
-    out = tmp_path_factory.mktemp("bench")
+def run_quick(argv: list[str], config, cache: str | None = None):
+    """(exit status, the Results it measured) of ``pendverify bench accuracy --quick ARGV`` with
+    ``config`` in place of QUICK (and ``cache`` as PENDVERIFY_CACHE when given)."""
     captured = {}
     real = benchrun.run_benchmark
 
@@ -59,11 +58,20 @@ def bench(tmp_path_factory):
         return captured["results"]
 
     with pytest.MonkeyPatch.context() as mp:
-        mp.setenv("PENDVERIFY_CACHE", str(out / "cache"))
-        mp.setattr(workprecision, "QUICK", SMALL)
+        if cache is not None:
+            mp.setenv("PENDVERIFY_CACHE", cache)
+        mp.setattr(workprecision, "QUICK", config)
         mp.setattr(benchrun, "run_benchmark", keep)
-        status = main(["bench", "accuracy", "--quick", "-o", str(out)])
-    return status, out, captured["results"]
+        status = main(["bench", "accuracy", "--quick", *argv])
+    return status, captured["results"]
+
+
+@pytest.fixture(scope="module")
+def bench(tmp_path_factory):
+    """Run the CLI once in --quick mode, with the small configuration; keep what it measured."""
+    out = tmp_path_factory.mktemp("bench")
+    status, results = run_quick(["-o", str(out)], SMALL, str(out / "cache"))
+    return status, out, results
 
 
 def test_quick_run_writes_plot_csv_and_table(bench):

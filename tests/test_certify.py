@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from pendverify.analytic.params import default_parameter_file
-from pendverify.certify.certificate import SCHEMA, digest_of
+from pendverify.certify.certificate import SCHEMA, digest_of, summary_of
 from pendverify.cli import main
 
 from .conftest import default_params
@@ -46,8 +46,22 @@ def test_certificate_has_every_field(certified):
     kinds = {c["kind"] for c in cert["checks"]}
     assert {"check", "invariant"} <= kinds
     for c in cert["checks"]:
-        assert {"name", "max_error", "tolerance", "samples", "seed", "passed"} <= set(c)
-        assert c["passed"] and c["max_error"] <= c["tolerance"]
+        assert {
+            "name",
+            "error",
+            "tolerance",
+            "at",
+            "max_error",
+            "max_error_at",
+            "samples",
+            "seed",
+            "passed",
+        } <= set(c)
+        assert c["passed"] and c["error"] <= c["tolerance"]
+        assert (c["max_error"] is None) == (c["kind"] == "stress")
+        if c["kind"] == "check":  # the largest error is at least the error at the worst ratio
+            assert c["max_error"] >= c["error"] and c["max_error_at"]
+    assert cert["summary"] == summary_of(cert["checks"]) and cert["summary"]["result"] == "PASSED"
     assert cert["digest"] == {"algorithm": "sha256", "value": digest_of(cert)}
     assert (
         (certified.parent / "double_pendulum.params.toml").read_text().startswith('model = "double_pendulum"')
@@ -71,14 +85,15 @@ def test_edited_field_is_rejected_by_digest(certified, tmp_path, capsys):
 
 def test_resigned_edit_names_the_differing_fields(certified, tmp_path, capsys):
     cert = json.loads(certified.read_text())
-    cert["checks"][0]["max_error"] *= 3
+    cert["checks"][0]["error"] *= 3
     cert["checks"][1]["samples"] += 1
+    cert["summary"] = summary_of(cert["checks"])  # the forger derives the summary again too
     cert["digest"]["value"] = digest_of(cert)
     forged = tmp_path / "forged.cert.json"
     forged.write_text(json.dumps(cert))
     assert main(["recheck", str(forged)]) == 1
     out = capsys.readouterr().out
-    assert f"differs: {cert['checks'][0]['name']}.max_error: recorded" in out
+    assert f"differs: {cert['checks'][0]['name']}.error: recorded" in out
     assert f"differs: {cert['checks'][1]['name']}.samples: recorded" in out
 
 
@@ -102,7 +117,7 @@ def test_failing_set_writes_nothing(tmp_path, capsys):
     assert not out.exists() or not list(out.iterdir())
 
 
-def test_writer_failing_midway_leaves_no_certificate(tmp_path, monkeypatch):
+def test_writer_failing_midway_leaves_no_certificate(tmp_path, monkeypatch, capsys):
     import pendverify.atomic as atomic
 
     calls = {"n": 0}
@@ -116,8 +131,9 @@ def test_writer_failing_midway_leaves_no_certificate(tmp_path, monkeypatch):
 
     monkeypatch.setattr(atomic.os, "fsync", failing_fsync)
     out = tmp_path / "out"
-    with pytest.raises(OSError, match="disk full"):
-        main(["certify", str(default_parameter_file("cart_double_pendulum")), "-o", str(out), *FAST])
+    # an output that cannot be written: status 2, naming the file and the OS's reason
+    assert main(["certify", str(default_parameter_file("cart_double_pendulum")), "-o", str(out), *FAST]) == 2
+    assert "cart_double_pendulum.cert.json: cannot write it: disk full" in capsys.readouterr().err
     assert not (out / "cart_double_pendulum.cert.json").exists()
     assert not [p for p in out.iterdir() if p.name.endswith(".tmp")]
 

@@ -94,3 +94,17 @@ def test_json_reports_are_standard_json_even_with_an_infinite_error():
     document = json.loads(text, parse_constant=refuse)
     assert document["results"][0]["max_error"] == "inf"
     assert document["status"] == "fail"
+
+
+def test_check_reports_the_largest_error_apart_from_the_worst_ratio(tmp_path, capsys):
+    """The table's error is at the worst error/tolerance; the largest error is reported too."""
+    out = tmp_path / "check.json"
+    assert main(["check", "--model", "cart_double_pendulum", "--samples", "200", "--json", str(out)]) == 0
+    text = capsys.readouterr().out
+    results = json.loads(out.read_text())["results"]
+    for r in results:
+        assert r["largest_error"] >= r["max_error"] and r["largest_state"]["label"]
+    top = max(results, key=lambda r: r["largest_error"])
+    assert f"largest relative error: {top['largest_error']:.2e} (cart_double_pendulum {top['check']}" in text
+    # on this sample the largest error and the worst ratio fall at different states for some check
+    assert any(r["largest_state"]["label"] != r["worst_state"]["label"] for r in results)

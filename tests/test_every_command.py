@@ -71,6 +71,9 @@ COMMANDS = {
     ],
     "stress": lambda m: [["stress", *m.files(), "--quick"]],
     "certify+recheck": _certify,
+    "bench": lambda m: [
+        ["bench", "accuracy", "--scene", str(m.scene()), "--quick", "-o", str(m.tmp / "bench")]
+    ],
 }
 
 

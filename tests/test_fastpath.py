@@ -16,7 +16,7 @@ from scipy.integrate._ivp import dop853_coefficients
 from pendverify.analytic import MODELS
 from pendverify.bench.workprecision import make_problem
 from pendverify.errors import FastPathError
-from pendverify.numerics import fastpath, reference, taylor
+from pendverify.numerics import fast_scene, fastpath, reference, taylor
 from pendverify.numerics.generate import GeneratedSystem
 from pendverify.simulation.dynamics import build_dynamics
 from pendverify.simulation.scene import load_scene, parse_scene
@@ -380,7 +380,7 @@ def test_ensemble_is_the_single_runs():
 
 @pytest.mark.parametrize("name", ["chaotic_double_pendulum", "damped_double_pendulum", "cart_rods_falling"])
 def test_fast_path_passes_the_simulators_invariants(name):
-    run = fastpath.simulate(load_scene(REPO / "scenes" / f"{name}.toml"))
+    run = fast_scene.simulate(load_scene(REPO / "scenes" / f"{name}.toml"))
     assert run.invariants, name
     assert run.passed, [(i.name, i.error, i.tolerance) for i in run.invariants]
     assert np.all(np.isfinite(run.x))
@@ -392,4 +392,4 @@ def test_fast_path_passes_the_simulators_invariants(name):
 )
 def test_time_varying_effects_are_refused_by_name(name, key):
     with pytest.raises(FastPathError, match=key):
-        fastpath.simulate(load_scene(REPO / "scenes" / f"{name}.toml"))
+        fast_scene.simulate(load_scene(REPO / "scenes" / f"{name}.toml"))

@@ -23,7 +23,7 @@ from pendverify.analytic import MODELS
 from pendverify.bench.workprecision import make_problem
 from pendverify.checks.sampling import sample_states
 from pendverify.errors import PendverifyError
-from pendverify.numerics import fastpath, fixedstep, generate, reference, taylor
+from pendverify.numerics import fast_scene, fastpath, fixedstep, generate, reference, taylor
 from pendverify.numerics.codegen.expressions import momentum_rate
 from pendverify.numerics.generate import GeneratedSystem
 from pendverify.simulation.scene import load_scene
@@ -319,6 +319,6 @@ def test_short_reference_agrees_with_scipys_dop853():
 
 
 def test_fast_path_runs_a_plugin_scene():
-    run = fastpath.simulate(load_scene(REPO / "scenes" / "damped_triple_pendulum.toml"))
+    run = fast_scene.simulate(load_scene(REPO / "scenes" / "damped_triple_pendulum.toml"))
     assert run.system.model == "triple_pendulum" and run.invariants
     assert run.passed, [(i.name, i.error, i.tolerance) for i in run.invariants]

@@ -116,3 +116,17 @@ def test_cli_needs_the_three_files(capsys):
     model, urdf, _ = files("cart_pole")
     assert main(["stress", "--analytic", model, "--urdf", urdf]) == 2
     assert "give --urdf and --params with --analytic" in capsys.readouterr().err
+
+
+def test_the_report_says_what_is_derived_and_so_not_evidence(tmp_path, capsys):
+    out = tmp_path / "stress.json"
+    argv = ["stress", "--quick", "--analytic", str(EXAMPLES / "minimal_double_pendulum.py")]
+    argv += ["--urdf", str(EXAMPLES.parent / "urdf" / "double_pendulum.urdf")]
+    argv += ["--params", str(EXAMPLES / "minimal_double_pendulum.toml"), "--case", "nominal"]
+    argv += ["--json", str(out)]
+    assert main(argv) == 0
+    text = capsys.readouterr().out
+    assert "evidence:" in text and "det not run: det M is derived from M" in text
+    evidence = json.loads(out.read_text())["evidence"]
+    assert any("minverse not run" in line for line in evidence)
+    assert any(line.startswith("derived, not hand-written: the gravity scale") for line in evidence)

@@ -34,6 +34,7 @@ from pendverify.analytic.params import check_value
 from pendverify.analytic.plugin import load_model_class, plugin_parameters, validate_model_class, where
 from pendverify.certify.battery import BatterySettings
 from pendverify.certify.issue import certification_input, issue
+from pendverify.certify.signing import load_private_key
 from pendverify.checks.report import CheckReport
 from pendverify.checks.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
 from pendverify.checks.targets import Target, default_target, model_target, params_target
@@ -272,6 +273,7 @@ def certify_set(
     model: str | None = None,
     urdf_params: str | Path | None = None,
     analytic: str | Path | None = None,
+    key: str | Path | None = None,
     samples: int | None = None,
     seed: int | None = None,
     force: bool = False,
@@ -282,6 +284,7 @@ def certify_set(
     ``erd:NAME``) with ``urdf_params`` (the set it must match) or a built-in ``model``
     whose parameters are read off the URDF; or a model file ``analytic`` with its
     ``urdf`` and ``urdf_params`` (the certificate then embeds the file's text).
+    ``key``: an Ed25519 private key file (``pendverify keygen``) that signs it.
     Returns the issued result (``items``, ``certified``, ``certificate``, ``path``).
     (Not ``certify``: that name is the ``pendverify.certify`` sub-package.)
     """
@@ -297,4 +300,5 @@ def certify_set(
         None if urdf_params is None else str(urdf_params),
         None if analytic is None else str(analytic),
     )
-    return issue(target, settings, str(output), force)
+    signer = None if key is None else load_private_key(key)  # a bad key fails before any work
+    return issue(target, settings, str(output), force, key=signer)

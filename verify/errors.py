@@ -132,6 +132,14 @@ class BrowserError(RuntimeError):
     """
 
 
+class BundleNameError(InputError):
+    """A set's name cannot name files: it must be a plain file name inside the output folder."""
+
+
+class SigningError(PendverifyError):
+    """A key cannot be read or written, or a signature does not hold (``pendverify.certify.signing``)."""
+
+
 class FileAccessError(PlaceError):
     """A user's file cannot be read, or an output cannot be written: the path and the OS's reason."""
 

@@ -14,11 +14,22 @@ and parameter set among them (``scene_targets``):
 example-robot-data's double pendulums join the table when ``erd`` is on and a
 scene simulates their model.  The folder holds ``index.html``, ``report.json``,
 ``scenes/<stem>.html`` and ``plots/<stem>.svg``.
+
+The folder is built as a temporary folder beside ``out`` and renamed to ``out``
+at the end, so an interruption or an error leaves neither a half-written folder
+nor the temporary one.  An existing ``out`` is refused before any work unless
+``force``, which swaps the new folder in (rename the old aside, rename the new
+into place, remove the old).  One progress bar (checks, then each scene) shows
+on a terminal.
 """
 
 from __future__ import annotations
 
+import os
+import shutil
+import tempfile
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -26,7 +37,8 @@ from pendverify.analytic.params import default_parameter_file, load_parameter_fi
 from pendverify.atomic import write_atomic
 from pendverify.checks.targets import Target, default_target, erd_targets, model_target, params_target
 from pendverify.checks.verification import build_report
-from pendverify.errors import SceneError
+from pendverify.errors import InputError, SceneError
+from pendverify.progress import bar
 from pendverify.robot.erd import MODEL as ERD_MODEL
 from pendverify.simulation.scene import Scene, load_scene
 from pendverify.simulation.simulate import simulate
@@ -107,22 +119,67 @@ def _review(path: Path, scene: Scene, out: Path, trace: bool) -> SceneReview:
     )
 
 
+def refuse_existing_folder(out: Path, force: bool) -> None:
+    """An existing ``out`` is refused unless ``force``; a file there always is."""
+    if out.exists() and not out.is_dir():
+        raise InputError("<command line>", "output", str(out), "exists and is not a folder")
+    if out.exists() and not force:
+        raise InputError("<command line>", "output", str(out), "exists; pass --force to replace it")
+
+
+@contextmanager
+def staged_folder(out: Path):
+    """A temporary folder beside ``out``, renamed to ``out`` when the block ends without error."""
+    out.parent.mkdir(parents=True, exist_ok=True)
+    work = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".tmp", dir=out.parent))
+    try:
+        yield work
+        mask = os.umask(0)
+        os.umask(mask)
+        os.chmod(work, 0o777 & ~mask)  # mkdtemp makes 0700
+        if not out.exists():
+            os.rename(work, out)
+            return
+        old = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".old", dir=out.parent))
+        os.replace(out, old)
+        try:
+            os.replace(work, out)
+        except BaseException:
+            os.replace(old, out)
+            raise
+        shutil.rmtree(old, ignore_errors=True)
+    except BaseException:
+        shutil.rmtree(work, ignore_errors=True)
+        raise
+
+
 def write_review(
-    scene_paths: list[Path], out: Path, samples: int, seed: int, erd: bool, trace: bool, log=print
+    scene_paths: list[Path],
+    out: Path,
+    samples: int,
+    seed: int,
+    erd: bool,
+    trace: bool,
+    log=print,
+    force: bool = False,
 ) -> ReviewFolder:
     """Check the scenes' models, run and draw every scene, and write ``out/index.html`` (docstring)."""
     out = Path(out)
+    refuse_existing_folder(out, force)
     scenes = [load_scene(path) for path in scene_paths]
     targets = scene_targets(scenes, erd)
-    start = time.perf_counter()
-    report = build_report(targets, samples, seed)
-    report.elapsed_s = time.perf_counter() - start
-    write_atomic(out / "report.json", report.to_json())
-    verdict = "pass" if report.passed else "FAIL"
-    log(f"checks: {len(report.results)} on {len(report.states)} model(s): {verdict}")
-    reviews = []
-    for path, scene in zip(scene_paths, scenes, strict=True):
-        reviews.append(_review(path, scene, out, trace))
-        log(f"scene {scene.name}: invariants {'pass' if reviews[-1].passed else 'FAIL'}")
-    index = write_atomic(out / "index.html", review_page(report, reviews))
-    return ReviewFolder(report, reviews, index)
+    with staged_folder(out) as work, bar(1 + len(scenes), "report", "step") as progress:
+        start = time.perf_counter()
+        report = build_report(targets, samples, seed)
+        report.elapsed_s = time.perf_counter() - start
+        write_atomic(work / "report.json", report.to_json())
+        progress.update(1)
+        verdict = "pass" if report.passed else "FAIL"
+        log(f"checks: {len(report.results)} on {len(report.states)} model(s): {verdict}")
+        reviews = []
+        for path, scene in zip(scene_paths, scenes, strict=True):
+            reviews.append(_review(path, scene, work, trace))
+            progress.update(1)
+            log(f"scene {scene.name}: invariants {'pass' if reviews[-1].passed else 'FAIL'}")
+        write_atomic(work / "index.html", review_page(report, reviews))
+    return ReviewFolder(report, reviews, out / "index.html")

@@ -2,7 +2,7 @@
 
 One panel per problem.  x: minimum wall time of the integration [s]; y: the
 final-state error (max over components) for the state problems, the max
-relative energy error over the run for the long one.  Adaptive methods are
+relative energy error over the run for the energy-only ones.  Adaptive methods are
 joined across their tolerances, fixed-step methods across their step sizes.
 The fast path is the thick line; scipy's methods are solid, fixed-step methods
 dotted.  Rendering uses matplotlib's Agg backend (no display needed).

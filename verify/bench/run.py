@@ -5,9 +5,10 @@
 2. generation (or cache load) of the models' modules and compilation of their numba
    functions, timed apart;
 3. the sweeps (``pendverify.bench.workprecision``), the observed orders;
-4. the fast path against scipy: the single-trajectory ratio from the sweeps,
-   the engine costs and the ensemble at the tolerance where scipy DOP853 first
-   reaches the target error (``pendverify.bench.fast``);
+4. the fast path against scipy on the configuration's anchor problem (``Config.anchor``:
+   the seeds' chaotic one, or a user's scene's state problem): the single-trajectory
+   ratio from the sweeps, the engine costs and the ensemble at the tolerance where scipy
+   DOP853 first reaches the target error (``pendverify.bench.fast``);
 5. the fast path's invariant checks on the state problems.
 """
 
@@ -20,6 +21,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from pendverify.bench import fast as fastbench
+from pendverify.bench.problems import engine_rhs
 from pendverify.bench.timing import machine_info
 from pendverify.bench.workprecision import (
     Config,
@@ -30,7 +33,8 @@ from pendverify.bench.workprecision import (
     order_fits,
     scipy_sweep,
 )
-from pendverify.numerics import fixedstep
+from pendverify.numerics import fastpath, fixedstep
+from pendverify.numerics.reference import references
 
 
 @dataclass
@@ -51,17 +55,21 @@ class Results:
     elapsed: float = 0.0
 
     def smallest_error(self) -> float:
-        errs = [p.final_error for p in self.points if p.ok and p.problem != "long" and p.final_error > 0]
-        errs += [p.max_error for p in self.points if p.ok and p.problem != "long" and p.max_error > 0]
+        state = [p for p in self.points if p.ok and p.metric == "state"]
+        errs = [p.final_error for p in state if p.final_error > 0]
+        errs += [p.max_error for p in state if p.max_error > 0]
         return min(errs) if errs else math.nan
+
+    @property
+    def anchor(self):
+        """The state problem of the single-trajectory ratio, engine study and ensemble (or None)."""
+        return next((p for p in self.problems if p.key == self.config.anchor and p.metric == "state"), None)
 
     def largest_reference_bound(self) -> float:
         return max((r.error_bound for r in self.references.values()), default=math.nan)
 
 
 def run_sweeps(problems, references, config: Config, log=print) -> list[Point]:
-    from pendverify.simulation.engines import build
-
     points: list[Point] = []
     for problem in problems:
         ref = references.get(problem.key)
@@ -69,7 +77,7 @@ def run_sweeps(problems, references, config: Config, log=print) -> list[Point]:
         points += fast_sweep(problem, config.tolerances, config, ref)
         spent = {"fast path": time.perf_counter() - start}
         if problem.metric == "state":
-            rhs = build("aba", problem.dynamics.model, problem.fast)
+            rhs = engine_rhs(problem, "aba")
             for method in config.scipy_methods:
                 start = time.perf_counter()
                 tols = config.tolerances if method == "DOP853" else config.other_tolerances
@@ -88,41 +96,43 @@ def run_sweeps(problems, references, config: Config, log=print) -> list[Point]:
 
 
 def run_benchmark(
-    config: Config, log=print, blas: str = "not limited", workers: int | None = None
+    config: Config,
+    log=print,
+    blas: str = "not limited",
+    workers: int | None = None,
+    specs: dict | None = None,
 ) -> Results:
-    """Everything ``pendverify bench accuracy`` reports, measured in this process."""
-    from pendverify.bench import fast as fastbench
-    from pendverify.numerics import fastpath
-    from pendverify.numerics.reference import references
+    """Everything ``pendverify bench accuracy`` reports, measured in this process.
+
+    ``specs``: the problems by key (``problems.ProblemSpec``; default: the seeds' table);
+    ``config.horizons`` says which run and for how long, ``config.anchor`` which one anchors
+    the single-trajectory ratio, the engine study and the ensemble."""
 
     start = time.perf_counter()
-    problems = make_problems(config)
+    problems = make_problems(config, specs)
     by_key = {p.key: p for p in problems}
     state = [p for p in problems if p.metric == "state"]
-    chaotic = by_key.get("chaotic")
+    results = Results(config, machine_info(blas), problems, {})
+    anchor = results.anchor
     jobs = [(p.fast, p.x0, p.duration, p.grid) for p in state]
     members = []
-    if chaotic is not None and config.ensemble_size > 0:
-        members = list(fastbench.ensemble_states(chaotic, config)[1 : config.ensemble_checked])
-        jobs += [(chaotic.fast, x, chaotic.duration, np.array([0.0, chaotic.duration])) for x in members]
+    if anchor is not None and config.ensemble_size > 0:
+        members = list(fastbench.ensemble_states(anchor, config)[1 : config.ensemble_checked])
+        jobs += [(anchor.fast, x, anchor.duration, np.array([0.0, anchor.duration])) for x in members]
     log(f"references: {len(jobs)} problems at {config.digits[0]} and {config.digits[1]} digits")
     t0 = time.perf_counter()
     refs = references(jobs, *config.digits, workers=workers or os.cpu_count() or 1)
-    results = Results(
-        config,
-        machine_info(blas),
-        problems,
-        {p.key: r for p, r in zip(state, refs[: len(state)], strict=True)},
-    )
+    results.references = {p.key: r for p, r in zip(state, refs[: len(state)], strict=True)}
     results.reference_seconds = time.perf_counter() - t0
-    results.compile_seconds = fastpath.warm_up() + fixedstep.warm_up()
+    systems = [p.fast for p in problems]
+    results.compile_seconds = fastpath.warm_up(systems) + fixedstep.warm_up(systems)
     log(f"generated back ends compiled or loaded in {results.compile_seconds:.1f} s; sweeping")
     results.points = run_sweeps(problems, results.references, config, log)
     results.orders = order_fits(results.points)
-    if chaotic is not None:
-        results.single = fastbench.single_ratio(results.points, "chaotic", config.target_error)
-        anchor = results.single.scipy or results.single.fast
-        tol = anchor.setting if anchor is not None else min(config.tolerances)
+    if anchor is not None:
+        results.single = fastbench.single_ratio(results.points, anchor.key, config.target_error)
+        best = results.single.scipy or results.single.fast
+        tol = best.setting if best is not None else min(config.tolerances)
         results.engine_tolerance = tol
         t0 = time.perf_counter()
         for key in config.engine_problems:
@@ -131,8 +141,8 @@ def run_benchmark(
         log(f"engines at rtol = atol = {tol:g}: {time.perf_counter() - t0:.1f} s")
         if config.ensemble_size > 0:
             t0 = time.perf_counter()
-            member_refs = [results.references["chaotic"], *refs[len(state) :]]
-            results.ensemble = fastbench.ensemble_study(chaotic, tol, config, member_refs)
+            member_refs = [results.references[anchor.key], *refs[len(state) :]]
+            results.ensemble = fastbench.ensemble_study(anchor, tol, config, member_refs)
             log(f"ensemble of {config.ensemble_size}: {time.perf_counter() - t0:.1f} s")
     t0 = time.perf_counter()
     results.invariants = fastbench.fast_invariants(problems)

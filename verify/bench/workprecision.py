@@ -1,19 +1,10 @@
 """Work–precision benchmark: how much wall time each digit of accuracy costs.
 
-Problems (model coordinates; each is a scene document, so the fast path's
-invariant checks run on the very same dynamics):
-
-==========  =====================================================================  ==========
-key         what                                                                   compared
-==========  =====================================================================  ==========
-mild        double pendulum, θ = (−π/2 + 0.5, 0.3) rad from rest, no friction:     states
-            a mild, quasi-periodic swing
-chaotic     double pendulum, θ = (2.0, 2.5) rad from rest, no friction; compared    states
-            over T = 2 s only (its double-precision solutions diverge beyond)
-cart_lqr    cart double pendulum near upright, (0, 0.1, −0.05) m/rad, rates          states
-            (0.2, 0, 0.3), friction on, LQR Q = diag(10, 100, 100, 1, 10, 10), R = 0.1
-long        the mild swing over T = 1e3 s (full) — energy only, never states        energy
-==========  =====================================================================  ==========
+Problems (``pendverify.bench.problems``): scenes, so the fast path's invariant checks run
+on the very same dynamics; by default the seeds' table (``pendverify.bench.seed_problems``:
+mild, chaotic, cart_lqr, long), or a user's scene, any model (``--scene``).  Each carries
+its metric: "state" problems are compared against references, "energy" ones by the
+relative energy error alone.
 
 Metrics per point: the error at the final time (max over components of
 |x − x_ref|, rad, m, rad/s, m/s), the max error over G + 1 equally spaced dense
@@ -38,7 +29,7 @@ explicit Euler, symplectic Euler, implicit midpoint and RK4 with halving steps;
 their observed order is the least-squares slope of log error against log h over
 the points whose error lies in the asymptotic window [1e-11, 1e-2].  A scipy
 method stops tightening once one run exceeds the configuration's time budget
-(the table says where).  scipy is not run on the long problem: a single run
+(the table says where).  scipy is not run on the energy-only (long) problems: a single run
 there takes seconds to minutes with a Python right-hand side, and the fast path
 takes exactly scipy's DOP853 steps (same tableau, initial step and error
 control), so its energy line is scipy DOP853's line.
@@ -52,52 +43,16 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from pendverify.bench import seed_problems
+from pendverify.bench.problems import Problem, ProblemSpec, build_problem
 from pendverify.bench.timing import measure
 from pendverify.numerics import fixedstep
 from pendverify.numerics.fastpath import integrate as fast_integrate
-from pendverify.numerics.generate import GeneratedSystem
+from pendverify.numerics.reference import energy_errors
 
-PI = math.pi
 ORDER_WINDOW = (1e-11, 1e-2)
 SCIPY_METHODS = ("RK45", "DOP853", "Radau", "LSODA")
 FIXED_METHODS = tuple(fixedstep.METHODS)
-
-SCENES = {
-    "mild": {
-        "name": "mild swing",
-        "model": "double_pendulum",
-        "initial": {"q": [-PI / 2 + 0.5, 0.3], "v": [0.0, 0.0]},
-        "effects": {"gravity": True},
-    },
-    "chaotic": {
-        "name": "chaotic double pendulum",
-        "model": "double_pendulum",
-        "initial": {"q": [2.0, 2.5], "v": [0.0, 0.0]},
-        "effects": {"gravity": True},
-    },
-    "cart_lqr": {
-        "name": "cart near upright under LQR",
-        "model": "cart_double_pendulum",
-        "initial": {"q": [0.0, 0.1, -0.05], "v": [0.2, 0.0, 0.3]},
-        "effects": {
-            "gravity": True,
-            "damping": True,
-            "actuation": {"type": "lqr", "Q": [10.0, 100.0, 100.0, 1.0, 10.0, 10.0], "R": [0.1]},
-        },
-    },
-    "long": {
-        "name": "long conservative run",
-        "model": "double_pendulum",
-        "initial": {"q": [-PI / 2 + 0.5, 0.3], "v": [0.0, 0.0]},
-        "effects": {"gravity": True},
-    },
-}
-TITLES = {
-    "mild": "double pendulum, mild swing",
-    "chaotic": "double pendulum, chaotic",
-    "cart_lqr": "cart double pendulum, LQR",
-    "long": "long conservative run (energy)",
-}
 
 
 @dataclass(frozen=True)
@@ -114,12 +69,15 @@ class Config:
     digits: tuple = (30, 40)  # reference and check precision
     ensemble_size: int = 1000
     ensemble_checked: int = 4  # members checked against their own reference (the first is the base state)
-    ensemble_spread: float = 0.05  # rad: uniform perturbation of θ1, θ2 around the chaotic state
+    ensemble_spread: float = 0.05  # rad, m: uniform perturbation of every coordinate around the anchor
     target_error: float = 1e-10
     scipy_methods: tuple = SCIPY_METHODS
+    anchor: str = "chaotic"  # the state problem of the single-trajectory ratio, engines and ensemble
     engine_problems: tuple = ("chaotic", "cart_lqr")
     ensemble_variants: tuple = ("threads", "serial", "vectorised")
     seed: int = 20260301
+    scene_horizon: float = 10.0  # s: a user's scene is compared over min(its duration, this)
+    scene_long: float = 1000.0  # s: the energy-only run of a conservative user's scene
 
 
 FULL = Config(
@@ -164,46 +122,22 @@ QUICK = replace(
     ensemble_checked=1,
     engine_problems=("chaotic",),
     ensemble_variants=("threads",),
+    scene_horizon=3.0,
+    scene_long=200.0,
 )
 
 
 # --- problems --------------------------------------------------------------------------------
-@dataclass
-class Problem:
-    key: str
-    title: str
-    scene: object  # pendverify.simulation.scene.Scene
-    dynamics: object  # pendverify.simulation.dynamics.Dynamics (closed form)
-    fast: GeneratedSystem  # the model's generated back ends and the scene's force law
-    x0: np.ndarray
-    duration: float
-    grid: np.ndarray
-    metric: str  # "state" or "energy"
-
-    @property
-    def conservative(self) -> bool:
-        return self.fast.conservative
+def make_problem(spec: ProblemSpec | str, duration: float, grid_intervals: int = 64) -> Problem:
+    """A problem over ``duration``: a ``ProblemSpec``, or the key of one of the seeds' problems."""
+    spec = seed_problems.specs()[spec] if isinstance(spec, str) else spec
+    return build_problem(spec, duration, grid_intervals)
 
 
-def make_problem(key: str, duration: float, grid_intervals: int = 64) -> Problem:
-    from pendverify.simulation.dynamics import build_dynamics
-    from pendverify.simulation.scene import parse_scene
-
-    doc = dict(SCENES[key])
-    doc["time"] = {"duration": duration, "sample_rate": grid_intervals / duration}
-    doc["integrator"] = {"method": "DOP853", "rtol": 1e-10, "atol": 1e-10}
-    scene = parse_scene(doc, f"<benchmark {key}>")
-    dyn = build_dynamics(scene, "closed_form")
-    fast = GeneratedSystem.from_dynamics(dyn)
-    x0 = np.concatenate([scene.q0, scene.v0])
-    grid = np.linspace(0.0, duration, grid_intervals + 1)
-    return Problem(
-        key, TITLES[key], scene, dyn, fast, x0, duration, grid, "energy" if key == "long" else "state"
-    )
-
-
-def make_problems(config: Config) -> list[Problem]:
-    return [make_problem(k, T, config.grid_intervals) for k, T in config.horizons.items()]
+def make_problems(config: Config, specs: dict | None = None) -> list[Problem]:
+    """The problems of ``config.horizons`` from ``specs`` (default: the seeds' table)."""
+    specs = seed_problems.specs() if specs is None else specs
+    return [make_problem(specs[k], T, config.grid_intervals) for k, T in config.horizons.items()]
 
 
 # --- one point of the plot -----------------------------------------------------------------------
@@ -214,6 +148,7 @@ class Point:
     engine: str  # aba, compiled, ...
     kind: str  # adaptive | fixed
     setting: float  # rtol = atol, or the step h [s]
+    metric: str = "state"  # the problem's: "state" or "energy"
     final_error: float = math.nan
     max_error: float = math.nan
     energy_final: float = math.nan
@@ -228,7 +163,7 @@ class Point:
 
     @property
     def plotted_error(self) -> float:
-        return self.energy_max if self.problem == "long" else self.final_error
+        return self.energy_max if self.metric == "energy" else self.final_error
 
 
 CSV_FIELDS = (
@@ -256,8 +191,6 @@ def _errors(point: Point, problem: Problem, ref, final_state, grid_states) -> No
         point.final_error = ref.final_error(final_state)
         point.max_error = float(np.max(ref.errors(grid_states)))
     if problem.conservative:
-        from pendverify.numerics.reference import energy_errors
-
         point.energy_final, point.energy_max = energy_errors(
             problem.fast, problem.x0, grid_states, final_state
         )
@@ -273,7 +206,7 @@ def scipy_sweep(problem: Problem, method: str, rhs, tolerances, config: Config, 
     label = f"{method} (scipy)"
     points, costs = [], []
     for tol in tolerances:
-        point = Point(problem.key, label, rhs.engine, "adaptive", tol)
+        point = Point(problem.key, label, rhs.engine, "adaptive", tol, problem.metric)
         guess = costs[-1] ** 2 / costs[-2] if len(costs) > 1 else (3 * costs[-1] if costs else 0.0)
         if guess > config.run_budget:
             points.append(
@@ -304,7 +237,7 @@ def scipy_sweep(problem: Problem, method: str, rhs, tolerances, config: Config, 
 def fast_sweep(problem: Problem, tolerances, config: Config, ref) -> list[Point]:
     points = []
     for tol in tolerances:
-        point = Point(problem.key, "DOP853 (fast path)", "compiled", "adaptive", tol)
+        point = Point(problem.key, "DOP853 (fast path)", "compiled", "adaptive", tol, problem.metric)
 
         def run(tol=tol):
             return fast_integrate(problem.fast, problem.x0, problem.duration, tol, tol)
@@ -331,7 +264,7 @@ def fixed_sweep(
     g = config.grid_intervals
     for steps in step_counts(problem.duration, largest, halvings, g):
         h = problem.duration / steps
-        point = Point(problem.key, method, "compiled", "fixed", h, steps=steps)
+        point = Point(problem.key, method, "compiled", "fixed", h, problem.metric, steps=steps)
 
         def run(steps=steps):
             return fixedstep.integrate_fixed(

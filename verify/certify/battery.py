@@ -28,6 +28,7 @@ from pendverify.certify.scenes import effect_scenes
 from pendverify.checks.catalogue import run_checks
 from pendverify.checks.sampling import sample_states
 from pendverify.errors import PendverifyError
+from pendverify.progress import bar
 from pendverify.robot.system import PinocchioSystem
 
 
@@ -44,14 +45,25 @@ class BatterySettings:
 
 @dataclass(frozen=True)
 class BatteryItem:
+    """One battery item's evidence: the worst error/tolerance ratio and, apart, the largest error.
+
+    ``error`` and ``tolerance`` are relative (as in the tables) and belong to the same
+    state or step, ``at``: the one with the worst ratio, which decides ``passed``.
+    ``max_error`` is the largest error over the item, at ``max_error_at`` (checks and
+    invariants); the stress cases keep only their worst ratio, so it is None there.
+    """
+
     name: str
     kind: str  # check | stress | invariant
-    max_error: float
+    error: float
     tolerance: float
     samples: int
     seed: int
     passed: bool
     detail: str = ""
+    at: str = ""
+    max_error: float | None = None
+    max_error_at: str = ""
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -59,7 +71,7 @@ class BatteryItem:
     @property
     def margin(self) -> float:
         """error / tolerance: below 1 passes."""
-        return self.max_error / self.tolerance if self.tolerance > 0 else float("inf")
+        return self.error / self.tolerance if self.tolerance > 0 else float("inf")
 
 
 def check_items(model, system, settings: BatterySettings) -> list[BatteryItem]:
@@ -74,6 +86,9 @@ def check_items(model, system, settings: BatterySettings) -> list[BatteryItem]:
             r.seed,
             r.passed,
             r.worst_state["label"],
+            at=r.worst_state["label"],
+            max_error=None if np.isnan(r.largest_error) else r.largest_error,  # nan: nothing judged
+            max_error_at=r.largest_state.get("label", ""),
         )
         for r in run_checks(model.name, model, system, states, settings.seed)
     ]
@@ -94,7 +109,15 @@ def invariant_items(model_cls, params, urdf: str, settings: BatterySettings) -> 
             # a run that diverges or dies is a failed item, not a crash of the battery
             items.append(
                 BatteryItem(
-                    f"invariant:{effect}", "invariant", np.inf, 0.0, 0, settings.seed, False, str(exc)
+                    f"invariant:{effect}",
+                    "invariant",
+                    np.inf,
+                    0.0,
+                    0,
+                    settings.seed,
+                    False,
+                    str(exc),
+                    max_error=np.inf,
                 )
             )
             continue
@@ -111,6 +134,9 @@ def invariant_items(model_cls, params, urdf: str, settings: BatterySettings) -> 
                     settings.seed,
                     inv.passed,
                     inv.name,
+                    at=f"t = {inv.worst_t:.6g} s",
+                    max_error=inv.max_error,
+                    max_error_at=f"t = {inv.max_error_t:.6g} s",
                 )
             )
     return items
@@ -168,8 +194,14 @@ def run_battery(model, params: ParameterSet, urdf: str, settings: BatterySetting
     """The battery for a model (a class, or a built-in model's name), its parameters and URDF."""
     cls = model_class(model)
     system = PinocchioSystem.for_model(cls, urdf, params.g, f"<URDF being certified: {cls.name}>")
-    return (
-        check_items(cls(params), system, settings)
-        + stress_items(cls, params, settings, urdf)
-        + invariant_items(cls, params, urdf, settings)
+    parts = (
+        lambda: check_items(cls(params), system, settings),
+        lambda: stress_items(cls, params, settings, urdf),
+        lambda: invariant_items(cls, params, urdf, settings),
     )
+    items = []
+    with bar(len(parts), "battery", "part") as progress:  # checks, stress cases, simulations
+        for part in parts:
+            items += part()
+            progress.update(1)
+    return items

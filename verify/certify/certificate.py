@@ -1,11 +1,11 @@
 """Certificates: a parameter set, its URDF and the evidence that the battery passed.
 
-Format (schema ``pendverify-certificate/1``), one JSON object:
+Format (schema ``pendverify-certificate/2``), one JSON object:
 
 =================  ===========================================================
 key                content
 =================  ===========================================================
-schema             "pendverify-certificate/1"
+schema             "pendverify-certificate/2"
 name               the set's name (file stem or sweep index)
 model              the model's name: double_pendulum | cart_double_pendulum, or a
                    plug-in's (its class's ``name``)
@@ -19,17 +19,32 @@ derived            the model's ``derived_constants()``: α, β, δ (double pendu
 urdf               {"text": the URDF verbatim, "sha256": of that text (UTF-8)}
 settings           the battery's settings: samples, seed, simulation length, rtol
 versions           pendverify, pinocchio, numpy, python
-checks             every battery item: name, kind (check | stress | invariant),
-                   max_error, tolerance, samples, seed, passed, detail
+checks             every battery item: name, kind (check | stress | invariant);
+                   error, tolerance, at: the worst error/tolerance ratio (the
+                   figures at that state or step, and where it is); max_error,
+                   max_error_at: the largest error and where (checks and invariants; null
+                   for checks and stress cases, which keep only the worst ratio);
+                   samples, seed, passed, detail
+summary            derived from ``checks``: items, passed, failed (names),
+                   result (PASSED | FAILED), worst_item, worst_ratio
 notes              what the URDF reader noticed (angle offsets, a centre of mass
                    off the seed's family and the allowance it implies)
 date               UTC time of certification, ISO 8601
+signature          signed certificates only (``certify --key``): envelope (the
+                   NAME.intoto.jsonl beside it), keyid (the key's fingerprint),
+                   format (``pendverify.certify.signing``)
 digest             {"algorithm": "sha256", "value": hex digest of the canonical
                    JSON of every other field}
 =================  ===========================================================
 
 Canonical JSON: keys sorted, separators "," and ":", UTF-8, floats as Python's
-shortest round-trip repr — so any edit to any field changes the digest.
+shortest round-trip repr — so any edit to any field changes the digest.  The digest
+detects accidental corruption only: anyone can recompute it after an edit.  The
+signature (``pendverify.certify.signing``) is what detects a deliberate edit.
+
+Schema /1 certificates (one figure per item, the error at the worst ratio, under
+the name ``max_error``) are rejected by ``recheck`` with a message saying so: their
+figures cannot be compared with /2's; certify the set again.
 """
 
 from __future__ import annotations
@@ -40,10 +55,19 @@ from datetime import datetime, timezone
 from pendverify.analytic import ParameterSet
 from pendverify.certify.battery import BatteryItem, BatterySettings
 from pendverify.certify.model_source import ModelSource, source_problem
+from pendverify.certify.names import envelope_name
 from pendverify.errors import CertificateError
-from pendverify.jsonio import to_json, versions
+from pendverify.jsonio import plain, to_json, versions
 
-SCHEMA = "pendverify-certificate/1"
+SCHEMA = "pendverify-certificate/2"
+OLD_SCHEMAS = {
+    "pendverify-certificate/1": (
+        "its items record one figure, the error at the worst error/tolerance ratio, under the "
+        "name max_error; schema /2 records the largest error and the worst ratio apart, so the "
+        "figures cannot be compared: certify the set again (its NAME.params.toml and NAME.urdf)"
+    )
+}
+SIGNATURE_FORMAT = "DSSE envelope of an in-toto Statement v1, test-result v0.1 predicate, Ed25519"
 
 
 def canonical_json(obj: dict) -> str:
@@ -60,6 +84,29 @@ def derived_constants(model: ModelSource, params: ParameterSet) -> dict[str, flo
     return {k: float(v) for k, v in model.load()(params).derived_constants().items()}
 
 
+def summary_of(checks: list[dict]) -> dict:
+    """The certificate's ``summary``, derived from its items (``recheck`` derives it again)."""
+    failed = [c["name"] for c in checks if not c["passed"]]
+    ratios = [(plain_ratio(c), c["name"]) for c in checks]
+    worst_ratio, worst_item = max(ratios, default=(0.0, ""))
+    return plain(
+        {
+            "items": len(checks),
+            "passed": len(checks) - len(failed),
+            "failed": failed,
+            "result": "FAILED" if failed or not checks else "PASSED",
+            "worst_item": worst_item,
+            "worst_ratio": worst_ratio,
+        }
+    )
+
+
+def plain_ratio(item: dict) -> float:
+    """error / tolerance of an item as recorded (non-finite numbers are written as strings)."""
+    error, tolerance = float(item["error"]), float(item["tolerance"])
+    return error / tolerance if tolerance > 0 else float("inf")
+
+
 def build_certificate(
     name: str,
     model: ModelSource,
@@ -69,7 +116,10 @@ def build_certificate(
     items: list[BatteryItem],
     date: datetime | None = None,
     notes: list[str] | None = None,
+    keyid: str | None = None,
 ) -> dict:
+    """The certificate; with ``keyid`` (the signing key's fingerprint) it names its envelope."""
+    checks = [item.as_dict() for item in items]
     cert = {
         "schema": SCHEMA,
         "name": name,
@@ -80,10 +130,13 @@ def build_certificate(
         "urdf": {"text": urdf, "sha256": hashlib.sha256(urdf.encode()).hexdigest()},
         "settings": settings.as_dict(),
         "versions": versions(),
-        "checks": [item.as_dict() for item in items],
+        "checks": checks,
+        "summary": summary_of(checks),
         "notes": list(notes or []),
         "date": (date or datetime.now(timezone.utc)).isoformat(timespec="seconds"),
     }
+    if keyid is not None:
+        cert["signature"] = {"envelope": envelope_name(name), "keyid": keyid, "format": SIGNATURE_FORMAT}
     cert["digest"] = {"algorithm": "sha256", "value": digest_of(cert)}
     return cert
 
@@ -126,55 +179,14 @@ def compare_items(recorded: list[dict], fresh: list[BatteryItem]) -> list[str]:
         for key in ("kind", "samples", "seed", "passed"):
             if old[key] != getattr(new, key):
                 differences.append(f"{old['name']}.{key}: recorded {old[key]!r}, now {getattr(new, key)!r}")
-        for key in ("max_error", "tolerance"):
-            a, b = float(old[key]), float(getattr(new, key))
+        for key in ("error", "tolerance", "max_error"):
+            a, b = old[key], getattr(new, key)
+            if a is None or b is None:
+                if (a is None) != (b is None):
+                    differences.append(f"{old['name']}.{key}: recorded {a!r}, now {b!r}")
+                continue
+            a, b = float(a), float(b)
             if abs(a - b) > FIGURE_RTOL * max(abs(a), abs(b)):
                 differences.append(f"{old['name']}.{key}: recorded {a:.6g}, now {b:.6g}")
     differences += [f"{name}: new in the re-run, not in the certificate" for name in by_name]
     return differences
-
-
-def bundle_paths(directory, name: str):
-    """NAME.urdf, NAME.params.toml, NAME.cert.json (and, for a plug-in, ``model_path``)."""
-    from pathlib import Path
-
-    d = Path(directory)
-    return d / f"{name}.urdf", d / f"{name}.params.toml", d / f"{name}.cert.json"
-
-
-def model_path(directory, name: str):
-    """Where a plug-in's bundle keeps a copy of the certified model file: NAME.model.py."""
-    from pathlib import Path
-
-    return Path(directory) / f"{name}.model.py"
-
-
-def refuse_existing(directory, name: str, force: bool) -> None:
-    """Raise unless ``force`` when any file of the bundle already exists."""
-    if force:
-        return
-    for path in (*reversed(bundle_paths(directory, name)), model_path(directory, name)):
-        if path.exists():
-            raise CertificateError(f"{path} exists; pass --force to replace it")
-
-
-def write_bundle(
-    directory, name: str, params: ParameterSet, urdf: str, cert: dict, force: bool = False, model=None
-):
-    """Write NAME.urdf, NAME.params.toml (NAME.model.py for a plug-in ``model``) and, last,
-    NAME.cert.json, each atomically.
-
-    An existing certificate is never replaced unless ``force``: the refusal names
-    the file.  A failure at any point leaves no certificate (the certificate is
-    the last file, written to a temporary name and renamed into place).
-    """
-    from pendverify.atomic import write_atomic
-
-    refuse_existing(directory, name, force)
-    urdf_path, params_path, cert_path = bundle_paths(directory, name)
-    write_atomic(urdf_path, urdf)
-    write_atomic(params_path, params.to_toml(name))
-    if model is not None and not model.builtin:
-        write_atomic(model_path(directory, name), model.text)
-    write_atomic(cert_path, certificate_text(cert))
-    return cert_path

@@ -5,8 +5,13 @@ URDF (a path or ``erd:NAME``) with a parameter file, or with a model whose
 parameters are read off the URDF; a model file (``--analytic``) with its URDF and
 parameter file — into (bundle name, model, parameters, URDF text).  ``issue``
 refuses an existing bundle before any work, runs the battery on that URDF, and
-writes the bundle only if every item passes.  ``recheck``
-verifies a certificate's digest and re-runs its battery.
+writes the bundle only if every item passes (signed when given a key).  ``recheck``
+checks a certificate's schema, digest and derived fields, with ``trust`` its
+signature, and re-runs its battery.
+
+Every name that becomes a file name is checked where it is read
+(``pendverify.certify.names``): a parameter file's ``name``, a URDF's stem, a sweep's
+set names.
 """
 
 from __future__ import annotations
@@ -19,14 +24,12 @@ from pendverify.analytic import ParameterSet
 from pendverify.analytic.params import load_parameter_file
 from pendverify.analytic.plugin import plugin_parameters
 from pendverify.certify.battery import BatteryItem, BatterySettings, run_battery
-from pendverify.certify.certificate import (
-    build_certificate,
-    compare_items,
-    refuse_existing,
-    verify_digest,
-    write_bundle,
-)
+from pendverify.certify.bundle import refuse_existing, verify_signature, write_bundle
+from pendverify.certify.certificate import build_certificate, compare_items, derived_constants, verify_digest
 from pendverify.certify.model_source import ModelSource
+from pendverify.certify.names import check_name
+from pendverify.certify.schema import check_derived, check_schema
+from pendverify.certify.signing import fingerprint
 from pendverify.checks.targets import PARAMS_HINT
 from pendverify.errors import CertificateError, ParameterError, PendverifyError
 from pendverify.robot.erd import resolve_urdf
@@ -58,7 +61,7 @@ def certification_input(
             raise PendverifyError(f"{analytic}: give a model file or a built-in model name, not both")
         return _plugin_input(analytic, urdf, urdf_params or params_file)
     if urdf:
-        path, name = resolve_urdf(urdf)
+        path, name = _urdf_and_name(urdf)
         text = path.read_text()
         if urdf_params:
             model_name, _, params = load_parameter_file(urdf_params)
@@ -78,6 +81,7 @@ def certification_input(
         return CertificationInput(name, ModelSource.of_builtin(model), params, text)
     if params_file:
         model_name, name, params = load_parameter_file(params_file)
+        check_name(name, str(params_file), "name")
         return CertificationInput(name, ModelSource.of_builtin(model_name), params, urdf_for(params, name))
     raise PendverifyError("give a parameter file, a URDF, a model file (--analytic), or a sweep")
 
@@ -100,8 +104,21 @@ def _plugin_input(model_file: str, urdf: str | None, params_file: str | None) ->
             None,
             "certify needs a gravity parameter g: its runs set gravity by it",
         )
-    path, name = resolve_urdf(urdf)
+    path, name = _urdf_and_name(urdf)
     return CertificationInput(name, source, params, path.read_text())
+
+
+def _urdf_and_name(urdf: str):
+    """(path, bundle name) of a URDF argument; its stem must be a valid bundle name."""
+    path, name = resolve_urdf(urdf)
+    check_name(name, str(urdf), "URDF file name (its stem names the bundle)")
+    return path, name
+
+
+def check_sweep_names(sweep, source: str) -> None:
+    """Every set name of a sweep is a valid bundle name (checked before any set runs)."""
+    for name, _ in sweep.sets:
+        check_name(name, source, "set name (the model's name and the set's index)")
 
 
 @dataclass(frozen=True)
@@ -115,32 +132,41 @@ class Issued:
         return self.certificate is not None
 
 
-def issue(target: CertificationInput, settings: BatterySettings, output, force: bool = False) -> Issued:
-    """Run the battery on the target's URDF; write the bundle only if every item passes."""
+def issue(
+    target: CertificationInput, settings: BatterySettings, output, force: bool = False, key=None
+) -> Issued:
+    """Run the battery on the target's URDF; write the bundle only if every item passes.
+
+    ``key`` (an Ed25519 private key, ``signing.load_private_key``) signs the certificate."""
+    check_name(target.name, "<certify>", "name")
     refuse_existing(output, target.name, force)
     cls = target.model.load()
     items = run_battery(cls, target.params, target.urdf, settings)
     if not all(i.passed for i in items):
         return Issued(items)
     notes = PinocchioSystem.for_model(cls, target.urdf, target.params.g).notes
+    keyid = fingerprint(key.public_key()) if key is not None else None
     cert = build_certificate(
-        target.name, target.model, target.params, target.urdf, settings, items, notes=notes
+        target.name, target.model, target.params, target.urdf, settings, items, notes=notes, keyid=keyid
     )
-    path = write_bundle(output, target.name, target.params, target.urdf, cert, force, target.model)
+    path = write_bundle(output, target.name, target.params, target.urdf, cert, force, target.model, key)
     return Issued(items, cert, path)
 
 
-def write_sweep_certificates(sweep, results, output, force: bool = False) -> int:
-    """Write the bundle of every set of a finished sweep whose battery passed; return how many."""
+def write_sweep_certificates(sweep, results, output, force: bool = False, key=None) -> int:
+    """Write the bundle of every set of a finished sweep whose battery passed (each signed by
+    ``key`` if given); return how many."""
     written = 0
+    keyid = fingerprint(key.public_key()) if key is not None else None
     params_type = sweep.model.load().params_type
     for r in results:
         if r["error"] is None and all(i["passed"] for i in r["items"]):
             params = params_type.from_mapping(r["values"])
             items = [BatteryItem(**i) for i in r["items"]]
             settings = BatterySettings(**sweep.settings.as_dict())
-            cert = build_certificate(r["name"], sweep.model, params, r["urdf"], settings, items)
-            write_bundle(output, r["name"], params, r["urdf"], cert, force, sweep.model)
+            check_name(r["name"], "<sweep>", "set name")
+            cert = build_certificate(r["name"], sweep.model, params, r["urdf"], settings, items, keyid=keyid)
+            write_bundle(output, r["name"], params, r["urdf"], cert, force, sweep.model, key)
             written += 1
     return written
 
@@ -150,23 +176,37 @@ class Rechecked:
     certificate: dict
     items: list[BatteryItem]
     differences: list[str]
+    signature: str = ""  # what was established about the signature, in words
 
     @property
     def passed(self) -> bool:
         return not self.differences and all(i.passed for i in self.items)
 
 
-def recheck(path: str) -> Rechecked:
-    """Verify a certificate's digest (a CertificateError if it fails), then re-run its battery."""
+def recheck(path: str, trust: str | None = None) -> Rechecked:
+    """Check a certificate, then re-run its battery.
+
+    Schema, digest, derived fields and (with ``trust``, a public-key PEM) the signature
+    are checked first: any failure raises a PendverifyError naming the field or the key.
+    """
     try:
         with open(path, encoding="utf-8") as fh:
             cert = json.load(fh)
     except FileNotFoundError:
         raise CertificateError(f"{path}: file not found") from None
-    except json.JSONDecodeError as exc:
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
         raise CertificateError(f"{path}: not JSON: {exc}") from None
+    check_schema(cert, path)
     verify_digest(cert, path)
-    cls = ModelSource.from_certificate(cert, path).load()  # a plug-in: from the embedded source
+    source = ModelSource.from_certificate(cert, path)  # a plug-in: from the embedded source
+    cls = source.load()
     params = cls.params_type.from_mapping(cert["parameters"], path, "parameters.")
+    check_derived(cert, derived_constants(source, params), path)
+    if trust is not None:
+        signature = verify_signature(path, cert, trust)
+    elif "signature" in cert:
+        signature = f"signed by key {cert['signature']['keyid']}: not verified (give --trust PUBLIC.pem)"
+    else:
+        signature = "unsigned: only the digest was checked (it detects accidental corruption, not edits)"
     items = run_battery(cls, params, cert["urdf"]["text"], BatterySettings(**cert["settings"]))
-    return Rechecked(cert, items, compare_items(cert["checks"], items))
+    return Rechecked(cert, items, compare_items(cert["checks"], items), signature)

@@ -19,15 +19,16 @@ values rewritten where the base set's values sit (``pendverify.robot.rebind``); 
 range over a parameter the URDF does not show is refused, naming it.  Tasks carry
 the model file's source text, not the class, and load it once per worker.
 
-Tasks run on local processes by default, or on a Dask distributed cluster
-(``--scheduler tcp://HOST:PORT``) through its Client's executor; the task is
-the same pure function either way, so both produce the same certificates.
+A sweep of more than ``max_sets`` sets (a count, or the product of a grid's
+points) is refused before any set is made.  ``pendverify.certify.sweep_run``
+runs the tasks, on local processes or a Dask cluster; the task is the same pure
+function either way, so both produce the same certificates.
 """
 
 from __future__ import annotations
 
 import itertools
-from concurrent.futures import Executor, ProcessPoolExecutor
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -39,6 +40,7 @@ from pendverify.analytic.plugin import plugin_parameters
 from pendverify.certify.battery import BatterySettings, run_battery
 from pendverify.certify.model_source import ModelSource
 from pendverify.errors import PendverifyError, SweepError
+from pendverify.progress import quiet
 from pendverify.robot.rebind import Binding
 from pendverify.robot.writer import urdf_for
 
@@ -83,7 +85,25 @@ def _range(source, key, value):
     return float(spec["min"]), float(spec["max"]), scale, points
 
 
-def load_sweep(path: str | Path) -> Sweep:
+DEFAULT_MAX_SETS = 100_000  # --max-sets raises it
+
+
+def _count(source, mode: str, count: int, specs: dict, max_sets: int) -> int:
+    """The number of sets, refused (naming the key, the count and the limit) above ``max_sets``."""
+    if mode == "grid":
+        n = math.prod(spec[3] for spec in specs.values())
+        key, value = "ranges", " × ".join(f"{k}: {spec[3]} points" for k, spec in specs.items())
+    else:
+        n, key, value = count, "count", count
+    if n > max_sets:
+        raise SweepError(
+            source, key, value, f"{n:,} sets exceed the limit of {max_sets:,}; raise it with --max-sets N"
+        )
+    return n
+
+
+def load_sweep(path: str | Path, max_sets: int = DEFAULT_MAX_SETS) -> Sweep:
+    """A sweep file's sets; more than ``max_sets`` of them is refused before any is made."""
     path = Path(path)
     source = str(path)
     data = read_toml(path)
@@ -123,6 +143,7 @@ def load_sweep(path: str | Path) -> Sweep:
             raise SweepError(source, f"ranges.{key}", value, f"cannot be varied: {binding.reasons[key]}")
         specs[key] = _range(source, key, value)
 
+    _count(source, mode, ints["count"], specs, max_sets)
     values = []
     if mode == "grid":
         axes = [
@@ -201,7 +222,14 @@ def certify_task(
     base_urdf: str | None = None,
     base_values: dict | None = None,
 ) -> dict:
-    """One set through the battery; a pure function of strings and numbers, so it runs anywhere."""
+    """One set through the battery; a pure function of strings and numbers, so it runs anywhere.
+
+    It draws no progress bar: the sweep's own bar is the only one."""
+    with quiet():
+        return _certify(model, name, values, settings, base_urdf, base_values)
+
+
+def _certify(model, name, values, settings, base_urdf, base_values) -> dict:
     try:
         cls = model.load()
         params = cls.params_type.from_mapping(values, f"<sweep set {name}>")
@@ -218,46 +246,12 @@ def certify_task(
     }
 
 
-def executor_for(scheduler: str | None, workers: int | None) -> tuple[Executor, object]:
-    """(executor, resource to close): local processes, or a Dask cluster's executor."""
-    if scheduler is None:
-        pool = ProcessPoolExecutor(max_workers=workers)
-        return pool, pool
-    try:
-        from distributed import Client
-    except ImportError:
-        raise PendverifyError("--scheduler needs Dask: pip install 'pendverify[dask]'") from None
-    try:
-        client = Client(scheduler, timeout="10s")
-    except OSError as exc:
-        raise PendverifyError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
-    return client.get_executor(), client
-
-
-def run_sweep(sweep: Sweep, executor: Executor, progress: bool = True):
-    """Yield task results in the sweep's order, updating a progress bar as they finish."""
-    from tqdm import tqdm
-
-    settings = sweep.settings.as_dict()
-    futures = [
-        executor.submit(certify_task, sweep.model, name, values, settings, sweep.urdf, sweep.base)
-        for name, values in sweep.sets
-    ]
-    bar = tqdm(total=len(futures), desc="sweep", unit="set", disable=not progress)
-    results = []
-    for future in futures:
-        results.append(future.result())
-        bar.update(1)
-    bar.close()
-    return results
-
-
 def summary_table(results: list[dict]) -> str:
     passed = [r for r in results if r["error"] is None and all(i["passed"] for i in r["items"])]
     worst: dict[str, tuple[float, str]] = {}
     for r in results:
         for item in r["items"]:
-            margin = item["max_error"] / item["tolerance"] if item["tolerance"] > 0 else float("inf")
+            margin = item["error"] / item["tolerance"] if item["tolerance"] > 0 else float("inf")
             if margin > worst.get(item["name"], (-1.0, ""))[0]:
                 worst[item["name"]] = (margin, r["name"])
     lines = [f"{len(passed)} passed, {len(results) - len(passed)} failed, {len(results)} sets"]

@@ -87,6 +87,9 @@ class CheckResult:
     seed: int
     worst_state: dict
     passed: bool
+    #: the largest relative error over the judged states, and where (the worst *ratio* is above)
+    largest_error: float = float("nan")
+    largest_state: dict = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
     #: pass, warn, fail or refused (``pendverify.checks.verdict``); ``passed`` is pass or warn
     status: str = ""
@@ -236,6 +239,7 @@ def run_check(check: Check, label: str, model, system, states, seed: int) -> Che
     for _, state, _, j in judged:
         if j.ratio > worst_ratio:
             worst_ratio, worst = j.ratio, (state, j.rel_err, j.rel_tol)
+    largest = max(judged, key=lambda f: f[3].rel_err, default=None)
     if refused:
         state, rounding = refused[0]
         lever = world_lever(model, system, state.q)
@@ -260,6 +264,8 @@ def run_check(check: Check, label: str, model, system, states, seed: int) -> Che
         samples=len(states),
         seed=seed,
         worst_state=state.as_dict(),
+        largest_error=float(largest[3].rel_err) if largest else float("nan"),
+        largest_state=largest[1].as_dict() if largest else {},
         passed=bool(worst_ratio <= 1.0) and not refused,
         notes=notes,
         status=status,

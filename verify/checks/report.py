@@ -112,6 +112,13 @@ def format_table(report: Report) -> str:
     for model, sentences in report.diagnoses.items():
         for sentence in sentences:
             out.append(f"diagnosis [{model}]: {sentence}")
+    judged = [r for r in report.results if r.largest_error == r.largest_error]  # not NaN
+    if judged:
+        top = max(judged, key=lambda r: r.largest_error)
+        out.append(
+            f"largest relative error: {top.largest_error:.2e} ({top.model} {top.check} at "
+            f"{_state_text(top.largest_state)}); the table's error is at each check's worst error/tolerance"
+        )
     total = sum(report.states.values())
     out.append(
         f"{len(report.results)} checks on {len(report.states)} model(s), {total} states "

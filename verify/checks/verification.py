@@ -25,8 +25,9 @@ from pendverify.checks.diagnose import diagnose
 from pendverify.checks.report import Report
 from pendverify.checks.sampling import sample_states
 from pendverify.checks.trust import check_conditioning
-from pendverify.checks.verdict import FAIL, REFUSED, apply_strict, non_christoffel_c
+from pendverify.checks.verdict import FAIL, REFUSED, WARN, apply_strict, non_christoffel_c
 from pendverify.errors import IllConditionedError
+from pendverify.progress import bar
 from pendverify.robot.geometry import MODEL_FORM_RTOL
 
 
@@ -60,6 +61,8 @@ def model_form_result(target, seed: int) -> CheckResult | None:
         samples=1,
         seed=seed,
         worst_state={"label": "URDF geometry", "q": []},
+        largest_error=form.relative,
+        largest_state={"label": "URDF geometry", "q": []},
         passed=form.within(rtol),
         notes=[form.sentence(rtol)],
     )
@@ -112,6 +115,8 @@ def verify_target(report: Report, target, samples: int, seed: int) -> None:
     if form is not None:
         results.append(form)
     warnings = coulomb_warnings(target)
+    # a closed form right in high precision but not in double (pendverify.checks.precision)
+    warnings += [f"{r.check}: {r.notes[0]}" for r in results if r.status == WARN and r.notes]
     sentence = non_christoffel_c(results)
     if sentence:
         warnings.append(sentence)
@@ -134,7 +139,9 @@ def build_report(
 ) -> Report:
     """Every applicable check on every target, judged and diagnosed: one Report."""
     report = Report(seed=seed, states={}, results=[], strict=strict)
-    for target in targets:
-        target.system.model_form_rtol = model_form_rtol
-        verify_target(report, target, samples, seed)
+    with bar(len(targets), "check", "model") as progress:
+        for target in targets:
+            target.system.model_form_rtol = model_form_rtol
+            verify_target(report, target, samples, seed)
+            progress.update(1)
     return report

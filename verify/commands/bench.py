@@ -1,4 +1,8 @@
-"""``pendverify bench accuracy [--quick] [-o DIR]``: the work–precision benchmark.
+"""``pendverify bench accuracy [--scene SCENE.toml] [--quick] [-o DIR]``: the work–precision benchmark.
+
+Without ``--scene``, the seeds' problems (``pendverify.bench.seed_problems``); with it, a
+user's scene, any model (``pendverify.bench.problems.scene_problems`` says which problems
+and refuses what the benchmark cannot run, exit status 2).
 
 Writes DIR/work_precision.png (the plot), DIR/work_precision.csv (every point)
 and DIR/work_precision.md (the tables), and prints the tables.  BLAS is limited
@@ -24,6 +28,12 @@ def register(sub) -> None:
     )
     a.add_argument(
         "--quick", action="store_true", help="fewer tolerances and shorter runs (well under a minute)"
+    )
+    a.add_argument(
+        "--scene",
+        default=None,
+        help="benchmark this scene (any model, a model file with its params and URDF) "
+        "instead of the seeds' problems",
     )
     a.add_argument("-o", "--output", default="bench-out", help="output folder (default: bench-out)")
     a.add_argument("--svg", action="store_true", help="also write the plot as SVG")
@@ -55,12 +65,15 @@ def run(args: argparse.Namespace) -> int:
 
         from pendverify.atomic import write_atomic
         from pendverify.bench.plot import render
+        from pendverify.bench.problems import scene_problems
         from pendverify.bench.report import fraction, ratios, to_csv, to_markdown
         from pendverify.bench.run import run_benchmark
         from pendverify.bench.workprecision import FULL, QUICK
 
-        config = QUICK if args.quick else FULL
-        results = run_benchmark(config, log=lambda msg: print(msg, flush=True), blas=blas)
+        config, specs = QUICK if args.quick else FULL, None
+        if args.scene is not None:
+            config, specs = scene_problems(args.scene, config)
+        results = run_benchmark(config, log=lambda msg: print(msg, flush=True), blas=blas, specs=specs)
         out = Path(args.output)
         markdown = to_markdown(results)
         write_atomic(out / "work_precision.csv", to_csv(results))

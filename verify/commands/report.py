@@ -6,7 +6,9 @@ writes; example-robot-data's URDFs too unless ``--no-erd``; see
 ``pendverify.viz.review_folder``), and for every scene its animation
 (``DIR/scenes/<stem>.html``, embedded), its energy and work-balance plot
 (``DIR/plots/<stem>.svg``) and its invariant results.
-The check report is also written as ``DIR/report.json``.
+The check report is also written as ``DIR/report.json``.  The folder is built
+beside ``DIR`` and renamed into place at the end; an existing ``DIR`` is
+refused unless ``--force``.
 
 The shipped scenes live in the checkout's ``scenes/`` folder, which is not part
 of the installed package: ``report`` runs from a checkout (an editable
@@ -31,6 +33,7 @@ def register(sub) -> None:
     p.add_argument("--seed", type=non_negative_int, default=None, help="seed of the state sampler")
     p.add_argument("--no-erd", dest="erd", action="store_false", help="skip example-robot-data's URDFs")
     p.add_argument("--trace", action="store_true", help="draw the tip's path in the animations")
+    p.add_argument("--force", action="store_true", help="replace an existing output folder")
     p.set_defaults(func=run)
 
 
@@ -64,6 +67,7 @@ def run(args: argparse.Namespace) -> int:
         args.erd,
         args.trace,
         log=lambda line: print(line, flush=True),
+        force=args.force,
     )
     print(f"review page written to {folder.index}")
     return 0 if folder.passed else 1

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 
 
 def register(sub) -> None:
@@ -34,13 +35,25 @@ def summary(run) -> str:
     checks = [*run.invariants, *([run.engine_comparison] if run.engine_comparison else [])]
     width = max(len(c.name) for c in checks)
     lines.append("")
-    lines.append(f"{'invariant'.ljust(width)}  {'error':>9}  {'tolerance':>9}  result")
+    lines.append(f"{''.ljust(width)}  {'largest error':^30}  {'worst error/tolerance':^32}".rstrip())
+    lines.append(
+        f"{'invariant'.ljust(width)}  {'relative':>9}  {'J':>9}  {'t (s)':>8}  "
+        f"{'error':>9}  {'tolerance':>9}  {'t (s)':>8}  result"
+    )
     for c in checks:
         verdict = "pass" if c.passed else "FAIL"
-        lines.append(f"{c.name.ljust(width)}  {c.error:9.2e}  {c.tolerance:9.2e}  {verdict}  ({c.detail})")
+        lines.append(
+            f"{c.name.ljust(width)}  {c.max_error:9.2e}  {_joules(c.max_error_abs)}  {c.max_error_t:8.4g}  "
+            f"{c.error:9.2e}  {c.tolerance:9.2e}  {c.worst_t:8.4g}  {verdict}  ({c.detail})"
+        )
     lines += [f"note: {n}" for n in run.notes]
     lines.append("all invariants hold" if run.passed else "an invariant FAILS")
     return "\n".join(lines)
+
+
+def _joules(value: float) -> str:
+    """The largest error in J, or a dash where errors are relative to each state's own scale."""
+    return f"{value:9.2e}" if math.isfinite(value) else f"{'—':>9}"
 
 
 def run(args: argparse.Namespace) -> int:

@@ -65,6 +65,10 @@ def format_table(report) -> str:
         out.append("")
         out.append("notes:")
         out += [f"  {'FAIL ' if not r.passed else ''}{r.case}: {r.note}" for r in notes]
+    if report.evidence:
+        out.append("")
+        out.append("evidence:")
+        out += [f"  {note}" for note in report.evidence]
     if report.notes:
         out.append("")
         out.append("not varied:")
@@ -151,6 +155,8 @@ def report_dict(report) -> dict:
         "passed": report.passed,
         "results": [r.as_dict() for r in report.results],
         "near_singular": study,
+        "evidence": report.evidence,
+        "not_varied": report.notes,
     }
 
 

@@ -35,10 +35,12 @@ marks the run as failed.  ``nfev`` counts evaluations of f or g.
 from __future__ import annotations
 
 import math
+import time
 
 import numpy as np
 
 from pendverify.numerics.codegen.templates import placeholder, template
+from pendverify.numerics.fastpath import distinct_modules
 from pendverify.numerics.generate import GeneratedSystem
 
 METHODS = {"euler": 1, "symplectic_euler": 1, "implicit_midpoint": 2, "rk4": 4}
@@ -168,15 +170,10 @@ def integrate_fixed(method: str, system: GeneratedSystem, x0, duration: float, s
     return out, int(nfev), status == OK
 
 
-def warm_up() -> float:
-    """Compile (or load from numba's cache) the seeds' fixed-step methods; the seconds it took."""
-    import time
-
-    from pendverify.analytic import CartDoublePendulum, DoublePendulum
-    from pendverify.analytic.params import default_parameter_file, load_parameter_file
-
+def warm_up(systems) -> float:
+    """Compile (or load from numba's cache) the fixed-step methods of each distinct generated module
+    among ``systems`` (``GeneratedSystem``s); the seconds it took."""
     start = time.perf_counter()
-    for cls in (DoublePendulum, CartDoublePendulum):
-        model = cls(load_parameter_file(default_parameter_file(cls.name))[2])
-        integrate_fixed("rk4", GeneratedSystem.from_model(model), np.full(2 * model.nv, 0.1), 0.01, 2)
+    for system in distinct_modules(systems):
+        integrate_fixed("rk4", system, np.full(2 * system.nv, 0.1), 0.01, 2)
     return time.perf_counter() - start

@@ -14,7 +14,7 @@ writes one Python module per model:
   when x has 2n + 2 entries), ``_hamilton(P, y, out)`` (q̇ and ṗ in canonical
   coordinates, derivation there) and ``_to_momentum``; common subexpressions
   eliminated (``sympy.cse``), floats as exact literals;
-* the DOP853 stepper of ``pendverify.numerics.fastpath`` and the fixed-step methods of
+* the DOP853 stepper of ``pendverify.numerics.dop853`` and the fixed-step methods of
   ``pendverify.numerics.fixedstep``, copied from their templates so that they call this
   model's functions inlined (``codegen.templates``, which says why copied);
 * plain-Python ``field``, ``energy`` and ``potential`` generic over the number type

@@ -10,7 +10,7 @@ from __future__ import annotations
 import importlib.metadata
 from pathlib import Path
 
-from pendverify.errors import PendverifyError
+from pendverify.errors import PendverifyError, UrdfShapeError
 
 DISTRIBUTION = "example-robot-data"
 #: the built-in model whose family example-robot-data's double-pendulum URDFs belong to
@@ -36,8 +36,6 @@ def double_pendulum_urdfs() -> dict[str, Path]:
 
 def resolve_urdf(spec: str) -> tuple[Path, str]:
     """(path, bundle name) of ``erd:NAME`` (example-robot-data's URDF NAME) or of a URDF path."""
-    from pendverify.errors import UrdfShapeError
-
     if spec.startswith("erd:"):
         found = double_pendulum_urdfs()
         stem = spec[4:]

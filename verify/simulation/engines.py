@@ -28,6 +28,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pendverify.robot.system import PinocchioSystem
+from pendverify.robot.writer import urdf_for
+
 ENGINES = ("closed_form", "compiled", "aba", "crba_cholesky", "minverse")
 PINOCCHIO_ENGINES = ("aba", "crba_cholesky", "minverse")
 
@@ -131,8 +134,5 @@ def build(engine: str, model, fast, system=None) -> EngineRhs:
     if engine == "compiled":
         return compiled_rhs(fast)
     if system is None:
-        from pendverify.robot.system import PinocchioSystem
-        from pendverify.robot.writer import urdf_for
-
         system = PinocchioSystem.from_urdf(model.name, urdf_for(model.params), model.params.g)
     return pinocchio_rhs(engine, system, fast)

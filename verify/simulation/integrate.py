@@ -9,7 +9,6 @@ that drive the progress bar.
 
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass
 from itertools import pairwise
 
@@ -17,6 +16,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from pendverify.errors import IntegrationError
+from pendverify.progress import new_bar
 
 PROGRESS_CHUNKS = 20
 
@@ -38,12 +38,7 @@ def _segments(duration: float, breakpoints: list[float]) -> np.ndarray:
 
 
 def _progress(total: int, label: str):
-    quiet = not sys.stderr.isatty()
-    try:
-        from tqdm import tqdm
-    except ImportError:  # pragma: no cover - tqdm is a dependency
-        return None
-    return tqdm(total=total, desc=label, unit="seg", disable=quiet, leave=False)
+    return new_bar(total, label, "seg", leave=False)
 
 
 def _finite(rhs, label: str):

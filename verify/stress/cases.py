@@ -13,8 +13,8 @@ import numpy as np
 
 from pendverify.analytic import MODELS
 from pendverify.checks.catalogue import EPS
-from pendverify.checks.sampling import State
-from pendverify.checks.trust import REFUSE_REL
+from pendverify.checks.sampling import RATE_RANGE, State
+from pendverify.checks.trust import KAPPA_K, REFUSE_REL, assess
 from pendverify.errors import PendverifyError
 from pendverify.stress.framework import (
     ANGLE_SHIFT,
@@ -31,8 +31,8 @@ from pendverify.stress.framework import (
     compare,
 )
 from pendverify.stress.seed_params import default
-from pendverify.stress.trust_study import study_states
-from pendverify.validate import model_state
+from pendverify.stress.trust_study import det_accuracy, study_states
+from pendverify.validate import finite_state, model_state
 
 
 # --- large angles and high speeds -------------------------------------------------------------
@@ -109,7 +109,6 @@ def large_angle_case(
 
 def high_speed_case(name: str, params_fn, model_cls=None) -> Case:
     def run(ctx: Context, name: str) -> StressResult:
-        from pendverify.checks.sampling import RATE_RANGE
 
         params = params_fn()
         model = _model(params, model_cls)
@@ -164,8 +163,6 @@ def trust_case(ctx: Context, name: str) -> StressResult:
 
 def det_case(ctx: Context, name: str) -> StressResult:
     """The cart's closed-form det (non-negative terms) stays at ε level even where LU fails."""
-    from pendverify.checks.trust import KAPPA_K
-
     study = ctx.trust_study()
     finite_m = [r for r in study.rows if r.kappa_scaled < 1 / EPS]  # M itself representable
     worst_cf = max(r.det_closed_form for r in finite_m)
@@ -188,9 +185,6 @@ def det_case(ctx: Context, name: str) -> StressResult:
 
 def dp_det_case(ctx: Context, name: str) -> StressResult:
     """The double pendulum's closed-form det, αδ − δ² − β²cos²θ2, is a difference: no better than LU."""
-    from pendverify.checks.trust import KAPPA_K, assess
-    from pendverify.stress.trust_study import det_accuracy
-
     base = default("double_pendulum").replace(I1=0.0, I2=0.0)  # point masses: det → m1 r1² m2 r2² at θ2 = 0
     rows = []
     for m1 in DP_DET_MASSES:
@@ -221,7 +215,6 @@ def dp_det_case(ctx: Context, name: str) -> StressResult:
 
 # --- invalid input ----------------------------------------------------------------------------
 def invalid_input_case(ctx: Context, name: str) -> StressResult:
-    from pendverify.validate import finite_state
 
     dp, cp = default("double_pendulum"), default("cart_double_pendulum")
     model = MODELS["double_pendulum"](dp)

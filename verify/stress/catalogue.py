@@ -181,6 +181,8 @@ class StressReport:
     elapsed_s: float = 0.0
     #: what the cases did not vary, and why (generic cases on a model file)
     notes: list[str] = field(default_factory=list)
+    #: which closed forms are hand-written and checked, which derived and so not evidence (model files)
+    evidence: list[str] = field(default_factory=list)
 
     @property
     def passed(self) -> bool:

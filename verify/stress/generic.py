@@ -26,6 +26,8 @@ import dataclasses
 import time
 from pathlib import Path
 
+from pendverify.checks.applicability import derived_notes
+from pendverify.checks.catalogue import skipped_notes
 from pendverify.checks.targets import plugin_target
 from pendverify.errors import PendverifyError, UnknownNameError
 from pendverify.robot.rebind import Binding
@@ -120,6 +122,8 @@ def run_generic(
             raise UnknownNameError("stress case", name, known)
     ctx = Context(settings, seed)
     chosen = [c for c in cases if names is None or c.name in names]
-    report = StressReport(settings, seed, [run_case(c, ctx) for c in chosen], notes=notes)
+    # what is hand-written and checked, and what is derived and therefore not evidence
+    evidence = [*skipped_notes(target.model, target.system), *derived_notes(target.model)]
+    report = StressReport(settings, seed, [run_case(c, ctx) for c in chosen], notes=notes, evidence=evidence)
     report.elapsed_s = time.perf_counter() - started
     return report

@@ -8,6 +8,8 @@ import numpy as np
 
 from pendverify.analytic import MODELS, DoublePendulumParams
 from pendverify.checks.catalogue import EPS
+from pendverify.checks.trust import conditioning
+from pendverify.stress import integrators as si
 from pendverify.stress.framework import (
     BOUNDED_GROWTH,
     ENERGY_INCREASE_TOL,
@@ -31,14 +33,12 @@ def energy_scale(model, q, v) -> float:
 
 
 def _kappa(model, q):
-    from pendverify.checks.trust import conditioning
 
     return conditioning(model.mass_matrix(q), model.diagonal_scale(q))
 
 
 def stiff_sim_case(name: str, params_fn, q0, model_cls=None) -> Case:
     def run(ctx: Context, name: str) -> StressResult:
-        from pendverify.stress import integrators as si
 
         st = ctx.settings
         params = params_fn()
@@ -102,7 +102,6 @@ LONG_HORIZON_Q0 = (-math.pi / 2 + 0.5, 0.3)  # 0.5 rad from hanging, link 2 bent
 
 def long_horizon_case(name: str, params_fn=long_horizon_params, model_cls=None) -> Case:
     def run(ctx: Context, name: str) -> StressResult:
-        from pendverify.stress import integrators as si
 
         st = ctx.settings
         params = params_fn()
@@ -163,7 +162,6 @@ def long_horizon_case(name: str, params_fn=long_horizon_params, model_cls=None) 
 
 def zero_gravity_sim_case(name: str, params_fn, q0, v0, cyclic: int, label: str, model_cls=None) -> Case:
     def run(ctx: Context, name: str) -> StressResult:
-        from pendverify.stress import integrators as si
 
         st = ctx.settings
         params = params_fn()

@@ -27,10 +27,11 @@ from dataclasses import dataclass, field
 import mpmath as mp
 import numpy as np
 
-from pendverify.analytic import CartDoublePendulum, CartDoublePendulumParams, DoublePendulumParams
+from pendverify.analytic import MODELS, CartDoublePendulum, CartDoublePendulumParams, DoublePendulumParams
 from pendverify.analytic.params import default_parameter_file, load_parameter_file
 from pendverify.checks import trust
 from pendverify.checks.trust import REFUSE_REL, IllConditionedError
+from pendverify.robot.system import PinocchioSystem
 
 REFERENCE_DIGITS = 50
 STUDY_MASSES = tuple(10.0**-k for k in range(17))  # m1 in kg
@@ -155,7 +156,6 @@ class StudyResult:
 
 
 def _measure(params, label, y, v, u, w) -> StudyRow:
-    from pendverify.robot.system import PinocchioSystem
 
     model = CartDoublePendulum(params)
     system = PinocchioSystem.for_params(params)
@@ -208,8 +208,6 @@ def zero_mass_demo(base: CartDoublePendulumParams):
     """
     import pinocchio as pin
 
-    from pendverify.robot.system import PinocchioSystem
-
     system = PinocchioSystem.for_params(base)
     inertia = system.model.inertias[2]  # rod 1's bob
     system.model.inertias[2] = pin.Inertia(0.0, inertia.lever, inertia.inertia)
@@ -258,9 +256,6 @@ def trust_study(base: CartDoublePendulumParams, masses=STUDY_MASSES) -> StudyRes
 
 def det_accuracy(params, q) -> tuple[float, float]:
     """(closed-form det, LU det of the CRBA): relative errors against the 50-digit det."""
-    from pendverify.analytic import MODELS
-    from pendverify.robot.system import PinocchioSystem
-
     model = MODELS[params.model](params)
     system = PinocchioSystem.for_params(params)
     with mp.workdps(REFERENCE_DIGITS):

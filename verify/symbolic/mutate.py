@@ -42,6 +42,7 @@ import sympy as sp
 from pendverify.checks.catalogue import CHECKS, applicable_checks, run_check
 from pendverify.checks.sampling import sample_states
 from pendverify.errors import PendverifyError, UnknownNameError
+from pendverify.progress import bar
 from pendverify.symbolic.equivalence import coriolis_equivalence, differences, equivalence
 from pendverify.symbolic.model import SymbolicModel, entries, show
 from pendverify.symbolic.mutants import Mutant, generate, is_coriolis_form
@@ -212,7 +213,11 @@ def run_mutation(
     controls = _controls(model, system, sm, states, seed)
     unseen = unseen_methods(sm.cls)
     mutants = [m for m in generate(sm) if (methods is None or m.method in methods) and m.method not in unseen]
-    outcomes = [classify(model, system, sm, m, rounds, seed, all_checks) for m in mutants]
+    outcomes = []
+    with bar(len(mutants), "mutate", "mutant") as progress:
+        for m in mutants:
+            outcomes.append(classify(model, system, sm, m, rounds, seed, all_checks))
+            progress.update(1)
     return MutationReport(
         target.label,
         target.source,

@@ -23,6 +23,7 @@ import numpy as np
 import sympy as sp
 
 from pendverify.errors import PendverifyError
+from pendverify.symbolic.model import SymbolicModel
 
 
 def term_bound(expr) -> sp.Expr:
@@ -47,8 +48,6 @@ class _ClassBounds:
 
 @functools.cache
 def _class_bounds(cls) -> _ClassBounds:
-    from pendverify.symbolic.model import SymbolicModel
-
     try:
         sm = SymbolicModel.of(cls)
     except PendverifyError as exc:

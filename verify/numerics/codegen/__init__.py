@@ -6,7 +6,7 @@ generated and the packed layout).  The pieces:
 * ``expressions``: the model's M(q), bias C(q, q̇)·q̇ + H(q) and V(q), read by SymPy;
 * ``printers``: SymPy printers for numba (floats) and for generic numbers (``N``);
 * ``ldlt``: the unrolled root-free Cholesky solve both renderers share;
-* ``templates``: functions written once in fastpath / fixedstep and copied into
+* ``templates``: functions written once in dop853 / fixedstep and copied into
   each generated module, so that they inline that model's right-hand side;
 * ``compiled``: the numba functions ``_rhs``, ``_hamilton``, ``_to_momentum``;
 * ``generic``: the plain-Python ``field``, ``energy`` and ``potential`` (Taylor, mpmath);

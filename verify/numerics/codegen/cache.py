@@ -33,7 +33,7 @@ from pendverify.numerics.codegen import expressions as _expressions
 from pendverify.numerics.codegen import module as _module
 
 #: the modules the generated source depends on besides the model's own
-SOURCES = ("pendverify.symbolic.model", "pendverify.numerics.fastpath", "pendverify.numerics.fixedstep")
+SOURCES = ("pendverify.symbolic.model", "pendverify.numerics.dop853", "pendverify.numerics.fixedstep")
 
 
 def cache_dir() -> Path:
@@ -60,7 +60,7 @@ def _outside_environment(path: str) -> bool:
 
 
 def _origin(module: str) -> str:
-    """A module's source file, without importing it (fastpath would import scipy.integrate)."""
+    """A module's source file, without importing it (dop853 would import scipy.integrate)."""
     return importlib.util.find_spec(module).origin
 
 

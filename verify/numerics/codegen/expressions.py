@@ -30,6 +30,7 @@ class Expressions:
 
 def expressions(model_cls) -> Expressions:
     """Read M, the bias and V of ``model_cls`` with ``SymbolicModel`` (a PendverifyError if it cannot)."""
+    # deferred on purpose: SymPy loads only when a model is generated, not when its module is cached
     import sympy as sp
 
     from pendverify.analytic.plugin import where

@@ -12,7 +12,7 @@ GENERATOR = "gen-2"  # bump when the generated code changes meaning
 def render(ex: Expressions, templates: bool = True) -> str:
     """Header, the numba functions, the copied templates (unless ``templates`` is False) and the
     generic part, as one module (see ``pendverify.numerics.generate``)."""
-    from pendverify.numerics import fastpath, fixedstep
+    from pendverify.numerics import dop853, fixedstep
     from pendverify.numerics.codegen.templates import copy
 
     lines = [
@@ -43,5 +43,5 @@ def render(ex: Expressions, templates: bool = True) -> str:
     ]
     source = "\n".join(lines)
     if templates:
-        source += "\n" + copy(fastpath, fixedstep) + "\n\n"
+        source += "\n" + copy(dop853, fixedstep) + "\n\n"
     return source + render_generic(ex)

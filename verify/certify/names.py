@@ -1,0 +1,54 @@
+"""Names are not paths: the one rule for the names a bundle's files are made of.
+
+A set's name becomes ``DIR/NAME.cert.json``, ``NAME.urdf``, ``NAME.params.toml``,
+``NAME.model.py`` and ``NAME.intoto.jsonl``.  Wherever a name is read (a parameter
+file's ``name``, a URDF's stem, a sweep's set names, a certificate's ``name`` and
+the envelope it names), it must match ``NAME_PATTERN``: a letter or digit, then up
+to 127 letters, digits, ``.``, ``_`` or ``-``, not ending in ``.``.  That excludes
+``..``, ``/`` and ``\\``, drive letters (``C:``), absolute paths, empty names,
+newlines and NUL.  As a second line of defence every bundle write resolves its
+target (symbolic links included) and refuses anything that is not directly inside
+the resolved output folder (``target_inside``).
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from pendverify.errors import BundleNameError, CertificateError
+
+NAME_PATTERN = r"[A-Za-z0-9][A-Za-z0-9._-]{0,127}"
+NAME_RULE = (
+    f"a bundle name must match {NAME_PATTERN} and not end in '.' "
+    "(it names files in the output folder, so no path, separator or control character)"
+)
+_NAME = re.compile(NAME_PATTERN)
+
+
+def check_name(value: object, source: str, key: str) -> str:
+    """``value`` if it is a valid bundle name, else a BundleNameError naming source, key, value and rule."""
+    if not isinstance(value, str) or not _NAME.fullmatch(value) or value.endswith("."):
+        raise BundleNameError(source, key, value, NAME_RULE)
+    return value
+
+
+def target_inside(directory: str | Path, path: str | Path) -> Path:
+    """``path`` resolved, if it lies directly in the resolved ``directory``; else a CertificateError.
+
+    Symbolic links are followed on both sides, so a link planted at ``DIR/NAME.cert.json``
+    that points elsewhere is refused, as is any name that climbs out of the folder.
+    """
+    folder = Path(directory).resolve()
+    target = Path(path).resolve()
+    if target.parent != folder:
+        raise CertificateError(
+            f"{path}: refused: it resolves to {target}, outside the output folder {folder} "
+            "(a bundle file is written only directly inside it)"
+        )
+    return target
+
+
+def envelope_name(name: str) -> str:
+    """The file a signed certificate's DSSE envelope is written to, beside it."""
+    return f"{name}.intoto.jsonl"

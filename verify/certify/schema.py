@@ -1,0 +1,158 @@
+"""What ``recheck`` verifies before it re-runs anything: the schema and the derived fields.
+
+``check_schema`` rejects a certificate that lacks a required key, has an unknown one,
+or holds a value of the wrong type, naming the field (``checks[3].error``).
+``check_derived`` computes again every field that is derived from others — the
+``summary`` from the items, ``derived`` from the parameters through the model's
+``derived_constants`` — and rejects a certificate whose recorded values differ.
+"""
+
+from __future__ import annotations
+
+import re
+from datetime import datetime
+
+from pendverify.certify.certificate import OLD_SCHEMAS, SCHEMA, summary_of
+from pendverify.certify.names import check_name
+from pendverify.errors import CertificateError, PendverifyError
+
+NONFINITE = ("inf", "-inf", "nan")  # how pendverify.jsonio writes non-finite numbers
+
+
+def _number(v) -> bool:
+    return (isinstance(v, (int, float)) and not isinstance(v, bool)) or v in NONFINITE
+
+
+def _integer(v) -> bool:
+    return isinstance(v, int) and not isinstance(v, bool)
+
+
+def _string(v) -> bool:
+    return isinstance(v, str)
+
+
+def _table_of(test):
+    return lambda v: isinstance(v, dict) and all(isinstance(k, str) and test(x) for k, x in v.items())
+
+
+def _hex64(v) -> bool:
+    return isinstance(v, str) and re.fullmatch(r"[0-9a-f]{64}", v) is not None
+
+
+def _date(v) -> bool:
+    try:
+        return isinstance(v, str) and datetime.fromisoformat(v).tzinfo is not None
+    except ValueError:
+        return False
+
+
+# key: (required, test, what it must be)
+TOP = {
+    "schema": (True, _string, "a string"),
+    "name": (True, _string, "a string"),
+    "model": (True, _string, "a string"),
+    "model_source": (False, lambda v: isinstance(v, dict), "a table"),
+    "parameters": (True, _table_of(_number), "a table of numbers"),
+    "derived": (True, _table_of(_number), "a table of numbers"),
+    "urdf": (True, lambda v: isinstance(v, dict), "a table"),
+    "settings": (True, lambda v: isinstance(v, dict), "a table"),
+    "versions": (True, _table_of(_string), "a table of strings"),
+    "checks": (True, lambda v: isinstance(v, list) and bool(v), "a non-empty list of items"),
+    "summary": (True, lambda v: isinstance(v, dict), "a table"),
+    "notes": (True, lambda v: isinstance(v, list) and all(map(_string, v)), "a list of strings"),
+    "date": (True, _date, "an ISO 8601 time with its UTC offset"),
+    "signature": (False, lambda v: isinstance(v, dict), "a table"),
+    "digest": (True, lambda v: isinstance(v, dict), "a table"),
+}
+NESTED = {
+    "urdf": {"text": (True, _string, "a string"), "sha256": (True, _hex64, "64 hex digits")},
+    "settings": {
+        "samples": (True, _integer, "an integer"),
+        "seed": (True, _integer, "an integer"),
+        "sim_duration": (True, _number, "a number"),
+        "sim_rtol": (True, _number, "a number"),
+    },
+    "digest": {"algorithm": (True, _string, "a string"), "value": (True, _string, "a string")},
+    "signature": {
+        "envelope": (True, _string, "a file name"),
+        "keyid": (True, _hex64, "64 hex digits (a key fingerprint)"),
+        "format": (True, _string, "a string"),
+    },
+}
+ITEM = {
+    "name": (True, _string, "a string"),
+    "kind": (True, lambda v: v in ("check", "stress", "invariant"), "check, stress or invariant"),
+    "error": (True, _number, "a number"),
+    "tolerance": (True, _number, "a number"),
+    "at": (True, _string, "a string"),
+    "max_error": (True, lambda v: v is None or _number(v), "a number or null"),
+    "max_error_at": (True, _string, "a string"),
+    "samples": (True, _integer, "an integer"),
+    "seed": (True, _integer, "an integer"),
+    "passed": (True, lambda v: isinstance(v, bool), "true or false"),
+    "detail": (True, _string, "a string"),
+}
+
+
+def _bad(source: str, key: str, value, rule: str) -> CertificateError:
+    shown = repr(value) if len(repr(value)) <= 80 else repr(value)[:77] + "..."
+    return CertificateError(f"{source}: key '{key}' = {shown}: {rule}")
+
+
+def _check_table(table: dict, spec: dict, source: str, prefix: str) -> None:
+    for key, value in table.items():
+        if key not in spec:
+            raise _bad(source, prefix + key, value, f"unknown key; expected {', '.join(spec)}")
+    for key, (required, test, what) in spec.items():
+        if key not in table:
+            if required:
+                raise CertificateError(f"{source}: key '{prefix}{key}' is missing: expected {what}")
+            continue
+        if not test(table[key]):
+            raise _bad(source, prefix + key, table[key], f"expected {what}")
+
+
+def check_schema(cert, source: str) -> None:
+    """Raise CertificateError naming the first field that breaks schema /2."""
+    if not isinstance(cert, dict):
+        raise CertificateError(f"{source}: not a certificate: expected a JSON object")
+    schema = cert.get("schema")
+    if schema in OLD_SCHEMAS:
+        raise CertificateError(f"{source}: schema {schema!r} is no longer rechecked: {OLD_SCHEMAS[schema]}")
+    if schema != SCHEMA:
+        raise _bad(source, "schema", schema, f"expected {SCHEMA!r}")
+    _check_table(cert, TOP, source, "")
+    for key, spec in NESTED.items():
+        if key in cert:
+            _check_table(cert[key], spec, source, f"{key}.")
+    for i, item in enumerate(cert["checks"]):
+        if not isinstance(item, dict):
+            raise _bad(source, f"checks[{i}]", item, "expected a table")
+        _check_table(item, ITEM, source, f"checks[{i}].")
+    try:
+        check_name(cert["name"], source, "name")
+        if "signature" in cert:
+            check_name(cert["signature"]["envelope"], source, "signature.envelope")
+    except PendverifyError as exc:
+        raise CertificateError(str(exc)) from None
+
+
+def check_derived(cert: dict, derived: dict[str, float], source: str) -> None:
+    """Raise CertificateError naming a derived field whose recorded value is not what it derives to.
+
+    ``derived`` is the model's ``derived_constants`` computed from the recorded parameters.
+    """
+    summary = summary_of(cert["checks"])
+    for key in sorted(set(summary) | set(cert["summary"])):
+        if cert["summary"].get(key) != summary.get(key):
+            raise CertificateError(
+                f"{source}: key 'summary.{key}': recorded {cert['summary'].get(key)!r}, derived from the "
+                f"items {summary.get(key)!r}: the certificate was edited after it was issued"
+            )
+    for key in sorted(set(derived) | set(cert["derived"])):
+        recorded, computed = cert["derived"].get(key), derived.get(key)
+        if recorded is None or computed is None or abs(float(recorded) - computed) > 1e-12 * abs(computed):
+            raise CertificateError(
+                f"{source}: key 'derived.{key}': recorded {recorded!r}, computed from the parameters "
+                f"{computed!r}: the certificate was edited after it was issued"
+            )

@@ -1,0 +1,22 @@
+"""``pendverify keygen -o DIR``: an Ed25519 key pair to sign certificates with."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def register(sub) -> None:
+    p = sub.add_parser("keygen", help="write an Ed25519 key pair for signing certificates")
+    p.add_argument("-o", "--output", required=True, help="directory for the private and public key (PEM)")
+    p.add_argument("--force", action="store_true", help="replace an existing key pair")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from pendverify.certify.signing import generate_keys
+
+    private, public, keyid = generate_keys(args.output, args.force)
+    print(f"private key: {private} (mode 0600: keep it secret; certify --key {private})")
+    print(f"public key:  {public} (give it to whoever rechecks: recheck --trust {public})")
+    print(f"fingerprint: {keyid}")
+    return 0
