@@ -161,6 +161,15 @@ def test_csv_without_output(capsys):
     )
 
 
+def test_certify_parameter_file_and_sweep(tmp_path, capsys):
+    sweep = REPO / "sweeps" / "cart_grid.toml"
+    assert main(["certify", str(PARAMS), "--sweep", str(sweep), "-o", str(tmp_path / "out")]) == 2
+    assert error_line(capsys) == (
+        "pendverify: error: --sweep with a parameter file: a sweep file names its own sets; give one of them"
+    )
+    assert not (tmp_path / "out").exists()
+
+
 def test_scene_and_trajectory(tmp_path, capsys):
     npz = tmp_path / "run.npz"
     assert main(["render", str(SCENE), "--trajectory", str(npz), "-o", str(tmp_path / "x.html")]) == 2

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from pendverify.commands import add_analytic_option, non_negative_int, positive_int
+from pendverify.commands import add_analytic_option, non_negative_int, positive_int, refuse_together
 
 DEFAULT_MAX_SETS = 100_000  # pendverify.certify.sweep.DEFAULT_MAX_SETS, without importing NumPy here
 
@@ -66,6 +66,8 @@ def run_certify(args: argparse.Namespace) -> int:
     from pendverify.certify.battery import BatterySettings
     from pendverify.certify.issue import certification_input, issue
 
+    if args.sweep and args.params_file:
+        refuse_together("--sweep", "a parameter file", "a sweep file names its own sets; give one of them")
     if args.sweep:
         return _run_sweep(args)
     settings = BatterySettings()
