@@ -3,7 +3,9 @@
 A module here defines ``register(subparsers)``, which adds its parser and sets
 ``func`` to a function taking the parsed arguments and returning an exit status
 (0 success, 1 a check or invariant failed; bad input raises a PendverifyError,
-which the CLI turns into status 2).  Heavy imports belong inside ``func``.
+which the CLI turns into status 2; anything else is an internal error, status 3:
+``pendverify.exitcodes``).  Output paths go through ``pendverify.atomic.check_output``
+before any work.  Heavy imports belong inside ``func``.
 """
 
 from __future__ import annotations
