@@ -124,6 +124,8 @@ OUTPUT_COMMANDS = [
     ["sympy", "--model", "double_pendulum", "--json", "{out}"],
     ["stress", "--quick", "--json", "{out}"],
     ["bench", "accuracy", "--quick", "-o", "{out}"],
+    ["certify", str(PARAMS), "-o", "{out}"],
+    ["keygen", "-o", "{out}"],
 ]
 
 
@@ -383,3 +385,23 @@ def test_usage_errors_stay_2(capsys):
     with pytest.raises(SystemExit) as info:
         main(["check", "--samples", "-1"])
     assert info.value.code == 2
+
+
+def test_a_scheduler_that_is_not_an_address(tmp_path, capsys):
+    sweep = tmp_path / "sweep.toml"
+    sweep.write_text('model = "double_pendulum"\nmode = "random"\ncount = 2\nseed = 1\n')
+    sweep.write_text(sweep.read_text() + "[ranges]\nm1 = [0.5, 2.0]\n")
+    argv = ["certify", "--sweep", str(sweep), "-o", str(tmp_path / "out"), "--scheduler", "notaurl"]
+    assert main(argv) == 2
+    assert "key '--scheduler' = 'notaurl': a Dask scheduler address" in error_line(capsys)
+
+
+def test_certify_of_a_set_beyond_the_trust_limit_is_refused_not_a_crash(tmp_path, capsys):
+    """m1 = 1e300 kg: every state is beyond the trust rule; the battery refuses its checks (exit 1)."""
+    params = tmp_path / "huge.toml"
+    params.write_text(PARAMS.read_text().replace("\nm1 = 1.0", "\nm1 = 1e300"))
+    assert "m1 = 1e300" in params.read_text()
+    assert main(["certify", str(params), "-o", str(tmp_path / "out"), "--samples", "20"]) == 1
+    out = capsys.readouterr().out
+    assert "check:crba" in out and "refused" in out and "NOT certified" in out
+    assert not (tmp_path / "out").exists() or not list((tmp_path / "out").glob("*.cert.json"))

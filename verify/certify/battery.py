@@ -25,8 +25,9 @@ import numpy as np
 
 from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
 from pendverify.certify.scenes import effect_scenes
-from pendverify.checks.catalogue import run_checks
 from pendverify.checks.sampling import sample_states
+from pendverify.checks.verdict import REFUSED
+from pendverify.checks.verification import guarded_checks
 from pendverify.errors import PendverifyError
 from pendverify.progress import bar
 from pendverify.robot.system import PinocchioSystem
@@ -85,12 +86,12 @@ def check_items(model, system, settings: BatterySettings) -> list[BatteryItem]:
             r.samples,
             r.seed,
             r.passed,
-            r.worst_state["label"],
+            f"{REFUSED}: {r.notes[0]}" if r.status == REFUSED else r.worst_state["label"],
             at=r.worst_state["label"],
             max_error=None if np.isnan(r.largest_error) else r.largest_error,  # nan: nothing judged
             max_error_at=r.largest_state.get("label", ""),
         )
-        for r in run_checks(model.name, model, system, states, settings.seed)
+        for r in guarded_checks(model.name, model, system, states, settings.seed)[0]
     ]
 
 

@@ -23,7 +23,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 
 from pendverify.certify.sweep import Sweep, certify_task
-from pendverify.errors import PendverifyError
+from pendverify.errors import InputError, PendverifyError
 from pendverify.progress import bar
 
 INTERRUPTED = 130  # 128 + SIGINT
@@ -56,9 +56,15 @@ class Workers:
             from distributed import Client
         except ImportError:
             raise PendverifyError("--scheduler needs Dask: pip install 'pendverify[dask]'") from None
+        scheme, _, rest = scheduler.partition("://")
+        host, _, port = rest.rpartition(":")
+        if not (scheme and host and port.isdigit()):
+            raise InputError(
+                "<command line>", "--scheduler", scheduler, "a Dask scheduler address, e.g. tcp://HOST:PORT"
+            )
         try:
             self.client = Client(scheduler, timeout="10s")
-        except OSError as exc:
+        except (OSError, ValueError) as exc:  # unreachable, refused, or an address Dask cannot parse
             raise PendverifyError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
         self.executor = self.client.get_executor()
 

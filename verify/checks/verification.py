@@ -31,13 +31,13 @@ from pendverify.progress import bar
 from pendverify.robot.geometry import MODEL_FORM_RTOL
 
 
-def trusted_states(target, states) -> tuple[list, list[str]]:
+def trusted_states(label: str, model, system, states) -> tuple[list, list[str]]:
     """(states within the trust limit, one sentence per refused state)."""
     kept, refused = [], []
     with np.errstate(all="ignore"):
         for state in states:
             try:
-                check_conditioning(target.model, state.q, target.system, what=target.label)
+                check_conditioning(model, state.q, system, what=label)
             except IllConditionedError as exc:
                 refused.append(f"{state.label}: {exc}")
             else:
@@ -89,11 +89,25 @@ def _refuse(results: list[CheckResult], refused: list[str], total: int) -> None:
             r.notes.insert(0, f"{len(refused)} of {total} states refused, e.g. {refused[0]}")
 
 
+def guarded_checks(label: str, model, system, states, seed: int) -> tuple[list[CheckResult], list[str]]:
+    """The checks that apply, on the states the trust rule accepts; checks refused where it refuses.
+
+    The one way every caller (``check``, the certification battery) runs the checks on
+    sampled states: (results, one sentence per refused state).
+    """
+    kept, refused = trusted_states(label, model, system, states)
+    names = applicable_checks(model, system)
+    with np.errstate(all="ignore"):
+        results = run_checks(label, model, system, kept or states, seed, names)
+    if refused:
+        _refuse(results, refused, len(states))
+    return results, refused
+
+
 def verify_target(report: Report, target, samples: int, seed: int) -> None:
     """Verify one target and add its results, notes, warnings and diagnoses to ``report``."""
     label = target.label
     states = sample_states(target.model, samples, seed)
-    kept, refused = trusted_states(target, states)
     report.states[label] = len(states)
     report.sources[label] = target.source
     notes = (
@@ -102,11 +116,9 @@ def verify_target(report: Report, target, samples: int, seed: int) -> None:
         + skipped_notes(target.model, target.system)
         + derived_notes(target.model)
     )
-    names = applicable_checks(target.model, target.system)
-    with np.errstate(all="ignore"):
-        results = run_checks(label, target.model, target.system, kept or states, seed, names)
+    results, refused = guarded_checks(label, target.model, target.system, states, seed)
+    kept = len(refused) < len(states)
     if refused:
-        _refuse(results, refused, len(states))
         notes.append(
             f"{len(refused)} of {len(states)} states refused by the trust rule "
             f"(rounding bound above the trust limit): {refused[0]}"

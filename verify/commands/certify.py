@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+from pendverify.atomic import check_output
 from pendverify.commands import add_analytic_option, non_negative_int, positive_int, refuse_together
 
 DEFAULT_MAX_SETS = 100_000  # pendverify.certify.sweep.DEFAULT_MAX_SETS, without importing NumPy here
@@ -49,7 +50,7 @@ def _print_items(items) -> None:
     print(f"{'battery item'.ljust(width)}  {'error':>9}  {'error':>9}  {'tolerance':>9}  result")
     for i in items:
         largest = f"{i.max_error:9.2e}" if i.max_error is not None else f"{'—':>9}"
-        verdict = "pass" if i.passed else "FAIL"
+        verdict = "pass" if i.passed else ("refused" if i.detail.startswith("refused:") else "FAIL")
         print(f"{i.name.ljust(width)}  {largest}  {i.error:9.2e}  {i.tolerance:9.2e}  {verdict}")
 
 
@@ -68,6 +69,7 @@ def run_certify(args: argparse.Namespace) -> int:
 
     if args.sweep and args.params_file:
         refuse_together("--sweep", "a parameter file", "a sweep file names its own sets; give one of them")
+    check_output(args.output, folder=True)  # before any work
     if args.sweep:
         return _run_sweep(args)
     settings = BatterySettings()

@@ -13,8 +13,10 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from pendverify.atomic import check_output
     from pendverify.certify.signing import generate_keys
 
+    check_output(args.output, folder=True)
     private, public, keyid = generate_keys(args.output, args.force)
     print(f"private key: {private} (mode 0600: keep it secret; certify --key {private})")
     print(f"public key:  {public} (give it to whoever rechecks: recheck --trust {public})")
