@@ -104,6 +104,7 @@ def test_check_reports_the_largest_error_apart_from_the_worst_ratio(tmp_path, ca
     results = json.loads(out.read_text())["results"]
     for r in results:
         assert r["largest_error"] >= r["max_error"] and r["largest_state"]["label"]
+        assert r["largest_error"] <= r["largest_tolerance"]  # every check passes
     top = max(results, key=lambda r: r["largest_error"])
     assert f"largest relative error: {top['largest_error']:.2e} (cart_double_pendulum {top['check']}" in text
     # on this sample the largest error and the worst ratio fall at different states for some check

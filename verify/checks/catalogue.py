@@ -89,6 +89,7 @@ class CheckResult:
     passed: bool
     #: the largest relative error over the judged states, and where (the worst *ratio* is above)
     largest_error: float = float("nan")
+    largest_tolerance: float = float("nan")  # the tolerance at that state
     largest_state: dict = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
     #: pass, warn, fail or refused (``pendverify.checks.verdict``); ``passed`` is pass or warn
@@ -265,6 +266,7 @@ def run_check(check: Check, label: str, model, system, states, seed: int) -> Che
         seed=seed,
         worst_state=state.as_dict(),
         largest_error=float(largest[3].rel_err) if largest else float("nan"),
+        largest_tolerance=float(largest[3].rel_tol) if largest else float("nan"),
         largest_state=largest[1].as_dict() if largest else {},
         passed=bool(worst_ratio <= 1.0) and not refused,
         notes=notes,

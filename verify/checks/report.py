@@ -117,7 +117,8 @@ def format_table(report: Report) -> str:
         top = max(judged, key=lambda r: r.largest_error)
         out.append(
             f"largest relative error: {top.largest_error:.2e} ({top.model} {top.check} at "
-            f"{_state_text(top.largest_state)}); the table's error is at each check's worst error/tolerance"
+            f"{_state_text(top.largest_state)}, where its tolerance is {top.largest_tolerance:.2e}); "
+            "the table's error is at each check's worst error/tolerance"
         )
     total = sum(report.states.values())
     out.append(

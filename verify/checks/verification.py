@@ -62,6 +62,7 @@ def model_form_result(target, seed: int) -> CheckResult | None:
         seed=seed,
         worst_state={"label": "URDF geometry", "q": []},
         largest_error=form.relative,
+        largest_tolerance=rtol,
         largest_state={"label": "URDF geometry", "q": []},
         passed=form.within(rtol),
         notes=[form.sentence(rtol)],
