@@ -116,6 +116,7 @@ def test_toml_integer_beyond_a_double(tmp_path, capsys):
 # --- outputs: refused before any work -----------------------------------------------------------
 OUTPUT_COMMANDS = [
     ["check", "--params", str(PARAMS), "--json", "{out}"],
+    ["check", "--params", str(PARAMS), "--junit", "{out}"],
     ["simulate", str(SCENE), "-o", "{out}"],
     ["simulate", str(SCENE), "--html", "{out}"],
     ["render", str(SCENE), "-o", "{out}"],

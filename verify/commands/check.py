@@ -22,6 +22,10 @@ def register(sub) -> None:
     p.add_argument("--samples", type=non_negative_int, default=None, help="random states per model")
     p.add_argument("--seed", type=non_negative_int, default=None, help="seed of the state sampler")
     p.add_argument("--json", help="also write the report as JSON to this path")
+    p.add_argument(
+        "--junit", metavar="PATH", help="also write the report as JUnit XML (one test case per check)"
+    )
+    p.add_argument("--quiet", action="store_true", help="print only the verdict line (and errors)")
     p.add_argument("--no-erd", dest="erd", action="store_false", help="skip example-robot-data's URDFs")
     p.add_argument(
         "--strict",
@@ -41,6 +45,7 @@ def register(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from pendverify.atomic import check_output, write_atomic
+    from pendverify.checks.junit import to_junit
     from pendverify.checks.report import format_table
     from pendverify.checks.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
     from pendverify.checks.targets import default_target, erd_targets, plugin_target, user_target
@@ -49,6 +54,7 @@ def run(args: argparse.Namespace) -> int:
     from pendverify.robot.geometry import MODEL_FORM_RTOL
 
     check_output(args.json)
+    check_output(args.junit)
     samples = DEFAULT_RANDOM_STATES if args.samples is None else args.samples
     seed = DEFAULT_SEED if args.seed is None else args.seed
     names = builtin_models(args.model, args.analytic)
@@ -63,8 +69,11 @@ def run(args: argparse.Namespace) -> int:
     rtol = MODEL_FORM_RTOL if args.model_form_rtol is None else args.model_form_rtol
     report = build_report(targets, samples, seed, strict=args.strict, model_form_rtol=rtol)
     report.elapsed_s = time.perf_counter() - args.started
-    print(format_table(report))
-    if args.json:
-        write_atomic(args.json, report.to_json())
-        print(f"report written to {args.json}")
+    table = format_table(report)
+    print(table.splitlines()[-1] if args.quiet else table)
+    for path, text in ((args.json, report.to_json), (args.junit, lambda: to_junit(report))):
+        if path:
+            write_atomic(path, text())
+            if not args.quiet:
+                print(f"report written to {path}")
     return 0 if report.passed else 1
