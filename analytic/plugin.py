@@ -34,6 +34,7 @@ import numpy as np
 
 from pendverify.analytic import ClosedFormModel, ParameterSet
 from pendverify.analytic.params import parse_parameter_document, read_toml
+from pendverify.analytic.text_model import load_text_model
 from pendverify.errors import FileAccessError, ParameterError, PendverifyError, UserCodeError
 
 
@@ -161,8 +162,12 @@ def load_model_class(path: str | Path) -> type[ClosedFormModel]:
         raise PendverifyError(f"{path}: is a directory, not a model file")
     if not path.is_file():
         raise PendverifyError(f"{path}: model file not found")
+    if path.suffix == ".toml":
+        cls = load_text_model(path)
+        validate_model_class(cls, path)
+        return cls
     if path.suffix != ".py":
-        raise PendverifyError(f"{path}: a model file is Python source (.py)")
+        raise PendverifyError(f"{path}: a model file is Python source (.py) or a text model (.toml)")
     module = _import(path)
     found = [
         obj

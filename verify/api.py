@@ -98,7 +98,12 @@ def load_model(source: ModelLike) -> type[ClosedFormModel]:
         if isinstance(source, str) and text in MODELS:
             return MODELS[text]
         path = Path(text)
-        if isinstance(source, Path) or path.suffix == ".py" or len(path.parts) > 1 or path.is_file():
+        if (
+            isinstance(source, Path)
+            or path.suffix in (".py", ".toml")
+            or len(path.parts) > 1
+            or path.is_file()
+        ):
             return load_model_class(text)
         raise PendverifyError(
             f"unknown model {text!r}: give a built-in model ({', '.join(MODELS)}), "

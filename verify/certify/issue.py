@@ -54,7 +54,7 @@ def certification_input(
 ) -> CertificationInput:
     """The set to certify, from a parameter file, a URDF with a parameter file or a model name,
     or a model file (``analytic``; a ``model`` ending in .py counts as one) with a URDF and parameters."""
-    if analytic is None and model is not None and str(model).endswith(".py"):
+    if analytic is None and model is not None and str(model).endswith((".py", ".toml")):
         analytic, model = model, None
     if analytic is not None:
         if model is not None:

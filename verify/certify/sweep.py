@@ -175,7 +175,7 @@ def _model_and_base(path: Path, data: dict):
     source = str(path)
     ref = data.get("model")
     base_ref = data.get("base", "default")
-    if isinstance(ref, str) and ref.endswith(".py"):
+    if isinstance(ref, str) and ref.endswith((".py", ".toml")):
         model_file = path.parent / ref
         try:
             model = ModelSource.of_file(model_file)

@@ -162,7 +162,7 @@ def _model(top: TableReader, scene_path: Path) -> tuple[type[ClosedFormModel], s
     value = top.get("model")
     if isinstance(value, type) and issubclass(value, ClosedFormModel):
         return value, None
-    if isinstance(value, str) and value.endswith(".py"):
+    if isinstance(value, str) and value.endswith((".py", ".toml")):
         path = scene_path.parent / value
         if not path.is_file():
             top.fail("model", value, f"model file not found (looked for {path})")

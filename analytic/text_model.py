@@ -1,0 +1,181 @@
+"""A text model file (TOML) made into a ``ClosedFormModel`` subclass like any other.
+
+``pendverify.analytic.text_parse`` reads the file; here the equations are
+completed (H = ∂V/∂q when only V is given, V integrated from H when only H is),
+checked (M symmetric, C or Cqdot, B when there are inputs) and turned into a
+class whose methods evaluate them: numerically through ``sympy.lambdify`` onto
+``self.math``'s functions (Python's ``math``, mpmath for the high-precision judge,
+complex functions for the LQR's complex step), and as the SymPy expressions
+themselves when ``self.math`` is SymPy's (``pendverify.symbolic.model``), so that
+``sympy``, ``mutate`` and the code generator read the text model as they read a
+Python one.  Only the methods whose equations the file gives are defined, so
+``hand_written()`` tells the truth.  The class's module is a stand-in whose
+``__file__`` is the text file (messages and the generated-code cache name it).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import sys
+import types
+from pathlib import Path
+
+import numpy as np
+import sympy as sp
+
+from pendverify.analytic.forms import Energies
+from pendverify.analytic.interface import BiasOnlyModel, ClosedFormModel
+from pendverify.analytic.params import ParameterSet
+from pendverify.analytic.text_parse import Reader, TextModelSpec, read_text_model
+
+#: equation key → (method, its arguments)
+METHODS = {
+    "M": ("mass_matrix", "q"),
+    "C": ("coriolis_matrix", "qv"),
+    "Cqdot": ("coriolis_force", "qv"),
+    "H": ("gravity", "q"),
+    "V": ("potential_energy", "q"),
+    "D": ("damping_matrix", ""),
+    "B": ("input_matrix", ""),
+    "W": ("disturbance_matrix", ""),
+    "det_M": ("det_mass_matrix", "q"),
+    "M_inv": ("inverse_mass_matrix", "q"),
+    "qddot": ("acceleration", "qvuw"),
+}
+
+
+def _is_zero(expr) -> bool:
+    expr = sp.expand(sp.expand_trig(expr))
+    return expr == 0 or sp.simplify(expr) == 0
+
+
+def complete_equations(reader: Reader, spec: TextModelSpec) -> None:
+    """Check the set of equations and derive H or V from the other (module docstring)."""
+    eq = spec.equations
+    if "M" not in eq:
+        reader.fail("M", "missing: the mass matrix, a list of rows of expressions")
+    if ("C" in eq) == ("Cqdot" in eq):
+        reader.fail("C", "give exactly one of C (the matrix) or Cqdot (the vector C·q̇)")
+    M = eq["M"]
+    for i in range(M.rows):
+        for j in range(i + 1, M.cols):
+            if not _is_zero(M[i, j] - M[j, i]):
+                reader.fail("M", f"not symmetric: M[{i},{j}] = {M[i, j]} but M[{j},{i}] = {M[j, i]}")
+    q = spec.symbols["q"]
+    if "H" not in eq and "V" not in eq:
+        reader.fail("H", "missing: give H (the gravity vector) or V (the potential energy), or both")
+    if "H" not in eq:
+        eq["H"] = sp.Matrix([sp.diff(eq["V"], x) for x in q])
+        spec.derived = ("H",)
+    elif "V" not in eq:
+        eq["V"] = _integrated(reader, eq["H"], q)
+        spec.derived = ("V",)
+    if spec.inputs and "B" not in eq:
+        reader.fail("B", f"missing: the model declares inputs {', '.join(spec.inputs)}")
+
+
+def _integrated(reader: Reader, H, q):
+    """V with ∂V/∂q = H, integrated one coordinate at a time; refused if H is not a gradient."""
+    V = sp.S.Zero
+    for i, x in enumerate(q):
+        V += sp.integrate(sp.expand(H[i] - sp.diff(V, x)), x)
+    if not all(_is_zero(sp.diff(V, x) - H[i]) for i, x in enumerate(q)):
+        reader.fail("H", "is not the gradient of a potential: give V as well")
+    return sp.simplify(V)
+
+
+def _method(key: str, args: str, spec: TextModelSpec):
+    expr = spec.equations[key]
+    syms = [s for g in args + "p" for s in spec.symbols[g]]
+    params = [s.name for s in spec.symbols["p"]]
+    entries = expr.tolist() if isinstance(expr, sp.MatrixBase) else expr
+    vector = isinstance(expr, sp.MatrixBase) and expr.cols == 1 and key not in ("B", "W")
+    if vector:
+        entries = [row[0] for row in entries]
+    compiled: dict[int, tuple] = {}
+
+    def method(self, *arrays):
+        values = [x for a in arrays for x in a] + [getattr(self.params, p) for p in params]
+        if self.math.cos is sp.cos:  # read by SymPy: the expressions themselves
+            value = expr.xreplace({s: sp.sympify(x) for s, x in zip(syms, values, strict=True)})
+            if not isinstance(value, sp.MatrixBase):
+                return value
+            return np.array(list(value) if vector else value.tolist(), dtype=object)
+        namespace = self.math
+        cached = compiled.get(id(namespace))
+        if cached is None or cached[0] is not namespace:
+            cached = compiled[id(namespace)] = (
+                namespace,
+                sp.lambdify(syms, entries, modules=[vars(namespace)]),
+            )
+        value = cached[1](*values)
+        if not isinstance(value, list):
+            return value
+        result = np.array(value)
+        return result.astype(float) if result.dtype.kind in "iub" else result
+
+    method.__name__ = METHODS[key][0]
+    method.__doc__ = f"{key} as written in {spec.path}"
+    return method
+
+
+def _energies(self, q, v, u, w) -> Energies:
+    """T = ½ q̇ᵀ M q̇, V, R = ½ q̇ᵀ D q̇ and P = (B u + W w)ᵀ q̇, from the file's own M, V, D, B, W."""
+    vv = sp.Matrix(list(v))
+    M, D = sp.Matrix(self.mass_matrix(q)), sp.Matrix(self.damping_matrix())
+    force = sp.Matrix(self.input_matrix()) * sp.Matrix(list(u)) if len(u) else sp.zeros(len(v), 1)
+    if len(w):
+        force += sp.Matrix(self.disturbance_matrix()) * sp.Matrix(list(w))
+    half = sp.Rational(1, 2)
+    return Energies(
+        kinetic=half * (vv.T * M * vv)[0],
+        potential=self.potential_energy(q),
+        dissipation=half * (vv.T * D * vv)[0],
+        power=(force.T * vv)[0],
+    )
+
+
+def build_model_class(spec: TextModelSpec) -> type[ClosedFormModel]:
+    """The ``ClosedFormModel`` (or ``BiasOnlyModel``) subclass of a parsed text model."""
+    class_name = "".join(part.capitalize() for part in spec.name.split("_")) or "TextModel"
+    digest = hashlib.sha256(str(spec.path.resolve()).encode()).hexdigest()[:16]
+    module = types.ModuleType(f"pendverify_textmodel_{digest}")
+    module.__file__ = str(spec.path)
+    fields = [
+        (p, float, dataclasses.field(metadata={"kind": kind, "unit": unit, "doc": f"{p} in [{unit}]"}))
+        for p, (kind, unit) in spec.parameters.items()
+    ]
+    params_type = dataclasses.make_dataclass(
+        f"{class_name}Params", fields, bases=(ParameterSet,), frozen=True, namespace={"model": spec.name}
+    )
+    namespace = {
+        "name": spec.name,
+        "params_type": params_type,
+        "coordinates": spec.coordinates,
+        "angular": spec.angular,
+        "inputs": spec.inputs,
+        "disturbances": spec.disturbances,
+        "urdf_joints": spec.urdf_joints,
+        "joint_transform": spec.joint_transform,
+        "joint_offset": spec.joint_offset,
+        "text_spec": spec,
+        "energies": _energies,
+    }
+    for key, (method, args) in METHODS.items():
+        if key in spec.equations:
+            namespace[method] = _method(key, args, spec)
+    base = BiasOnlyModel if "Cqdot" in spec.equations else ClosedFormModel
+    cls = type(class_name, (base,), namespace)
+    for c in (cls, params_type):
+        c.__module__ = module.__name__
+        setattr(module, c.__name__, c)
+    sys.modules[module.__name__] = module
+    return cls
+
+
+def load_text_model(path: str | Path) -> type[ClosedFormModel]:
+    """Read, check and build the model class of a text model file."""
+    spec = read_text_model(path)
+    complete_equations(Reader(spec.path), spec)
+    return build_model_class(spec)

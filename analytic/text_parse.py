@@ -1,0 +1,254 @@
+"""Read a model written as text (TOML): its names, parameters, equations and URDF map.
+
+A text model declares ``name``; ``[coordinates]`` (in order, each ``"angle"`` or
+``"position"``); ``inputs`` and ``disturbances`` (optional lists of names);
+``[parameters]`` (``m1 = { kind = "mass", unit = "kg" }``, the kinds of
+``pendverify.analytic.params``); the equations as strings in SymPy syntax — ``M``
+(rows of entries), ``C`` (matrix) or ``Cqdot`` (the vector C·q̇), ``H`` (vector)
+and/or ``V`` (scalar; a missing H is ∂V/∂q, a missing V is integrated from H),
+optional ``D``, ``B``, ``W``, ``det_M``, ``M_inv``, ``qddot`` — with the rates named
+``d<coordinate>``; and ``[urdf]`` (``joints``, ``transform``, ``offset``).
+
+Parsing is safe: no Python is run.  Each string is first read by ``ast`` and may
+hold only numbers, the declared names, + − * / ** and calls of sin, cos, tan,
+sqrt, exp (and pi); SymPy's ``parse_expr`` then builds it from an explicit symbol
+table, with no builtins and no automatic symbols.  Every problem is one line
+naming the file, the key and what is wrong.
+"""
+
+from __future__ import annotations
+
+import ast
+import difflib
+import keyword
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import sympy as sp
+from sympy.parsing.sympy_parser import auto_number, parse_expr
+
+from pendverify.analytic.params import _RULES, read_toml
+from pendverify.errors import PendverifyError
+
+FUNCTIONS = {"sin": sp.sin, "cos": sp.cos, "tan": sp.tan, "sqrt": sp.sqrt, "exp": sp.exp}
+CONSTANTS = {"pi": sp.pi}
+_GLOBALS = {"__builtins__": {}, "Integer": sp.Integer, "Float": sp.Float, "Rational": sp.Rational}
+_OPERATORS = (ast.Add, ast.Sub, ast.Mult, ast.Div, ast.Pow, ast.USub, ast.UAdd)
+TOP_KEYS = (
+    "name", "coordinates", "inputs", "disturbances", "parameters", "urdf",
+    "M", "C", "Cqdot", "H", "V", "D", "B", "W", "det_M", "M_inv", "qddot",
+)  # fmt: skip
+#: each equation: (shape as a string of dimension names, the argument groups it may use)
+EQUATIONS = {
+    "M": ("nn", "q"), "C": ("nn", "qv"), "Cqdot": ("n", "qv"), "H": ("n", "q"), "V": ("", "q"),
+    "D": ("nn", ""), "B": ("nu", ""), "W": ("nw", ""), "det_M": ("", "q"), "M_inv": ("nn", "q"),
+    "qddot": ("n", "qvuw"),
+}  # fmt: skip
+
+
+@dataclass
+class TextModelSpec:
+    """What a text model file declares, its equations parsed into SymPy."""
+
+    path: Path
+    name: str
+    coordinates: tuple[str, ...]
+    angular: tuple[bool, ...]
+    inputs: tuple[str, ...]
+    disturbances: tuple[str, ...]
+    parameters: dict[str, tuple[str, str]]  # name → (kind, unit)
+    symbols: dict[str, tuple[sp.Symbol, ...]]  # "q", "v", "u", "w", "p"
+    equations: dict[str, object] = field(default_factory=dict)  # key → sp.Matrix or scalar
+    derived: tuple[str, ...] = ()  # H or V when computed from the other
+    urdf_joints: tuple[str, ...] = ()
+    joint_transform: tuple | None = None
+    joint_offset: tuple | None = None
+
+
+class Reader:
+    def __init__(self, path: Path):
+        self.path = path
+
+    def fail(self, key: str, problem: str):
+        raise PendverifyError(f"{self.path}: key '{key}': {problem}")
+
+    def names(self, data: dict, key: str) -> tuple[str, ...]:
+        value = data.get(key, [])
+        if not isinstance(value, list) or not all(isinstance(x, str) for x in value):
+            self.fail(key, "must be a list of names")
+        for name in value:
+            self.identifier(key, name)
+        return tuple(value)
+
+    def identifier(self, key: str, name: str) -> None:
+        if not name.isidentifier() or keyword.iskeyword(name) or name in FUNCTIONS or name in CONSTANTS:
+            self.fail(key, f"{name!r} is not a usable name (a Python identifier, not sin/cos/…/pi)")
+
+    def numbers(self, key: str, value, shape: tuple[int, ...]):
+        """A list (or list of rows) of finite numbers of the given shape, as tuples."""
+        try:
+            array = sp.Matrix(value) if len(shape) == 2 else sp.Matrix([value])
+        except (TypeError, ValueError, IndexError, sp.SympifyError):
+            self.fail(key, f"must be {'rows of numbers' if len(shape) == 2 else 'a list of numbers'}")
+        if (array.shape if len(shape) == 2 else (array.shape[1],)) != shape or not all(
+            isinstance(x, int | float) and not isinstance(x, bool) and x == x and abs(x) != float("inf")
+            for x in (value if len(shape) == 1 else [y for row in value for y in row])
+        ):
+            self.fail(key, f"must be finite numbers of shape {shape}")
+        return tuple(map(float, value)) if len(shape) == 1 else tuple(tuple(map(float, row)) for row in value)
+
+
+def _check_ast(reader: Reader, key: str, text: str, allowed: dict) -> None:
+    try:
+        tree = ast.parse(text.strip(), mode="eval")
+    except SyntaxError as exc:
+        reader.fail(key, f"{text!r} is not an expression ({exc.msg})")
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Name):
+            if node.id not in allowed:
+                close = difflib.get_close_matches(node.id, list(allowed), n=3)
+                hint = f"; did you mean {', '.join(close)}?" if close else ""
+                reader.fail(key, f"unknown name {node.id!r} in {text!r}{hint}")
+        elif isinstance(node, ast.Call):
+            if not (isinstance(node.func, ast.Name) and node.func.id in FUNCTIONS) or node.keywords:
+                reader.fail(key, f"only {', '.join(FUNCTIONS)} may be called, in {text!r}")
+        elif isinstance(node, ast.Constant):
+            if isinstance(node.value, bool) or not isinstance(node.value, int | float):
+                reader.fail(key, f"{node.value!r} is not a number, in {text!r}")
+        elif isinstance(node, ast.BitXor):
+            reader.fail(key, f"'^' in {text!r}: write powers as **")
+        elif not isinstance(node, (ast.Expression, ast.BinOp, ast.UnaryOp, ast.Load, *_OPERATORS)):
+            reader.fail(key, f"{type(node).__name__} is not allowed in {text!r} (numbers, names, + - * / **)")
+
+
+def parse_entry(reader: Reader, key: str, value, allowed: dict):
+    """One expression: a string in SymPy syntax (or a plain number)."""
+    if isinstance(value, bool) or not isinstance(value, str | int | float):
+        reader.fail(key, f"each entry must be an expression string, got {value!r}")
+    text = str(value)
+    _check_ast(reader, key, text, allowed)
+    try:
+        expr = parse_expr(text.strip(), local_dict=dict(allowed), global_dict=dict(_GLOBALS),
+                          transformations=(auto_number,))  # fmt: skip
+    except (SyntaxError, TypeError, ValueError, NameError, ZeroDivisionError) as exc:
+        reader.fail(key, f"{text!r} cannot be read ({type(exc).__name__}: {exc})")
+    if expr.has(sp.zoo, sp.oo, sp.nan):
+        reader.fail(key, f"{text!r} is not finite")
+    return expr
+
+
+def parse_equation(reader: Reader, key: str, value, rows: int, cols: int | None, allowed: dict):
+    """A matrix (rows × cols), a column vector (cols None, rows entries) or a scalar (rows 0)."""
+    if rows == 0:
+        return parse_entry(reader, key, value, allowed)
+    want = f"{rows} × {cols} (a list of {rows} rows of {cols})" if cols is not None else f"{rows} entries"
+    if cols is None:
+        if not isinstance(value, list) or len(value) != rows or any(isinstance(x, list) for x in value):
+            reader.fail(key, f"wrong shape: must be a vector of {want}")
+        return sp.Matrix([parse_entry(reader, f"{key}[{i}]", x, allowed) for i, x in enumerate(value)])
+    if (
+        not isinstance(value, list)
+        or len(value) != rows
+        or not all(isinstance(r, list) and len(r) == cols for r in value)
+    ):
+        reader.fail(key, f"wrong shape: must be a matrix of {want}")
+    return sp.Matrix(
+        [
+            [parse_entry(reader, f"{key}[{i},{j}]", x, allowed) for j, x in enumerate(r)]
+            for i, r in enumerate(value)
+        ]
+    )
+
+
+def read_text_model(path: str | Path) -> TextModelSpec:
+    """Parse and check a text model file (module docstring)."""
+    path = Path(path)
+    reader = Reader(path)
+    try:
+        data = read_toml(path)
+    except PendverifyError as exc:
+        raise PendverifyError(str(exc)) from None
+    for key in data:
+        if key not in TOP_KEYS:
+            close = difflib.get_close_matches(key, TOP_KEYS, n=3)
+            reader.fail(key, f"unknown key{'; did you mean ' + ', '.join(close) + '?' if close else ''}")
+    name = data.get("name")
+    if not isinstance(name, str) or not name.isidentifier():
+        reader.fail("name", "missing, or not a name (letters, digits, _)")
+    coords = data.get("coordinates")
+    if not isinstance(coords, dict) or not coords:
+        reader.fail("coordinates", 'missing: a table such as theta1 = "angle", x = "position"')
+    for c, kind in coords.items():
+        reader.identifier(f"coordinates.{c}", c)
+        if kind not in ("angle", "position"):
+            reader.fail(f"coordinates.{c}", f'{kind!r}: must be "angle" or "position"')
+    inputs, disturbances = reader.names(data, "inputs"), reader.names(data, "disturbances")
+    params = data.get("parameters")
+    if not isinstance(params, dict):
+        reader.fail("parameters", 'missing: a table such as m1 = { kind = "mass", unit = "kg" }')
+    parameters = {}
+    for p, decl in params.items():
+        reader.identifier(f"parameters.{p}", p)
+        if (
+            not isinstance(decl, dict)
+            or decl.get("kind") not in _RULES
+            or set(decl) - {"kind", "unit", "doc"}
+        ):
+            reader.fail(
+                f"parameters.{p}",
+                f"must be {{ kind = ..., unit = ... }} with kind one of {', '.join(_RULES)}",
+            )
+        unit = decl.get("unit", _RULES[decl["kind"]][1])
+        if not isinstance(unit, str):
+            reader.fail(f"parameters.{p}.unit", "must be a string")
+        parameters[p] = (decl["kind"], unit)
+    rates = tuple(f"d{c}" for c in coords)
+    all_names = [*coords, *rates, *inputs, *disturbances, *parameters]
+    twice = sorted({n for n in all_names if all_names.count(n) > 1})
+    if twice:
+        reader.fail("coordinates", f"name(s) {', '.join(twice)} used twice among coordinates, d<coordinate> "
+                                   "rates, inputs, disturbances and parameters")  # fmt: skip
+    symbols = {
+        "q": tuple(sp.Symbol(c, real=True) for c in coords),
+        "v": tuple(sp.Symbol(r, real=True) for r in rates),
+        "u": tuple(sp.Symbol(n, real=True) for n in inputs),
+        "w": tuple(sp.Symbol(n, real=True) for n in disturbances),
+        "p": tuple(
+            sp.Symbol(
+                p, real=True, **({"positive": True} if k in ("mass", "length") else {"nonnegative": True})
+            )
+            for p, (k, _) in parameters.items()
+        ),
+    }
+    spec = TextModelSpec(
+        path, name, tuple(coords), tuple(k == "angle" for k in coords.values()),
+        inputs, disturbances, parameters, symbols,
+    )  # fmt: skip
+    _read_equations(reader, spec, data)
+    _read_urdf(reader, spec, data.get("urdf", {}))
+    return spec
+
+
+def _read_equations(reader: Reader, spec: TextModelSpec, data: dict) -> None:
+    n = len(spec.coordinates)
+    dims = {"n": n, "u": len(spec.inputs), "w": len(spec.disturbances)}
+    for key, (shape, groups) in EQUATIONS.items():
+        if key not in data:
+            continue
+        allowed = {s.name: s for g in groups + "p" for s in spec.symbols[g]} | FUNCTIONS | CONSTANTS
+        rows = n if shape else 0
+        cols = dims[shape[1]] if len(shape) == 2 else None
+        spec.equations[key] = parse_equation(reader, key, data[key], rows, cols, allowed)
+
+
+def _read_urdf(reader: Reader, spec: TextModelSpec, urdf) -> None:
+    if not isinstance(urdf, dict) or set(urdf) - {"joints", "transform", "offset"}:
+        reader.fail("urdf", "must be a table of joints, transform, offset")
+    n = len(spec.coordinates)
+    spec.urdf_joints = reader.names({"urdf.joints": urdf.get("joints", [])}, "urdf.joints")
+    if "joints" in urdf and len(spec.urdf_joints) != n:
+        reader.fail("urdf.joints", f"must name {n} joints, one per coordinate")
+    if "transform" in urdf:
+        spec.joint_transform = reader.numbers("urdf.transform", urdf["transform"], (n, n))
+    if "offset" in urdf:
+        spec.joint_offset = reader.numbers("urdf.offset", urdf["offset"], (n,))
