@@ -406,3 +406,24 @@ def test_certify_of_a_set_beyond_the_trust_limit_is_refused_not_a_crash(tmp_path
     out = capsys.readouterr().out
     assert "check:crba" in out and "refused" in out and "NOT certified" in out
     assert not (tmp_path / "out").exists() or not list((tmp_path / "out").glob("*.cert.json"))
+
+
+def test_a_closed_pipe_is_quiet_not_an_internal_error():
+    """``pendverify show MODEL | head -1``: the reader is gone; no error line, status 141 (SIGPIPE).
+
+    The pipe's read end is closed before the command starts, so its first write fails."""
+    model = REPO / "examples" / "minimal_double_pendulum_text.toml"
+    cmd = [
+        sys.executable,
+        "-c",
+        "import sys; from pendverify.cli import main; sys.exit(main())",
+        "show",
+        str(model),
+    ]
+    read_end, write_end = os.pipe()
+    os.close(read_end)
+    try:
+        proc = subprocess.run(cmd, stdout=write_end, stderr=subprocess.PIPE, timeout=120)
+    finally:
+        os.close(write_end)
+    assert proc.returncode == 141 and proc.stderr.decode() == "", proc.stderr.decode()

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import pkgutil
 import sys
 import time
@@ -74,9 +75,12 @@ def args_parsed(exc: SystemExit) -> bool:
 
 
 def _fail(exc: BaseException, debug: bool) -> int:
-    from pendverify.exitcodes import INTERNAL_ERROR, classify
+    from pendverify.exitcodes import INTERNAL_ERROR, PIPE_CLOSED, classify
 
     code, line = classify(exc)
+    if code == PIPE_CLOSED:  # stdout's reader is gone: nothing more to say, and no flush error at exit
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return code
     sys.stdout.flush()
     if debug and code == INTERNAL_ERROR:
         traceback.print_exception(exc, file=sys.stderr)

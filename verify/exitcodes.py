@@ -8,6 +8,8 @@ code meaning
 2    bad input or usage: a file, a key, an option, an output path
 3    internal error: a bug in pendverify (one line; the traceback with ``--debug``)
 130  interrupted (Ctrl-C)
+141  the reader of standard output went away (``pendverify show X | head``): nothing printed,
+     as a shell reports a command ended by SIGPIPE (128 + 13)
 ==== =====================================================================
 
 An exception raised by a user's model file (``--analytic``, a scene's ``model``)
@@ -26,6 +28,7 @@ FAILED = 1
 BAD_INPUT = 2
 INTERNAL_ERROR = 3
 INTERRUPTED = 130
+PIPE_CLOSED = 141
 
 REPORT_BUGS = (
     "this is a bug in pendverify, not in your input: please report it on the project's issues "
@@ -37,6 +40,8 @@ def classify(exc: BaseException) -> tuple[int, str]:
     """(exit status, the one line to print on stderr) for an exception a command raised."""
     if isinstance(exc, KeyboardInterrupt):
         return INTERRUPTED, "interrupted"
+    if isinstance(exc, BrokenPipeError):
+        return PIPE_CLOSED, ""
     if isinstance(exc, PendverifyError):
         return BAD_INPUT, f"error: {one_line(str(exc))}"
     user = user_code_error(exc)
