@@ -134,3 +134,22 @@ def test_mutate_runs_on_the_text_model(capsys):
     args = ["--analytic", str(TEXT), "--urdf", str(URDF), "--params", str(PARAMS), "--samples", "10"]
     assert main(["mutate", *args, "--method", "coriolis_matrix"]) in (0, 1)
     assert "coriolis_matrix" in capsys.readouterr().out
+
+
+def test_a_certified_text_model_keeps_its_text_as_model_toml_and_rechecks(tmp_path, capsys):
+    examples = Path(__file__).resolve().parents[1] / "examples"
+    urdf = examples.parent / "urdf" / "double_pendulum.urdf"
+    argv = ["certify", "--analytic", str(examples / "minimal_double_pendulum_text.toml"), "--urdf", str(urdf)]
+    argv += [
+        "--params",
+        str(examples / "minimal_double_pendulum.toml"),
+        "-o",
+        str(tmp_path),
+        "--samples",
+        "30",
+    ]
+    assert main(argv) == 0
+    copy = tmp_path / "double_pendulum.model.toml"
+    assert copy.read_text() == (examples / "minimal_double_pendulum_text.toml").read_text()
+    assert not (tmp_path / "double_pendulum.model.py").exists()
+    assert main(["recheck", str(tmp_path / "double_pendulum.cert.json")]) == 0

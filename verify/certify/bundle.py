@@ -1,6 +1,6 @@
 """A certificate bundle on disk: which files, written how.
 
-``DIR/NAME.urdf``, ``DIR/NAME.params.toml``, ``DIR/NAME.model.py`` (a model file's
+``DIR/NAME.urdf``, ``DIR/NAME.params.toml``, ``DIR/NAME.model.py`` or ``.model.toml`` (a model file's
 bundle), ``DIR/NAME.intoto.jsonl`` (a signed certificate's DSSE envelope) and, last,
 ``DIR/NAME.cert.json``, each written atomically (``pendverify.atomic``).  The
 certificate is written last, so an interruption never leaves a certificate without
@@ -33,9 +33,14 @@ def bundle_paths(directory, name: str) -> tuple[Path, Path, Path]:
     return d / f"{name}.urdf", d / f"{name}.params.toml", d / f"{name}.cert.json"
 
 
-def model_path(directory, name: str) -> Path:
-    """Where a plug-in's bundle keeps a copy of the certified model file: NAME.model.py."""
-    return Path(directory) / f"{name}.model.py"
+MODEL_SUFFIXES = (".py", ".toml")  # a Python model file, or a text one
+
+
+def model_path(directory, name: str, file: str = "model.py") -> Path:
+    """Where a plug-in's bundle keeps a copy of the certified model file: NAME.model.py, or
+    NAME.model.toml for a text model (``file``: the model file's name)."""
+    suffix = ".toml" if str(file).endswith(".toml") else ".py"
+    return Path(directory) / f"{name}.model{suffix}"
 
 
 def envelope_path(directory, name: str) -> Path:
@@ -45,7 +50,8 @@ def envelope_path(directory, name: str) -> Path:
 def refuse_existing(directory, name: str, force: bool) -> None:
     """Raise unless ``force`` when any file of the bundle already exists; refuse a target
     outside the output folder whatever ``force`` says."""
-    extra = (model_path(directory, name), envelope_path(directory, name))
+    models = (model_path(directory, name, f"model{suffix}") for suffix in MODEL_SUFFIXES)
+    extra = (*models, envelope_path(directory, name))
     paths = (*reversed(bundle_paths(directory, name)), *extra)
     if Path(directory).exists():
         for path in paths:
@@ -74,7 +80,7 @@ def write_bundle(
     urdf_path, params_path, cert_path = bundle_paths(directory, name)
     files = {urdf_path: urdf, params_path: params.to_toml(name)}
     if model is not None and not model.builtin:
-        files[model_path(directory, name)] = model.text
+        files[model_path(directory, name, model.file)] = model.text
     text = certificate_text(cert)
     if key is not None:
         contents = {p.name: t.encode() for p, t in {**files, cert_path: text}.items()}
