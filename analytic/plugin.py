@@ -34,7 +34,6 @@ import numpy as np
 
 from pendverify.analytic import ClosedFormModel, ParameterSet
 from pendverify.analytic.params import parse_parameter_document, read_toml
-from pendverify.analytic.text_model import load_text_model
 from pendverify.errors import FileAccessError, ParameterError, PendverifyError, UserCodeError
 
 
@@ -163,6 +162,9 @@ def load_model_class(path: str | Path) -> type[ClosedFormModel]:
     if not path.is_file():
         raise PendverifyError(f"{path}: model file not found")
     if path.suffix == ".toml":
+        # deferred on purpose: SymPy loads only for a text model, not for every model file
+        from pendverify.analytic.text_model import load_text_model
+
         cls = load_text_model(path)
         validate_model_class(cls, path)
         return cls
