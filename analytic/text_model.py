@@ -51,12 +51,21 @@ def _is_zero(expr) -> bool:
 
 
 def complete_equations(reader: Reader, spec: TextModelSpec) -> None:
-    """Check the set of equations and derive H or V from the other (module docstring)."""
+    """Check the set of equations and derive what is given in another form (module docstring)."""
     eq = spec.equations
     if "M" not in eq:
         reader.fail("M", "missing: the mass matrix, a list of rows of expressions")
+    if "f" in eq:
+        _split_f(reader, spec)
+    if "C_plus_D" in eq:
+        if "D" not in eq:
+            reader.fail("C_plus_D", "needs D: C_plus_D is C with the friction inside, C = C_plus_D − D")
+        if "C" in eq or "Cqdot" in eq:
+            reader.fail("C_plus_D", "give one of C, Cqdot or C_plus_D")
+        eq["C"] = eq.pop("C_plus_D") - eq["D"]
+        spec.derived["C"] = "C_plus_D − D"
     if ("C" in eq) == ("Cqdot" in eq):
-        reader.fail("C", "give exactly one of C (the matrix) or Cqdot (the vector C·q̇)")
+        reader.fail("C", "give exactly one of C (the matrix), C_plus_D (C + D) or Cqdot (the vector C·q̇)")
     M = eq["M"]
     for i in range(M.rows):
         for j in range(i + 1, M.cols):
@@ -67,12 +76,66 @@ def complete_equations(reader: Reader, spec: TextModelSpec) -> None:
         reader.fail("H", "missing: give H (the gravity vector) or V (the potential energy), or both")
     if "H" not in eq:
         eq["H"] = sp.Matrix([sp.diff(eq["V"], x) for x in q])
-        spec.derived = ("H",)
+        spec.derived["H"] = "∂V/∂q"
     elif "V" not in eq:
         eq["V"] = _integrated(reader, eq["H"], q)
-        spec.derived = ("V",)
+        spec.derived["V"] = "integrated from H"
+    elif "H" in spec.derived and not all(_is_zero(sp.diff(eq["V"], x) - eq["H"][i]) for i, x in enumerate(q)):
+        reader.fail("f", "its gravity part −f(q, 0, 0, 0) is not ∂V/∂q of the V given")
     if spec.inputs and "B" not in eq:
         reader.fail("B", f"missing: the model declares inputs {', '.join(spec.inputs)}")
+
+
+_F_PARTS = {
+    "H": "−f(q, 0, 0, 0)",
+    "Cqdot": "the part quadratic in q̇",
+    "D": "−∂f/∂q̇ at q̇ = 0",
+    "B": "∂f/∂u",
+    "W": "∂f/∂w",
+}
+
+
+def _split_f(reader: Reader, spec: TextModelSpec) -> None:
+    """M q̈ = f(q, q̇, u, w) split into H, Cqdot, D, B, W (module docstring); each part is checked."""
+    eq, sym = spec.equations, spec.symbols
+    parts = [k for k in ("C", "C_plus_D", "Cqdot", "H", "D", "B", "W", "qddot") if k in eq]
+    if parts:
+        reader.fail("f", f"give f or its parts, not both (the file also gives {', '.join(parts)})")
+    f = eq.pop("f")
+    zero = {s: 0 for g in "vuw" for s in sym[g]}
+    rest = {s: 0 for g in "uw" for s in sym[g]}
+    H = -f.xreplace(zero)
+    for key, group in (("B", "u"), ("W", "w")):
+        if sym[group]:
+            J = f.jacobian(list(sym[group]))
+            if J.free_symbols & set(sym["q"] + sym["v"] + sym["u"] + sym["w"]):
+                reader.fail(
+                    "f", f"is not f0(q, q̇) + {key}·{group} with a constant {key}: ∂f/∂{group} = {J.tolist()}"
+                )
+            eq[key] = J
+    driven = f.xreplace(rest)
+    if not all(
+        _is_zero(x)
+        for x in f
+        - driven
+        - sum((eq[k] * sp.Matrix(sym[g]) for k, g in (("B", "u"), ("W", "w")) if sym[g]), sp.zeros(f.rows, 1))
+    ):
+        reader.fail("f", "is not affine in the inputs and disturbances")
+    velocity = driven + H  # f(q, q̇, 0, 0) − f(q, 0, 0, 0)
+    v = sp.Matrix(sym["v"])
+    D = -velocity.jacobian(list(v)).xreplace(zero)
+    if D.free_symbols & set(sym["q"]):
+        reader.fail(
+            "f", f"its part linear in q̇ (the damping −D·q̇) depends on the coordinates: D = {D.tolist()}"
+        )
+    Cqdot = sp.expand(-(velocity + D * v))
+    lam = sp.Dummy("lam")
+    if not all(_is_zero(x) for x in Cqdot.xreplace({s: lam * s for s in v}) - lam**2 * Cqdot):
+        reader.fail("f", "its velocity part is not −D·q̇ − C(q, q̇)·q̇ (linear plus quadratic in q̇)")
+    eq["H"], eq["Cqdot"] = H, -(velocity + D * v)
+    if any(x != 0 for x in D):
+        eq["D"] = D
+    spec.derived.update({k: f"from f: {how}" for k, how in _F_PARTS.items() if k in eq})
 
 
 def _integrated(reader: Reader, H, q):
@@ -81,7 +144,10 @@ def _integrated(reader: Reader, H, q):
     for i, x in enumerate(q):
         V += sp.integrate(sp.expand(H[i] - sp.diff(V, x)), x)
     if not all(_is_zero(sp.diff(V, x) - H[i]) for i, x in enumerate(q)):
-        reader.fail("H", "is not the gradient of a potential: give V as well")
+        reader.fail(
+            "H",
+            "is not the gradient of any potential (∂H_i/∂q_j ≠ ∂H_j/∂q_i): a typo in H? else give V as well",
+        )
     return sp.simplify(V)
 
 

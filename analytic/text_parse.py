@@ -28,6 +28,7 @@ import sympy as sp
 from sympy.parsing.sympy_parser import auto_number, parse_expr
 
 from pendverify.analytic.params import _RULES, read_toml
+from pendverify.analytic.text_latex import parse_latex_equation, read_symbol_table
 from pendverify.errors import PendverifyError
 
 FUNCTIONS = {"sin": sp.sin, "cos": sp.cos, "tan": sp.tan, "sqrt": sp.sqrt, "exp": sp.exp}
@@ -35,14 +36,15 @@ CONSTANTS = {"pi": sp.pi}
 _GLOBALS = {"__builtins__": {}, "Integer": sp.Integer, "Float": sp.Float, "Rational": sp.Rational}
 _OPERATORS = (ast.Add, ast.Sub, ast.Mult, ast.Div, ast.Pow, ast.USub, ast.UAdd)
 TOP_KEYS = (
-    "name", "coordinates", "inputs", "disturbances", "parameters", "urdf",
-    "M", "C", "Cqdot", "H", "V", "D", "B", "W", "det_M", "M_inv", "qddot",
+    "name", "notation", "coordinates", "inputs", "disturbances", "parameters", "symbols", "urdf",
+    "M", "C", "C_plus_D", "Cqdot", "H", "V", "D", "B", "W", "f", "det_M", "M_inv", "qddot",
 )  # fmt: skip
+NOTATIONS = ("sympy", "latex")
 #: each equation: (shape as a string of dimension names, the argument groups it may use)
 EQUATIONS = {
-    "M": ("nn", "q"), "C": ("nn", "qv"), "Cqdot": ("n", "qv"), "H": ("n", "q"), "V": ("", "q"),
-    "D": ("nn", ""), "B": ("nu", ""), "W": ("nw", ""), "det_M": ("", "q"), "M_inv": ("nn", "q"),
-    "qddot": ("n", "qvuw"),
+    "M": ("nn", "q"), "C": ("nn", "qv"), "C_plus_D": ("nn", "qv"), "Cqdot": ("n", "qv"), "H": ("n", "q"),
+    "V": ("", "q"), "D": ("nn", ""), "B": ("nu", ""), "W": ("nw", ""), "f": ("n", "qvuw"),
+    "det_M": ("", "q"), "M_inv": ("nn", "q"), "qddot": ("n", "qvuw"),
 }  # fmt: skip
 
 
@@ -59,7 +61,8 @@ class TextModelSpec:
     parameters: dict[str, tuple[str, str]]  # name → (kind, unit)
     symbols: dict[str, tuple[sp.Symbol, ...]]  # "q", "v", "u", "w", "p"
     equations: dict[str, object] = field(default_factory=dict)  # key → sp.Matrix or scalar
-    derived: tuple[str, ...] = ()  # H or V when computed from the other
+    derived: dict[str, str] = field(default_factory=dict)  # key → how it was computed from others
+    notation: str = "sympy"
     urdf_joints: tuple[str, ...] = ()
     joint_transform: tuple | None = None
     joint_offset: tuple | None = None
@@ -172,6 +175,11 @@ def read_text_model(path: str | Path) -> TextModelSpec:
         if key not in TOP_KEYS:
             close = difflib.get_close_matches(key, TOP_KEYS, n=3)
             reader.fail(key, f"unknown key{'; did you mean ' + ', '.join(close) + '?' if close else ''}")
+    notation = data.get("notation", "sympy")
+    if notation not in NOTATIONS:
+        reader.fail("notation", f"{notation!r}: must be one of {', '.join(map(repr, NOTATIONS))}")
+    if "symbols" in data and notation != "latex":
+        reader.fail("symbols", 'a symbol table is for notation = "latex"')
     name = data.get("name")
     if not isinstance(name, str) or not name.isidentifier():
         reader.fail("name", "missing, or not a name (letters, digits, _)")
@@ -224,6 +232,7 @@ def read_text_model(path: str | Path) -> TextModelSpec:
         path, name, tuple(coords), tuple(k == "angle" for k in coords.values()),
         inputs, disturbances, parameters, symbols,
     )  # fmt: skip
+    spec.notation = notation
     _read_equations(reader, spec, data)
     _read_urdf(reader, spec, data.get("urdf", {}))
     return spec
@@ -232,13 +241,20 @@ def read_text_model(path: str | Path) -> TextModelSpec:
 def _read_equations(reader: Reader, spec: TextModelSpec, data: dict) -> None:
     n = len(spec.coordinates)
     dims = {"n": n, "u": len(spec.inputs), "w": len(spec.disturbances)}
+    latex = None
+    if spec.notation == "latex":
+        everything = {s.name: s for g in "qvuwp" for s in spec.symbols[g]} | FUNCTIONS | CONSTANTS
+        latex = read_symbol_table(reader, data.get("symbols"), everything, parse_entry)
     for key, (shape, groups) in EQUATIONS.items():
         if key not in data:
             continue
         allowed = {s.name: s for g in groups + "p" for s in spec.symbols[g]} | FUNCTIONS | CONSTANTS
         rows = n if shape else 0
         cols = dims[shape[1]] if len(shape) == 2 else None
-        spec.equations[key] = parse_equation(reader, key, data[key], rows, cols, allowed)
+        if latex is not None:
+            spec.equations[key] = parse_latex_equation(reader, latex, key, data[key], rows, cols, allowed)
+        else:
+            spec.equations[key] = parse_equation(reader, key, data[key], rows, cols, allowed)
 
 
 def _read_urdf(reader: Reader, spec: TextModelSpec, urdf) -> None:

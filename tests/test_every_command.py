@@ -26,15 +26,19 @@ STEMS = {
     "triple_pendulum": [1.0, 0.4, -0.3],
     "furuta_pendulum": [0.2, 0.3],
     "minimal_double_pendulum": [0.4, 0.9],  # the text model's (examples/minimal_double_pendulum_text.toml)
+    "cart_double_pendulum": [0.0, 0.3, -0.2],  # the LaTeX model's (examples/cart_double_pendulum_latex.toml)
 }
+TEXT_ONLY = ("minimal_double_pendulum", "cart_double_pendulum")
 
 
 class Model:
     """A model file with its URDF and parameter file, and a short scene on it."""
 
-    def __init__(self, model: Path, stem: str, tmp_path: Path, urdf: Path | None = None):
+    def __init__(
+        self, model: Path, stem: str, tmp_path: Path, urdf: Path | None = None, params: Path | None = None
+    ):
         self.model, self.stem, self.tmp = model, stem, tmp_path
-        self.urdf, self.params = urdf or EXAMPLES / f"{stem}.urdf", EXAMPLES / f"{stem}.toml"
+        self.urdf, self.params = urdf or EXAMPLES / f"{stem}.urdf", params or EXAMPLES / f"{stem}.toml"
 
     def files(self) -> list[str]:
         return ["--analytic", str(self.model), "--urdf", str(self.urdf), "--params", str(self.params)]
@@ -97,7 +101,7 @@ def _written_here(tmp_path: Path) -> Path:
 
 
 @pytest.mark.parametrize("command", list(COMMANDS))
-@pytest.mark.parametrize("stem", [s for s in STEMS if s != "minimal_double_pendulum"])
+@pytest.mark.parametrize("stem", [s for s in STEMS if s not in TEXT_ONLY])
 def test_each_command_on_each_example(command, stem, tmp_path, capsys):
     model = Model(EXAMPLES / f"{stem}.py", stem, tmp_path)
     for argv in COMMANDS[command](model):
@@ -117,6 +121,17 @@ def test_each_command_on_a_text_model(command, tmp_path, capsys):
     text = EXAMPLES / "minimal_double_pendulum_text.toml"
     urdf = EXAMPLES.parent / "urdf" / "double_pendulum.urdf"
     model = Model(text, "minimal_double_pendulum", tmp_path, urdf)
+    for argv in COMMANDS[command](model):
+        assert main(argv) == 0, (argv, capsys.readouterr())
+
+
+@pytest.mark.parametrize("command", list(COMMANDS))
+def test_each_command_on_a_latex_model(command, tmp_path, capsys):
+    """Seed 001's equations as the document prints them in LaTeX: every command takes them too."""
+    latex = EXAMPLES / "cart_double_pendulum_latex.toml"
+    urdf = EXAMPLES.parent / "urdf" / "cart_double_pendulum.urdf"
+    params = EXAMPLES.parent / "analytic" / "params" / "cart_double_pendulum.toml"
+    model = Model(latex, "cart_double_pendulum", tmp_path, urdf, params)
     for argv in COMMANDS[command](model):
         assert main(argv) == 0, (argv, capsys.readouterr())
 

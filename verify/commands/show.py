@@ -18,12 +18,14 @@ def run(args: argparse.Namespace) -> int:
     import sympy as sp
 
     from pendverify.analytic.plugin import load_model_class
+    from pendverify.analytic.text_model import METHODS
     from pendverify.symbolic.model import SymbolicModel
 
     cls = load_model_class(args.model)
     sm = SymbolicModel.of(cls)
     spec = getattr(cls, "text_spec", None)
-    derived = set(spec.derived) if spec is not None else set()
+    derived = spec.derived if spec is not None else {}
+    keys = {method: key for key, (method, _) in METHODS.items()}
     kinds = ", ".join(
         f"{c} ({'angle' if a else 'position'})" for c, a in zip(cls.coordinates, cls.angular, strict=True)
     )
@@ -33,11 +35,8 @@ def run(args: argparse.Namespace) -> int:
     print(f"parameters {', '.join(sm.parameters)}")
     for method, form in cls.written_closed_forms().items():
         value = sm.evaluate(method, form.args)
-        note = (
-            " (derived from the other of H, V)"
-            if method in _DERIVED_NAMES and _DERIVED_NAMES[method] in derived
-            else ""
-        )
+        how = derived.get(keys.get(method, ""))
+        note = f" (derived: {how})" if how else ""
         if args.pretty:
             text = sp.pretty(value, use_unicode=True)
         elif isinstance(value, sp.MatrixBase):
@@ -46,6 +45,3 @@ def run(args: argparse.Namespace) -> int:
             text = str(value)
         print(f"\n{method}{note} =\n{text}" if args.pretty else f"{method}{note} = {text}")
     return 0
-
-
-_DERIVED_NAMES = {"gravity": "H", "potential_energy": "V"}

@@ -1,0 +1,284 @@
+"""Read equations written in LaTeX, as they stand in a derivation, into SymPy.
+
+A text model with ``notation = "latex"`` gives its equations as LaTeX copied from
+the paper and a ``[symbols]`` table mapping the document's symbols to the model's
+names (``'\\theta_1' = "theta1"``, ``'\\dot{\\theta}_1' = "dtheta1"``, ``'m_1' = "m1"``)
+or defining them by an expression in SymPy syntax over those names
+(``'\\alpha' = "I1 + I2 + m1*r1**2 + m2*(l1**2 + r2**2)"``).
+
+What is read
+------------
+* ``\\begin{bmatrix} … \\end{bmatrix}`` (and ``pmatrix``, ``Bmatrix``, ``matrix``),
+  cells split by ``&``, rows by ``\\\\``; matrix sums and products.
+* ``+ − \\cdot \\times * /``, ``\\frac{a}{b}``, ``\\sqrt{x}``, powers ``x^2``, ``x^{n}``;
+  **implicit products** of declared symbols: ``m_1gr_1\\cos(\\theta_1)`` is
+  m1·g·r1·cos θ1 — the lexer matches the longest declared symbol first, so
+  declare every symbol the document uses.
+* ``\\sin \\cos \\tan \\exp`` with a parenthesised argument or one symbol
+  (``\\sin\\theta_1``, ``\\cos \\theta_1 \\sin \\theta_2`` is cos θ1 · sin θ2), and
+  powers of them (``\\sin^2(\\theta_1 - \\theta_2)`` is sin²(θ1 − θ2)).
+* ``( ) [ ] \\{ \\}`` and their ``\\left``/``\\right``/``\\bigl`` forms as grouping;
+  ``\\mathbf{}``, ``\\boldsymbol{}``, ``\\bm{}``, ``\\mathrm{}`` are dropped around
+  their content; ``\\underbrace{X}_{…}`` and ``\\overbrace{X}^{…}`` read as X;
+  ``\\dot\\theta``, ``\\dot{\\theta_1}`` and ``\\dot{\\theta}_1`` are one symbol, as are
+  ``x_1`` and ``x_{1}``; spacing (``\\, \\; \\quad`` …) is ignored.
+* A chain ``LABEL = A = B``: a leading label of the form ``NAME(args)`` (such as
+  ``\\mathbf{M}(\\mathbf{x})`` or ``f(y,\\dot{y},u,w)``) is dropped, a leading ``=``
+  too, and every right-hand side must be read and be *equal* (seed 000 prints each
+  matrix in θ and in x = (θ, θ̇) notation: both are read and compared).
+
+Anything else is an error that shows the LaTeX and where reading stopped.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+import sympy as sp
+from lark import Lark, Transformer, v_args
+from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken, VisitError
+
+from pendverify.analytic.latex_text import Stop, Text, canonical_symbol, normalise
+from pendverify.errors import PendverifyError
+
+#: commands that only typeset their argument: dropped around it
+FUNCTIONS = {"sin": sp.sin, "cos": sp.cos, "tan": sp.tan, "exp": sp.exp}
+_MATRICES = ("bmatrix", "pmatrix", "Bmatrix", "matrix", "smallmatrix")
+
+
+class LatexError(PendverifyError):
+    """LaTeX that cannot be read: the message shows the text and where reading stopped."""
+
+
+_GRAMMAR = r"""
+?start: sum
+?sum: term
+    | "-" term            -> neg
+    | "+" term
+    | sum "+" term        -> add
+    | sum "-" term        -> sub
+?term: power
+    | term "*" power      -> mul
+    | term "/" power      -> div
+    | term power          -> mul
+?power: primary
+    | primary "^" "{" sum "}"  -> pow
+?primary: NUMBER          -> number
+    | SYMBOL              -> symbol
+    | "(" sum ")"
+    | "{" sum "}"
+    | FUNC arg            -> func
+    | FUNC "^" "{" sum "}" arg -> funcpow
+    | "\\frac" "{" sum "}" "{" sum "}" -> div
+    | "\\sqrt" "{" sum "}" -> sqrt
+    | BEGIN rows END      -> matrix
+?arg: "(" sum ")" | "{" sum "}" | SYMBOL -> symbol
+rows: row (ROWSEP row)* ROWSEP?
+row: sum ("&" sum)*
+FUNC: /\\(sin|cos|tan|exp)(?![A-Za-z])/
+BEGIN: /\\begin\{[A-Za-z]+\}/
+END: /\\end\{[A-Za-z]+\}/
+ROWSEP: /\\\\/
+NUMBER: /\d+(\.\d*)?|\.\d+/
+%ignore " "
+"""
+
+
+@dataclass
+class SymbolTable:
+    """The document's symbols (canonical LaTeX) → SymPy expressions over the model's names."""
+
+    entries: dict[str, sp.Expr]
+    source: dict[str, str]  # canonical → the key as the file wrote it
+
+    def grammar(self) -> str:
+        # longest first, so that m_1 is read before m; a bare command (\\alpha) must end there
+        keys = sorted(self.entries, key=len, reverse=True)
+        alternation = "|".join(
+            re.escape(k).replace("/", "\\/") + ("(?![A-Za-z])" if re.fullmatch(r"\\[A-Za-z]+", k) else "")
+            for k in keys
+        )
+        return _GRAMMAR + f"SYMBOL.2: /({alternation or '(?!)x'})/\n"
+
+
+@v_args(inline=True)
+class _ToSympy(Transformer):
+    def __init__(self, table: SymbolTable):
+        super().__init__()
+        self.table = table
+
+    def number(self, tok):
+        return sp.Integer(tok) if tok.isdigit() else sp.Float(str(tok))
+
+    def symbol(self, tok):
+        return self.table.entries[str(tok).replace(" ", "")]
+
+    def neg(self, a):
+        return -a
+
+    def add(self, a, b):
+        return a + b
+
+    def sub(self, a, b):
+        return a - b
+
+    def mul(self, a, b):
+        return a * b
+
+    def div(self, a, b):
+        if isinstance(b, sp.MatrixBase):
+            raise ValueError("division by a matrix")
+        return a / b
+
+    def pow(self, a, b):
+        if isinstance(a, sp.MatrixBase):
+            raise ValueError("a power of a matrix (write the product, or give M_inv as its own key)")
+        return a**b
+
+    def func(self, name, a):
+        if isinstance(a, sp.MatrixBase):
+            raise ValueError(f"{name} of a matrix")
+        return FUNCTIONS[str(name)[1:]](a)
+
+    def funcpow(self, name, power, a):
+        return self.func(name, a) ** power
+
+    def sqrt(self, a):
+        return sp.sqrt(a)
+
+    def rows(self, *rows):
+        return [r for r in rows if not (hasattr(r, "type") and r.type == "ROWSEP")]
+
+    def row(self, *cells):
+        return list(cells)
+
+    def matrix(self, begin, rows, end):
+        kind, close = str(begin)[7:-1], str(end)[5:-1]
+        if kind != close:
+            raise ValueError(f"\\begin{{{kind}}} closed by \\end{{{close}}}")
+        if kind not in _MATRICES:
+            raise ValueError(f"\\begin{{{kind}}} is not a matrix ({', '.join(_MATRICES)})")
+        widths = {len(r) for r in rows}
+        if len(widths) != 1:
+            raise ValueError(f"a matrix whose rows have {sorted(widths)} cells")
+        if any(isinstance(c, sp.MatrixBase) for r in rows for c in r):
+            raise ValueError("a matrix inside a matrix cell")
+        return sp.Matrix(rows)
+
+
+_LABEL = re.compile(r"^\s*(\\det\s*)?[A-Za-z](_\w)?\s*(\^\{-1\})?\s*\([^()=]*\)\s*$")
+
+
+def _split_chain(t: Text) -> list[tuple[int, int]]:
+    """Spans of the sides of ``A = B = C`` at brace depth 0 (``=:`` and ``:=`` are not splits)."""
+    spans, depth, start = [], 0, 0
+    s = t.text
+    for i, c in enumerate(s):
+        if c in "{(":
+            depth += 1
+        elif c in "})":
+            depth -= 1
+        elif c == "=" and depth == 0 and s[i - 1 : i] != ":" and s[i + 1 : i + 2] != ":":
+            spans.append((start, i))
+            start = i + 1
+    spans.append((start, len(s)))
+    return spans
+
+
+class LatexReader:
+    """Parses LaTeX for one model file with its symbol table."""
+
+    def __init__(self, table: SymbolTable):
+        self.table = table
+        self.parser = Lark(table.grammar(), parser="lalr", maybe_placeholders=False)
+
+    def read(self, text: str) -> tuple[object, str]:
+        """The expression (or matrix) ``text`` holds, and the label it dropped ("" if none).
+
+        Raises ``LatexError`` with the LaTeX and where reading stopped.
+        """
+        try:
+            t = normalise(text)
+        except Stop as stop:
+            raise LatexError(_show(text, stop.at, stop.why)) from None
+        t.sub(r"[\s,.;]+$", "")  # a sentence's punctuation after a display
+        sides = _split_chain(t)
+        label = ""
+        if len(sides) > 1 and not t.text[slice(*sides[0])].strip():
+            sides = sides[1:]  # a continuation line "= …"
+        elif len(sides) > 1 and _LABEL.match(t.text[slice(*sides[0])]):
+            label = t.text[slice(*sides[0])].strip()
+            sides = sides[1:]
+        values = [self._side(t, a, b, text) for a, b in sides]
+        first = values[0]
+        for k, other in enumerate(values[1:], start=2):
+            if not _equal(first, other):
+                raise LatexError(
+                    f"the chain's right-hand sides 1 and {k} differ: {_brief(first)} vs {_brief(other)} "
+                    f"in {_excerpt(text)}"
+                )
+        return first, label
+
+    def _side(self, t: Text, a: int, b: int, original: str):
+        piece = t.text[a:b]
+        if not piece.strip():
+            raise LatexError(_show(original, t.where(a), "an empty side of '='"))
+        try:
+            return _ToSympy(self.table).transform(self.parser.parse(piece))
+        except UnexpectedInput as exc:
+            at = t.where(a + _position(exc, piece))
+            raise LatexError(_show(original, at, _why(exc, piece))) from None
+        except VisitError as exc:
+            raise LatexError(f"{exc.orig_exc} in {_excerpt(original)}") from None
+
+
+def _position(exc: UnexpectedInput, piece: str) -> int:
+    if isinstance(exc, UnexpectedEOF):
+        return len(piece)
+    if isinstance(exc, UnexpectedToken) and exc.token.type != "$END":
+        return exc.token.start_pos if exc.token.start_pos is not None else len(piece)
+    if isinstance(exc, UnexpectedCharacters):
+        return exc.pos_in_stream
+    return len(piece)
+
+
+def _why(exc: UnexpectedInput, piece: str) -> str:
+    if isinstance(exc, UnexpectedCharacters):
+        m = re.match(r"\\[A-Za-z]+|[A-Za-z](_\w|_\{[^}]*\})?", piece[exc.pos_in_stream :])
+        if m:
+            return f"unknown symbol or command '{m.group(0)}' (declare symbols in [symbols])"
+        return f"unexpected '{piece[exc.pos_in_stream]}'"
+    if isinstance(exc, UnexpectedEOF) or (isinstance(exc, UnexpectedToken) and exc.token.type == "$END"):
+        return "the text ends too early (an unclosed bracket or a missing operand?)"
+    return f"unexpected '{exc.token}'"
+
+
+def _show(text: str, at: int, why: str) -> str:
+    before, after = text[max(0, at - 40) : at], text[at : at + 30]
+    return (
+        f"cannot read the LaTeX at character {at + 1}: {why}: "
+        f"{'…' if at > 40 else ''}{before} ⟨stopped here⟩ {after}{'…' if at + 30 < len(text) else ''}"
+    ).replace("\n", " ")
+
+
+def _excerpt(text: str) -> str:
+    one = " ".join(text.split())
+    return repr(one if len(one) <= 80 else one[:77] + "...")
+
+
+def _brief(value) -> str:
+    s = str(value.tolist() if isinstance(value, sp.MatrixBase) else value)
+    return s if len(s) <= 60 else s[:57] + "..."
+
+
+def _equal(a, b) -> bool:
+    if isinstance(a, sp.MatrixBase) != isinstance(b, sp.MatrixBase):
+        return False
+    if isinstance(a, sp.MatrixBase):
+        return a.shape == b.shape and all(_equal(x, y) for x, y in zip(a, b, strict=True))
+    diff = sp.expand(sp.expand_trig(a - b))
+    return diff == 0 or sp.simplify(diff) == 0
+
+
+__all__ = ["LatexError", "LatexReader", "SymbolTable", "canonical_symbol", "normalise"]

@@ -1,0 +1,96 @@
+"""The LaTeX side of a text model: its ``[symbols]`` table and its equations in LaTeX.
+
+With ``notation = "latex"`` every equation value is LaTeX (``pendverify.analytic.
+latex_parse``): one string holding the whole matrix or vector (a ``bmatrix``), or a
+list of rows of LaTeX entries.  ``[symbols]`` maps each LaTeX symbol the equations
+use to an expression in SymPy syntax over the model's names (coordinates, their
+rates ``d<coordinate>``, inputs, disturbances, parameters): usually just a name
+(``'\\theta_1' = "theta1"``), or a definition (``'\\beta' = "m2*l1*r2"``).  Two keys
+that read as the same symbol (``x_1`` and ``x_{1}``) are refused.
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from pendverify.analytic.latex_parse import LatexError, LatexReader, SymbolTable, canonical_symbol
+
+
+def read_symbol_table(reader, table, allowed: dict, parse_entry) -> LatexReader:
+    """The ``[symbols]`` table read into a ``LatexReader`` (each value parsed by ``parse_entry``)."""
+    if not isinstance(table, dict) or not table:
+        reader.fail("symbols", 'missing: with notation = "latex", a table such as \'\\theta_1\' = "theta1"')
+    entries, source = {}, {}
+    for key, value in table.items():
+        if not isinstance(value, str):
+            reader.fail(
+                f"symbols.{key}", "must be a model name or an expression in SymPy syntax, as a string"
+            )
+        try:
+            canonical = canonical_symbol(key)
+        except LatexError as exc:
+            reader.fail(f"symbols.{key}", str(exc))
+        if not canonical or any(c in canonical for c in "+-*/=&()"):
+            reader.fail(f"symbols.{key}", "is not one LaTeX symbol (a letter or command, with a subscript)")
+        if canonical in entries:
+            reader.fail(f"symbols.{key}", f"reads as the same symbol as '{source[canonical]}'")
+        entries[canonical] = parse_entry(reader, f"symbols.{key}", value, allowed)
+        source[canonical] = key
+    return LatexReader(SymbolTable(entries, source))
+
+
+def parse_latex_equation(reader, latex: LatexReader, key: str, value, rows: int, cols: int | None, allowed):
+    """One equation in LaTeX: a matrix (rows × cols), a column vector (cols None) or a scalar (rows 0)."""
+
+    def read(k: str, text):
+        if not isinstance(text, str):
+            reader.fail(k, f"must be LaTeX, as a string, got {text!r}")
+        try:
+            return latex.read(text)[0]
+        except LatexError as exc:
+            reader.fail(k, str(exc))
+
+    if isinstance(value, list):
+        if cols is None or rows == 0:
+            value = [value] if rows == 0 else [[x] for x in value]
+        parsed = sp.Matrix(
+            [[read(f"{key}[{i},{j}]", x) for j, x in enumerate(r)] for i, r in enumerate(value)]
+        )
+        if any(isinstance(x, sp.MatrixBase) for x in parsed):
+            reader.fail(key, "an entry of the list is itself a matrix")
+    else:
+        parsed = read(key, value)
+    want = (rows, cols if cols is not None else 1)
+    if rows == 0:
+        if isinstance(parsed, sp.MatrixBase):
+            if parsed.shape != (1, 1):
+                reader.fail(key, f"wrong shape: the LaTeX gives a {_shape(parsed)}, {key} is a scalar")
+            parsed = parsed[0, 0]
+    else:
+        if not isinstance(parsed, sp.MatrixBase):
+            parsed = sp.Matrix([[parsed]])
+        if cols is None and parsed.rows == 1 and parsed.cols == rows and rows > 1:
+            parsed = parsed.T  # a vector printed as a row
+        if parsed.shape != want:
+            kind = f"{rows} × {cols}" if cols is not None else f"a vector of {rows}"
+            given = _shape(parsed)
+            reader.fail(
+                key, f"wrong shape: the LaTeX gives {given}; with {rows} coordinates {key} must be {kind}"
+            )
+    stray = _free(parsed) - set(allowed.values())
+    if stray:
+        names = ", ".join(sorted(s.name for s in stray))
+        reader.fail(key, f"depends on {names}, which {key} may not (its arguments: {_args(allowed)})")
+    return parsed
+
+
+def _shape(m) -> str:
+    return f"{m.rows} row{'s' if m.rows != 1 else ''} of {m.cols} entr{'ies' if m.cols != 1 else 'y'}"
+
+
+def _free(expr) -> set:
+    return set(expr.free_symbols)
+
+
+def _args(allowed: dict) -> str:
+    return ", ".join(k for k, v in allowed.items() if isinstance(v, sp.Symbol)) or "none"
