@@ -251,7 +251,11 @@ def _why(exc: UnexpectedInput, piece: str) -> str:
         return f"unexpected '{piece[exc.pos_in_stream]}'"
     if isinstance(exc, UnexpectedEOF) or (isinstance(exc, UnexpectedToken) and exc.token.type == "$END"):
         return "the text ends too early (an unclosed bracket or a missing operand?)"
-    return f"unexpected '{exc.token}'"
+    before = piece[: _position(exc, piece)]
+    unclosed = before.count("(") - before.count(")")
+    closing = str(exc.token) in ("&", ")", "\\\\") or str(exc.token).startswith("\\end")
+    hint = " (a '(' opened before it is not closed)" if unclosed > 0 and closing else ""
+    return f"unexpected '{exc.token}'{hint}"
 
 
 def _show(text: str, at: int, why: str) -> str:

@@ -196,7 +196,7 @@ def test_the_two_sides_of_a_display_must_agree(tmp_path, capsys):
     "old, new, words",
     [
         ("'\\alpha' = ", "'\\gamma' = ", ["key 'M'", "unknown symbol or command '\\alpha'", "⟨stopped here⟩"]),
-        (r"\sin(\theta_2)\dot{\theta}_2 + b_1", r"\sin(\theta_2\dot{\theta}_2 + b_1", ["key 'C_plus_D'", "⟨stopped here⟩"]),
+        (r"\sin(\theta_2)\dot{\theta}_2 + b_1", r"\sin(\theta_2\dot{\theta}_2 + b_1", ["key 'C_plus_D'", "at character 82: unexpected '&' (a '(' opened before it is not closed)", "⟨stopped here⟩"]),
         (r"\delta + \beta\cos(x_2) & \delta \end", r"\delta + \beta\cos(x_2) & \delta + \dot{\theta}_1 \end",
          ["key 'M'"]),
         ("notation = \"latex\"", "notation = \"tex\"", ["key 'notation'", "'tex'"]),
