@@ -1,8 +1,11 @@
 """A text model file (TOML) made into a ``ClosedFormModel`` subclass like any other.
 
 ``pendverify.analytic.text_parse`` reads the file; here the equations are
-completed (H = ∂V/∂q when only V is given, V integrated from H when only H is),
-checked (M symmetric, C or Cqdot, B when there are inputs) and turned into a
+completed (H = ∂V/∂q when only V is given, V integrated from H when only H is;
+C = C_plus_D − D; f split into H = −f(q, 0, 0, 0), D = −∂f/∂q̇ at q̇ = 0 (required
+constant), C·q̇ = the rest of f(q, q̇, 0, 0) − f(q, 0, 0, 0) (required quadratic in
+q̇), B = ∂f/∂u and W = ∂f/∂w (required constant, f affine in u and w)), checked
+(M symmetric, C or Cqdot, B when there are inputs) and turned into a
 class whose methods evaluate them: numerically through ``sympy.lambdify`` onto
 ``self.math``'s functions (Python's ``math``, mpmath for the high-precision judge,
 complex functions for the LQR's complex step), and as the SymPy expressions

@@ -4,10 +4,14 @@ A text model declares ``name``; ``[coordinates]`` (in order, each ``"angle"`` or
 ``"position"``); ``inputs`` and ``disturbances`` (optional lists of names);
 ``[parameters]`` (``m1 = { kind = "mass", unit = "kg" }``, the kinds of
 ``pendverify.analytic.params``); the equations as strings in SymPy syntax — ``M``
-(rows of entries), ``C`` (matrix) or ``Cqdot`` (the vector C·q̇), ``H`` (vector)
-and/or ``V`` (scalar; a missing H is ∂V/∂q, a missing V is integrated from H),
-optional ``D``, ``B``, ``W``, ``det_M``, ``M_inv``, ``qddot`` — with the rates named
-``d<coordinate>``; and ``[urdf]`` (``joints``, ``transform``, ``offset``).
+(rows of entries), ``C`` (matrix), ``C_plus_D`` (C with the friction inside, as
+some derivations print it; needs ``D``) or ``Cqdot`` (the vector C·q̇), ``H``
+(vector) and/or ``V`` (scalar; a missing H is ∂V/∂q, a missing V is integrated
+from H), optional ``D``, ``B``, ``W``, ``det_M``, ``M_inv``, ``qddot`` — or, instead
+of C, H, D, B and W, ``f``, the right-hand side of M q̈ = f(q, q̇, u, w) — with the
+rates named ``d<coordinate>``; and ``[urdf]`` (``joints``, ``transform``,
+``offset``).  With ``notation = "latex"`` the equations are LaTeX and a
+``[symbols]`` table maps the document's symbols (``pendverify.analytic.text_latex``).
 
 Parsing is safe: no Python is run.  Each string is first read by ``ast`` and may
 hold only numbers, the declared names, + − * / ** and calls of sin, cos, tan,
