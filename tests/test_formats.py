@@ -225,6 +225,14 @@ def test_xacro_elements_in_a_file_named_urdf_are_expanded_not_ignored(tmp_path):
     assert load_description(text).format == "xacro"  # XML text too
 
 
+def test_what_xacro_prints_becomes_a_note(tmp_path):
+    path = tmp_path / "a.xacro"
+    path.write_text(xacro_doc('<xacro:include filename="none*.xacro"/><link name="a"/>'))
+    notes = load_description(path).notes()
+    assert notes[0] == "expanded by xacro, with the defaults of its xacro:arg arguments"
+    assert notes[1] == 'xacro printed: warning: Include tag\'s filename spec "none*.xacro" matched no files.'
+
+
 def test_xacro_refuses_a_doctype_as_the_urdf_reader_does(tmp_path):
     path = tmp_path / "a.xacro"
     path.write_text('<?xml version="1.0"?>\n<!DOCTYPE robot [<!ENTITY m "1.0">]>\n' + xacro_doc("")[22:])

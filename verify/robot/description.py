@@ -124,8 +124,9 @@ def load_description(description: str | Path, source: str | None = None) -> Load
             model, facts, urdf_log = build_pinocchio_model(text, source)
         except UrdfShapeError as exc:
             raise UrdfShapeError(exc.source, f"{exc.problem} (in the URDF xacro expanded it to)") from None
-        log = [f"(xacro) {line}" for line in log] + urdf_log
         notes.append("expanded by xacro, with the defaults of its xacro:arg arguments")
+        notes += [f"xacro printed: {line}" for line in log]
+        log = urdf_log
     elif fmt == "urdf":
         model, facts, log = build_pinocchio_model(text, source)
     elif fmt == "mjcf":
