@@ -230,7 +230,10 @@ def test_what_xacro_prints_becomes_a_note(tmp_path):
     path.write_text(xacro_doc('<xacro:include filename="none*.xacro"/><link name="a"/>'))
     notes = load_description(path).notes()
     assert notes[0] == "expanded by xacro, with the defaults of its xacro:arg arguments"
-    assert notes[1] == 'xacro printed: warning: Include tag\'s filename spec "none*.xacro" matched no files.'
+    assert (
+        notes[1]
+        == f'xacro printed: warning: Include tag\'s filename spec "{tmp_path}/none*.xacro" matched no files.'
+    )
 
 
 def test_xacro_refuses_a_doctype_as_the_urdf_reader_does(tmp_path):
