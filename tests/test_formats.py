@@ -379,3 +379,14 @@ def test_an_unknown_root_names_the_formats(tmp_path):
         f"{path}: the root element is <model>: pendverify reads URDF (<robot>), xacro (*.xacro), "
         "MJCF (<mujoco>) and SDFormat (<sdf>)"
     )
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_the_animation_draws_each_formats_visuals_where_the_urdfs_are(fmt):
+    from pendverify.viz.geometry import VisualSystem
+
+    def shapes(path):
+        objects = VisualSystem.for_model(SEED_MODEL, path).objects
+        return [(o.parentJoint, type(o.geometry).__name__, o.placement.translation.tolist()) for o in objects]
+
+    assert shapes(FORMATS[fmt]) == shapes(URDF)
