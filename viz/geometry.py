@@ -23,15 +23,11 @@ import numpy as np
 import pinocchio as pin
 
 from pendverify.analytic import ParameterSet
+from pendverify.robot.mjcf import mjcf_visuals
 from pendverify.robot.system import PinocchioSystem
-from pendverify.robot.urdf import read_text_file
 from pendverify.robot.writer import urdf_for
 
 ROOT = "pendverify"
-
-
-def _is_path(urdf) -> bool:
-    return isinstance(urdf, Path) or "<" not in str(urdf)
 
 
 UP = np.array([0.0, 0.0, 1.0])
@@ -56,14 +52,18 @@ class VisualSystem:
 
     @classmethod
     def for_model(cls, model_cls, urdf: str | Path, g: float | None = None) -> VisualSystem:
-        """A given URDF (path or XML text) with its visuals, seen in ``model_cls``'s coordinates.
+        """A given description (path or XML text: URDF, xacro, MJCF) with its visuals, seen in
+        ``model_cls``'s coordinates.
 
         The way a model file (plug-in) is drawn: its URDF is the one the simulation integrated.
         """
-        text = read_text_file(Path(urdf), str(urdf)) if _is_path(urdf) else str(urdf)
-        system = PinocchioSystem.for_model(model_cls, text, g, str(urdf) if _is_path(urdf) else None)
-        visual_model = pin.buildGeomFromUrdfString(system.model, text, pin.GeometryType.VISUAL)
-        return cls(system, visual_model, visual_model.createData(), text)
+        system = PinocchioSystem.for_model(model_cls, urdf, g)
+        loaded = system.urdf  # the verified text: a xacro file's is the URDF it expanded to
+        if loaded.format == "mjcf":
+            visual_model = mjcf_visuals(system.model, loaded.text)
+        else:
+            visual_model = pin.buildGeomFromUrdfString(system.model, loaded.text, pin.GeometryType.VISUAL)
+        return cls(system, visual_model, visual_model.createData(), loaded.text)
 
     @property
     def objects(self) -> list[pin.GeometryObject]:

@@ -1,6 +1,7 @@
 """A certificate bundle on disk: which files, written how.
 
-``DIR/NAME.urdf``, ``DIR/NAME.params.toml``, ``DIR/NAME.model.py`` or ``.model.toml`` (a model file's
+``DIR/NAME.urdf`` (the verified description: ``NAME.mjcf.xml`` for an MJCF; a xacro file's is the
+URDF it expanded to), ``DIR/NAME.params.toml``, ``DIR/NAME.model.py`` or ``.model.toml`` (a model file's
 bundle), ``DIR/NAME.intoto.jsonl`` (a signed certificate's DSSE envelope) and, last,
 ``DIR/NAME.cert.json``, each written atomically (``pendverify.atomic``).  The
 certificate is written last, so an interruption never leaves a certificate without
@@ -25,12 +26,13 @@ from pendverify.certify.signing import (
     statement,
 )
 from pendverify.errors import CertificateError, SigningError
+from pendverify.robot.description import FILE_SUFFIXES, text_suffix
 
 
-def bundle_paths(directory, name: str) -> tuple[Path, Path, Path]:
-    """NAME.urdf, NAME.params.toml, NAME.cert.json."""
+def bundle_paths(directory, name: str, description_suffix: str = ".urdf") -> tuple[Path, Path, Path]:
+    """NAME.urdf (or NAME.mjcf.xml, ...: ``description_suffix``), NAME.params.toml, NAME.cert.json."""
     d = Path(directory)
-    return d / f"{name}.urdf", d / f"{name}.params.toml", d / f"{name}.cert.json"
+    return d / f"{name}{description_suffix}", d / f"{name}.params.toml", d / f"{name}.cert.json"
 
 
 MODEL_SUFFIXES = (".py", ".toml")  # a Python model file, or a text one
@@ -51,7 +53,8 @@ def refuse_existing(directory, name: str, force: bool) -> None:
     """Raise unless ``force`` when any file of the bundle already exists; refuse a target
     outside the output folder whatever ``force`` says."""
     models = (model_path(directory, name, f"model{suffix}") for suffix in MODEL_SUFFIXES)
-    extra = (*models, envelope_path(directory, name))
+    descriptions = (Path(directory) / f"{name}{suffix}" for suffix in sorted(set(FILE_SUFFIXES.values())))
+    extra = (*models, *descriptions, envelope_path(directory, name))
     paths = (*reversed(bundle_paths(directory, name)), *extra)
     if Path(directory).exists():
         for path in paths:
@@ -77,7 +80,7 @@ def write_bundle(
     certificate last.  An existing bundle is never replaced unless ``force``."""
     refuse_existing(directory, name, force)
     Path(directory).mkdir(parents=True, exist_ok=True)
-    urdf_path, params_path, cert_path = bundle_paths(directory, name)
+    urdf_path, params_path, cert_path = bundle_paths(directory, name, text_suffix(urdf))
     files = {urdf_path: urdf, params_path: params.to_toml(name)}
     if model is not None and not model.builtin:
         files[model_path(directory, name, model.file)] = model.text

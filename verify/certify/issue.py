@@ -32,6 +32,7 @@ from pendverify.certify.schema import check_derived, check_schema
 from pendverify.certify.signing import fingerprint
 from pendverify.checks.targets import PARAMS_HINT
 from pendverify.errors import CertificateError, ParameterError, PendverifyError
+from pendverify.robot.description import load_description
 from pendverify.robot.erd import resolve_urdf
 from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
@@ -62,7 +63,7 @@ def certification_input(
         return _plugin_input(analytic, urdf, urdf_params or params_file)
     if urdf:
         path, name = _urdf_and_name(urdf)
-        text = path.read_text()
+        text = load_description(path).text  # a xacro file's: the URDF it expands to
         if urdf_params:
             model_name, _, params = load_parameter_file(urdf_params)
             if model and model != model_name:
@@ -105,7 +106,7 @@ def _plugin_input(model_file: str, urdf: str | None, params_file: str | None) ->
             "certify needs a gravity parameter g: its runs set gravity by it",
         )
     path, name = _urdf_and_name(urdf)
-    return CertificationInput(name, source, params, path.read_text())
+    return CertificationInput(name, source, params, load_description(path).text)
 
 
 def _urdf_and_name(urdf: str):

@@ -41,6 +41,7 @@ from pendverify.certify.battery import BatterySettings, run_battery
 from pendverify.certify.model_source import ModelSource
 from pendverify.errors import PendverifyError, SweepError
 from pendverify.progress import quiet
+from pendverify.robot.description import urdf_text
 from pendverify.robot.rebind import Binding
 from pendverify.robot.writer import urdf_for
 
@@ -192,7 +193,7 @@ def _model_and_base(path: Path, data: dict):
         urdf_ref = data.get("urdf")
         if not isinstance(urdf_ref, str) or not (path.parent / urdf_ref).is_file():
             raise SweepError(source, "urdf", urdf_ref, "a model file needs the URDF of its base set (a file)")
-        return model, base, (path.parent / urdf_ref).read_text()
+        return model, base, urdf_text(path.parent / urdf_ref, "a sweep")
     if ref not in MODELS:
         raise SweepError(source, "model", ref, f"expected a model file (.py) or one of {', '.join(MODELS)}")
     if "urdf" in data:

@@ -23,7 +23,7 @@ from pathlib import Path
 from pendverify.certify.certificate import verify_digest
 from pendverify.errors import CertificateError, InputError
 
-BUNDLE_SUFFIXES = (".cert.json", ".urdf", ".params.toml", ".model.py", ".model.toml")
+BUNDLE_SUFFIXES = (".cert.json", ".urdf", ".mjcf.xml", ".sdf", ".params.toml", ".model.py", ".model.toml")
 TEMPORARY = re.compile(r"^\.(?P<file>.+)\.[a-z0-9_]+\.tmp$")  # pendverify.atomic's temporaries
 
 

@@ -26,11 +26,11 @@ from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
 from pendverify.analytic.params import default_parameter_file, load_parameter_file
 from pendverify.analytic.plugin import check_model_outputs, load_model_class, plugin_parameters
 from pendverify.errors import PendverifyError, UnknownNameError
+from pendverify.robot.description import description_stem, is_description_text
 from pendverify.robot.erd import MODEL as ERD_MODEL
 from pendverify.robot.erd import double_pendulum_urdfs
 from pendverify.robot.seed_geometry import DEFAULT_G
 from pendverify.robot.system import PinocchioSystem
-from pendverify.robot.urdf import is_urdf_text
 from pendverify.robot.writer import urdf_for
 
 PARAMETER_MATCH_RTOL = 1e-9
@@ -92,8 +92,9 @@ def model_target(
 ) -> Target:
     """A model class, a URDF and (unless the URDF fixes them) its parameters: built-in or plug-in.
 
-    ``urdf`` is a file path or the XML text itself.  The target is labelled
-    ``{model}:{name}``; ``name`` defaults to the URDF file's stem, or ``urdf-text`` for text.
+    ``urdf`` is a description's file path (URDF, xacro, MJCF) or the XML text itself.  The target
+    is labelled ``{model}:{name}``; ``name`` defaults to the file's stem without its format's
+    suffixes (``arm.urdf.xacro`` → ``arm``), or ``urdf-text`` for text.
     """
     g = getattr(params, "g", None)
     system = PinocchioSystem.for_model(cls, urdf, g)
@@ -117,7 +118,7 @@ def model_target(
         raise PendverifyError(f"{cls.name}: building the model failed: {type(exc).__name__}: {exc}") from None
     check_model_outputs(model)
     if name is None:
-        name = "urdf-text" if is_urdf_text(urdf) else Path(urdf).stem
+        name = "urdf-text" if is_description_text(urdf) else description_stem(urdf)
     return Target(f"{cls.name}:{name}", model, system, system.source, notes)
 
 

@@ -15,7 +15,9 @@ def register(sub) -> None:
     p.add_argument("params_file", nargs="?", help="a parameter file (TOML)")
     p.add_argument("--model", help="with --urdf: the model the URDF describes")
     add_analytic_option(p, "certify it on --urdf with --params")
-    p.add_argument("--urdf", help="a URDF to certify (or erd:NAME for example-robot-data's)")
+    p.add_argument(
+        "--urdf", help="a URDF, xacro or MJCF file to certify (or erd:NAME for example-robot-data's)"
+    )
     p.add_argument("--params", dest="params_option", help="with --urdf: the parameter set it must match")
     p.add_argument("--sweep", help="a sweep file: certify many sets in parallel")
     p.add_argument("--scheduler", help="with --sweep: a Dask scheduler address, tcp://HOST:PORT")

@@ -17,7 +17,7 @@ def register(sub) -> None:
         help="your own closed-form model: a Python file defining one ClosedFormModel subclass "
         "(see examples/cart_pole.py); needs --urdf",
     )
-    p.add_argument("--urdf", help="a URDF to check (with --model, or with --params)")
+    p.add_argument("--urdf", help="a URDF, xacro or MJCF file to check (with --model, or with --params)")
     p.add_argument("--params", help="a parameter file (TOML) giving the closed form")
     p.add_argument("--samples", type=non_negative_int, default=None, help="random states per model")
     p.add_argument("--seed", type=non_negative_int, default=None, help="seed of the state sampler")

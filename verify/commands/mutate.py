@@ -14,7 +14,7 @@ def register(sub) -> None:
     )
     p.add_argument("--model", help="double_pendulum or cart_double_pendulum (default: both)")
     p.add_argument("--analytic", metavar="FILE", help="your own model file instead (with --urdf, --params)")
-    p.add_argument("--urdf", help="the URDF of --analytic")
+    p.add_argument("--urdf", help="the URDF (or xacro, MJCF) of --analytic")
     p.add_argument("--params", help="the parameter file of --analytic")
     p.add_argument(
         "--samples", type=non_negative_int, default=None, help="random states per model (default 40)"

@@ -14,7 +14,7 @@ def register(sub) -> None:
     p.add_argument("--engine", choices=("aba", "closed_form", "both"), help="override the scene's engine")
     p.add_argument(
         "--urdf",
-        help="the URDF ABA integrates (and the animation draws), instead of the scene's urdf "
+        help="the URDF (or xacro, MJCF) ABA integrates and the animation draws, instead of the scene's urdf "
         "or the project's URDF of the parameter set",
     )
     p.add_argument("--html", help="also write a self-contained HTML animation (as `pendverify render`)")

@@ -22,7 +22,7 @@ def register(sub) -> None:
     p.add_argument("--seed", type=non_negative_int, default=None, help="seed of the state sampler")
     p.add_argument("--json", help="also write the report as JSON to this path")
     add_analytic_option(p, "run hard cases derived from its parameters' kinds; needs --urdf, --params")
-    p.add_argument("--urdf", help="with --analytic: the model's URDF")
+    p.add_argument("--urdf", help="with --analytic: the model's URDF or xacro file")
     p.add_argument("--params", help="with --analytic: its parameter file (TOML)")
     p.set_defaults(func=run)
 

@@ -11,6 +11,7 @@ import importlib.metadata
 from pathlib import Path
 
 from pendverify.errors import PendverifyError, UrdfShapeError
+from pendverify.robot.description import description_stem
 
 DISTRIBUTION = "example-robot-data"
 #: the built-in model whose family example-robot-data's double-pendulum URDFs belong to
@@ -35,7 +36,8 @@ def double_pendulum_urdfs() -> dict[str, Path]:
 
 
 def resolve_urdf(spec: str) -> tuple[Path, str]:
-    """(path, bundle name) of ``erd:NAME`` (example-robot-data's URDF NAME) or of a URDF path."""
+    """(path, bundle name) of ``erd:NAME`` (example-robot-data's URDF NAME) or of a description's path
+    (its stem without the format's suffixes: ``arm.urdf.xacro`` → ``arm``)."""
     if spec.startswith("erd:"):
         found = double_pendulum_urdfs()
         stem = spec[4:]
@@ -45,4 +47,4 @@ def resolve_urdf(spec: str) -> tuple[Path, str]:
     path = Path(spec)
     if not path.is_file():
         raise UrdfShapeError(spec, "file not found")
-    return path, path.stem
+    return path, description_stem(path)

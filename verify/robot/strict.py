@@ -57,7 +57,7 @@ from pendverify.errors import UrdfShapeError
 from pendverify.robot.inertia_rounding import check_inertia_tensor
 from pendverify.robot.urdf_numbers import NOT_A_NUMBER, RAW_WHITESPACE, parse_number, parse_vector, why_not
 
-__all__ = ["JointDynamics", "UrdfFacts", "read_urdf_strictly"]
+__all__ = ["DescriptionFacts", "JointDynamics", "UrdfFacts", "parse_xml", "read_urdf_strictly"]
 
 #: tag → (attribute → how many numbers it holds), following the URDF format.
 VECTORS: dict[str, dict[str, int]] = {
@@ -125,15 +125,23 @@ class JointDynamics:
 
 
 @dataclass(frozen=True)
-class UrdfFacts:
-    """What the URDF says that Pinocchio's model does not keep.
+class DescriptionFacts:
+    """What a robot description says that Pinocchio's model does not keep (any format).
 
-    ``joint_dynamics``: joint name → its ``<dynamics>``, for every joint that has one.
-    ``joint_types``: joint name → its ``type`` attribute, for every joint.
+    ``joint_dynamics``: joint name → its damping and Coulomb friction as written (a URDF's
+    ``<dynamics>``, an MJCF joint's ``damping``/``frictionloss``), for every joint that has one.
+    ``joint_types``: joint name → its type as written (``revolute``, ``hinge``, ...), for every joint.
+    ``gravity``: g [m/s²] the description itself sets (an MJCF's ``<option gravity>``, MuJoCo's
+    default 9.81 when absent); None for a format that sets none (URDF).
     """
 
     joint_dynamics: dict[str, JointDynamics]
     joint_types: dict[str, str]
+    gravity: float | None = None
+
+
+#: The facts of a URDF (the name the URDF reader has always used).
+UrdfFacts = DescriptionFacts
 
 
 @dataclass(frozen=True)
@@ -154,7 +162,7 @@ def read_urdf_strictly(text: str, source: str) -> UrdfFacts:
     ``UrdfShapeError(source, problem)`` whose one-line problem names the link or joint,
     the element path, the attribute, the offending value and the rule.
     """
-    root = _parse_xml(text, source)
+    root = parse_xml(text, source)
     if root.tag != "robot":
         raise UrdfShapeError(source, f"the root element is <{root.tag}>, a URDF's must be <robot>")
     for element, parent, place in _walk(root):
@@ -165,7 +173,8 @@ def read_urdf_strictly(text: str, source: str) -> UrdfFacts:
 # --------------------------------------------------------------------------- XML
 
 
-def _parse_xml(text: str, source: str) -> ET.Element:
+def parse_xml(text: str, source: str) -> ET.Element:
+    """The XML of a description, DTDs and entities refused, tabs/line breaks in attributes kept."""
     try:
         root = DET.fromstring(text, forbid_dtd=True)
     except defusedxml.DefusedXmlException as exc:

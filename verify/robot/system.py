@@ -59,11 +59,21 @@ class PinocchioSystem:
 
     @classmethod
     def for_model(cls, model_cls, urdf: str | Path, g: float | None = None, source: str | None = None):
-        """The one constructor: a URDF (path or XML text) seen in model class ``model_cls``'s coordinates.
+        """The one constructor: a description (path or XML text; URDF, xacro, MJCF) seen in model
+        class ``model_cls``'s coordinates.
 
-        ``g`` is the gravity of the closed form (Pinocchio's default 9.81 m/s² if None).
+        ``g`` is the gravity of the closed form; if None, the description's own (an MJCF's
+        ``<option gravity>``), else Pinocchio's default 9.81 m/s².  A description whose own g
+        differs from ``g`` is evaluated with ``g``, and its notes say so.
         """
         loaded = load_urdf(urdf, source)
+        own = loaded.facts.gravity
+        if g is not None and own is not None and g != own:
+            loaded.reading_notes.append(
+                f"the description's own gravity is g = {own:g} m/s²; "
+                f"it is evaluated with the closed form's g = {g:g}"
+            )
+        g = own if g is None else g
         geometry = geometry_for(model_cls, loaded.model, loaded.source, g)
         return cls(loaded.model, geometry, DEFAULT_G if g is None else g, loaded.source, loaded)
 

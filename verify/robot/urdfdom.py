@@ -72,7 +72,7 @@ def log_records(text: str) -> list[str]:
 
 
 class _Captured:
-    """The text written to file descriptor 2 inside a ``_capture_fd2`` block (set on exit)."""
+    """The text written to the captured file descriptors inside a ``capture_output`` block (set on exit)."""
 
     text = ""
 
@@ -81,18 +81,27 @@ _FD2_LOCK = threading.Lock()
 
 
 @contextmanager
-def _capture_fd2() -> Iterator[_Captured]:
-    """Redirect file descriptor 2 (where urdfdom's C++ ``std::cerr`` writes) into a temporary file."""
+def capture_output(fds: tuple[int, ...] = (2,)) -> Iterator[_Captured]:
+    """Redirect file descriptors ``fds`` (2: C++ ``std::cerr``; 1: ``std::cout``) into one temporary file."""
     captured = _Captured()
     with _FD2_LOCK, tempfile.TemporaryFile() as tmp:
+        sys.stdout.flush()
         sys.stderr.flush()
-        saved = os.dup(2)
+        saved = [os.dup(fd) for fd in fds]
         try:
-            os.dup2(tmp.fileno(), 2)
+            for fd in fds:
+                os.dup2(tmp.fileno(), fd)
             yield captured
         finally:
+            sys.stdout.flush()
             sys.stderr.flush()
-            os.dup2(saved, 2)
-            os.close(saved)
+            for fd, copy in zip(fds, saved, strict=True):
+                os.dup2(copy, fd)
+                os.close(copy)
             tmp.seek(0)
             captured.text = tmp.read().decode("utf-8", errors="replace")
+
+
+def _capture_fd2():
+    """``capture_output`` of file descriptor 2, where urdfdom's C++ ``std::cerr`` writes."""
+    return capture_output((2,))

@@ -24,14 +24,13 @@ from __future__ import annotations
 
 import dataclasses
 import time
-from pathlib import Path
 
 from pendverify.checks.applicability import derived_notes
 from pendverify.checks.catalogue import skipped_notes
 from pendverify.checks.targets import plugin_target
 from pendverify.errors import PendverifyError, UnknownNameError
+from pendverify.robot.description import urdf_text
 from pendverify.robot.rebind import Binding
-from pendverify.robot.urdf import read_text_file
 from pendverify.stress.cases import high_speed_case, large_angle_case
 from pendverify.stress.catalogue import StressReport, run_case
 from pendverify.stress.framework import SEED, Case, Context, Settings, StressResult, checks_case
@@ -114,7 +113,7 @@ def run_generic(
     """``pendverify stress --analytic FILE --urdf URDF --params PARAMS``: the generic cases, run."""
     started = time.perf_counter()
     target = plugin_target(model_file, urdf, params_file)  # validates the three files, as check does
-    text = read_text_file(Path(urdf), urdf)  # UTF-8 (a BOM allowed) whatever the locale
+    text = urdf_text(urdf, "stress --analytic")  # UTF-8 whatever the locale; a xacro file expanded
     cases, notes = generic_cases(type(target.model), target.model.params, text, urdf)
     known = tuple(c.name for c in cases)
     for name in names or ():

@@ -1,0 +1,150 @@
+"""SDFormat (``<sdf>``) descriptions: read by Pinocchio's SDFormat reader when this build has one.
+
+Conventions:
+
+* Without SDFormat support in Pinocchio (``pinocchio.WITH_SDFORMAT`` is False, as in the
+  build this project is tested with) an SDF file is refused with one line saying so.
+* With it, the file is read strictly first: every number held by an element pendverify
+  knows (``NUMBERS``: poses, masses, inertias, axes, dynamics, limits, sizes, gravity) is a
+  plain finite decimal, or as many such numbers as the element holds, separated by XML
+  whitespace (surrounding whitespace in element text is allowed: SDF is pretty-printed);
+  masses, damping, friction and sizes are ≥ 0; each inertia tensor is valid
+  (``pendverify.robot.inertia_rounding``); a joint spring (``spring_stiffness``) is refused.
+  Then ``pinocchio.buildModelsFromSdf`` builds the model; a model with constraints (a closed
+  chain) is refused.  A joint's ``<axis><dynamics>`` damping and friction are its facts.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+import xml.etree.ElementTree as ET
+
+import pinocchio as pin
+
+from pendverify.errors import UrdfShapeError
+from pendverify.robot.inertia_rounding import check_inertia_tensor
+from pendverify.robot.strict import DescriptionFacts, JointDynamics, parse_xml
+from pendverify.robot.urdf_numbers import NOT_A_NUMBER, parse_number, why_not
+from pendverify.robot.urdfdom import capture_output, log_records
+
+#: element tag → how many numbers its text holds
+NUMBERS: dict[str, tuple[int, ...]] = {
+    "pose": (6, 7),
+    "xyz": (3,),
+    "size": (3,),
+    "scale": (3,),
+    "gravity": (3,),
+    **{tag: (1,) for tag in ("mass", "ixx", "ixy", "ixz", "iyy", "iyz", "izz", "damping", "friction")},
+    **{tag: (1,) for tag in ("spring_reference", "spring_stiffness", "lower", "upper", "effort", "velocity")},
+    **{tag: (1,) for tag in ("radius", "length")},
+}
+NON_NEGATIVE = (
+    "mass",
+    "damping",
+    "friction",
+    "effort",
+    "velocity",
+    "radius",
+    "length",
+    "size",
+    "spring_stiffness",
+)
+INERTIA = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+
+NO_SDFORMAT = (
+    "an SDFormat description (<sdf>), but this Pinocchio build has no SDFormat support "
+    "(pinocchio.WITH_SDFORMAT is False): use a Pinocchio built with SDFormat, "
+    "or describe the robot as URDF, xacro or MJCF"
+)
+
+
+def build_sdf_model(text: str, source: str) -> tuple[pin.Model, DescriptionFacts, list[str]]:
+    """(model, facts, log) of an SDF document; refused without SDFormat support (see the module docstring)."""
+    if not getattr(pin, "WITH_SDFORMAT", False):
+        raise UrdfShapeError(source, NO_SDFORMAT)
+    facts = read_sdf_strictly(text, source)
+    with tempfile.TemporaryDirectory(prefix="pendverify-sdf-") as folder:
+        path = os.path.join(folder, "model.sdf")
+        with open(path, "w", encoding="utf-8") as handle:
+            handle.write(text)
+        with capture_output((1, 2)) as captured:
+            try:
+                built = pin.buildModelsFromSdf(path)
+            except (RuntimeError, ValueError, IndexError) as exc:
+                failure: Exception | None = exc
+            else:
+                failure = None
+    log = log_records(captured.text)
+    if failure is not None:
+        lines = [line.strip() for line in str(failure).splitlines() if line.strip()]
+        raise UrdfShapeError(
+            source, f"Pinocchio cannot parse it as SDFormat: {lines[-1] if lines else failure!r}"
+        )
+    model, constraints = (built[0], built[1]) if isinstance(built, tuple) else (built, [])
+    if len(constraints):
+        raise UrdfShapeError(source, f"has {len(constraints)} constraint(s) (a closed chain); refused")
+    return model, facts, log
+
+
+def read_sdf_strictly(text: str, source: str) -> DescriptionFacts:
+    """Check an SDF document's numbers (see the module docstring); the joints' facts."""
+    root = parse_xml(text, source)
+    if root.tag != "sdf":
+        raise UrdfShapeError(source, f"the root element is <{root.tag}>, an SDF's must be <sdf>")
+    for element, place in _walk(root, "sdf"):
+        _check(element, place, source)
+    dynamics, types = {}, {}
+    for joint in root.iter("joint"):
+        name = joint.get("name", "")
+        if name in types:
+            raise UrdfShapeError(source, f"joint {name!r} is defined twice")
+        types[name] = joint.get("type", "")
+        found = joint.find("axis/dynamics")
+        if found is not None:
+            damping, friction = (found.findtext(t) for t in ("damping", "friction"))
+            dynamics[name] = JointDynamics(
+                None if damping is None else float(damping), None if friction is None else float(friction)
+            )
+    return DescriptionFacts(dynamics, types)
+
+
+def _walk(element: ET.Element, owner: str):
+    for child in element:
+        if not isinstance(child.tag, str):
+            continue
+        name = child.get("name")
+        here = (
+            f"{child.tag} {name!r}"
+            if child.tag in ("model", "link", "joint") and name
+            else f"{owner} <{child.tag}>"
+        )
+        yield child, here
+        yield from _walk(child, here if child.tag in ("model", "link", "joint") else owner)
+
+
+def _check(element: ET.Element, place: str, source: str) -> None:
+    tag = element.tag
+    if tag == "inertia":
+        # SDFormat's defaults for a missing entry: 1 on the diagonal, 0 off it
+        literals = {k: (element.findtext(k) or ("1" if k[1] == k[2] else "0")).strip() for k in INERTIA}
+        check_inertia_tensor(literals, place, source)
+    if tag not in NUMBERS or len(element):
+        return
+    raw = (element.text or "").strip()
+    pieces = raw.split()
+    if len(pieces) not in NUMBERS[tag]:
+        need = " or ".join(str(c) for c in NUMBERS[tag])
+        raise UrdfShapeError(source, f"{place} = {raw!r}: needs exactly {need} numbers, found {len(pieces)}")
+    values = []
+    for piece in pieces:
+        value = parse_number(piece)
+        if value is None:
+            raise UrdfShapeError(source, f"{place} = {raw!r}: {piece!r} is {NOT_A_NUMBER}{why_not(piece)}")
+        values.append(value)
+    if tag in NON_NEGATIVE and min(values) < 0:
+        raise UrdfShapeError(source, f"{place} = {raw!r}: must be ≥ 0")
+    if tag == "spring_stiffness" and values[0] != 0:
+        raise UrdfShapeError(
+            source, f"{place} = {raw!r}: a joint spring is refused (Pinocchio's model has none)"
+        )
