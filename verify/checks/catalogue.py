@@ -32,8 +32,11 @@ trust limit (``pendverify.checks.trust.REFUSE_REL``) is refused, not judged.
 
 from __future__ import annotations
 
+import numpy as np
+
 from pendverify.checks import quantities
 from pendverify.checks.applicability import hand_written, needs_matrix_c, needs_urdf_damping
+from pendverify.checks.batch import BatchContext, collect_batch
 from pendverify.checks.judge import OUT_OF_RANGE, collect_per_state, conclude
 from pendverify.checks.result import Check, CheckResult
 from pendverify.checks.trust import EPS
@@ -108,8 +111,23 @@ def run_check_per_state(check: Check, label: str, model, system, states, seed: i
     )
 
 
-def run_check(check: Check, label: str, model, system, states, seed: int) -> CheckResult:
-    """One check on every state (see ``run_check_per_state``)."""
+def run_check(check: Check, label: str, model, system, states, seed: int, batch=None) -> CheckResult:
+    """One check on every state, evaluated over all states at once (``pendverify.checks.batch``).
+
+    The same verdict, errors, tolerances, states and notes as ``run_check_per_state``,
+    which it falls back to wherever the batch cannot follow it exactly.  ``batch``: a
+    ``BatchContext`` of these states to share with other checks (``run_checks``).
+    """
+    if batch is None:
+        batch = BatchContext.of(model, system, states)
+    if batch is not None:
+        try:
+            with np.errstate(all="ignore"):
+                evidence = collect_batch(check, batch)
+        except Exception as exc:  # anything unusual: the reference path decides, as it always has
+            batch.fallbacks.append((check.name, f"{type(exc).__name__}: {exc}"))
+        else:
+            return conclude(check, label, model, system, states, seed, evidence)
     return run_check_per_state(check, label, model, system, states, seed)
 
 
@@ -133,7 +151,12 @@ def applicable_checks(model, system=None) -> tuple[str, ...]:
     return tuple(name for name in CHECK_NAMES if name not in skipped)
 
 
-def run_checks(label, model, system, states, seed, names=CHECK_NAMES) -> list[CheckResult]:
-    """The named checks that apply to ``model`` and ``system``, each on every state."""
+def run_checks(label, model, system, states, seed, names=CHECK_NAMES, batch=None) -> list[CheckResult]:
+    """The named checks that apply to ``model`` and ``system``, each on every state.
+
+    The checks share one batch of the states (``batch``, if given, must hold these states).
+    """
     names = set(names) & set(applicable_checks(model, system))
-    return [run_check(c, label, model, system, states, seed) for c in CHECKS if c.name in names]
+    if batch is None:
+        batch = BatchContext.of(model, system, states)
+    return [run_check(c, label, model, system, states, seed, batch) for c in CHECKS if c.name in names]

@@ -1,0 +1,302 @@
+"""A model's own closed forms run once over a whole batch of states, bit for bit as state by state.
+
+A closed form is plain Python over ``self.math`` and ``np.array`` (``analytic.interface``).
+Called with ``Lanes`` in place of the state's numbers — one object per coordinate holding
+that coordinate at every state of the batch — the same code runs once for all states:
+``Lanes`` does each scalar operation on a numpy array of lanes (elementwise IEEE
+arithmetic, the same bits as on one number), ``np.array`` of them gives an object array
+whose entries are ``Lanes``, and ``self.math`` maps Python's own ``math`` functions over
+the lanes (not numpy's, whose SIMD versions may round differently).  What cannot be
+done so raises and the method is evaluated state by state instead (``ClosedFormBatch``):
+
+* a comparison, ``if``, ``float()``, a NumPy function on a ``Lanes`` (``np.cos``), an
+  unsupported operator;
+* code the scan ``elementwise`` rejects: ``@``, and reductions and linear algebra
+  (``np.sum``, ``sum``, ``.dot``, ``np.linalg`` …), whose results on float arrays come
+  from BLAS or pairwise sums, not from the sequence of scalar operations an object
+  array would do.
+
+Two operations can round differently on one number and on an array element: ``x ** y``
+(Python and numpy scalars call the C library's ``pow``; a float array squares for y = 2,
+takes the root for 0.5, the reciprocal for −1) and a division by zero or a math
+function out of its domain (a Python float raises, an array gives inf or nan).  Such
+lanes are marked ``unsure`` and their states evaluated one by one.
+"""
+
+from __future__ import annotations
+
+import dis
+import functools
+import inspect
+import math
+import operator
+import types
+
+import numpy as np
+
+#: names whose use makes a method unfit for object arrays (see the module docstring)
+NOT_ELEMENTWISE = frozenset(
+    {
+        "accumulate", "average", "convolve", "correlate", "cumprod", "cumsum", "dot", "einsum", "fsum",
+        "inner", "linalg", "matmul", "matrix_power", "mean", "multi_dot", "nanprod", "nansum", "norm",
+        "polyval", "prod", "reduce", "reduceat", "std", "sum", "tensordot", "trace", "var", "vdot",
+    }
+)  # fmt: skip
+_LOADS = ("LOAD_ATTR", "LOAD_METHOD", "LOAD_GLOBAL", "LOAD_NAME", "LOAD_DEREF", "IMPORT_FROM")
+_MATMUL = ("BINARY_MATRIX_MULTIPLY", "INPLACE_MATRIX_MULTIPLY")
+_SCALARS = (float, int, np.integer)  # np.float64 is a float; other floating types are refused
+
+
+class NotVectorisable(Exception):
+    """The batch cannot run this code as written; the caller evaluates state by state."""
+
+
+def _merge(*masks):
+    present = [m for m in masks if m is not None]
+    if not present:
+        return None
+    out = present[0]
+    for m in present[1:]:
+        out = out | m
+    return out
+
+
+class Lanes:
+    """One scalar of a closed form at every state of a batch: ``a`` the values, ``unsure`` (or None)."""
+
+    __slots__ = ("a", "unsure")
+    __array_ufunc__ = None  # numpy hands binary operations with a Lanes to its reflected methods
+    __hash__ = None
+
+    def __init__(self, a: np.ndarray, unsure=None):
+        self.a, self.unsure = a, unsure
+
+    def _operand(self, other):
+        if isinstance(other, Lanes):
+            return other.a, other.unsure
+        if isinstance(other, _SCALARS) and not (isinstance(other, int) and abs(other) > 2**53):
+            return other, None
+        return None, None
+
+    def _binary(self, other, op, reflected=False):
+        if isinstance(other, np.ndarray):
+            f = (lambda e: op(e, self)) if reflected else (lambda e: op(self, e))
+            return _each(other, f)
+        b, unsure = self._operand(other)
+        if b is None:
+            return NotImplemented
+        x, y = (b, self.a) if reflected else (self.a, b)
+        out = op(x, y)
+        mask = _merge(self.unsure, unsure)
+        if op is operator.truediv:  # a Python float raises where the array gives inf or nan
+            zero = np.asarray(y == 0)
+            if zero.any():
+                mask = _merge(mask, np.broadcast_to(zero, out.shape))
+        return Lanes(out, mask)
+
+    def __add__(self, o):
+        return self._binary(o, operator.add)
+
+    def __radd__(self, o):
+        return self._binary(o, operator.add, True)
+
+    def __sub__(self, o):
+        return self._binary(o, operator.sub)
+
+    def __rsub__(self, o):
+        return self._binary(o, operator.sub, True)
+
+    def __mul__(self, o):
+        return self._binary(o, operator.mul)
+
+    def __rmul__(self, o):
+        return self._binary(o, operator.mul, True)
+
+    def __truediv__(self, o):
+        return self._binary(o, operator.truediv)
+
+    def __rtruediv__(self, o):
+        return self._binary(o, operator.truediv, True)
+
+    def __pow__(self, o):
+        return self._power(o, False)
+
+    def __rpow__(self, o):
+        return self._power(o, True)
+
+    def _power(self, other, reflected):
+        if isinstance(other, np.ndarray):
+            return _each(other, lambda e: (e**self) if reflected else (self**e))
+        b, unsure = self._operand(other)
+        if b is None:
+            return NotImplemented
+        base, exponent = (b, self.a) if reflected else (self.a, b)
+        # one number: the C library's pow (Python and numpy scalars alike); an array element:
+        # numpy's array power (fast paths for 2, 0.5, -1); where they differ, the lane is unsure
+        scalar, failed = _map(math.pow, [base, exponent], self.a.size)
+        with np.errstate(all="ignore"):  # the exponent as given: numpy's fast paths depend on its type
+            array = (b**self.a) if reflected else (self.a**b)
+        differ = failed | ~((scalar == array) | (np.isnan(scalar) & np.isnan(array)))
+        return Lanes(scalar, _merge(self.unsure, unsure, differ if differ.any() else None))
+
+    def __neg__(self):
+        return Lanes(-self.a, self.unsure)
+
+    def __pos__(self):
+        return Lanes(+self.a, self.unsure)
+
+    def __abs__(self):
+        return Lanes(np.abs(self.a), self.unsure)
+
+    def _refuse(self, *_):
+        raise NotVectorisable("a closed form compares or converts a number: evaluated state by state")
+
+    __eq__ = __ne__ = __lt__ = __le__ = __gt__ = __ge__ = _refuse
+    __bool__ = __float__ = __int__ = __index__ = __complex__ = __round__ = _refuse
+
+
+def _each(array: np.ndarray, f) -> np.ndarray:
+    """``f`` of every entry of ``array``: an object array (what numpy does entry by entry anyway)."""
+    out = np.empty(array.shape, dtype=object)
+    for index in np.ndindex(array.shape):
+        out[index] = f(array[index])
+    return out
+
+
+def _map(f, args, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """(f over the lanes as Python floats, lanes where f raised); a scalar argument is repeated."""
+    columns = [np.broadcast_to(np.asarray(a, dtype=float), (n,)).tolist() for a in args]
+    failed = np.zeros(n, dtype=bool)
+    try:
+        return np.fromiter(map(f, *columns), dtype=float, count=n), failed
+    except (ValueError, OverflowError, ZeroDivisionError, TypeError):
+        out = np.empty(n)
+        for i, xs in enumerate(zip(*columns, strict=True)):
+            try:
+                out[i] = f(*xs)
+            except (ValueError, OverflowError, ZeroDivisionError, TypeError):
+                out[i], failed[i] = np.nan, True
+        return out, failed
+
+
+def lane_function(f):
+    """``f`` on numbers as it is; on ``Lanes``, ``f`` applied lane by lane (the same bits)."""
+
+    @functools.wraps(f)
+    def call(*args):
+        lanes = [a for a in args if isinstance(a, Lanes)]
+        if not lanes:
+            return f(*args)
+        if any(not isinstance(a, (Lanes, *_SCALARS)) for a in args):
+            raise NotVectorisable(f"{getattr(f, '__name__', f)} of a non-number")
+        values, failed = _map(f, [a.a if isinstance(a, Lanes) else a for a in args], lanes[0].a.size)
+        return Lanes(values, _merge(*(a.unsure for a in lanes), failed if failed.any() else None))
+
+    return call
+
+
+def lane_math(namespace: types.SimpleNamespace) -> types.SimpleNamespace:
+    """A ``self.math`` whose functions take ``Lanes`` too (constants such as π unchanged)."""
+    return types.SimpleNamespace(
+        **{k: lane_function(v) if callable(v) else v for k, v in vars(namespace).items()}
+    )
+
+
+def to_lanes(X: np.ndarray) -> np.ndarray:
+    """The batch (N, n) as one object vector of n ``Lanes``: what a closed form gets for q."""
+    out = np.empty(X.shape[1], dtype=object)
+    for i in range(X.shape[1]):
+        out[i] = Lanes(np.ascontiguousarray(X[:, i]))
+    return out
+
+
+def stack(value, n: int) -> tuple[np.ndarray, np.ndarray | None]:
+    """(values with the batch axis first, float (N, …), states marked unsure or None)."""
+    if isinstance(value, Lanes):
+        return np.broadcast_to(value.a, (n,)).astype(float), value.unsure
+    if isinstance(value, list | tuple):
+        value = np.array(value, dtype=object)
+    if not isinstance(value, np.ndarray):
+        if isinstance(value, _SCALARS):
+            return np.full(n, float(value)), None
+        raise NotVectorisable(f"a closed form returned a {type(value).__name__}")
+    if value.dtype != object:
+        if value.dtype.kind not in "fiub":
+            raise NotVectorisable(f"a closed form returned an array of {value.dtype}")
+        return np.broadcast_to(value.astype(float), (n, *value.shape)).copy(), None
+    out, unsure = np.empty((n, *value.shape)), None
+    for index in np.ndindex(value.shape):
+        entry = value[index]
+        if isinstance(entry, Lanes):
+            out[(slice(None), *index)] = entry.a
+            unsure = _merge(unsure, entry.unsure)
+        elif isinstance(entry, _SCALARS):
+            out[(slice(None), *index)] = float(entry)
+        else:
+            raise NotVectorisable(f"a closed form returned an entry {type(entry).__name__}")
+    return out, unsure
+
+
+# --- which code runs on Lanes as written ---------------------------------------------------
+_SCANS: dict = {}  # (class, method) -> (elementwise?, the lookups the answer depends on)
+
+
+def elementwise(cls: type, name: str) -> bool:
+    """Whether method ``name`` of ``cls`` (and what it calls on self or module level) is elementwise.
+
+    False when its code, or that of the methods, properties and module functions it
+    reaches, uses ``@`` or a name of ``NOT_ELEMENTWISE``.  Answers are kept while every
+    name they looked up still resolves to the same object (a patched method is scanned
+    again).
+    """
+    entry = _SCANS.get((cls, name))
+    if entry is not None and all(_unchanged(*lookup) for lookup in entry[1]):
+        return entry[0]
+    lookups: list = []
+    func = _class_function(cls, name, lookups)
+    answer = func is not None and _scan(func.__code__, func.__globals__, cls, set(), lookups)
+    if len(_SCANS) >= 1024:
+        _SCANS.clear()
+    _SCANS[(cls, name)] = (answer, lookups)
+    return answer
+
+
+def _unchanged(holder, name, value) -> bool:
+    if isinstance(holder, dict):
+        return holder.get(name) is value
+    return inspect.getattr_static(holder, name, None) is value
+
+
+def _class_function(cls: type, name: str, lookups: list):
+    attribute = inspect.getattr_static(cls, name, None)
+    lookups.append((cls, name, attribute))
+    if isinstance(attribute, property):
+        attribute = attribute.fget
+    attribute = getattr(attribute, "__func__", attribute)
+    return attribute if isinstance(attribute, types.FunctionType) else None
+
+
+def _scan(code: types.CodeType, globals_: dict, cls: type, seen: set, lookups: list) -> bool:
+    if code in seen:
+        return True
+    seen.add(code)
+    for ins in dis.get_instructions(code):
+        if ins.opname in _MATMUL or (ins.opname == "BINARY_OP" and ins.argrepr in ("@", "@=")):
+            return False
+        if ins.opname in _LOADS and isinstance(ins.argval, str):
+            if ins.argval in NOT_ELEMENTWISE:
+                return False
+            target = None
+            if ins.opname in ("LOAD_ATTR", "LOAD_METHOD"):  # a method or property of the class
+                target = _class_function(cls, ins.argval, lookups)
+            elif ins.opname in ("LOAD_GLOBAL", "LOAD_NAME"):  # a function of the module
+                value = globals_.get(ins.argval)
+                lookups.append((globals_, ins.argval, value))
+                target = value if isinstance(value, types.FunctionType) else None
+            if target is not None and not _scan(target.__code__, target.__globals__, cls, seen, lookups):
+                return False
+    return all(
+        _scan(const, globals_, cls, seen, lookups)
+        for const in code.co_consts
+        if isinstance(const, types.CodeType)
+    )
