@@ -5,7 +5,8 @@
 for two plug-in models, at large angles through the stress catalogue's reduced-angle
 system, and through the precision re-judgement, every judged state's rounding tolerance,
 relative error, relative tolerance and absolute error, the refused states and the notes
-must be equal (``==`` on the bits), and so the verdicts, worst and largest states.
+must be equal (``==`` on the bits), and so the verdicts, worst and largest states.  The
+trust rule's verdict at each state (``trust_batch.assess_batch``) must be ``assess``'s.
 """
 
 from __future__ import annotations
@@ -26,6 +27,8 @@ from pendverify.checks.judge import collect_per_state
 from pendverify.checks.lanes import Lanes, elementwise
 from pendverify.checks.sampling import sample_states
 from pendverify.checks.targets import default_target, plugin_target
+from pendverify.checks.trust import assess
+from pendverify.checks.trust_batch import assess_batch
 from pendverify.stress.cases import ReducedAngleSystem, shifted_states
 from pendverify.stress.framework import QUICK
 from pendverify.stress.generic import run_generic
@@ -69,6 +72,7 @@ def assert_both_paths_agree(label, model, system, states, seed=1):
         )
         assert same(result.as_dict(), expected.as_dict()), (label, check.name)
     assert ctx.fallbacks == []
+    assert assess_batch(ctx) == [assess(model, s.q, system) for s in states], label
     return ctx
 
 

@@ -151,12 +151,15 @@ def assess(model, q, system=None) -> Conditioning:
     return max(verdicts, key=lambda c: (c.bound, c.kappa_raw))
 
 
-def check_conditioning(model, q, system=None, what: str | None = None) -> Conditioning:
+def check_conditioning(
+    model, q, system=None, what: str | None = None, verdict: Conditioning | None = None
+) -> Conditioning:
     """``assess``, raising ``IllConditionedError`` when the verdict is ``refuse``.
 
     Returns the verdict when it is ``ok`` or ``warn`` (see ``Conditioning.note``).
+    ``verdict``: ``assess(model, q, system)`` when already made (``trust_batch.assess_batch``).
     """
-    verdict = assess(model, q, system)
+    verdict = assess(model, q, system) if verdict is None else verdict
     if verdict.level == "refuse":
         raise IllConditionedError(
             what or model.name,

@@ -18,10 +18,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from pendverify.analytic import MODELS
-from pendverify.checks.catalogue import CHECKS, applicable_checks, run_check
+from pendverify.checks.batch import BatchContext
+from pendverify.checks.catalogue import applicable_checks, run_checks
 from pendverify.checks.sampling import DEFAULT_SEED, State, sample_states
 from pendverify.checks.trust import check_conditioning
 from pendverify.checks.verdict import WARN
+from pendverify.checks.verification import batch_verdicts
 from pendverify.errors import IllConditionedError
 from pendverify.robot.system import PinocchioSystem
 from pendverify.stress.trust_study import StudyResult, cart_study
@@ -161,10 +163,12 @@ def compare(name: str, model, system, states: list[State], seed: int) -> _Compar
     kept, refused = [], []
     kappa_raw = kappa_scaled = amplification = 0.0
     level = "ok"
-    for s in states:
+    batch = BatchContext.of(model, system, states)
+    verdicts = batch_verdicts(model, system, states, batch) or [None] * len(states)
+    for s, verdict in zip(states, verdicts, strict=True):
         model_state(model, s.q, s.v, s.u, s.w, source=f"<{name}: {s.label}>")
         try:
-            c = check_conditioning(model, s.q, system, what=name)
+            c = check_conditioning(model, s.q, system, what=name, verdict=verdict)
         except IllConditionedError as exc:
             refused.append(str(exc))
             continue
@@ -173,9 +177,10 @@ def compare(name: str, model, system, states: list[State], seed: int) -> _Compar
         amplification = max(amplification, c.amplification)
         level = "warn" if c.level == "warn" else level
     names = applicable_checks(model, system)
-    checks = [c for c in CHECKS if c.name in names]
+    if batch is not None and len(kept) < len(states):
+        batch = BatchContext.of(model, system, kept)
     with np.errstate(all="ignore"):
-        results = [run_check(c, name, model, system, kept, seed) for c in checks] if kept else []
+        results = run_checks(name, model, system, kept, seed, names, batch) if kept else []
     return _Comparison(results, len(kept), refused, kappa_raw, kappa_scaled, amplification, level)
 
 
