@@ -188,3 +188,41 @@ def test_a_system_without_a_batch_takes_the_per_state_path():
     assert same(
         result.as_dict(), run_check_per_state(check, "w", target.model, target.system, states, 5).as_dict()
     )
+
+
+def _one_draw_per_vector(model, n_random, seed):
+    """The sampler as it was written before issue 15: one ``uniform`` call per vector."""
+    from pendverify.checks import sampling as s
+
+    rng = np.random.default_rng(seed)
+    angular = np.array(model.angular)
+    q_range = np.where(angular, s.ANGLE_RANGE, s.POSITION_RANGE)
+    u_scale = s._force_scales(model, model.input_matrix())
+    w_scale = s._force_scales(model, model.disturbance_matrix())
+    out = []
+    for name, q in model.special_states().items():
+        q = np.asarray(q, dtype=float)
+        out.append((f"{name} at rest", q, np.zeros(model.nv), np.zeros(u_scale.size), np.zeros(w_scale.size)))
+        v = rng.uniform(-s.RATE_RANGE, s.RATE_RANGE, model.nv)
+        u, w = rng.uniform(-1, 1, u_scale.size) * u_scale, rng.uniform(-1, 1, w_scale.size) * w_scale
+        out.append((f"{name} moving", q, v, u, w))
+    for i in range(n_random):
+        q = rng.uniform(-1, 1, model.nv) * q_range
+        v = rng.uniform(-s.RATE_RANGE, s.RATE_RANGE, model.nv)
+        u, w = rng.uniform(-1, 1, u_scale.size) * u_scale, rng.uniform(-1, 1, w_scale.size) * w_scale
+        out.append((f"random #{i}", q, v, u, w))
+    return out
+
+
+@pytest.mark.parametrize("stem", ("cart_pole", "furuta_pendulum", *SEEDS))
+def test_the_sampler_draws_the_states_one_draw_per_vector_would(stem):
+    if stem in SEEDS:
+        model = default_target(stem).model
+    else:
+        model = plugin_target(*(str(EXAMPLES / f"{stem}.{ext}") for ext in ("py", "urdf", "toml"))).model
+    for seed in (0, 20260301):
+        drawn = sample_states(model, 50, seed)
+        expected = _one_draw_per_vector(model, 50, seed)
+        assert [s.label for s in drawn] == [e[0] for e in expected]
+        for s, (_, *arrays) in zip(drawn, expected, strict=True):
+            assert all(same_bits(a, b) for a, b in zip((s.q, s.v, s.u, s.w), arrays, strict=True)), s.label
