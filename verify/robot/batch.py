@@ -63,6 +63,13 @@ class PinocchioBatch:
         self.v = np.ascontiguousarray(_mv(cmap.T, np.ascontiguousarray(theta_dot, dtype=float)))
         self.N = len(theta)
         self._cache: dict[str, object] = {}
+        #: the joint torques of the last ``acceleration`` (what ``bench certify`` times ABA on)
+        self.aba_torques: np.ndarray | None = None
+
+    @property
+    def computed(self) -> tuple[str, ...]:
+        """The quantities computed so far (``crba``, ``M``, ``Minv``, ``bias``, ``H``, ``C``, ``Mdot``, …)."""
+        return tuple(self._cache)
 
     def _once(self, name, compute):
         if name not in self._cache:
@@ -144,6 +151,7 @@ class PinocchioBatch:
             raise ValueError("a generalized force that is not finite")
         cmap = self.system.cmap
         tau = _mv(cmap._T_inv.T, np.ascontiguousarray(tau_theta, dtype=float))
+        self.aba_torques = tau
         return _mv(cmap._T_inv, self._loop(pin.aba, self.q, self.v, tau))
 
     def kinetic_energy(self) -> np.ndarray:
