@@ -27,59 +27,82 @@ def _cond(M: np.ndarray) -> np.ndarray:
     return np.where(finite & np.isfinite(kappa), kappa, np.inf)
 
 
-def _verdict(M, S, angle, amplification):
-    """``trust.conditioning`` of each state: (κ raw, κ̃, bound, spread, by_spread)."""
+def _kappas(M, S):
+    """κ raw, κ̃ (M scaled by S) and the scale spread of each state, as ``trust.conditioning``."""
     usable = np.all(S > 0, axis=-1) & np.all(np.isfinite(S), axis=-1)
     with np.errstate(all="ignore"):
         root = np.sqrt(S)
         kappa_scaled = np.where(usable, _cond(M / (root[:, :, None] * root[:, None, :])), np.inf)
         spread = np.where(usable, np.sqrt(np.max(S, axis=-1) / np.min(S, axis=-1)), np.inf)
+    return _cond(M), kappa_scaled, spread
+
+
+def _bound(kappa_scaled, spread, angle, amplification):
+    """(the rounding bound, whether the spread decides it), as ``trust.conditioning``."""
+    with np.errstate(all="ignore"):
         growth = 1.0 + np.abs(angle)
         rounding, visibility = kappa_scaled * (growth + (amplification - 1.0)), growth * spread
-        bound = KAPPA_K * EPS * np.where(visibility > rounding, visibility, rounding)
-    return _cond(M), kappa_scaled, bound, spread, visibility > rounding
+        return KAPPA_K * EPS * np.where(visibility > rounding, visibility, rounding), visibility > rounding
 
 
 def _level(bound: float) -> str:
     return "ok" if bound <= WARN_REL else "warn" if bound <= REFUSE_REL else "refuse"
 
 
-def assess_batch(ctx) -> list[Conditioning]:
-    """``trust.assess(model, state.q, system)`` for every state of the batch ``ctx``."""
-    M_hand, S = ctx.forms.value("mass_matrix"), ctx.forms.value("diagonal_scale")
-    M_pin, A = ctx.pin.mass_matrix(), ctx.lever
-    n = len(ctx.states)
-    one = np.ones(n)
-    candidates = [
-        (*_verdict(M_hand, S, ctx.angle, one), one),
-        (*_verdict(M_hand, S, ctx.angle, A), A),
-        (*_verdict(M_pin, np.abs(np.diagonal(M_pin, axis1=-2, axis2=-1)), ctx.angle, A), A),
-    ]
-    # max(verdicts, key=lambda c: (c.bound, c.kappa_raw)): the first of equals wins
-    best = np.zeros(n, dtype=int)
-    for j in (1, 2):
-        b, k = candidates[j][2], candidates[j][0]
-        b0, k0 = np.choose(best, [c[2] for c in candidates]), np.choose(best, [c[0] for c in candidates])
-        best = np.where(np.where(b == b0, k > k0, b > b0), j, best)
-    finite = np.ones(n, dtype=bool)
-    for c in candidates:
-        for x in c:
-            finite &= np.isfinite(np.asarray(x, dtype=float))
-    out = []
-    for i in range(n):
-        if not finite[i]:  # inf or nan somewhere: the state's own assessment decides
-            out.append(assess(ctx.model, ctx.states[i].q, ctx.system))
-            continue
-        kappa_raw, kappa_scaled, bound, spread, by_spread, amplification = (x[i] for x in candidates[best[i]])
-        out.append(
-            Conditioning(
-                float(kappa_raw),
-                float(kappa_scaled),
-                float(bound),
-                _level(float(bound)),
-                float(amplification),
-                float(spread),
-                bool(by_spread),
-            )
+class BatchVerdicts:
+    """``trust.assess`` at each state of a batch: ``verdicts[i]`` is the state's ``Conditioning``."""
+
+    def __init__(self, ctx):
+        M_hand, S = ctx.forms.value("mass_matrix"), ctx.forms.value("diagonal_scale")
+        M_pin, A = ctx.pin.mass_matrix(), ctx.lever
+        n = len(ctx.states)
+        one = np.ones(n)
+        hand, pin = _kappas(M_hand, S), _kappas(M_pin, np.abs(np.diagonal(M_pin, axis1=-2, axis2=-1)))
+        # (κ raw, κ̃, bound, spread, by_spread, A) of the closed form's M alone, with A, and Pinocchio's M
+        candidates = [
+            (hand[0], hand[1], *_bound(hand[1], hand[2], ctx.angle, one), hand[2], one),
+            (hand[0], hand[1], *_bound(hand[1], hand[2], ctx.angle, A), hand[2], A),
+            (pin[0], pin[1], *_bound(pin[1], pin[2], ctx.angle, A), pin[2], A),
+        ]
+        self.fields = [np.stack([c[k] for c in candidates]) for k in range(6)]
+        # max(verdicts, key=lambda c: (c.bound, c.kappa_raw)): the first of equals wins
+        kappa, bound = self.fields[0], self.fields[2]
+        best = np.zeros(n, dtype=int)
+        for j in (1, 2):
+            b0, k0 = np.choose(best, bound), np.choose(best, kappa)
+            best = np.where(np.where(bound[j] == b0, kappa[j] > k0, bound[j] > b0), j, best)
+        self.best = best
+        finite = np.ones(n, dtype=bool)
+        for x in self.fields:
+            finite &= np.all(np.isfinite(x.astype(float)), axis=0)
+        self.finite = finite
+        self.bound = np.choose(best, bound)
+        self.ctx = ctx
+
+    def __len__(self) -> int:
+        return len(self.best)
+
+    def refuses(self, i: int) -> bool:
+        """Whether state i's verdict is ``refuse`` (or not certain without ``assess`` itself)."""
+        return not (self.finite[i] and self.bound[i] <= REFUSE_REL)
+
+    def __getitem__(self, i: int) -> Conditioning:
+        if not self.finite[i]:  # inf or nan somewhere: the state's own assessment decides
+            return assess(self.ctx.model, self.ctx.states[i].q, self.ctx.system)
+        kappa_raw, kappa_scaled, bound, by_spread, spread, amplification = (
+            x[self.best[i], i] for x in self.fields
         )
-    return out
+        return Conditioning(
+            float(kappa_raw),
+            float(kappa_scaled),
+            float(bound),
+            _level(float(bound)),
+            float(amplification),
+            float(spread),
+            bool(by_spread),
+        )
+
+
+def assess_batch(ctx) -> BatchVerdicts:
+    """``trust.assess(model, state.q, system)`` for every state of the batch ``ctx``."""
+    return BatchVerdicts(ctx)

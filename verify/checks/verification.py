@@ -33,7 +33,7 @@ from pendverify.progress import bar
 from pendverify.robot.geometry import MODEL_FORM_RTOL
 
 
-def batch_verdicts(model, system, states, batch=None) -> list | None:
+def batch_verdicts(model, system, states, batch=None):
     """``trust.assess`` at every state, for all states at once (``trust_batch``); None if no batch."""
     batch = batch if batch is not None else BatchContext.of(model, system, states)
     if batch is None:
@@ -51,10 +51,14 @@ def trusted_states(label: str, model, system, states, batch=None) -> tuple[list,
     ``batch``: a ``BatchContext`` of ``states`` whose quantities the verdicts may share.
     """
     kept, refused = [], []
-    verdicts = batch_verdicts(model, system, states, batch) or [None] * len(states)
+    verdicts = batch_verdicts(model, system, states, batch)
     with np.errstate(all="ignore"):
-        for state, verdict in zip(states, verdicts, strict=True):
+        for i, state in enumerate(states):
+            if verdicts is not None and not verdicts.refuses(i):
+                kept.append(state)  # ok or warn: check_conditioning would return the verdict
+                continue
             try:
+                verdict = None if verdicts is None else verdicts[i]
                 check_conditioning(model, state.q, system, what=label, verdict=verdict)
             except IllConditionedError as exc:
                 refused.append(f"{state.label}: {exc}")

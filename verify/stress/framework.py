@@ -164,10 +164,11 @@ def compare(name: str, model, system, states: list[State], seed: int) -> _Compar
     kappa_raw = kappa_scaled = amplification = 0.0
     level = "ok"
     batch = BatchContext.of(model, system, states)
-    verdicts = batch_verdicts(model, system, states, batch) or [None] * len(states)
-    for s, verdict in zip(states, verdicts, strict=True):
+    verdicts = batch_verdicts(model, system, states, batch)
+    for i, s in enumerate(states):
         model_state(model, s.q, s.v, s.u, s.w, source=f"<{name}: {s.label}>")
         try:
+            verdict = None if verdicts is None else verdicts[i]
             c = check_conditioning(model, s.q, system, what=name, verdict=verdict)
         except IllConditionedError as exc:
             refused.append(str(exc))
