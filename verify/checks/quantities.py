@@ -86,6 +86,15 @@ class Terms:
     def d_rate(self):
         return damping_rate_of(self.D, self.w)
 
+    def norm2(self, A):
+        """``norms2(A)``, once per matrix content (minverse, aba and energy share theirs)."""
+        A = np.ascontiguousarray(A)
+        memo = self.__dict__.setdefault("_norms", {})
+        key = (A.shape, A.tobytes())
+        if key not in memo:
+            memo[key] = norms2(A)
+        return memo[key]
+
 
 class StateTerms(Terms):
     """One state's terms: the model's and the system's methods at that state, called when first read."""
@@ -197,9 +206,9 @@ def measure_det(t):
 def measure_minverse(t):
     sqrt_s = 1.0 / t.w
     diff = t.Minv_pin - t.Minv_hand
-    Minv_norm = norms2(scaled_matrix(t.Minv_hand, sqrt_s))
+    Minv_norm = t.norm2(scaled_matrix(t.Minv_hand, sqrt_s))
     # δ(M⁻¹) = −M⁻¹ δM M⁻¹ with |δM̃| ~ ε‖M̃‖
-    scale = Minv_norm * Minv_norm * norms2(scaled_matrix(t.M_hand, 1.0 / sqrt_s))
+    scale = Minv_norm * Minv_norm * t.norm2(scaled_matrix(t.M_hand, 1.0 / sqrt_s))
     return Measure(_max2(np.abs(scaled_matrix(diff, sqrt_s))), scale)
 
 
@@ -208,8 +217,8 @@ def measure_aba(t):
     tau = mv(t.B, t.u) + mv(t.W, t.w_in) - mv(t.D, t.v)
     a_pin = t.acceleration_pin(tau)
     a_hand = t.a_hand
-    Minv_norm = norms2(scaled_matrix(t.Minv_hand, 1.0 / w))
-    M_norm = norms2(scaled_matrix(t.M_hand, w))
+    Minv_norm = t.norm2(scaled_matrix(t.Minv_hand, 1.0 / w))
+    M_norm = t.norm2(scaled_matrix(t.M_hand, w))
     forces = force_scale_of(t.rate, t.v, w, t.g_scale, t.B, t.W, t.D, t.u, t.w_in)
     scale = Minv_norm * (forces + M_norm * np.max(np.abs(a_pin / w), axis=-1))
     allowance = Minv_norm * np.max(w * t.allowance, axis=-1)
@@ -222,7 +231,7 @@ def measure_energy(t):
     # potential energies agree up to a constant: compare differences from θ = 0
     dv_pin = t.V_pin - t.V_pin0
     dv_hand = t.V_hand - t.V_hand0
-    kinetic_scale = 0.5 * total((t.v / w) ** 2) * norms2(scaled_matrix(t.M_hand, w))
+    kinetic_scale = 0.5 * total((t.v / w) ** 2) * t.norm2(scaled_matrix(t.M_hand, w))
     potential_scale = float(np.max(t.g_scale))
     allowance = 2 * float(np.sum(t.allowance))  # |ΔV| ≤ m g |offset| at both ends
     return Measure(kinetic + np.abs(dv_pin - dv_hand), kinetic_scale + potential_scale, allowance)

@@ -80,8 +80,13 @@ class PinocchioBatch:
         """f(model, data, *rows) at every state, stacked (the tight loop over bare Pinocchio calls)."""
         pm, data = self.system.model, self.system.data
         out = np.empty((self.N, *(shape if shape is not None else (pm.nv,))))
-        for i in range(self.N):
-            out[i] = f(pm, data, *(a[i] for a in arrays))
+        if len(arrays) == 1:
+            (a,) = arrays
+            for i in range(self.N):
+                out[i] = f(pm, data, a[i])
+        else:
+            for i, rows in enumerate(zip(*arrays, strict=True)):
+                out[i] = f(pm, data, *rows)
         return out
 
     # --- joint-space quantities, each once ----------------------------------------------
@@ -133,12 +138,12 @@ class PinocchioBatch:
         def compute():
             system = self.system
             m, d, n = system._no_gravity, system._no_gravity_data, system.model.nv
-            zero, unit = np.zeros(n), np.eye(n)
+            zero, unit = np.zeros(n), [np.eye(n)[j].copy() for j in range(n)]
             dtau = np.empty((n, self.N, n, n))
-            for i in range(self.N):
-                q = self.q[i]
+            derivatives = pin.computeRNEADerivatives
+            for i, q in enumerate(self.q):
                 for j in range(n):
-                    dtau[j, i] = pin.computeRNEADerivatives(m, d, q, zero, np.array(unit[j]))[0]
+                    dtau[j, i] = derivatives(m, d, q, zero, unit[j])[0]
             columns = [_mv(dtau[j], self.v) for j in range(n)]
             T = system.cmap.T
             return T.T @ np.stack(columns, axis=-1) @ T
