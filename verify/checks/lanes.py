@@ -257,19 +257,23 @@ def elementwise(cls: type, name: str) -> bool:
     answer = func is not None and _scan(func.__code__, func.__globals__, cls, set(), lookups)
     if len(_SCANS) >= 1024:
         _SCANS.clear()
-    _SCANS[(cls, name)] = (answer, lookups)
+    unique = {(id(holder), key): (holder, key, value) for holder, key, value in lookups}
+    _SCANS[(cls, name)] = (answer, list(unique.values()))
     return answer
+
+
+_MISSING = object()
 
 
 def _unchanged(holder, name, value) -> bool:
     if isinstance(holder, dict):
-        return holder.get(name) is value
-    return inspect.getattr_static(holder, name, None) is value
+        return holder.get(name, _MISSING) is value
+    return getattr(holder, name, _MISSING) is value
 
 
 def _class_function(cls: type, name: str, lookups: list):
     attribute = inspect.getattr_static(cls, name, None)
-    lookups.append((cls, name, attribute))
+    lookups.append((cls, name, getattr(cls, name, _MISSING)))
     if isinstance(attribute, property):
         attribute = attribute.fget
     attribute = getattr(attribute, "__func__", attribute)
@@ -290,7 +294,7 @@ def _scan(code: types.CodeType, globals_: dict, cls: type, seen: set, lookups: l
             if ins.opname in ("LOAD_ATTR", "LOAD_METHOD"):  # a method or property of the class
                 target = _class_function(cls, ins.argval, lookups)
             elif ins.opname in ("LOAD_GLOBAL", "LOAD_NAME"):  # a function of the module
-                value = globals_.get(ins.argval)
+                value = globals_.get(ins.argval, _MISSING)
                 lookups.append((globals_, ins.argval, value))
                 target = value if isinstance(value, types.FunctionType) else None
             if target is not None and not _scan(target.__code__, target.__globals__, cls, seen, lookups):
