@@ -10,10 +10,11 @@ The cases live in ``pendverify.stress.cases`` (states and parameters) and
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -116,13 +117,24 @@ class Context:
     urdf: str | None = None
     #: the model class of the sets (a plug-in's); None: the built-in model each set names
     model_cls: type | None = None
+    #: the systems made so far, by parameter set (cases on the same set share one)
+    systems: dict = field(default_factory=dict, repr=False, compare=False)
 
     def system(self, params):
         """Pinocchio's side for a parameter set: ``urdf`` if given (the battery's), else the project's."""
+        try:
+            return self.systems[params]
+        except (KeyError, TypeError):
+            pass
         if self.urdf is None:
-            return system_for(params)
-        cls = self.model_cls or MODELS[params.model]
-        return PinocchioSystem.for_model(cls, self.urdf, getattr(params, "g", None), "<URDF being compared>")
+            system = system_for(params)
+        else:
+            cls = self.model_cls or MODELS[params.model]
+            g = getattr(params, "g", None)
+            system = PinocchioSystem.for_model(cls, self.urdf, g, "<URDF being compared>")
+        with contextlib.suppress(TypeError):  # a set that cannot be a key is not kept
+            self.systems[params] = system
+        return system
 
     def trust_study(self) -> StudyResult:
         """The cart seed's m1 → 0 study (``pendverify.stress.trust_study``), run once per context."""
