@@ -3,13 +3,13 @@
 How, per method (``ClosedFormBatch.value``):
 
 1. a hand-written method whose code is elementwise (``lanes.elementwise``) runs once on
-   ``Lanes`` (``pendverify.checks.lanes``): the model's own code, its own arithmetic;
+   ``Lanes`` (``pendverify.checks.lanes``): the model's own code, its own arithmetic, its
+   ``@`` and ``np.linalg`` as one state's BLAS/LAPACK calls (``checks.lane_arrays``);
 2. the interface's derived ``bias``, ``kinetic_energy``, ``inverse_mass_matrix`` and
    ``acceleration`` are formed from the batch of their parts with the same NumPy calls
    on stacked arrays (BLAS and LAPACK are called once per state with the same arguments);
-3. anything else — a method using ``@`` or ``np.linalg`` (both seeds' hand-written q̈),
-   the SymPy-derived scales, a method that raises on ``Lanes`` — is called state by
-   state, as the reference path calls it.
+3. anything else — a reduction (``np.sum``, ``.dot``), the SymPy-derived scales, a method
+   that raises on ``Lanes`` — is called state by state, as the reference path calls it.
 
 Whatever ran on the batch is compared bit for bit with state-by-state calls at a few
 probe states, and a method that differs there is evaluated state by state everywhere;
@@ -24,11 +24,10 @@ computes, and a model SymPy cannot read would have no batch at all.
 
 from __future__ import annotations
 
-import copy
-
 import numpy as np
 
 from pendverify.analytic.interface import BiasOnlyModel, ClosedFormModel
+from pendverify.checks.lane_arrays import lane_array, lane_twin_class
 from pendverify.checks.lanes import elementwise, lane_math, stack, to_lanes
 from pendverify.checks.scaling import mv
 
@@ -121,11 +120,12 @@ class ClosedFormBatch:
         return np.array([self._one(name, i) for i in range(self.n)], dtype=float)
 
     def _lanes(self, name: str):
-        if self._twin is None:
-            twin = copy.copy(self.model)
+        if self._twin is None:  # made for each batch: a method patched meanwhile is the one called
+            twin = object.__new__(lane_twin_class(type(self.model)))
+            twin.__dict__.update(self.model.__dict__)
             twin.math = lane_math(self.model.math)
             self._twin = twin
-        args = [to_lanes(self.arrays[a]) for a in ARGUMENTS[name]]
+        args = [lane_array(to_lanes(self.arrays[a])) for a in ARGUMENTS[name]]
         with np.errstate(all="ignore"):
             return stack(getattr(self._twin, name)(*args), self.n)
 

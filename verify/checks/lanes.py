@@ -11,10 +11,13 @@ done so raises and the method is evaluated state by state instead (``ClosedFormB
 
 * a comparison, ``if``, ``float()``, a NumPy function on a ``Lanes`` (``np.cos``), an
   unsupported operator;
-* code the scan ``elementwise`` rejects: ``@``, and reductions and linear algebra
-  (``np.sum``, ``sum``, ``.dot``, ``np.linalg`` …), whose results on float arrays come
-  from BLAS or pairwise sums, not from the sequence of scalar operations an object
-  array would do.
+* code the scan ``elementwise`` rejects: reductions (``np.sum``, ``sum``, ``.dot``,
+  ``np.linalg.norm`` …), whose results on float arrays come from BLAS or pairwise sums,
+  not from the sequence of scalar operations an object array would do;
+* a ``@`` NumPy would carry out entry by entry: ``@`` and ``np.linalg.solve``/``inv``/``det``
+  on the arrays the batch hands out are done as one state's BLAS/LAPACK calls
+  (``pendverify.checks.lane_arrays``), and an operation on lanes from inside any other
+  ``@`` raises.
 
 Two operations can round differently on one number and on an array element: ``x ** y``
 (Python and numpy scalars call the C library's ``pow``; a float array squares for y = 2,
@@ -30,6 +33,7 @@ import functools
 import inspect
 import math
 import operator
+import sys
 import types
 
 import numpy as np
@@ -38,12 +42,15 @@ import numpy as np
 NOT_ELEMENTWISE = frozenset(
     {
         "accumulate", "average", "convolve", "correlate", "cumprod", "cumsum", "dot", "einsum", "fsum",
-        "inner", "linalg", "matmul", "matrix_power", "mean", "multi_dot", "nanprod", "nansum", "norm",
+        "inner", "matmul", "matrix_power", "mean", "multi_dot", "nanprod", "nansum", "norm",
         "polyval", "prod", "reduce", "reduceat", "std", "sum", "tensordot", "trace", "var", "vdot",
     }
 )  # fmt: skip
 _LOADS = ("LOAD_ATTR", "LOAD_METHOD", "LOAD_GLOBAL", "LOAD_NAME", "LOAD_DEREF", "IMPORT_FROM")
-_MATMUL = ("BINARY_MATRIX_MULTIPLY", "INPLACE_MATRIX_MULTIPLY")
+_MATMUL_OPCODES = {
+    dis.opmap[k] for k in ("BINARY_MATRIX_MULTIPLY", "INPLACE_MATRIX_MULTIPLY") if k in dis.opmap
+}
+_BINARY_OP = dis.opmap.get("BINARY_OP", -1)  # Python ≥ 3.11: its argument 4 is @, 17 is @=
 _SCALARS = (float, int, np.integer)  # np.float64 is a float; other floating types are refused
 
 
@@ -51,7 +58,7 @@ class NotVectorisable(Exception):
     """The batch cannot run this code as written; the caller evaluates state by state."""
 
 
-def _merge(*masks):
+def merge(*masks):
     present = [m for m in masks if m is not None]
     if not present:
         return None
@@ -79,6 +86,8 @@ class Lanes:
         return None, None
 
     def _binary(self, other, op, reflected=False):
+        if _in_matmul(sys._getframe(2)):  # the caller of the operator: NumPy adds the products one by one
+            raise NotVectorisable("@ of arrays built from lanes: evaluated state by state")
         if isinstance(other, np.ndarray):
             f = (lambda e: op(e, self)) if reflected else (lambda e: op(self, e))
             return _each(other, f)
@@ -87,11 +96,11 @@ class Lanes:
             return NotImplemented
         x, y = (b, self.a) if reflected else (self.a, b)
         out = op(x, y)
-        mask = _merge(self.unsure, unsure)
+        mask = merge(self.unsure, unsure)
         if op is operator.truediv:  # a Python float raises where the array gives inf or nan
             zero = np.asarray(y == 0)
             if zero.any():
-                mask = _merge(mask, np.broadcast_to(zero, out.shape))
+                mask = merge(mask, np.broadcast_to(zero, out.shape))
         return Lanes(out, mask)
 
     def __add__(self, o):
@@ -137,7 +146,7 @@ class Lanes:
         with np.errstate(all="ignore"):  # the exponent as given: numpy's fast paths depend on its type
             array = (b**self.a) if reflected else (self.a**b)
         differ = failed | ~((scalar == array) | (np.isnan(scalar) & np.isnan(array)))
-        return Lanes(scalar, _merge(self.unsure, unsure, differ if differ.any() else None))
+        return Lanes(scalar, merge(self.unsure, unsure, differ if differ.any() else None))
 
     def __neg__(self):
         return Lanes(-self.a, self.unsure)
@@ -157,10 +166,20 @@ class Lanes:
 
 def _each(array: np.ndarray, f) -> np.ndarray:
     """``f`` of every entry of ``array``: an object array (what numpy does entry by entry anyway)."""
+    from pendverify.checks.lane_arrays import lane_array
+
     out = np.empty(array.shape, dtype=object)
     for index in np.ndindex(array.shape):
         out[index] = f(array[index])
-    return out
+    return lane_array(out)
+
+
+def _in_matmul(frame) -> bool:
+    """Whether ``frame`` is executing ``@``: an operation on lanes from there is NumPy's object matmul."""
+    code, i = frame.f_code.co_code, frame.f_lasti
+    if not 0 <= i < len(code) - 1:
+        return False
+    return code[i] in _MATMUL_OPCODES or (code[i] == _BINARY_OP and code[i + 1] in (4, 17))
 
 
 def _map(f, args, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -190,7 +209,7 @@ def lane_function(f):
         if any(not isinstance(a, (Lanes, *_SCALARS)) for a in args):
             raise NotVectorisable(f"{getattr(f, '__name__', f)} of a non-number")
         values, failed = _map(f, [a.a if isinstance(a, Lanes) else a for a in args], lanes[0].a.size)
-        return Lanes(values, _merge(*(a.unsure for a in lanes), failed if failed.any() else None))
+        return Lanes(values, merge(*(a.unsure for a in lanes), failed if failed.any() else None))
 
     return call
 
@@ -229,7 +248,7 @@ def stack(value, n: int) -> tuple[np.ndarray, np.ndarray | None]:
         entry = value[index]
         if isinstance(entry, Lanes):
             out[(slice(None), *index)] = entry.a
-            unsure = _merge(unsure, entry.unsure)
+            unsure = merge(unsure, entry.unsure)
         elif isinstance(entry, _SCALARS):
             out[(slice(None), *index)] = float(entry)
         else:
@@ -245,7 +264,7 @@ def elementwise(cls: type, name: str) -> bool:
     """Whether method ``name`` of ``cls`` (and what it calls on self or module level) is elementwise.
 
     False when its code, or that of the methods, properties and module functions it
-    reaches, uses ``@`` or a name of ``NOT_ELEMENTWISE``.  Answers are kept while every
+    reaches, uses a name of ``NOT_ELEMENTWISE``.  Answers are kept while every
     name they looked up still resolves to the same object (a patched method is scanned
     again).
     """
@@ -285,8 +304,6 @@ def _scan(code: types.CodeType, globals_: dict, cls: type, seen: set, lookups: l
         return True
     seen.add(code)
     for ins in dis.get_instructions(code):
-        if ins.opname in _MATMUL or (ins.opname == "BINARY_OP" and ins.argrepr in ("@", "@=")):
-            return False
         if ins.opname in _LOADS and isinstance(ins.argval, str):
             if ins.argval in NOT_ELEMENTWISE:
                 return False
