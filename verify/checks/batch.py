@@ -65,6 +65,11 @@ class BatchContext:
         return PinocchioBatch(self.system, self.Q, self.V)
 
     @cached_property
+    def c_T(self) -> float:
+        """cond₂(T)², the coordinate map's amplification (``CoordinateMap.amplification``)."""
+        return self.system.cmap.amplification
+
+    @cached_property
     def angle(self) -> np.ndarray:
         return np.max(np.abs(self.Q[:, np.array(self.model.angular)]), axis=1, initial=0.0)
 
@@ -144,9 +149,7 @@ _BATCH_QUANTITIES = {
 def collect_batch(check, ctx: BatchContext) -> Evidence:
     """The check at every state at once: the ``Evidence`` the per-state path would collect."""
     lever = ctx.lever if check.world_frame else 1.0
-    rounding = np.broadcast_to(
-        rounding_tolerance(check, ctx.angle, ctx.system.cmap.amplification, lever), ctx.angle.shape
-    )
+    rounding = np.broadcast_to(rounding_tolerance(check, ctx.angle, ctx.c_T, lever), ctx.angle.shape)
     judged = np.flatnonzero(rounding <= REFUSE_REL)
     refused = [(int(i), float(rounding[i])) for i in np.flatnonzero(~(rounding <= REFUSE_REL))]
     m = MEASURES[check.name](ctx.terms)
