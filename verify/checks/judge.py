@@ -15,7 +15,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pendverify.checks import precision
 from pendverify.checks.result import Check, CheckResult
 from pendverify.checks.sampling import State
 from pendverify.checks.scaling import world_lever
@@ -117,6 +116,8 @@ def rejudge_precisely(check: Check, model, system, failing) -> tuple[dict[int, J
     first; stops at the first state that still fails.  Returns {index: judged} for the
     states that pass so (all of them, or the check still fails) and why not.
     """
+    from pendverify.checks import precision  # mpmath, loaded only when a state fails
+
     try:
         precise = precision.precise_model(model)
     except precision.PrecisionUnavailable as exc:
@@ -223,6 +224,8 @@ def conclude(check: Check, label: str, model, system, states, seed: int, ev: Evi
 
 
 def unstable_note(check: Check, state: State, double: Judged, precise: Judged, n: int, of: int) -> str:
+    from pendverify.checks import precision
+
     return (
         f"{precision.UNSTABLE} at {n} of {of} states: at {state.label} {check.name} is off by "
         f"{double.rel_err:.2g} in double ({double.ratio:.3g}× its tolerance {double.rel_tol:.2g}) and by "
