@@ -23,8 +23,9 @@ from pendverify.certify.battery import BatterySettings
 from pendverify.checks import batch as batch_module
 from pendverify.checks.batch import BatchContext, collect_batch
 from pendverify.checks.catalogue import CHECKS, applicable_checks, run_check, run_check_per_state
+from pendverify.checks.elementwise import elementwise
 from pendverify.checks.judge import collect_per_state
-from pendverify.checks.lanes import Lanes, elementwise
+from pendverify.checks.lanes import Lanes
 from pendverify.checks.sampling import sample_states
 from pendverify.checks.targets import default_target, plugin_target
 from pendverify.checks.trust import assess

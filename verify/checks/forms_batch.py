@@ -2,7 +2,7 @@
 
 How, per method (``ClosedFormBatch.value``):
 
-1. a hand-written method whose code is elementwise (``lanes.elementwise``) runs once on
+1. a hand-written method whose code is elementwise (``checks.elementwise``) runs once on
    ``Lanes`` (``pendverify.checks.lanes``): the model's own code, its own arithmetic, its
    ``@`` and ``np.linalg`` as one state's BLAS/LAPACK calls (``checks.lane_arrays``);
 2. the interface's derived ``bias``, ``kinetic_energy``, ``inverse_mass_matrix`` and
@@ -27,8 +27,9 @@ from __future__ import annotations
 import numpy as np
 
 from pendverify.analytic.interface import BiasOnlyModel, ClosedFormModel
+from pendverify.checks.elementwise import elementwise
 from pendverify.checks.lane_arrays import lane_array, lane_twin_class
-from pendverify.checks.lanes import elementwise, lane_math, stack, to_lanes
+from pendverify.checks.lanes import lane_math, stack, to_lanes
 from pendverify.checks.scaling import mv
 
 #: the arguments of each method the checks call, from the state (q, q̇, u, w)
