@@ -27,7 +27,7 @@ from pendverify.checks.elementwise import elementwise
 from pendverify.checks.judge import collect_per_state
 from pendverify.checks.lanes import Lanes
 from pendverify.checks.sampling import sample_states
-from pendverify.checks.targets import default_target, plugin_target
+from pendverify.checks.targets import default_target, erd_targets, plugin_target
 from pendverify.checks.trust import assess
 from pendverify.checks.trust_batch import assess_batch
 from pendverify.stress.cases import ReducedAngleSystem, shifted_states
@@ -114,6 +114,15 @@ def test_plug_in_models_agree(stem, seed):
     target = plugin_target(*(str(EXAMPLES / f"{stem}.{ext}") for ext in ("py", "urdf", "toml")))
     states = sample_states(target.model, 200, seed)
     assert_both_paths_agree(stem, target.model, target.system, states, seed)
+
+
+def test_example_robot_datas_urdfs_agree_continuous_joints_included():
+    """Their ``double_pendulum_continuous`` has continuous joints: Pinocchio takes (cos φ, sin φ)."""
+    targets = erd_targets()
+    assert any(2 in t.system.cmap.joint_nq for t in targets)
+    for target in targets:
+        states = sample_states(target.model, 100, 11)
+        assert_both_paths_agree(target.label, target.model, target.system, states)
 
 
 def test_a_warning_from_the_precise_rejudgement_is_the_same(monkeypatch):

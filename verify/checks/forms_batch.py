@@ -16,10 +16,13 @@ probe states, and a method that differs there is evaluated state by state everyw
 states whose lanes are ``unsure`` are evaluated one by one.  So the numbers are the
 reference path's numbers; ``tests/test_batch_checks.py`` compares the two on every check.
 
-Why not the SymPy-generated back ends (``pendverify.numerics.generate``)?  They are
-faster still, but they are SymPy's rearrangement of the formulas, not the model's code:
-their rounding differs from what the reference path (and a user calling the model)
-computes, and a model SymPy cannot read would have no batch at all.
+Measured (2010 states, every method the checks call, one core): 11 ms on the batch for
+either seed against 150–165 ms calling each method once per state.  Why not the
+SymPy-generated back ends (``pendverify.numerics.generate``)?  They would be faster still,
+but they are SymPy's rearrangement of the formulas, not the model's code: their
+rounding differs from what the reference path (and a user calling the model) computes,
+they give M, C·q̇ + H and V but not the hand-written C, det M, M⁻¹ or q̈ the checks
+judge, and a model SymPy cannot read would have no batch at all.
 """
 
 from __future__ import annotations

@@ -172,5 +172,8 @@ def configurations(cmap, theta: np.ndarray) -> np.ndarray:
     parts = []
     for k, nq in enumerate(cmap.joint_nq):
         angle = np.ascontiguousarray(positions[:, k])
-        parts += [angle] if nq == 1 else [np.cos(angle), np.sin(angle)]
+        if nq == 1:
+            parts.append(angle)
+        else:  # np.cos of each number, as one state's map takes it (an array's SIMD loop may round otherwise)
+            parts += [np.array([np.cos(x) for x in angle]), np.array([np.sin(x) for x in angle])]
     return np.ascontiguousarray(np.stack(parts, axis=-1))
