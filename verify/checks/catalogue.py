@@ -28,6 +28,13 @@ simulator's checks call these checks as they are.  Reported: e/s and the
 tolerance (K·ε·((1 + |θ|max)·c_T + (A − 1)) + a/s) at the worst state, the state
 with the largest e / tolerance.  A state whose rounding term alone exceeds the
 trust limit (``pendverify.checks.trust.REFUSE_REL``) is refused, not judged.
+
+Two ways, one set of numbers: ``run_check`` and ``run_checks`` evaluate a check over all
+states at once (``pendverify.checks.batch``: the tolerance above as arrays), and
+``run_check_per_state`` one state at a time, the reference the batch falls back to
+wherever it cannot follow it exactly; both hand their evidence to
+``pendverify.checks.judge.conclude``.  ``tests/test_batch_checks.py`` holds them equal,
+state by state, bit for bit.
 """
 
 from __future__ import annotations
