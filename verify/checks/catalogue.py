@@ -28,79 +28,40 @@ simulator's checks call these checks as they are.  Reported: e/s and the
 tolerance (K·ε·((1 + |θ|max)·c_T + (A − 1)) + a/s) at the worst state, the state
 with the largest e / tolerance.  A state whose rounding term alone exceeds the
 trust limit (``pendverify.checks.trust.REFUSE_REL``) is refused, not judged.
+
+Two ways, one set of numbers: ``run_check`` and ``run_checks`` evaluate a check over all
+states at once (``pendverify.checks.batch``: the tolerance above as arrays), and
+``run_check_per_state`` one state at a time, the reference the batch falls back to
+wherever it cannot follow it exactly; both hand their evidence to
+``pendverify.checks.judge.conclude``.  ``tests/test_batch_checks.py`` holds them equal,
+state by state, bit for bit.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass, field
-
 import numpy as np
 
-from pendverify.analytic import ClosedFormModel
-from pendverify.checks import precision, quantities
+from pendverify.checks import quantities
 from pendverify.checks.applicability import hand_written, needs_matrix_c, needs_urdf_damping
-from pendverify.checks.quantities import Sample
-from pendverify.checks.sampling import State
-from pendverify.checks.scaling import world_lever
-from pendverify.checks.trust import EPS, REFUSE_REL
-from pendverify.checks.verdict import FAIL, PASS, REFUSED, WARN
-from pendverify.robot.system import PinocchioSystem
+from pendverify.checks.batch import BatchContext, collect_batch
+from pendverify.checks.judge import OUT_OF_RANGE, collect_per_state, conclude
+from pendverify.checks.result import Check, CheckResult
+from pendverify.checks.trust import EPS
 
 __all__ = [
     "CHECKS",
     "CHECK_NAMES",
+    "EPS",
+    "OUT_OF_RANGE",
     "Check",
     "CheckResult",
     "applicable_checks",
     "not_applicable",
     "run_check",
+    "run_check_per_state",
     "run_checks",
     "skipped_notes",
 ]
-
-
-@dataclass(frozen=True)
-class Check:
-    name: str
-    pinocchio: str
-    closed_form: str
-    K: float
-    evaluate: Callable[[ClosedFormModel, PinocchioSystem, State], Sample]
-    #: "" when the check applies to this model and system, else why it is not run
-    requires: Callable[[ClosedFormModel, PinocchioSystem | None], str] = lambda model, system: ""
-    #: whether the Pinocchio side is computed by its world-frame recursions (then A counts)
-    world_frame: bool = True
-
-
-@dataclass
-class CheckResult:
-    """The evidence of one check on one model: errors, tolerance, where it was worst."""
-
-    model: str
-    check: str
-    description: str
-    max_error: float
-    tolerance: float
-    max_abs_error: float
-    samples: int
-    seed: int
-    worst_state: dict
-    passed: bool
-    #: the largest relative error over the judged states, and where (the worst *ratio* is above)
-    largest_error: float = float("nan")
-    largest_tolerance: float = float("nan")  # the tolerance at that state
-    largest_state: dict = field(default_factory=dict)
-    notes: list[str] = field(default_factory=list)
-    #: pass, warn, fail or refused (``pendverify.checks.verdict``); ``passed`` is pass or warn
-    status: str = ""
-
-    def __post_init__(self) -> None:
-        if not self.status:
-            self.status = PASS if self.passed else FAIL
-
-    def as_dict(self) -> dict:
-        return dict(self.__dict__)
 
 
 CHECKS: tuple[Check, ...] = (
@@ -142,144 +103,39 @@ CHECKS: tuple[Check, ...] = (
 CHECK_NAMES = tuple(c.name for c in CHECKS)
 
 
-@dataclass(frozen=True)
-class _Judged:
-    """One state judged: relative error and tolerance, the absolute error, a note."""
+def run_check_per_state(check: Check, label: str, model, system, states, seed: int) -> CheckResult:
+    """Evaluate one check on every state, one state at a time, and keep the evidence of the worst one.
 
-    rel_err: float
-    rel_tol: float
-    abs_err: float
-    note: str = ""
-
-    @property
-    def ratio(self) -> float:
-        return self.rel_err / self.rel_tol if np.isfinite(self.rel_err) else np.inf
-
-
-#: what evaluating a state raises when its numbers leave double's range (parameters of 1e200)
-OUT_OF_RANGE = (OverflowError, FloatingPointError, np.linalg.LinAlgError)
-
-
-def _judge(check: Check, model, system, state: State, rounding: float) -> _Judged:
-    sample = check.evaluate(model, system, state)
-    if sample.scale > 0:
-        rel_tol = rounding + sample.allowance / sample.scale
-        rel_err = sample.error / sample.scale
-    else:  # nothing acts (at rest with g = 0): any error at all is a failure
-        rel_tol = rounding
-        rel_err = 0.0 if sample.error == 0 else np.inf
-    note = sample.note or ("NaN" if np.isnan(rel_err) else "")
-    return _Judged(np.inf if np.isnan(rel_err) else float(rel_err), float(rel_tol), float(sample.error), note)
-
-
-def _rejudge_precisely(check: Check, model, system, failing) -> tuple[dict[int, _Judged], str]:
-    """Failing states judged again with the closed forms in high precision (``checks.precision``).
-
-    Worst first; stops at the first state that still fails.  Returns {index: judged}
-    for the states that pass so (all of them, or the check still fails) and why not.
-    """
-    try:
-        precise = precision.precise_model(model)
-    except precision.PrecisionUnavailable as exc:
-        return {}, str(exc)
-    passed = {}
-    for i, state, rounding, _ in sorted(failing, key=lambda f: -f[3].ratio):
-        try:
-            judged = _judge(check, precise, system, state, rounding)
-        except precision.PrecisionUnavailable as exc:
-            return passed, str(exc)
-        if not judged.ratio <= 1.0:
-            return passed, ""
-        passed[i] = judged
-    return passed, ""
-
-
-def run_check(check: Check, label: str, model, system, states, seed: int) -> CheckResult:
-    """Evaluate one check on every state and keep the evidence of the worst one.
-
-    A state whose own rounding tolerance K·ε·((1 + |θ|)·c_T + (A − 1)) exceeds the
-    trust limit (``trust.REFUSE_REL``) is not judged: a tolerance that wide would
-    pass a 1 ppm modelling error.  The check is then ``refused`` (unless another
-    state fails), whatever the guard before it let through.  Failing states are
-    judged again with the hand-written closed forms evaluated in high precision
+    The reference path.  A state whose own rounding tolerance K·ε·((1 + |θ|)·c_T + (A − 1))
+    exceeds the trust limit (``trust.REFUSE_REL``) is not judged: a tolerance that wide
+    would pass a 1 ppm modelling error.  The check is then ``refused`` (unless another
+    state fails), whatever the guard before it let through.  Failing states are judged
+    again with the hand-written closed forms evaluated in high precision
     (``pendverify.checks.precision``): if all then pass, the check is a warning.
     """
-    c_T = system.cmap.amplification
-    notes: list[str] = []
-    refused: list[tuple[State, float]] = []
-    judged: list[tuple[int, State, float, _Judged]] = []
-    for i, state in enumerate(states):
-        angle = float(np.max(np.abs(state.q[np.array(model.angular)]), initial=0.0))
-        lever = world_lever(model, system, state.q) if check.world_frame else 1.0
-        rounding = check.K * EPS * ((1.0 + angle) * c_T + (lever - 1.0))
-        if not rounding <= REFUSE_REL:
-            refused.append((state, rounding))
-            continue
+    return conclude(
+        check, label, model, system, states, seed, collect_per_state(check, model, system, states)
+    )
+
+
+def run_check(check: Check, label: str, model, system, states, seed: int, batch=None) -> CheckResult:
+    """One check on every state, evaluated over all states at once (``pendverify.checks.batch``).
+
+    The same verdict, errors, tolerances, states and notes as ``run_check_per_state``,
+    which it falls back to wherever the batch cannot follow it exactly.  ``batch``: a
+    ``BatchContext`` of these states to share with other checks (``run_checks``).
+    """
+    if batch is None:
+        batch = BatchContext.of(model, system, states)
+    if batch is not None:
         try:
-            j = _judge(check, model, system, state, rounding)
-        except OUT_OF_RANGE as exc:  # terms beyond double's range: nothing can be verified there
-            refused.append((state, np.inf))
-            notes.append(f"{state.label}: refused: its terms overflow double ({type(exc).__name__}: {exc})")
-            continue
-        if j.note and len(notes) < 3:
-            notes.append(f"{state.label}: {j.note}")
-        judged.append((i, state, rounding, j))
-    max_abs = max((j.abs_err for *_, j in judged), default=0.0)
-    status = ""
-    failing = [f for f in judged if not f[3].ratio <= 1.0]
-    if failing:
-        precise, why = _rejudge_precisely(check, model, system, failing)
-        if len(precise) == len(failing):
-            i, state, _, double = max(failing, key=lambda f: f[3].ratio)
-            notes.insert(0, _unstable_note(check, state, double, precise[i], len(failing), len(judged)))
-            judged = [(k, s, r, precise.get(k, j)) for k, s, r, j in judged]
-            status = WARN
-        elif why:
-            notes.append(f"not judged in high precision: {why}")
-    worst_ratio, worst = -1.0, None
-    for _, state, _, j in judged:
-        if j.ratio > worst_ratio:
-            worst_ratio, worst = j.ratio, (state, j.rel_err, j.rel_tol)
-    largest = max(judged, key=lambda f: f[3].rel_err, default=None)
-    if refused:
-        state, rounding = refused[0]
-        lever = world_lever(model, system, state.q)
-        notes.insert(
-            0,
-            f"{len(refused)} of {len(states)} states refused: at {state.label} the rounding tolerance "
-            f"{rounding:.2g} exceeds the trust limit {REFUSE_REL:g} (Pinocchio's terms {lever:.2g}× the "
-            "result)",
-        )
-        if worst is None:
-            worst = (state, float("nan"), rounding)
-        if worst_ratio <= 1.0:
-            status = REFUSED
-    state, rel_err, rel_tol = worst
-    return CheckResult(
-        model=label,
-        check=check.name,
-        description=f"{check.pinocchio} vs {check.closed_form}",
-        max_error=float(rel_err),
-        tolerance=float(rel_tol),
-        max_abs_error=max_abs,
-        samples=len(states),
-        seed=seed,
-        worst_state=state.as_dict(),
-        largest_error=float(largest[3].rel_err) if largest else float("nan"),
-        largest_tolerance=float(largest[3].rel_tol) if largest else float("nan"),
-        largest_state=largest[1].as_dict() if largest else {},
-        passed=bool(worst_ratio <= 1.0) and not refused,
-        notes=notes,
-        status=status,
-    )
-
-
-def _unstable_note(check: Check, state: State, double: _Judged, precise: _Judged, n: int, of: int) -> str:
-    return (
-        f"{precision.UNSTABLE} at {n} of {of} states: at {state.label} {check.name} is off by "
-        f"{double.rel_err:.2g} in double ({double.ratio:.3g}× its tolerance {double.rel_tol:.2g}) and by "
-        f"{precise.rel_err:.2g} with the hand-written closed forms evaluated to {precision.DIGITS} digits"
-    )
+            with np.errstate(all="ignore"):
+                evidence = collect_batch(check, batch)
+        except Exception as exc:  # anything unusual: the reference path decides, as it always has
+            batch.fallbacks.append((check.name, f"{type(exc).__name__}: {exc}"))
+        else:
+            return conclude(check, label, model, system, states, seed, evidence)
+    return run_check_per_state(check, label, model, system, states, seed)
 
 
 def not_applicable(model, system=None) -> dict[str, str]:
@@ -302,7 +158,12 @@ def applicable_checks(model, system=None) -> tuple[str, ...]:
     return tuple(name for name in CHECK_NAMES if name not in skipped)
 
 
-def run_checks(label, model, system, states, seed, names=CHECK_NAMES) -> list[CheckResult]:
-    """The named checks that apply to ``model`` and ``system``, each on every state."""
+def run_checks(label, model, system, states, seed, names=CHECK_NAMES, batch=None) -> list[CheckResult]:
+    """The named checks that apply to ``model`` and ``system``, each on every state.
+
+    The checks share one batch of the states (``batch``, if given, must hold these states).
+    """
     names = set(names) & set(applicable_checks(model, system))
-    return [run_check(c, label, model, system, states, seed) for c in CHECKS if c.name in names]
+    if batch is None:
+        batch = BatchContext.of(model, system, states)
+    return [run_check(c, label, model, system, states, seed, batch) for c in CHECKS if c.name in names]

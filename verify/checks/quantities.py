@@ -1,10 +1,17 @@
 """What each check measures: its error at one state and the scale that error is judged against.
 
-Each function takes (model, Pinocchio system, state) and returns a ``Sample``: the
-error e in scaled coordinates (``pendverify.checks.scaling``), the scale s (the size
-of the terms that produced the quantity, including cancellation) and the known
-model-form allowance a.  ``pendverify.checks.catalogue`` names them, gives each its
-constant K and passes a state when e ≤ K·ε·((1 + |θ|max)·c_T + (A − 1))·s + a.
+Each check's measure (``MEASURES``) reads the closed forms' and Pinocchio's quantities
+from ``Terms`` and returns the error e in scaled coordinates (``pendverify.checks.scaling``),
+the scale s (the size of the terms that produced the quantity, including cancellation)
+and the known model-form allowance a.  One state's terms (``StateTerms``, the model's and
+the system's methods called at that state) give numbers; a batch's terms
+(``pendverify.checks.batch``) give arrays with the batch axis first, and the measure
+runs once for all states.  The measures use only operations that give each state the
+same bits either way (elementwise arithmetic, reductions over the last axes, one
+BLAS/LAPACK call per state).  The per-state functions (``crba``, ``rnea``, …: model,
+Pinocchio system, state → ``Sample``) are what ``Check.evaluate`` calls.
+``pendverify.checks.catalogue`` names them, gives each its constant K and passes a
+state when e ≤ K·ε·((1 + |θ|max)·c_T + (A − 1))·s + a.
 
 The scales:
 
@@ -24,11 +31,22 @@ The scales:
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
-from pendverify.checks.scaling import damping_rate, force_scale, norm2, rate_scale, scaled_matrix, weights
+from pendverify.checks.scaling import (
+    damping_rate_of,
+    force_scale_of,
+    mv,
+    norms2,
+    rates_of,
+    scaled_matrix,
+    total,
+    weights_of,
+)
 
 
 @dataclass(frozen=True)
@@ -39,107 +57,235 @@ class Sample:
     note: str = ""
 
 
-def _allowance(system) -> np.ndarray:
-    return system.allowance
+@dataclass(frozen=True)
+class Measure:
+    """A measure at one state (numbers) or at each state of a batch (arrays, batch axis first).
+
+    ``noted``: where a note is due; ``describe(index)`` writes it (index () for one state).
+    """
+
+    error: object
+    scale: object
+    allowance: object = 0.0
+    noted: object = False
+    describe: Callable[[tuple], str] | None = None
 
 
-# --- the checks ---------------------------------------------------------------------------
-def crba(model, system, s):
-    w = weights(model, s.q)
-    err = np.max(np.abs(scaled_matrix(system.mass_matrix(s.q) - model.mass_matrix(s.q), w)))
-    return Sample(err, 1.0)
+class Terms:
+    """What the measures read; subclasses give the quantities, the derived scales are formed here."""
+
+    @cached_property
+    def w(self):
+        return weights_of(self.S)
+
+    @cached_property
+    def rate(self):
+        return rates_of(self.S, self.v, self.angular)
+
+    @cached_property
+    def d_rate(self):
+        return damping_rate_of(self.D, self.w)
+
+    def norm2(self, A):
+        """``norms2(A)``, once per matrix content (minverse, aba and energy share theirs)."""
+        A = np.ascontiguousarray(A)
+        memo = self.__dict__.setdefault("_norms", {})
+        key = (A.shape, A.tobytes())
+        if key not in memo:
+            memo[key] = norms2(A)
+        return memo[key]
 
 
-def rnea(model, system, s):
-    w = weights(model, s.q)
-    err = np.max(w * np.abs(system.bias(s.q, s.v) - model.bias(s.q, s.v)))
-    zdot = s.v / w
-    scale = (rate_scale(model, s.q, s.v) + damping_rate(model, w)) * np.sum(np.abs(zdot)) + np.max(
-        w * model.gravity_scale()
+class StateTerms(Terms):
+    """One state's terms: the model's and the system's methods at that state, called when first read."""
+
+    def __init__(self, model, system, s):
+        self.model, self.system = model, system
+        self.q, self.v, self.u, self.w_in = s.q, s.v, s.u, s.w
+        self.angular, self.coordinates = model.angular, model.coordinates
+
+    def __getattr__(self, name):  # the quantities, each computed once
+        if name.startswith("__") or name not in _STATE_QUANTITIES:
+            raise AttributeError(name)
+        value = _STATE_QUANTITIES[name](self.model, self.system, self)
+        self.__dict__[name] = value
+        return value
+
+    def acceleration_pin(self, tau):
+        return self.system.acceleration(self.q, self.v, tau)
+
+
+def _zero(model):
+    return np.zeros(model.nv)
+
+
+_STATE_QUANTITIES = {
+    "S": lambda m, sy, t: m.diagonal_scale(t.q),
+    "g_scale": lambda m, sy, t: m.gravity_scale(),
+    "D": lambda m, sy, t: m.damping_matrix(),
+    "B": lambda m, sy, t: m.input_matrix(),
+    "W": lambda m, sy, t: m.disturbance_matrix(),
+    "allowance": lambda m, sy, t: sy.allowance,
+    "D_urdf": lambda m, sy, t: sy.cmap.matrix_to_model(np.diag(sy.urdf_damping())),
+    "M_pin": lambda m, sy, t: sy.mass_matrix(t.q),
+    "M_hand": lambda m, sy, t: m.mass_matrix(t.q),
+    "bias_pin": lambda m, sy, t: sy.bias(t.q, t.v),
+    "bias_hand": lambda m, sy, t: m.bias(t.q, t.v),
+    "H_pin": lambda m, sy, t: sy.gravity(t.q),
+    "H_hand": lambda m, sy, t: m.gravity(t.q),
+    "C_pin": lambda m, sy, t: sy.coriolis_matrix(t.q, t.v),
+    "C_hand": lambda m, sy, t: m.coriolis_matrix(t.q, t.v),
+    "Mdot_pin": lambda m, sy, t: sy.mass_matrix_derivative(t.q, t.v),
+    "det_hand": lambda m, sy, t: m.det_mass_matrix(t.q),
+    "det_pin": lambda m, sy, t: sy.det_mass_matrix(t.q),
+    "Minv_pin": lambda m, sy, t: sy.inverse_mass_matrix(t.q),
+    "Minv_hand": lambda m, sy, t: m.inverse_mass_matrix(t.q),
+    "a_hand": lambda m, sy, t: m.acceleration(t.q, t.v, t.u, t.w_in),
+    "KE_pin": lambda m, sy, t: sy.kinetic_energy(t.q, t.v),
+    "KE_hand": lambda m, sy, t: m.kinetic_energy(t.q, t.v),
+    "V_pin": lambda m, sy, t: sy.potential_energy(t.q),
+    "V_pin0": lambda m, sy, t: sy.potential_energy(_zero(m)),
+    "V_hand": lambda m, sy, t: m.potential_energy(t.q),
+    "V_hand0": lambda m, sy, t: m.potential_energy(_zero(m)),
+}
+
+
+def _max2(A):
+    return np.max(A, axis=(-2, -1))
+
+
+def _at_least_one(x):
+    return np.where(1.0 > x, 1.0, x)  # max(x, 1.0) as Python takes it
+
+
+# --- the measures ----------------------------------------------------------------------------
+def measure_crba(t):
+    w = t.w
+    return Measure(_max2(np.abs(scaled_matrix(t.M_pin - t.M_hand, w))), 1.0)
+
+
+def measure_rnea(t):
+    w = t.w
+    err = np.max(w * np.abs(t.bias_pin - t.bias_hand), axis=-1)
+    scale = (t.rate + t.d_rate) * total(np.abs(t.v / w)) + np.max(w * t.g_scale, axis=-1)
+    return Measure(err, scale, np.max(w * t.allowance, axis=-1))
+
+
+def measure_gravity(t):
+    w = t.w
+    err = np.max(w * np.abs(t.H_pin - t.H_hand), axis=-1)
+    return Measure(err, np.max(w * t.g_scale, axis=-1), np.max(w * t.allowance, axis=-1))
+
+
+def measure_coriolis(t):
+    w = t.w
+    diff = t.C_pin - t.C_hand
+    return Measure(_max2(np.abs(scaled_matrix(diff, w))), _at_least_one(t.rate + t.d_rate))
+
+
+def measure_skew(t):
+    w = t.w
+    N = t.Mdot_pin - 2 * t.C_hand
+    return Measure(
+        _max2(np.abs(scaled_matrix(N + np.swapaxes(N, -1, -2), w))), _at_least_one(t.rate + t.d_rate)
     )
-    return Sample(err, scale, float(np.max(w * _allowance(system))))
 
 
-def gravity(model, system, s):
-    w = weights(model, s.q)
-    err = np.max(w * np.abs(system.gravity(s.q) - model.gravity(s.q)))
-    return Sample(err, float(np.max(w * model.gravity_scale())), float(np.max(w * _allowance(system))))
+def measure_det(t):
+    scale = np.prod(t.S, axis=-1)
+    closed, lu = t.det_hand, t.det_pin
+    bad = np.logical_not(np.logical_and(closed > 0, lu > 0))
+    err = np.where(bad, np.inf, np.abs(closed - lu))
+
+    def describe(i):
+        return f"det M not positive: closed form {np.asarray(closed)[i]:.3g}, LU {np.asarray(lu)[i]:.3g}"
+
+    return Measure(err, scale, 0.0, bad, describe)
 
 
-def coriolis(model, system, s):
-    w = weights(model, s.q)
-    diff = system.coriolis_matrix(s.q, s.v) - model.coriolis_matrix(s.q, s.v)
-    rates = max(rate_scale(model, s.q, s.v) + damping_rate(model, w), 1.0)
-    return Sample(np.max(np.abs(scaled_matrix(diff, w))), rates)
-
-
-def skew(model, system, s):
-    w = weights(model, s.q)
-    N = system.mass_matrix_derivative(s.q, s.v) - 2 * model.coriolis_matrix(s.q, s.v)
-    rates = max(rate_scale(model, s.q, s.v) + damping_rate(model, w), 1.0)
-    return Sample(np.max(np.abs(scaled_matrix(N + N.T, w))), rates)
-
-
-def det(model, system, s):
-    scale = float(np.prod(model.diagonal_scale(s.q)))
-    closed, lu = model.det_mass_matrix(s.q), system.det_mass_matrix(s.q)
-    if not (closed > 0 and lu > 0):
-        return Sample(np.inf, scale, note=f"det M not positive: closed form {closed:.3g}, LU {lu:.3g}")
-    return Sample(abs(closed - lu), scale)
-
-
-def minverse(model, system, s):
-    sqrt_s = 1.0 / weights(model, s.q)
-    diff = system.inverse_mass_matrix(s.q) - model.inverse_mass_matrix(s.q)
-    Minv_scaled = scaled_matrix(model.inverse_mass_matrix(s.q), sqrt_s)
-    M_scaled = scaled_matrix(model.mass_matrix(s.q), 1.0 / sqrt_s)
+def measure_minverse(t):
+    sqrt_s = 1.0 / t.w
+    diff = t.Minv_pin - t.Minv_hand
+    Minv_norm = t.norm2(scaled_matrix(t.Minv_hand, sqrt_s))
     # δ(M⁻¹) = −M⁻¹ δM M⁻¹ with |δM̃| ~ ε‖M̃‖
-    scale = norm2(Minv_scaled) ** 2 * norm2(M_scaled)
-    return Sample(np.max(np.abs(scaled_matrix(diff, sqrt_s))), scale)
+    scale = Minv_norm * Minv_norm * t.norm2(scaled_matrix(t.M_hand, 1.0 / sqrt_s))
+    return Measure(_max2(np.abs(scaled_matrix(diff, sqrt_s))), scale)
 
 
-def aba(model, system, s):
-    w = weights(model, s.q)
-    tau = model.input_matrix() @ s.u + model.disturbance_matrix() @ s.w - model.damping_matrix() @ s.v
-    a_pin = system.acceleration(s.q, s.v, tau)
-    a_hand = model.acceleration(s.q, s.v, s.u, s.w)
-    Minv_norm = norm2(scaled_matrix(model.inverse_mass_matrix(s.q), 1.0 / w))
-    M_norm = norm2(scaled_matrix(model.mass_matrix(s.q), w))
-    scale = Minv_norm * (force_scale(model, s, w) + M_norm * np.max(np.abs(a_pin / w)))
-    allowance = float(np.max(Minv_norm * np.max(w * _allowance(system))))
-    return Sample(np.max(np.abs((a_pin - a_hand) / w)), scale, allowance)
+def measure_aba(t):
+    w = t.w
+    tau = mv(t.B, t.u) + mv(t.W, t.w_in) - mv(t.D, t.v)
+    a_pin = t.acceleration_pin(tau)
+    a_hand = t.a_hand
+    Minv_norm = t.norm2(scaled_matrix(t.Minv_hand, 1.0 / w))
+    M_norm = t.norm2(scaled_matrix(t.M_hand, w))
+    forces = force_scale_of(t.rate, t.v, w, t.g_scale, t.B, t.W, t.D, t.u, t.w_in)
+    scale = Minv_norm * (forces + M_norm * np.max(np.abs(a_pin / w), axis=-1))
+    allowance = Minv_norm * np.max(w * t.allowance, axis=-1)
+    return Measure(np.max(np.abs((a_pin - a_hand) / w), axis=-1), scale, allowance)
 
 
-def energy(model, system, s):
-    w = weights(model, s.q)
-    zero = np.zeros(model.nv)
-    kinetic = abs(system.kinetic_energy(s.q, s.v) - model.kinetic_energy(s.q, s.v))
+def measure_energy(t):
+    w = t.w
+    kinetic = np.abs(t.KE_pin - t.KE_hand)
     # potential energies agree up to a constant: compare differences from θ = 0
-    dv_pin = system.potential_energy(s.q) - system.potential_energy(zero)
-    dv_hand = model.potential_energy(s.q) - model.potential_energy(zero)
-    kinetic_scale = 0.5 * float(np.sum((s.v / w) ** 2)) * norm2(scaled_matrix(model.mass_matrix(s.q), w))
-    potential_scale = float(np.max(model.gravity_scale()))
-    allowance = 2 * float(np.sum(_allowance(system)))  # |ΔV| ≤ m g |offset| at both ends
-    return Sample(kinetic + abs(dv_pin - dv_hand), kinetic_scale + potential_scale, allowance)
+    dv_pin = t.V_pin - t.V_pin0
+    dv_hand = t.V_hand - t.V_hand0
+    kinetic_scale = 0.5 * total((t.v / w) ** 2) * t.norm2(scaled_matrix(t.M_hand, w))
+    potential_scale = float(np.max(t.g_scale))
+    allowance = 2 * float(np.sum(t.allowance))  # |ΔV| ≤ m g |offset| at both ends
+    return Measure(kinetic + np.abs(dv_pin - dv_hand), kinetic_scale + potential_scale, allowance)
 
 
-def damping(model, system, s):
+def measure_damping(t):
     """The URDF's <dynamics damping> seen in the model's coordinates (Tᵀ·diag(b)·T) against D.
 
     Pinocchio keeps the damping but none of its algorithms applies it, so no other
     check can see a URDF whose damping disagrees with the hand model's D.
     """
-    w = weights(model, s.q)
-    D_urdf = system.cmap.matrix_to_model(np.diag(system.urdf_damping()))
-    D = model.damping_matrix()
+    w = t.w
+    D_urdf, D = t.D_urdf, t.D
     diff = np.abs(scaled_matrix(D_urdf - D, w))
-    scale = max(np.max(np.abs(scaled_matrix(D, w))), np.max(np.abs(scaled_matrix(D_urdf, w))))
-    note = ""
-    if np.max(diff) > 0:
-        i, j = np.unravel_index(np.argmax(diff), diff.shape)
-        names = model.coordinates
-        note = (
+    own, urdf = _max2(np.abs(scaled_matrix(D, w))), _max2(np.abs(scaled_matrix(D_urdf, w)))
+    err = _max2(diff)
+
+    def describe(index):
+        d = diff[index]
+        i, j = np.unravel_index(np.argmax(d), d.shape)
+        names = t.coordinates
+        return (
             f"D[{names[i]},{names[j]}]: the URDF's <dynamics damping> gives {D_urdf[i, j]:.6g}, "
             f"the hand model {D[i, j]:.6g}"
         )
-    return Sample(float(np.max(diff)), float(scale), note=note)
+
+    return Measure(err, np.where(urdf > own, urdf, own), 0.0, err > 0, describe)
+
+
+MEASURES: dict[str, Callable] = {
+    "crba": measure_crba,
+    "rnea": measure_rnea,
+    "gravity": measure_gravity,
+    "coriolis": measure_coriolis,
+    "skew": measure_skew,
+    "det": measure_det,
+    "minverse": measure_minverse,
+    "aba": measure_aba,
+    "energy": measure_energy,
+    "damping": measure_damping,
+}
+
+
+def _at_one_state(measure):
+    def evaluate(model, system, s) -> Sample:
+        m = measure(StateTerms(model, system, s))
+        note = m.describe(()) if m.describe is not None and bool(m.noted) else ""
+        return Sample(float(m.error), float(m.scale), float(m.allowance), note)
+
+    evaluate.__name__ = evaluate.__qualname__ = measure.__name__.removeprefix("measure_")
+    evaluate.__doc__ = measure.__doc__
+    return evaluate
+
+
+crba, rnea, gravity, coriolis, skew, det, minverse, aba, energy, damping = (
+    _at_one_state(MEASURES[name]) for name in MEASURES
+)

@@ -49,29 +49,36 @@ def _force_scales(model: ClosedFormModel, columns: np.ndarray) -> np.ndarray:
 
 
 def sample_states(model: ClosedFormModel, n_random: int = DEFAULT_RANDOM_STATES, seed: int = DEFAULT_SEED):
-    """The special states first, then ``n_random`` random ones; deterministic in ``seed``."""
+    """The special states first, then ``n_random`` random ones; deterministic in ``seed``.
+
+    Each moving special state draws q̇, u, w and each random state q, q̇, u, w, in that
+    order, uniformly from the generator seeded with ``seed``; all draws are made by one
+    ``Generator.uniform`` call on arrays of bounds, which takes the same numbers from the
+    stream, one per entry and in order, as one call per vector would.
+    """
     rng = np.random.default_rng(seed)
+    nv = model.nv
     angular = np.array(model.angular)
     q_range = np.where(angular, ANGLE_RANGE, POSITION_RANGE)
     u_scale = _force_scales(model, model.input_matrix())
     w_scale = _force_scales(model, model.disturbance_matrix())
-
-    def draw_v():
-        return rng.uniform(-RATE_RANGE, RATE_RANGE, model.nv)
-
-    def draw_u():
-        return rng.uniform(-1, 1, u_scale.size) * u_scale
-
-    def draw_w():
-        return rng.uniform(-1, 1, w_scale.size) * w_scale
-
+    nu, nw = u_scale.size, w_scale.size
+    special = {name: np.asarray(q, dtype=float) for name, q in model.special_states().items()}
+    moving = np.concatenate([np.full(nv, RATE_RANGE), np.ones(nu + nw)])  # q̇, u, w of a moving state
+    bounds = np.concatenate([moving] * len(special) + [np.concatenate([np.ones(nv), moving])] * n_random)
+    draws = rng.uniform(-bounds, bounds) if bounds.size else bounds
+    scale = np.concatenate([np.ones(nv), u_scale, w_scale])  # u and w scaled after the draw, as before
+    at = len(special) * (nv + nu + nw)
+    specials = draws[:at].reshape(len(special), nv + nu + nw)
+    randoms = draws[at:].reshape(n_random, 2 * nv + nu + nw)
     states = []
-    zero_u, zero_w = np.zeros(u_scale.size), np.zeros(w_scale.size)
-    for name, q in model.special_states().items():
-        q = np.asarray(q, dtype=float)
-        states.append(State(f"{name} at rest", q, np.zeros(model.nv), zero_u, zero_w))
-        states.append(State(f"{name} moving", q, draw_v(), draw_u(), draw_w()))
+    zero_u, zero_w = np.zeros(nu), np.zeros(nw)
+    vuw = specials * scale  # q̇ as drawn (its scale is exactly 1), u and w times their force scales
+    for (name, q), x in zip(special.items(), vuw, strict=True):
+        states.append(State(f"{name} at rest", q, np.zeros(nv), zero_u, zero_w))
+        states.append(State(f"{name} moving", q, x[:nv], x[nv : nv + nu], x[nv + nu :]))
+    qs, vuw = randoms[:, :nv] * q_range, randoms[:, nv:] * scale
     for i in range(n_random):
-        q = rng.uniform(-1, 1, model.nv) * q_range
-        states.append(State(f"random #{i}", q, draw_v(), draw_u(), draw_w()))
+        x = vuw[i]
+        states.append(State(f"random #{i}", qs[i], x[:nv], x[nv : nv + nu], x[nv + nu :]))
     return states

@@ -11,6 +11,11 @@ Rates are measured in 1/s (``rate_scale``): angular rates as they are, linear ra
 over a radius of gyration.  A ≥ 1 (``world_lever``) is the factor by which
 Pinocchio's world-frame terms exceed the result.  The checks
 (``pendverify.checks.quantities``) build each state's *scale* from these.
+
+The functions ending in ``_of`` (and ``scaled_matrix``, ``mv``, ``total``, ``norms2``)
+take one state's arrays or a batch's (leading batch axes): elementwise arithmetic,
+reductions over the last axes and one BLAS/LAPACK call per state, so that a state
+judged alone and judged in a batch (``pendverify.checks.batch``) give the same bits.
 """
 
 from __future__ import annotations
@@ -20,12 +25,37 @@ import numpy as np
 from pendverify.checks.trust import term_amplification
 
 
+def weights_of(S):
+    """w = 1/√S, the scaled coordinates' weights (S with optional leading batch axes)."""
+    return 1.0 / np.sqrt(S)
+
+
 def weights(model, q):
-    return 1.0 / np.sqrt(model.diagonal_scale(q))
+    return weights_of(model.diagonal_scale(q))
 
 
 def scaled_matrix(A, w):
-    return A * np.outer(w, w)
+    """A·(w wᵀ) (= A * np.outer(w, w) for one state; leading batch axes allowed)."""
+    return A * (w[..., :, None] * w[..., None, :])
+
+
+def mv(A, x):
+    """A·x as NumPy multiplies one state's matrix and vector (one BLAS call per state in a batch)."""
+    return (A @ x[..., None])[..., 0]
+
+
+def total(x):
+    """Σ x_i over the last axis (one state's sum, or each state's of a batch, the same bits)."""
+    return np.sum(x, axis=-1)
+
+
+def rates_of(S, v, angular):
+    """Largest rate in 1/s per state: angular rates as they are, linear rates over a natural length."""
+    angular = np.asarray(angular, dtype=bool)
+    rates = np.abs(v).astype(float)
+    if np.any(~angular) and np.any(angular):
+        rates[..., ~angular] /= np.sqrt(np.min(S[..., angular], axis=-1, keepdims=True) / S[..., ~angular])
+    return np.max(rates, axis=-1, initial=0.0)
 
 
 def rate_scale(model, q, v) -> float:
@@ -35,12 +65,7 @@ def rate_scale(model, q, v) -> float:
     cart's), so they set the size of the intermediate terms too.  The length for
     a linear coordinate i is ℓ_i = √(min S_angular / S_i), a radius of gyration.
     """
-    angular = np.array(model.angular)
-    S = model.diagonal_scale(q)
-    rates = np.abs(v).astype(float)
-    if np.any(~angular) and np.any(angular):
-        rates[~angular] /= np.sqrt(np.min(S[angular]) / S[~angular])
-    return float(np.max(rates, initial=0.0))
+    return float(rates_of(model.diagonal_scale(q), v, model.angular))
 
 
 def norm2(A) -> float:
@@ -60,20 +85,19 @@ def world_lever(model, system, q) -> float:
     return term_amplification(model, system, q)
 
 
-def force_scale(model, state, w) -> float:
-    """Size of the generalized forces acting, in scaled units (sum of |terms|)."""
-    rate = rate_scale(model, state.q, state.v)
-    zdot = state.v / w
-    coriolis = rate * np.sum(np.abs(zdot))
-    gravity = np.max(w * model.gravity_scale())
-    applied = w * (
-        np.abs(model.input_matrix()) @ np.abs(state.u)
-        + np.abs(model.disturbance_matrix()) @ np.abs(state.w)
-        + np.abs(model.damping_matrix()) @ np.abs(state.v)
-    )
-    return float(coriolis + gravity + np.max(applied, initial=0.0))
+def norms2(A):
+    """The 2-norm of a matrix, or of each matrix of a batch (LAPACK's SVD, once per matrix)."""
+    return np.linalg.norm(A, 2, axis=(-2, -1))
 
 
-def damping_rate(model, w) -> float:
-    """max |D̃| in 1/s: a hand C written with friction inside (C + D, as seed 000) rounds at this size."""
-    return float(np.max(np.abs(scaled_matrix(model.damping_matrix(), w)), initial=0.0))
+def force_scale_of(rate, v, w, g_scale, B, W, D, u, w_in):
+    """Size of the generalized forces acting, in scaled units (sum of |terms|), per state."""
+    coriolis = rate * total(np.abs(v / w))
+    gravity = np.max(w * g_scale, axis=-1)
+    applied = w * (mv(np.abs(B), np.abs(u)) + mv(np.abs(W), np.abs(w_in)) + mv(np.abs(D), np.abs(v)))
+    return coriolis + gravity + np.max(applied, axis=-1, initial=0.0)
+
+
+def damping_rate_of(D, w):
+    """max |D̃| in 1/s per state: a hand C with friction inside (C + D, as seed 000) rounds at this size."""
+    return np.max(np.abs(scaled_matrix(D, w)), axis=(-2, -1), initial=0.0)

@@ -59,7 +59,9 @@ Pinocchio's (absolute angles from relative joints).  Their rounding is ε times
 tr I_k for a revolute joint (M_q,jj for a prismatic one, never less than M_q,jj),
 W̄_ij = √(W_i W_j) and T the coordinate map (M_θ = Tᵀ M_q T),
 
-    A = max_i (|T|ᵀ W̄ |T|)_ii / S_i.
+    A = max_i (|T|ᵀ W̄ |T|)_ii / S_i = max_i (Σ_k |T|_ki √W_k)² / S_i
+
+(computed in ``pendverify.checks.amplification``).
 
 Measured: a 1 mm double rod on a cart 8 m from the origin (A ≈ 6e7) gives
 Pinocchio's M⁻¹ a relative error of 1.3e6·ε although κ̃ ≈ 12; a 1 km link carrying a
@@ -79,13 +81,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pendverify.checks.amplification import term_amplification
 from pendverify.errors import IllConditionedError
 
 EPS = float(np.finfo(float).eps)
 KAPPA_K = 16  # the K of the checks that solve with M (aba, minverse)
 WARN_REL = 1e-10  # predicted relative error above which results carry a warning
 REFUSE_REL = 1e-6  # predicted relative error above which results are refused
-AMPLIFICATION_CACHE = 4096  # states whose term amplification a system remembers
 
 
 @dataclass(frozen=True)
@@ -137,51 +139,6 @@ def conditioning(
     return Conditioning(_cond(M), kappa_scaled, bound, level, amplification, spread, visibility > rounding)
 
 
-def term_amplification(model, system, q) -> float:
-    """A ≥ 1: how much larger than the result (in the model's scaled coordinates) Pinocchio's terms are.
-
-    The trust guard and two checks ask for it at every state: answers are kept on the
-    system, keyed by the state, with the model and Pinocchio data they came from (held,
-    so that their ids cannot be reused while the entry lives).
-    """
-    key = np.asarray(q, dtype=float).tobytes()
-    cache = system.__dict__.setdefault("_amplification_cache", {})
-    entry = cache.get(key)
-    if entry is None or entry[0] is not model or entry[1] is not system.data:
-        if len(cache) >= AMPLIFICATION_CACHE:
-            cache.clear()
-        entry = cache[key] = (model, system.data, _term_amplification(model, system, q))
-    return entry[2]
-
-
-def _term_amplification(model, system, q) -> float:
-    import pinocchio as pin
-
-    pm, data = system.model, system.data
-    config = system.cmap.configuration(q)
-    pin.forwardKinematics(pm, data, config)
-    upper = pin.crba(pm, data, config)
-    Mq = np.triu(upper) + np.triu(upper, 1).T
-    W = np.abs(np.diag(Mq)).copy()
-    for j in range(1, pm.njoints):
-        v = pm.joints[j].idx_v
-        if "Prismatic" in pm.joints[j].shortname() or pm.joints[j].shortname().startswith("JointModelP"):
-            continue
-        world = 0.0
-        for k in pm.subtrees[j]:
-            Y = pm.inertias[k]
-            c = data.oMi[k].act(Y.lever)
-            world += Y.mass * float(c @ c) + float(np.trace(Y.inertia))
-        W[v] = max(W[v], world)
-    root = np.sqrt(W)
-    T = np.abs(system.cmap.T)
-    E = T.T @ np.outer(root, root) @ T
-    S = model.diagonal_scale(np.asarray(q, dtype=float))
-    with np.errstate(all="ignore"):
-        A = float(np.max(np.diag(E) / S))
-    return max(A, 1.0) if math.isfinite(A) else math.inf
-
-
 def assess(model, q, system=None) -> Conditioning:
     """The verdict on M(q) from the closed form and, if given, Pinocchio's CRBA and terms; never raises."""
     q = np.asarray(q, dtype=float)
@@ -194,12 +151,15 @@ def assess(model, q, system=None) -> Conditioning:
     return max(verdicts, key=lambda c: (c.bound, c.kappa_raw))
 
 
-def check_conditioning(model, q, system=None, what: str | None = None) -> Conditioning:
+def check_conditioning(
+    model, q, system=None, what: str | None = None, verdict: Conditioning | None = None
+) -> Conditioning:
     """``assess``, raising ``IllConditionedError`` when the verdict is ``refuse``.
 
     Returns the verdict when it is ``ok`` or ``warn`` (see ``Conditioning.note``).
+    ``verdict``: ``assess(model, q, system)`` when already made (``trust_batch.assess_batch``).
     """
-    verdict = assess(model, q, system)
+    verdict = assess(model, q, system) if verdict is None else verdict
     if verdict.level == "refuse":
         raise IllConditionedError(
             what or model.name,

@@ -1,4 +1,6 @@
-"""``pendverify bench accuracy [--scene SCENE.toml] [--quick] [-o DIR]``: the work–precision benchmark.
+"""``pendverify bench accuracy [--scene SCENE.toml] [--quick] [-o DIR]``: the work–precision benchmark;
+``pendverify bench certify [--quick] [--json PATH]``: the certification battery's cost
+(``pendverify.bench.certify``).
 
 Without ``--scene``, the seeds' problems (``pendverify.bench.seed_problems``); with it, a
 user's scene, any model (``pendverify.bench.problems.scene_problems`` says which problems
@@ -16,6 +18,7 @@ from __future__ import annotations
 import argparse
 
 from pendverify.atomic import check_output
+from pendverify.commands import positive_int
 
 BLAS_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
@@ -38,6 +41,26 @@ def register(sub) -> None:
     a.add_argument("-o", "--output", default="bench-out", help="output folder (default: bench-out)")
     a.add_argument("--svg", action="store_true", help="also write the plot as SVG")
     a.set_defaults(func=run)
+    c = what.add_parser(
+        "certify",
+        help="the certification battery's cost per parameter set on one core: batch, per-state path, floor",
+    )
+    c.add_argument("--quick", action="store_true", help="100 states, short simulations, one run each")
+    c.add_argument("--repeats", type=positive_int, default=None, help="runs per figure, least kept (3)")
+    c.add_argument(
+        "--reference-repeats",
+        type=positive_int,
+        default=1,
+        help="runs of the slow per-state path, least kept (1)",
+    )
+    c.add_argument(
+        "--params",
+        action="append",
+        metavar="FILE",
+        help="a parameter set to measure (repeat for more; default: each built-in model's own set)",
+    )
+    c.add_argument("--json", metavar="PATH", help="also write every figure as JSON")
+    c.set_defaults(func=run_certify)
 
 
 def limit_blas() -> tuple[object, str]:
@@ -91,4 +114,41 @@ def run(args: argparse.Namespace) -> int:
             f"target ≤ {target}: {'met' if met else 'NOT met'}"
         )
     print(f"written: {out}/work_precision.png, .csv, .md")
+    return 0
+
+
+def run_certify(args: argparse.Namespace) -> int:
+    """``bench certify``: the battery per set, its per-state path and its floor, in one run."""
+    check_output(args.json)
+    guard, blas = limit_blas()
+    with guard:
+        import json
+        import os
+        import platform
+
+        import numpy as np
+        import pinocchio
+
+        from pendverify.atomic import write_atomic
+        from pendverify.bench.certify import measure, quick_settings
+        from pendverify.bench.certify_report import table, to_json
+        from pendverify.bench.timing import cpu_model
+        from pendverify.certify.battery import BatterySettings
+
+        settings = quick_settings() if args.quick else BatterySettings()
+        repeats = args.repeats or (1 if args.quick else 3)
+        costs = measure(args.params, settings, repeats, args.reference_repeats)
+    print(table(costs, settings, repeats, args.reference_repeats, blas))
+    if args.json:
+        machine = {
+            "cpu": cpu_model(),
+            "cores": os.cpu_count(),
+            "blas_threads": blas,
+            "python": platform.python_version(),
+            "numpy": np.__version__,
+            "pinocchio": pinocchio.__version__,
+        }
+        text = json.dumps(to_json(costs, settings, repeats, args.reference_repeats, machine), indent=2)
+        write_atomic(args.json, text + "\n")
+        print(f"written: {args.json}")
     return 0

@@ -64,6 +64,10 @@ class ReducedAngleSystem:
         turns = np.where(self._angular, np.round(theta / (2 * math.pi)), 0.0)
         return theta - turns * (2 * math.pi)
 
+    def pinocchio_batch_source(self):
+        """(the system Pinocchio runs on, the map of the angles), for ``pendverify.robot.batch``."""
+        return self._system, self.reduce
+
     def __getattr__(self, name):
         attribute = getattr(self._system, name)
         if name not in self._METHODS:

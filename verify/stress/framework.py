@@ -10,18 +10,21 @@ The cases live in ``pendverify.stress.cases`` (states and parameters) and
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from pendverify.analytic import MODELS
-from pendverify.checks.catalogue import CHECKS, applicable_checks, run_check
+from pendverify.checks.batch import BatchContext
+from pendverify.checks.catalogue import applicable_checks, run_checks
 from pendverify.checks.sampling import DEFAULT_SEED, State, sample_states
 from pendverify.checks.trust import check_conditioning
 from pendverify.checks.verdict import WARN
+from pendverify.checks.verification import batch_verdicts
 from pendverify.errors import IllConditionedError
 from pendverify.robot.system import PinocchioSystem
 from pendverify.stress.trust_study import StudyResult, cart_study
@@ -114,13 +117,24 @@ class Context:
     urdf: str | None = None
     #: the model class of the sets (a plug-in's); None: the built-in model each set names
     model_cls: type | None = None
+    #: the systems made so far, by parameter set (cases on the same set share one)
+    systems: dict = field(default_factory=dict, repr=False, compare=False)
 
     def system(self, params):
         """Pinocchio's side for a parameter set: ``urdf`` if given (the battery's), else the project's."""
+        try:
+            return self.systems[params]
+        except (KeyError, TypeError):
+            pass
         if self.urdf is None:
-            return system_for(params)
-        cls = self.model_cls or MODELS[params.model]
-        return PinocchioSystem.for_model(cls, self.urdf, getattr(params, "g", None), "<URDF being compared>")
+            system = system_for(params)
+        else:
+            cls = self.model_cls or MODELS[params.model]
+            g = getattr(params, "g", None)
+            system = PinocchioSystem.for_model(cls, self.urdf, g, "<URDF being compared>")
+        with contextlib.suppress(TypeError):  # a set that cannot be a key is not kept
+            self.systems[params] = system
+        return system
 
     def trust_study(self) -> StudyResult:
         """The cart seed's m1 → 0 study (``pendverify.stress.trust_study``), run once per context."""
@@ -161,10 +175,13 @@ def compare(name: str, model, system, states: list[State], seed: int) -> _Compar
     kept, refused = [], []
     kappa_raw = kappa_scaled = amplification = 0.0
     level = "ok"
-    for s in states:
+    batch = BatchContext.of(model, system, states)
+    verdicts = batch_verdicts(model, system, states, batch)
+    for i, s in enumerate(states):
         model_state(model, s.q, s.v, s.u, s.w, source=f"<{name}: {s.label}>")
         try:
-            c = check_conditioning(model, s.q, system, what=name)
+            verdict = None if verdicts is None else verdicts[i]
+            c = check_conditioning(model, s.q, system, what=name, verdict=verdict)
         except IllConditionedError as exc:
             refused.append(str(exc))
             continue
@@ -173,9 +190,10 @@ def compare(name: str, model, system, states: list[State], seed: int) -> _Compar
         amplification = max(amplification, c.amplification)
         level = "warn" if c.level == "warn" else level
     names = applicable_checks(model, system)
-    checks = [c for c in CHECKS if c.name in names]
+    if batch is not None and len(kept) < len(states):
+        batch = BatchContext.of(model, system, kept)
     with np.errstate(all="ignore"):
-        results = [run_check(c, name, model, system, kept, seed) for c in checks] if kept else []
+        results = run_checks(name, model, system, kept, seed, names, batch) if kept else []
     return _Comparison(results, len(kept), refused, kappa_raw, kappa_scaled, amplification, level)
 
 
