@@ -245,3 +245,16 @@ def test_the_sampler_draws_the_states_one_draw_per_vector_would(stem):
         assert [s.label for s in drawn] == [e[0] for e in expected]
         for s, (_, *arrays) in zip(drawn, expected, strict=True):
             assert all(same_bits(a, b) for a, b in zip((s.q, s.v, s.u, s.w), arrays, strict=True)), s.label
+
+
+@pytest.mark.parametrize("name", SEEDS)
+def test_the_seeds_written_in_latex_agree(name):
+    """A text model's methods (``sympy.lambdify`` onto ``self.math``) run on the batch as well."""
+    root = EXAMPLES.parent
+    target = plugin_target(
+        str(EXAMPLES / f"{name}_latex.toml"),
+        str(root / "urdf" / f"{name}.urdf"),
+        str(root / "analytic" / "params" / f"{name}.toml"),
+    )
+    states = sample_states(target.model, 200, SAMPLER_SEEDS[1])
+    assert_both_paths_agree(name, target.model, target.system, states, SAMPLER_SEEDS[1])
