@@ -1,10 +1,12 @@
 """A scene run on the fast path: the compiled DOP853 of the model's generated back ends, with invariants.
 
-``simulate(scene)`` integrates any scene whose effects compile (time-invariant force
-law τ = B (u0 − K x) − D q̇; ``GeneratedSystem.from_dynamics`` refuses the others with a
-``FastPathError``) at the scene's rtol and atol, samples it at the scene's rate and
-checks the scene's invariants (``pendverify.simulation.invariants``) on the accepted
-steps, with the closed-form ``Dynamics`` for E, ∇E and the energy scale.
+``simulate(scene)`` integrates any scene whose effects compile (τ = B (u0 − K x) − D q̇
+plus a sine input and seeded noise, ``pendverify.numerics.forcing``;
+``GeneratedSystem.from_dynamics`` refuses the others with a ``FastPathError``) at the
+scene's rtol and atol, samples it at the scene's rate and checks the scene's invariants
+(``pendverify.simulation.invariants``) on the accepted steps, with E, ∇E and the energy
+scale from the model's generated functions on all steps at once
+(``pendverify.numerics.energies``).
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pendverify.errors import FastPathError
+from pendverify.numerics.energies import GeneratedEnergies
 from pendverify.numerics.fastpath import FastResult, integrate
 from pendverify.numerics.generate import GeneratedSystem
 from pendverify.simulation.dynamics import build_dynamics
@@ -44,8 +47,8 @@ def simulate(scene) -> FastRun:
 
     The invariants are ``pendverify.simulation.invariants``' — the energy drift, dissipation
     or work–energy balance with the bound an adaptive method's tolerance implies —
-    evaluated on the fast path's accepted steps, with the scene's closed-form
-    ``Dynamics`` for E, ∇E and the energy scale.
+    evaluated on the fast path's accepted steps, with the model's generated E, M q̇ and T
+    (``GeneratedEnergies``; the per-state closed form where the generated energy is missing).
     """
     if not scene.integrator.adaptive:
         raise FastPathError(
@@ -57,7 +60,8 @@ def simulate(scene) -> FastRun:
     n_samples = int(np.floor(scene.duration * scene.sample_rate + 1e-9)) + 1
     t = np.arange(n_samples) / scene.sample_rate
     res = integrate(system, x0, scene.duration, scene.integrator.rtol, scene.integrator.atol, t, record=True)
-    scale = energy_scale(dyn, res.steps_x)
-    bound = adaptive_bound(dyn, res.steps_x, scene.integrator, scale)
-    invariants = evaluate(dyn, scene, res.steps_t, res.steps_x, bound, scale)
+    energies = GeneratedEnergies.of(dyn, system)
+    scale = energy_scale(energies, res.steps_x)
+    bound = adaptive_bound(energies, res.steps_x, scene.integrator, scale)
+    invariants = evaluate(energies, scene, res.steps_t, res.steps_x, bound, scale)
     return FastRun(scene, dyn, system, res, t, res.dense, invariants)
