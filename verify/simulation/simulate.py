@@ -111,32 +111,14 @@ def _breakpoints(scene: Scene) -> list[float]:
 
 def _engine_comparison(dyn: Dynamics, steps_t, steps_x) -> InvariantResult:
     """ABA against the closed-form right-hand side at the trajectory's own states."""
-    return accelerations_agree(
-        "engines agree: ABA vs closed-form q̈ at the same states",
-        dyn.model,
-        dyn.generalized_force,
-        lambda t, q, v, tau: dyn.acceleration(q, v, tau, "aba"),
-        lambda t, q, v, tau: dyn.acceleration(q, v, tau, "closed_form"),
-        steps_t,
-        steps_x,
-    )
-
-
-def accelerations_agree(name, model, force, reference, other, steps_t, steps_x) -> InvariantResult:
-    """Two engines' q̈ at the same states, each error relative to its state's own scale.
-
-    ``force(t, q, v)`` is the scene's (τ_in, τ_diss); ``reference`` and ``other`` map
-    (t, q, v, τ) to q̈.  The scale is ‖M⁻¹‖ (rates, gravity, forces, ‖M‖·|q̈|) in the
-    weights of the checks; the tolerance ``ENGINE_K``·ε·(1 + max|θ|), as the aba check's.
-    """
-    n = model.nv
+    n, model = dyn.nv, dyn.model
     errors, tolerances = [], []
     for t, x in zip(steps_t, steps_x, strict=True):
         q, v = x[:n], x[n : 2 * n]
-        tau_in, tau_diss = force(t, q, v)
+        tau_in, tau_diss = dyn.generalized_force(t, q, v)
         tau = tau_in + tau_diss
-        a_pin = reference(t, q, v, tau)
-        a_cf = other(t, q, v, tau)
+        a_pin = dyn.acceleration(q, v, tau, "aba")
+        a_cf = dyn.acceleration(q, v, tau, "closed_form")
         w = weights(model, q)
         Minv = norm2(scaled_matrix(model.inverse_mass_matrix(q), 1 / w))
         M = norm2(scaled_matrix(model.mass_matrix(q), w))
@@ -146,7 +128,12 @@ def accelerations_agree(name, model, force, reference, other, steps_t, steps_x) 
         errors.append(np.max(np.abs((a_pin - a_cf) / w)) / scale)
         tolerances.append(ENGINE_K * EPS * (1 + np.max(np.abs(q[np.array(model.angular)]), initial=0.0)))
     result = figures_of(
-        name, np.array(errors), np.array(tolerances), steps_t, 1.0, f"over {len(steps_t)} states"
+        "engines agree: ABA vs closed-form q̈ at the same states",
+        np.array(errors),
+        np.array(tolerances),
+        steps_t,
+        1.0,
+        f"over {len(steps_t)} states",
     )
     return replace(result, scale=float("nan"))  # each state's error is relative to its own scale
 
