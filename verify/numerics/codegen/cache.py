@@ -106,8 +106,11 @@ def _model_key(model_cls) -> str | None:
     # not the module's name: a plug-in's is salted per process (pendverify.analytic.plugin)
     version = importlib.metadata.version("sympy")
     h = hashlib.sha256(f"{_module.GENERATOR}|{version}|{model_cls.__qualname__}".encode())
-    for path in sorted(files):
-        h.update(f"|{Path(path).name}:{_file_digest(path)}".encode())
+    try:
+        for path in sorted(files):
+            h.update(f"|{Path(path).name}:{_file_digest(path)}".encode())
+    except OSError:  # a class loaded from a file that is gone (a certificate's source, on a new process)
+        return None
     return h.hexdigest()
 
 
