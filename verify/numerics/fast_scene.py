@@ -40,22 +40,30 @@ class FastRun:
         return all(i.passed for i in self.invariants)
 
 
-def simulate(scene) -> FastRun:
+def compile_scene(scene):
+    """(the scene's closed-form ``Dynamics``, its ``GeneratedSystem``), or a FastPathError naming the key.
+
+    A model whose closed forms SymPy cannot read raises a ``PendverifyError`` here too."""
+    if not scene.integrator.adaptive:
+        raise FastPathError(
+            scene.source, "integrator.method", scene.integrator.method, "an adaptive method (rtol, atol)"
+        )
+    dyn = build_dynamics(scene, "closed_form")
+    return dyn, GeneratedSystem.from_dynamics(dyn, scene.source)
+
+
+def simulate(scene, compiled=None) -> FastRun:
     """Run a scene with the compiled DOP853 (at the scene's rtol, atol) and check its invariants.
 
     Any model a scene names, seed or plug-in file: its module is generated on first use.
+    ``compiled``: what ``compile_scene(scene)`` returned, if the caller has it already.
 
     The invariants are ``pendverify.simulation.invariants``' — the energy drift, dissipation
     or work–energy balance with the bound an adaptive method's tolerance implies —
     evaluated on the fast path's accepted steps, with the model's generated E, M q̇ and T
     (``GeneratedEnergies``; the per-state closed form where the generated energy is missing).
     """
-    if not scene.integrator.adaptive:
-        raise FastPathError(
-            scene.source, "integrator.method", scene.integrator.method, "an adaptive method (rtol, atol)"
-        )
-    dyn = build_dynamics(scene, "closed_form")
-    system = GeneratedSystem.from_dynamics(dyn, scene.source)
+    dyn, system = compiled or compile_scene(scene)
     x0 = np.concatenate([scene.q0, scene.v0, [0.0, 0.0]])
     n_samples = int(np.floor(scene.duration * scene.sample_rate + 1e-9)) + 1
     t = np.arange(n_samples) / scene.sample_rate
