@@ -21,8 +21,9 @@ the model file's source text, not the class, and load it once per worker.
 
 A sweep of more than ``max_sets`` sets (a count, or the product of a grid's
 points) is refused before any set is made.  ``pendverify.certify.sweep_run``
-runs the tasks, on local processes or a Dask cluster; the task is the same pure
-function either way, so both produce the same certificates.
+runs the tasks (``pendverify.certify.sweep_task``), on local processes or a Dask
+cluster; the task is the same pure function either way, so both produce the same
+certificates.
 """
 
 from __future__ import annotations
@@ -37,12 +38,10 @@ import numpy as np
 from pendverify.analytic import MODELS
 from pendverify.analytic.params import default_parameter_file, load_parameter_file, read_toml
 from pendverify.analytic.plugin import plugin_parameters
-from pendverify.certify.battery import BatterySettings, run_battery
+from pendverify.certify.battery import BatterySettings
 from pendverify.certify.model_source import ModelSource
 from pendverify.errors import PendverifyError, SweepError
-from pendverify.progress import quiet
 from pendverify.robot.rebind import Binding
-from pendverify.robot.writer import urdf_for
 
 
 @dataclass(frozen=True)
@@ -204,46 +203,6 @@ def _model_and_base(path: Path, data: dict):
     if base_model != ref:
         raise SweepError(source, "base", base_ref, f"that parameter file is for {base_model!r}")
     return ModelSource(ref), base, None
-
-
-def set_urdf(model_cls, params, name: str, base_urdf: str | None, base_values: dict | None) -> str:
-    """A set's URDF: the project's for a built-in model, else the base URDF rewritten for the set."""
-    if base_urdf is None:
-        return urdf_for(params, name)
-    base = model_cls.params_type.from_mapping(base_values, "<sweep base>")
-    return Binding.of(base_urdf, base).rewrite(params)
-
-
-def certify_task(
-    model: ModelSource,
-    name: str,
-    values: dict,
-    settings: dict,
-    base_urdf: str | None = None,
-    base_values: dict | None = None,
-) -> dict:
-    """One set through the battery; a pure function of strings and numbers, so it runs anywhere.
-
-    It draws no progress bar: the sweep's own bar is the only one."""
-    with quiet():
-        return _certify(model, name, values, settings, base_urdf, base_values)
-
-
-def _certify(model, name, values, settings, base_urdf, base_values) -> dict:
-    try:
-        cls = model.load()
-        params = cls.params_type.from_mapping(values, f"<sweep set {name}>")
-        urdf = set_urdf(cls, params, name, base_urdf, base_values)
-    except PendverifyError as exc:
-        return {"name": name, "values": values, "error": str(exc), "items": []}
-    items = run_battery(cls, params, urdf, BatterySettings(**settings))
-    return {
-        "name": name,
-        "values": values,
-        "error": None,
-        "items": [i.as_dict() for i in items],
-        "urdf": urdf,
-    }
 
 
 def summary_table(results: list[dict]) -> str:

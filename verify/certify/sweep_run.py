@@ -22,7 +22,8 @@ from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from contextlib import contextmanager
 from dataclasses import dataclass
 
-from pendverify.certify.sweep import Sweep, certify_task
+from pendverify.certify.sweep import Sweep
+from pendverify.certify.sweep_task import certify_task
 from pendverify.errors import InputError, PendverifyError
 from pendverify.progress import bar
 
