@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -142,18 +143,51 @@ def load_sweep(path: str | Path, max_sets: int = DEFAULT_MAX_SETS) -> Sweep:
             raise SweepError(source, f"ranges.{key}", value, f"cannot be varied: {binding.reasons[key]}")
         specs[key] = _range(source, key, value)
 
-    _count(source, mode, ints["count"], specs, max_sets)
-    values = []
-    if mode == "grid":
-        axes = [
-            np.geomspace(lo, hi, n) if scale == "log" else np.linspace(lo, hi, n)
-            for lo, hi, scale, n in specs.values()
-        ]
-        for combo in itertools.product(*axes):
-            values.append(dict(zip(specs, (float(x) for x in combo), strict=True)))
-    else:
-        rng = np.random.default_rng(ints["seed"])
-        for _ in range(ints["count"]):
+    count = _count(source, mode, ints["count"], specs, max_sets)
+    sets = SweepSets(model.name, base.as_dict(), specs, mode, count, ints["seed"])
+    settings = BatterySettings(samples=ints["samples"], seed=ints["seed"], sim_duration=float(duration))
+    return Sweep(model, sets, settings, urdf, None if urdf is None else base.as_dict())
+
+
+class SweepSets(Sequence):
+    """A sweep's sets (name, values), made one at a time as they are iterated, never all at once.
+
+    Each pass makes them again, the same every time: a grid in ``itertools.product``
+    order, or ``count`` seeded rows, one ``uniform()`` draw per range in order.  Indexing
+    walks from the start (O(i): for tests and messages, not for loops).
+    """
+
+    def __init__(self, prefix: str, base: dict, specs: dict, mode: str, count: int, seed: int):
+        self.prefix, self.base, self.specs = prefix, dict(base), dict(specs)
+        self.mode, self.count, self.seed = mode, count, seed
+
+    def __len__(self) -> int:
+        return self.count
+
+    def __iter__(self) -> Iterator[tuple[str, dict]]:
+        width = len(str(self.count - 1))
+        for i, row in enumerate(self._rows()):
+            yield f"{self.prefix}-{i:0{width}d}", {**self.base, **row}
+
+    def __getitem__(self, i):
+        if isinstance(i, slice):
+            return list(itertools.islice(self, *i.indices(self.count)))
+        if not -self.count <= i < self.count:
+            raise IndexError(i)
+        return next(itertools.islice(self, i % self.count, None))
+
+    def _rows(self) -> Iterator[dict]:
+        specs = self.specs
+        if self.mode == "grid":
+            axes = [
+                np.geomspace(lo, hi, n) if scale == "log" else np.linspace(lo, hi, n)
+                for lo, hi, scale, n in specs.values()
+            ]
+            for combo in itertools.product(*axes):
+                yield dict(zip(specs, (float(x) for x in combo), strict=True))
+            return
+        rng = np.random.default_rng(self.seed)
+        for _ in range(self.count):
             row = {}
             for key, (lo, hi, scale, _) in specs.items():
                 u = rng.uniform()
@@ -162,11 +196,7 @@ def load_sweep(path: str | Path, max_sets: int = DEFAULT_MAX_SETS) -> Sweep:
                     if scale == "log"
                     else lo + u * (hi - lo)
                 )
-            values.append(row)
-    width = len(str(len(values) - 1))
-    sets = [(f"{model.name}-{i:0{width}d}", {**base.as_dict(), **row}) for i, row in enumerate(values)]
-    settings = BatterySettings(samples=ints["samples"], seed=ints["seed"], sim_duration=float(duration))
-    return Sweep(model, sets, settings, urdf, None if urdf is None else base.as_dict())
+            yield row
 
 
 def _model_and_base(path: Path, data: dict):
