@@ -233,22 +233,3 @@ def _model_and_base(path: Path, data: dict):
     if base_model != ref:
         raise SweepError(source, "base", base_ref, f"that parameter file is for {base_model!r}")
     return ModelSource(ref), base, None
-
-
-def summary_table(results: list[dict]) -> str:
-    passed = [r for r in results if r["error"] is None and all(i["passed"] for i in r["items"])]
-    worst: dict[str, tuple[float, str]] = {}
-    for r in results:
-        for item in r["items"]:
-            margin = item["error"] / item["tolerance"] if item["tolerance"] > 0 else float("inf")
-            if margin > worst.get(item["name"], (-1.0, ""))[0]:
-                worst[item["name"]] = (margin, r["name"])
-    lines = [f"{len(passed)} passed, {len(results) - len(passed)} failed, {len(results)} sets"]
-    width = max((len(k) for k in worst), default=5)
-    lines.append(f"{'check'.ljust(width)}  worst error/tolerance  set")
-    lines += [f"{name.ljust(width)}  {m:21.3g}  {who}" for name, (m, who) in sorted(worst.items())]
-    failures = [r for r in results if r not in passed]
-    for r in failures[:20]:
-        reason = r["error"] or ", ".join(i["name"] for i in r["items"] if not i["passed"])
-        lines.append(f"FAIL {r['name']}: {reason}")
-    return "\n".join(lines)
