@@ -168,12 +168,10 @@ def energy_scale(dyn, xs: np.ndarray) -> float:
 
 def adaptive_bound(dyn, xs: np.ndarray, integrator, scale: float) -> np.ndarray:
     """Cumulative bound on |r| after each step of an adaptive run."""
-    G = gradients(dyn, xs[:-1])
-    atol, rtol = integrator.atol, integrator.rtol
-    per_step = [
-        SAFETY * np.sqrt(x.size) * g @ (atol + rtol * np.abs(x)) + ROUNDING * EPS * scale
-        for g, x in zip(G, xs[:-1], strict=True)
-    ]
+    X = xs[:-1]
+    G = gradients(dyn, X)
+    weights = integrator.atol + integrator.rtol * np.abs(X)
+    per_step = SAFETY * np.sqrt(X.shape[1]) * np.einsum("ij,ij->i", G, weights) + ROUNDING * EPS * scale
     return np.concatenate([[ROUNDING * EPS * scale], ROUNDING * EPS * scale + np.cumsum(per_step)])
 
 
