@@ -226,7 +226,8 @@ def test_a_sweep_task_never_draws_a_bar(tmp_path, monkeypatch):
     """Even on a terminal, a worker's task (battery, simulations) opens only disabled bars."""
     import tqdm
 
-    from pendverify.certify.sweep import certify_task, load_sweep
+    from pendverify.certify.sweep import load_sweep
+    from pendverify.certify.sweep_task import certify_task
 
     bars = []
 

@@ -8,7 +8,9 @@
    a short run with gravity alone (energy drift), with damping when D is not zero
    (dissipation balance, energy never rises), with actuation when it has inputs
    (work–energy balance) and with a seeded noise disturbance when it has
-   disturbances (work–energy balance).
+   disturbances (work–energy balance); on the fast path (the compiled closed form),
+   the gravity run's q̈ compared with ABA on the URDF at its own steps
+   (``pendverify.certify.simulations``, which says why).
 
 Nothing here depends on which model it is: a plug-in model file runs the same battery.
 
@@ -24,11 +26,9 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
-from pendverify.certify.scenes import effect_scenes
 from pendverify.checks.sampling import sample_states
 from pendverify.checks.verdict import REFUSED
 from pendverify.checks.verification import guarded_checks
-from pendverify.errors import PendverifyError
 from pendverify.progress import bar
 from pendverify.robot.system import PinocchioSystem
 
@@ -65,9 +65,13 @@ class BatteryItem:
     at: str = ""
     max_error: float | None = None
     max_error_at: str = ""
+    engine: str = ""  # invariant items: what ran the simulation (pendverify.certify.simulations)
 
     def as_dict(self) -> dict:
-        return asdict(self)
+        record = asdict(self)
+        if not record["engine"]:
+            del record["engine"]  # checks and stress cases run no simulation
+        return record
 
     @property
     def margin(self) -> float:
@@ -95,52 +99,15 @@ def check_items(model, system, settings: BatterySettings) -> list[BatteryItem]:
     ]
 
 
-def invariant_items(model_cls, params, urdf: str, settings: BatterySettings) -> list[BatteryItem]:
-    """One simulation per effect the model has (``pendverify.certify.scenes``), ABA on ``urdf``."""
-    from pendverify.simulation.scene import parse_scene
-    from pendverify.simulation.simulate import simulate
+def invariant_items(
+    model_cls, params, urdf: str, settings: BatterySettings, engines=None, system=None
+) -> list[BatteryItem]:
+    """One simulation per effect the model has (``pendverify.certify.scenes``), on the fast path
+    where it compiles, else ABA on ``urdf``; ``engines``: effect → engine, as a certificate
+    records them (``pendverify.certify.simulations``)."""
+    from pendverify.certify import simulations
 
-    items = []
-    scenes = effect_scenes(model_cls, params, settings.sim_duration, settings.sim_rtol, settings.seed)
-    for effect, doc in scenes.items():
-        try:
-            with np.errstate(over="ignore", invalid="ignore"):  # a diverging run is judged below
-                run = simulate(parse_scene(doc, f"<battery {effect}>"), "aba", urdf)
-        except (PendverifyError, RuntimeError, FloatingPointError) as exc:
-            # a run that diverges or dies is a failed item, not a crash of the battery
-            items.append(
-                BatteryItem(
-                    f"invariant:{effect}",
-                    "invariant",
-                    np.inf,
-                    0.0,
-                    0,
-                    settings.seed,
-                    False,
-                    str(exc),
-                    max_error=np.inf,
-                )
-            )
-            continue
-        steps = len(run.integration.steps_t) - 1
-        for inv in run.invariants:
-            items.append(
-                BatteryItem(
-                    f"invariant:{effect}:{inv.name.split(' ')[0]}"
-                    + (":no-increase" if inv.name.startswith("energy never") else ""),
-                    "invariant",
-                    inv.error,
-                    inv.tolerance,
-                    steps,
-                    settings.seed,
-                    inv.passed,
-                    inv.name,
-                    at=f"t = {inv.worst_t:.6g} s",
-                    max_error=inv.max_error,
-                    max_error_at=f"t = {inv.max_error_t:.6g} s",
-                )
-            )
-    return items
+    return simulations.invariant_items(model_cls, params, urdf, settings, engines, system)
 
 
 def stress_items(model_cls, params, settings: BatterySettings, urdf: str | None = None) -> list[BatteryItem]:
@@ -191,14 +158,18 @@ def model_class(model) -> type[ClosedFormModel]:
     return MODELS[model] if isinstance(model, str) else model
 
 
-def run_battery(model, params: ParameterSet, urdf: str, settings: BatterySettings) -> list[BatteryItem]:
-    """The battery for a model (a class, or a built-in model's name), its parameters and URDF."""
+def run_battery(
+    model, params: ParameterSet, urdf: str, settings: BatterySettings, engines: dict | None = None
+) -> list[BatteryItem]:
+    """The battery for a model (a class, or a built-in model's name), its parameters and URDF.
+
+    ``engines``: effect → the engine its invariant items ran on (``recheck``: the certificate's)."""
     cls = model_class(model)
     system = PinocchioSystem.for_model(cls, urdf, params.g, f"<URDF being certified: {cls.name}>")
     parts = (
         lambda: check_items(cls(params), system, settings),
         lambda: stress_items(cls, params, settings, urdf),
-        lambda: invariant_items(cls, params, urdf, settings),
+        lambda: invariant_items(cls, params, urdf, settings, engines, system),
     )
     items = []
     with bar(len(parts), "battery", "part") as progress:  # checks, stress cases, simulations

@@ -23,8 +23,11 @@ checks             every battery item: name, kind (check | stress | invariant);
                    error, tolerance, at: the worst error/tolerance ratio (the
                    figures at that state or step, and where it is); max_error,
                    max_error_at: the largest error and where (checks and invariants; null
-                   for checks and stress cases, which keep only the worst ratio);
-                   samples, seed, passed, detail
+                   for stress cases, which keep only the worst ratio);
+                   samples, seed, passed, detail; invariant items also engine
+                   (compiled | aba: what ran the simulation,
+                   ``pendverify.certify.simulations``; an invariant item without one
+                   ran on aba, as every item issued before the key existed)
 summary            derived from ``checks``: items, passed, failed (names),
                    result (PASSED | FAILED), worst_item, worst_ratio
 notes              what the URDF reader noticed (angle offsets, a centre of mass
@@ -56,6 +59,7 @@ from pendverify.analytic import ParameterSet
 from pendverify.certify.battery import BatteryItem, BatterySettings
 from pendverify.certify.model_source import ModelSource, source_problem
 from pendverify.certify.names import envelope_name
+from pendverify.certify.simulations import UNRECORDED
 from pendverify.errors import CertificateError
 from pendverify.jsonio import plain, to_json, versions
 
@@ -179,6 +183,9 @@ def compare_items(recorded: list[dict], fresh: list[BatteryItem]) -> list[str]:
         for key in ("kind", "samples", "seed", "passed"):
             if old[key] != getattr(new, key):
                 differences.append(f"{old['name']}.{key}: recorded {old[key]!r}, now {getattr(new, key)!r}")
+        engine = old.get("engine", UNRECORDED if old["kind"] == "invariant" else "")
+        if engine != new.engine:
+            differences.append(f"{old['name']}.engine: recorded {engine!r}, now {new.engine!r}")
         for key in ("error", "tolerance", "max_error"):
             a, b = old[key], getattr(new, key)
             if a is None or b is None:

@@ -7,7 +7,7 @@ parameter file — into (bundle name, model, parameters, URDF text).  ``issue``
 refuses an existing bundle before any work, runs the battery on that URDF, and
 writes the bundle only if every item passes (signed when given a key).  ``recheck``
 checks a certificate's schema, digest and derived fields, with ``trust`` its
-signature, and re-runs its battery.
+signature, and re-runs its battery, each invariant item on the engine it records.
 
 Every name that becomes a file name is checked where it is read
 (``pendverify.certify.names``): a parameter file's ``name``, a URDF's stem, a sweep's
@@ -30,6 +30,7 @@ from pendverify.certify.model_source import ModelSource
 from pendverify.certify.names import check_name
 from pendverify.certify.schema import check_derived, check_schema
 from pendverify.certify.signing import fingerprint
+from pendverify.certify.simulations import recorded_engines
 from pendverify.checks.targets import PARAMS_HINT
 from pendverify.errors import CertificateError, ParameterError, PendverifyError
 from pendverify.robot.description import load_description
@@ -209,5 +210,7 @@ def recheck(path: str, trust: str | None = None) -> Rechecked:
         signature = f"signed by key {cert['signature']['keyid']}: not verified (give --trust PUBLIC.pem)"
     else:
         signature = "unsigned: only the digest was checked (it detects accidental corruption, not edits)"
-    items = run_battery(cls, params, cert["urdf"]["text"], BatterySettings(**cert["settings"]))
+    settings = BatterySettings(**cert["settings"])
+    engines = recorded_engines(cert["checks"])  # each invariant item on the engine it ran on
+    items = run_battery(cls, params, cert["urdf"]["text"], settings, engines)
     return Rechecked(cert, items, compare_items(cert["checks"], items), signature)

@@ -14,6 +14,7 @@ from datetime import datetime
 
 from pendverify.certify.certificate import OLD_SCHEMAS, SCHEMA, summary_of
 from pendverify.certify.names import check_name
+from pendverify.certify.simulations import ENGINES
 from pendverify.errors import CertificateError, PendverifyError
 
 NONFINITE = ("inf", "-inf", "nan")  # how pendverify.jsonio writes non-finite numbers
@@ -91,6 +92,7 @@ ITEM = {
     "seed": (True, _integer, "an integer"),
     "passed": (True, lambda v: isinstance(v, bool), "true or false"),
     "detail": (True, _string, "a string"),
+    "engine": (False, lambda v: v in ENGINES, f"one of {', '.join(ENGINES)} (invariant items)"),
 }
 
 

@@ -21,14 +21,16 @@ the model file's source text, not the class, and load it once per worker.
 
 A sweep of more than ``max_sets`` sets (a count, or the product of a grid's
 points) is refused before any set is made.  ``pendverify.certify.sweep_run``
-runs the tasks, on local processes or a Dask cluster; the task is the same pure
-function either way, so both produce the same certificates.
+runs the tasks (``pendverify.certify.sweep_task``), on local processes or a Dask
+cluster; the task is the same pure function either way, so both produce the same
+certificates.
 """
 
 from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -37,13 +39,11 @@ import numpy as np
 from pendverify.analytic import MODELS
 from pendverify.analytic.params import default_parameter_file, load_parameter_file, read_toml
 from pendverify.analytic.plugin import plugin_parameters
-from pendverify.certify.battery import BatterySettings, run_battery
+from pendverify.certify.battery import BatterySettings
 from pendverify.certify.model_source import ModelSource
 from pendverify.errors import PendverifyError, SweepError
-from pendverify.progress import quiet
 from pendverify.robot.description import urdf_text
 from pendverify.robot.rebind import Binding
-from pendverify.robot.writer import urdf_for
 
 
 @dataclass(frozen=True)
@@ -144,18 +144,51 @@ def load_sweep(path: str | Path, max_sets: int = DEFAULT_MAX_SETS) -> Sweep:
             raise SweepError(source, f"ranges.{key}", value, f"cannot be varied: {binding.reasons[key]}")
         specs[key] = _range(source, key, value)
 
-    _count(source, mode, ints["count"], specs, max_sets)
-    values = []
-    if mode == "grid":
-        axes = [
-            np.geomspace(lo, hi, n) if scale == "log" else np.linspace(lo, hi, n)
-            for lo, hi, scale, n in specs.values()
-        ]
-        for combo in itertools.product(*axes):
-            values.append(dict(zip(specs, (float(x) for x in combo), strict=True)))
-    else:
-        rng = np.random.default_rng(ints["seed"])
-        for _ in range(ints["count"]):
+    count = _count(source, mode, ints["count"], specs, max_sets)
+    sets = SweepSets(model.name, base.as_dict(), specs, mode, count, ints["seed"])
+    settings = BatterySettings(samples=ints["samples"], seed=ints["seed"], sim_duration=float(duration))
+    return Sweep(model, sets, settings, urdf, None if urdf is None else base.as_dict())
+
+
+class SweepSets(Sequence):
+    """A sweep's sets (name, values), made one at a time as they are iterated, never all at once.
+
+    Each pass makes them again, the same every time: a grid in ``itertools.product``
+    order, or ``count`` seeded rows, one ``uniform()`` draw per range in order.  Indexing
+    walks from the start (O(i): for tests and messages, not for loops).
+    """
+
+    def __init__(self, prefix: str, base: dict, specs: dict, mode: str, count: int, seed: int):
+        self.prefix, self.base, self.specs = prefix, dict(base), dict(specs)
+        self.mode, self.count, self.seed = mode, count, seed
+
+    def __len__(self) -> int:
+        return self.count
+
+    def __iter__(self) -> Iterator[tuple[str, dict]]:
+        width = len(str(self.count - 1))
+        for i, row in enumerate(self._rows()):
+            yield f"{self.prefix}-{i:0{width}d}", {**self.base, **row}
+
+    def __getitem__(self, i):
+        if isinstance(i, slice):
+            return list(itertools.islice(self, *i.indices(self.count)))
+        if not -self.count <= i < self.count:
+            raise IndexError(i)
+        return next(itertools.islice(self, i % self.count, None))
+
+    def _rows(self) -> Iterator[dict]:
+        specs = self.specs
+        if self.mode == "grid":
+            axes = [
+                np.geomspace(lo, hi, n) if scale == "log" else np.linspace(lo, hi, n)
+                for lo, hi, scale, n in specs.values()
+            ]
+            for combo in itertools.product(*axes):
+                yield dict(zip(specs, (float(x) for x in combo), strict=True))
+            return
+        rng = np.random.default_rng(self.seed)
+        for _ in range(self.count):
             row = {}
             for key, (lo, hi, scale, _) in specs.items():
                 u = rng.uniform()
@@ -164,11 +197,7 @@ def load_sweep(path: str | Path, max_sets: int = DEFAULT_MAX_SETS) -> Sweep:
                     if scale == "log"
                     else lo + u * (hi - lo)
                 )
-            values.append(row)
-    width = len(str(len(values) - 1))
-    sets = [(f"{model.name}-{i:0{width}d}", {**base.as_dict(), **row}) for i, row in enumerate(values)]
-    settings = BatterySettings(samples=ints["samples"], seed=ints["seed"], sim_duration=float(duration))
-    return Sweep(model, sets, settings, urdf, None if urdf is None else base.as_dict())
+            yield row
 
 
 def _model_and_base(path: Path, data: dict):
@@ -205,62 +234,3 @@ def _model_and_base(path: Path, data: dict):
     if base_model != ref:
         raise SweepError(source, "base", base_ref, f"that parameter file is for {base_model!r}")
     return ModelSource(ref), base, None
-
-
-def set_urdf(model_cls, params, name: str, base_urdf: str | None, base_values: dict | None) -> str:
-    """A set's URDF: the project's for a built-in model, else the base URDF rewritten for the set."""
-    if base_urdf is None:
-        return urdf_for(params, name)
-    base = model_cls.params_type.from_mapping(base_values, "<sweep base>")
-    return Binding.of(base_urdf, base).rewrite(params)
-
-
-def certify_task(
-    model: ModelSource,
-    name: str,
-    values: dict,
-    settings: dict,
-    base_urdf: str | None = None,
-    base_values: dict | None = None,
-) -> dict:
-    """One set through the battery; a pure function of strings and numbers, so it runs anywhere.
-
-    It draws no progress bar: the sweep's own bar is the only one."""
-    with quiet():
-        return _certify(model, name, values, settings, base_urdf, base_values)
-
-
-def _certify(model, name, values, settings, base_urdf, base_values) -> dict:
-    try:
-        cls = model.load()
-        params = cls.params_type.from_mapping(values, f"<sweep set {name}>")
-        urdf = set_urdf(cls, params, name, base_urdf, base_values)
-    except PendverifyError as exc:
-        return {"name": name, "values": values, "error": str(exc), "items": []}
-    items = run_battery(cls, params, urdf, BatterySettings(**settings))
-    return {
-        "name": name,
-        "values": values,
-        "error": None,
-        "items": [i.as_dict() for i in items],
-        "urdf": urdf,
-    }
-
-
-def summary_table(results: list[dict]) -> str:
-    passed = [r for r in results if r["error"] is None and all(i["passed"] for i in r["items"])]
-    worst: dict[str, tuple[float, str]] = {}
-    for r in results:
-        for item in r["items"]:
-            margin = item["error"] / item["tolerance"] if item["tolerance"] > 0 else float("inf")
-            if margin > worst.get(item["name"], (-1.0, ""))[0]:
-                worst[item["name"]] = (margin, r["name"])
-    lines = [f"{len(passed)} passed, {len(results) - len(passed)} failed, {len(results)} sets"]
-    width = max((len(k) for k in worst), default=5)
-    lines.append(f"{'check'.ljust(width)}  worst error/tolerance  set")
-    lines += [f"{name.ljust(width)}  {m:21.3g}  {who}" for name, (m, who) in sorted(worst.items())]
-    failures = [r for r in results if r not in passed]
-    for r in failures[:20]:
-        reason = r["error"] or ", ".join(i["name"] for i in r["items"] if not i["passed"])
-        lines.append(f"FAIL {r['name']}: {reason}")
-    return "\n".join(lines)

@@ -1,9 +1,15 @@
-"""Running a sweep: tasks on workers, each set's bundle written as it finishes, Ctrl-C handled.
+"""Running a sweep: chunks of sets streamed to workers, each bundle written as it arrives, Ctrl-C handled.
 
 Tasks run on local processes (``concurrent.futures``) by default, or on a Dask
 distributed cluster (``--scheduler tcp://HOST:PORT``) through its Client's
-executor.  ``run_sweep`` hands every result to ``write`` as soon as it arrives,
-so a sweep stopped part way keeps the certificates of the sets it finished.
+executor.  A task is a chunk of ``chunk`` sets (``sweep_task.certify_chunk``: default
+``chunk_size``), made from the sweep's sets as they are needed: at most ``in_flight``
+chunks (default two per worker: one running, one queued) are submitted and not yet
+finished at any time, and ``run_sweep`` hands each result to ``write`` as soon as its
+chunk arrives and then drops it, so the main process holds neither all the sets, nor
+their results, nor their futures: its memory does not grow with the number of sets
+(``SweepSummary`` keeps counters, the worst figure per battery item and the first
+failures).  A sweep stopped part way keeps the certificates of the sets it finished.
 
 On SIGINT (Ctrl-C) the run stops: queued tasks are cancelled, local workers are
 terminated (they ignore SIGINT themselves, so a terminal's Ctrl-C reaches only
@@ -15,6 +21,8 @@ sweep's progress bar is the only one: tasks draw none.
 
 from __future__ import annotations
 
+import itertools
+import math
 import os
 import signal
 import sys
@@ -22,21 +30,35 @@ from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from contextlib import contextmanager
 from dataclasses import dataclass
 
-from pendverify.certify.sweep import Sweep, certify_task
+from pendverify.certify.sweep import Sweep
+from pendverify.certify.sweep_summary import SweepSummary
+from pendverify.certify.sweep_task import certify_chunk
 from pendverify.errors import InputError, PendverifyError
 from pendverify.progress import bar
 
 INTERRUPTED = 130  # 128 + SIGINT
 POLL_S = 0.2  # how often the run looks for an interruption
+MAX_CHUNK = 8  # sets per task at most: a chunk's results arrive together
+CHUNKS_PER_WORKER = 4  # smaller chunks below this many per worker, so the workers finish together
 
 
 @dataclass
 class SweepRun:
-    results: list[dict]  # the sets computed in this run, in the sweep's order
+    summary: SweepSummary  # the sets computed in this run: counts, worst figures, first failures
     written: int  # bundles written in this run
     skipped: int  # sets whose valid bundle was already there (--resume)
     total: int
     interrupted: bool = False
+    chunk: int = 1  # sets per task
+    in_flight: int = 0  # tasks submitted and not finished, at most (the bound)
+    peak_in_flight: int = 0  # the most there were at once
+    submitted: int = 0  # tasks
+
+
+def chunk_size(sets: int, workers: int) -> int:
+    """Sets per task: ``MAX_CHUNK`` at most, fewer when the sweep would give a worker under
+    ``CHUNKS_PER_WORKER`` chunks."""
+    return max(1, min(MAX_CHUNK, math.ceil(sets / (CHUNKS_PER_WORKER * max(1, workers)))))
 
 
 def _ignore_interrupts() -> None:
@@ -45,12 +67,14 @@ def _ignore_interrupts() -> None:
 
 
 class Workers:
-    """Local worker processes, or a Dask cluster through a Client (``close`` stops either)."""
+    """Local worker processes, or a Dask cluster through a Client (``close`` stops either);
+    ``count``: how many tasks they run at once."""
 
     def __init__(self, scheduler: str | None = None, workers: int | None = None):
         self.client = None
         if scheduler is None:
-            self.executor = ProcessPoolExecutor(max_workers=workers, initializer=_ignore_interrupts)
+            self.count = workers or os.cpu_count() or 1
+            self.executor = ProcessPoolExecutor(max_workers=self.count, initializer=_ignore_interrupts)
             return
         try:
             from distributed import Client
@@ -67,6 +91,7 @@ class Workers:
         except (OSError, ValueError) as exc:  # unreachable, refused, or an address Dask cannot parse
             raise PendverifyError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
         self.executor = self.client.get_executor()
+        self.count = max(1, sum(self.client.nthreads().values()))  # tasks the cluster runs at once
 
     def submit(self, *args):
         return self.executor.submit(*args)
@@ -143,34 +168,53 @@ class Interrupts:
                 self.exit_now()
 
 
-def run_sweep(sweep: Sweep, workers: Workers, write, skip=frozenset(), replace=frozenset()) -> SweepRun:
+def run_sweep(
+    sweep: Sweep,
+    workers: Workers,
+    write,
+    skip=frozenset(),
+    replace=frozenset(),
+    chunk: int | None = None,
+    in_flight: int | None = None,
+) -> SweepRun:
     """Compute every set not in ``skip``; ``write(result, replace: bool) -> bundles written`` is
-    called for each result as it arrives (``replace`` for the sets in ``replace``)."""
+    called for each result as its chunk arrives (``replace`` for the sets in ``replace``).
+
+    ``chunk``: sets per task (default ``chunk_size``); ``in_flight``: tasks submitted and not
+    finished at most (default two per worker)."""
     settings = sweep.settings.as_dict()
-    todo = [(i, name, values) for i, (name, values) in enumerate(sweep.sets) if name not in skip]
-    skipped = len(sweep.sets) - len(todo)
-    done: dict[int, dict] = {}
-    written = 0
-    pending: set = set()
-    with Interrupts(workers) as interrupts, bar(len(sweep.sets), "sweep", "set", initial=skipped) as progress:
+    total = len(sweep.sets)
+    skipped = sum(name in skip for name, _ in sweep.sets) if skip else 0
+    chunk = chunk or chunk_size(total - skipped, workers.count)
+    in_flight = in_flight or 2 * workers.count
+    todo = ((name, values) for name, values in sweep.sets if name not in skip)
+    chunks = iter(lambda: list(itertools.islice(todo, chunk)), [])
+    run = SweepRun(SweepSummary(), 0, skipped, total, chunk=chunk, in_flight=in_flight)
+    pending: dict = {}  # future → its chunk's size
+    with Interrupts(workers) as interrupts, bar(total, "sweep", "set", initial=skipped) as progress:
         try:
-            futures = {}
-            for i, name, values in todo:
-                if interrupts.requested:
+            exhausted = False
+            while not interrupts.requested:
+                while not exhausted and len(pending) < in_flight and not interrupts.requested:
+                    sets = next(chunks, None)
+                    if sets is None:
+                        exhausted = True
+                        break
+                    task = (sweep.model, sets, settings, sweep.urdf, sweep.base)
+                    pending[workers.submit(certify_chunk, *task)] = len(sets)
+                    run.submitted += 1
+                    run.peak_in_flight = max(run.peak_in_flight, len(pending))
+                if not pending:
                     break
-                task = (sweep.model, name, values, settings, sweep.urdf, sweep.base)
-                futures[workers.submit(certify_task, *task)] = (i, name)
-            pending = set(futures)
-            while pending and not interrupts.requested:
-                finished, pending = wait(pending, timeout=POLL_S, return_when=FIRST_COMPLETED)
-                for future in sorted(finished, key=lambda f: futures[f][0]):
-                    i, name = futures[future]
-                    done[i] = future.result()
-                    with interrupts.writing():
-                        written += write(done[i], name in replace)
-                    progress.update(1)
+                finished, _ = wait(list(pending), timeout=POLL_S, return_when=FIRST_COMPLETED)
+                for future in finished:
+                    del pending[future]
+                    for result in future.result():
+                        run.summary.add(result)
+                        with interrupts.writing():
+                            run.written += write(result, result["name"] in replace)
+                        progress.update(1)
         finally:
             workers.close(cancel=bool(pending) or interrupts.requested)
-    results = [done[i] for i in sorted(done)]
-    stopped = interrupts.requested and len(done) < len(todo)
-    return SweepRun(results, written, skipped, len(sweep.sets), stopped)
+    run.interrupted = interrupts.requested and run.summary.sets < total - skipped
+    return run

@@ -97,7 +97,7 @@ def _run_sweep(args) -> int:
     import sys
 
     from pendverify.certify.issue import check_sweep_names, write_sweep_certificates
-    from pendverify.certify.sweep import load_sweep, summary_table
+    from pendverify.certify.sweep import load_sweep
     from pendverify.certify.sweep_output import prepare_output
     from pendverify.certify.sweep_run import INTERRUPTED, Workers, run_sweep
 
@@ -118,7 +118,7 @@ def _run_sweep(args) -> int:
             file=sys.stderr,
         )
         return INTERRUPTED
-    print(summary_table(run.results))
+    print(run.summary.table())
     if args.resume:  # how many it skipped, zero included
         print(f"{run.skipped} set(s) already certified in {args.output} (--resume): not recomputed")
     print(f"{run.written} certificate(s) written to {args.output}")

@@ -6,9 +6,12 @@ step factors in [0.2, 10], with scipy's 7th-order dense output when output
 times are asked for (3 extra evaluations per step that contains one, as scipy
 counts them).  The functions are *templates* (``pendverify.numerics.codegen.
 templates``): copied verbatim into each model's generated module, where they call
-that model's ``_rhs`` inlined and are compiled and cached with it
+that model's ``_rhs_t`` inlined and are compiled and cached with it
 (``pendverify.numerics.fastpath.integrate`` runs the copy).  They take one packed
-float array P (``GeneratedSystem.packed``).
+float array P (``GeneratedSystem.packed``).  Every evaluation is at its stage's
+time, t + c_s·h as scipy has it, so a system with time-varying forcing (a sine
+input, band-limited noise: ``pendverify.numerics.generate``) takes the steps scipy
+takes on the same right-hand side; without forcing, t is read by nothing.
 """
 
 from __future__ import annotations
@@ -20,7 +23,7 @@ from scipy.integrate._ivp import dop853_coefficients as _coef
 
 from pendverify.numerics.codegen.templates import placeholder, template
 
-_rhs = placeholder("_rhs")  # each generated module defines its model's
+_rhs_t = placeholder("_rhs_t")  # each generated module defines its model's
 
 # --- DOP853 tableau, as scipy has it ----------------------------------------------------
 _NS = _coef.N_STAGES  # 12 stages, then f(t + h, y_new) as the 13th row of K
@@ -48,7 +51,7 @@ def _rms(x):
 
 @template()
 def _initial_step(P, t0, y0, f0, t_end, rtol, atol, tmp, f1):
-    """scipy's ``select_initial_step`` for an error estimator of order 7."""
+    """scipy's ``select_initial_step`` for an error estimator of order 7 (from t0, forward)."""
     n = y0.shape[0]
     length = abs(t_end - t0)
     scale = atol + np.abs(y0) * rtol
@@ -57,7 +60,7 @@ def _initial_step(P, t0, y0, f0, t_end, rtol, atol, tmp, f1):
     h0 = min(h0, length)
     for i in range(n):
         tmp[i] = y0[i] + h0 * f0[i]
-    _rhs(P, tmp, f1)
+    _rhs_t(P, t0 + h0, tmp, f1)
     d2 = _rms((f1 - f0) / scale) / h0
     if d1 <= 1e-15 and d2 <= 1e-15:
         h1 = max(1e-6, h0 * 1e-3)
@@ -67,8 +70,8 @@ def _initial_step(P, t0, y0, f0, t_end, rtol, atol, tmp, f1):
 
 
 @template()
-def _stages(P, y, h, K, first, last, x, f):
-    """K[s] = f(y + h Σ_j A[s, j] K[j]) for s in [first, last).
+def _stages(P, t, y, h, K, first, last, x, f):
+    """K[s] = f(t + C[s] h, y + h Σ_j A[s, j] K[j]) for s in [first, last).
 
     f goes to the scratch ``f`` and is copied: a row view K[s] would cost a
     reference count per stage, more than the copy."""
@@ -79,16 +82,16 @@ def _stages(P, y, h, K, first, last, x, f):
             for j in range(s):
                 acc += _A[s, j] * K[j, i]
             x[i] = y[i] + acc * h
-        _rhs(P, x, f)
+        _rhs_t(P, t + _C[s] * h, x, f)
         for i in range(n):
             K[s, i] = f[i]
 
 
 @template()
-def _dense(P, y_old, y_new, h, K, x, f, F):
+def _dense(P, t_old, y_old, y_new, h, K, x, f, F):
     """scipy's DOP853 interpolant coefficients F (7 × n) for the step just taken."""
     n = y_old.shape[0]
-    _stages(P, y_old, h, K, _NS + 1, 16, x, f)
+    _stages(P, t_old, y_old, h, K, _NS + 1, 16, x, f)
     for i in range(n):
         dy = y_new[i] - y_old[i]
         F[0, i] = dy
@@ -146,7 +149,7 @@ def _dop853(P, y, t_end, rtol, atol, t_out, out, st, sx):
         st[0] = 0.0
         sx[0] = y
     nrec = 1
-    _rhs(P, y, f)
+    _rhs_t(P, 0.0, y, f)
     h_abs = _initial_step(P, 0.0, y, f, t_end, rtol, atol, tmp, fs)
     nfev = 2
     k_out = 0
@@ -170,13 +173,13 @@ def _dop853(P, y, t_end, rtol, atol, t_out, out, st, sx):
             h_abs = abs(h)
             for i in range(n):
                 K[0, i] = f[i]
-            _stages(P, y, h, K, 1, _NS, tmp, fs)
+            _stages(P, t, y, h, K, 1, _NS, tmp, fs)
             for i in range(n):
                 acc = 0.0
                 for j in range(_NS):
                     acc += _B[j] * K[j, i]
                 y_new[i] = y[i] + h * acc
-            _rhs(P, y_new, fs)
+            _rhs_t(P, t + h, y_new, fs)
             for i in range(n):
                 K[_NS, i] = fs[i]
             nfev += _NS
@@ -197,7 +200,7 @@ def _dop853(P, y, t_end, rtol, atol, t_out, out, st, sx):
         if status != OK:
             break
         if k_out < t_out.shape[0] and t_out[k_out] <= t_new:
-            _dense(P, y, y_new, h, K, tmp, fs, F)
+            _dense(P, t, y, y_new, h, K, tmp, fs, F)
             nfev += 3
             while k_out < t_out.shape[0] and t_out[k_out] <= t_new:
                 _interpolate(F, y, (t_out[k_out] - t) / h, out[k_out])

@@ -39,6 +39,7 @@ import time
 
 import numpy as np
 
+from pendverify.errors import PendverifyError
 from pendverify.numerics.codegen.templates import placeholder, template
 from pendverify.numerics.fastpath import distinct_modules
 from pendverify.numerics.generate import GeneratedSystem
@@ -164,6 +165,8 @@ def integrate_fixed(method: str, system: GeneratedSystem, x0, duration: float, s
         raise ValueError(f"unknown fixed-step method {method!r}; expected one of {', '.join(_IDS)}")
     if steps % every:
         raise ValueError(f"steps ({steps}) must be a multiple of every ({every})")
+    if system.forcing:
+        raise PendverifyError(f"{system.model}: the fixed-step methods integrate a time-invariant force law")
     x0 = np.ascontiguousarray(x0, dtype=float)
     run = system.kernel.module._run
     out, nfev, status = run(_IDS[method], system.packed(), x0, duration / steps, steps, every)

@@ -8,10 +8,11 @@ or ``coriolis_force + gravity`` for a ``BiasOnlyModel``) and V(q) from
 ``potential_energy`` (``codegen.expressions``).  From them ``pendverify.numerics.codegen``
 writes one Python module per model:
 
-* numba functions with n literal (``codegen.compiled``): ``_rhs(P, x, out)`` (ẋ under
-  τ = B (u0 − K x) − D q̇, M q̈ = τ − bias solved by an unrolled root-free Cholesky
-  M = L diag(d) Lᵀ, with the work integrals dW_in/dt = q̇ᵀ B u, dW_diss/dt = q̇ᵀ D q̇
-  when x has 2n + 2 entries), ``_hamilton(P, y, out)`` (q̇ and ṗ in canonical
+* numba functions with n literal (``codegen.compiled``): ``_rhs_t(P, t, x, out)`` (ẋ at
+  time t under τ = B (u0 − K x) − D q̇ + f(t), M q̈ = τ − bias solved by an unrolled
+  root-free Cholesky M = L diag(d) Lᵀ, with the work integrals dW_in/dt = q̇ᵀ (B u + f(t)),
+  dW_diss/dt = q̇ᵀ D q̇ when x has 2n + 2 entries) and ``_rhs(P, x, out)``, the same at
+  t = 0; ``_hamilton(P, y, out)`` (q̇ and ṗ in canonical
   coordinates, derivation there) and ``_to_momentum``; common subexpressions
   eliminated (``sympy.cse``), floats as exact literals;
 * the DOP853 stepper of ``pendverify.numerics.dop853`` and the fixed-step methods of
@@ -30,11 +31,18 @@ nu inputs of the force law::
 
     P[0] = n,  P[1] = nu,
     P[2 : 2 + n_p]            the parameter values, in the field order of the model's params_type,
-    then D (n × n), B (n × nu), K (nu × 2n), u0 (nu), matrices row-major.
+    then D (n × n), B (n × nu), K (nu × 2n), u0 (nu), matrices row-major;
+    then, only when the system has forcing: the number of channels, and per channel
+    g (n), its amplitude a, its number of components m and m pairs (ω_k, φ_k).
 
 The force law τ = B (u0 − K x) − D q̇ covers every time-invariant scene: conservative
 (K = 0, D = 0), joint friction (any D: a plug-in's absolute angles couple it), PD control (B = I, K = [kp kd],
-u0 = kp·target), LQR about upright (B = e_q, K the gain), a constant input (K = 0).
+u0 = kp·target), LQR about upright (B = e_q, K the gain), a constant input (K = 0).  The
+forcing f(t) = Σ_channels g·a·Σ_k sin(ω_k t + φ_k) adds the smooth time-varying laws
+(``Forcing``): a sine input u = offset + A sin(2π f t + φ) (the offset in u0, one channel
+per input, g the column of B) and band-limited noise w (one channel per disturbance, g the
+column of W, its seeded components).  Laws that jump or kink (step, table, impulse) and a
+saturated LQR are not compiled (``FastPathError``).
 """
 
 from __future__ import annotations
@@ -50,10 +58,12 @@ from pendverify.errors import FastPathError, PendverifyError
 from pendverify.numerics.codegen.cache import GeneratedKernel, cache_dir, forget, kernel, model_key
 from pendverify.numerics.codegen.expressions import Expressions, expressions
 from pendverify.numerics.codegen.module import GENERATOR, render
+from pendverify.numerics.forcing import NO_FORCING, Forcing, forcing_of
 
 __all__ = [
     "GENERATOR",
     "Expressions",
+    "Forcing",
     "GeneratedKernel",
     "GeneratedSystem",
     "cache_dir",
@@ -76,7 +86,7 @@ def _float_sincos(u):
 
 @dataclass(frozen=True)
 class GeneratedSystem:
-    """A model's generated module and a time-invariant force law τ = B (u0 − K x) − D q̇, packed."""
+    """A model's generated module and its force law τ = B (u0 − K x) − D q̇ + f(t), packed."""
 
     kernel: GeneratedKernel
     params: np.ndarray  # parameter values in the field order of the model's params_type
@@ -85,6 +95,7 @@ class GeneratedSystem:
     K: np.ndarray  # (nu, 2n) state feedback
     u0: np.ndarray  # (nu,) feed-forward input
     anchors: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros((0, 0)))  # special states' q
+    forcing: Forcing = NO_FORCING  # time-varying generalized forces f(t)
 
     @property
     def model(self) -> str:
@@ -100,18 +111,21 @@ class GeneratedSystem:
 
     @property
     def conservative(self) -> bool:
-        return not (np.any(self.D) or np.any(self.K) or np.any(self.u0))
+        return not (np.any(self.D) or np.any(self.K) or np.any(self.u0) or self.forcing)
 
     def packed(self) -> np.ndarray:
         """The one array the generated functions take (layout in the module docstring)."""
         head = np.array([self.nv, self.B.shape[1]], dtype=float)
-        return np.concatenate([head, self.params, self.D.ravel(), self.B.ravel(), self.K.ravel(), self.u0])
+        matrices = [self.D.ravel(), self.B.ravel(), self.K.ravel(), self.u0]
+        return np.concatenate([head, self.params, *matrices, self.forcing.packed()])
 
     @classmethod
-    def from_model(cls, model, D=None, B=None, K=None, u0=None, fresh: bool = False) -> GeneratedSystem:
+    def from_model(
+        cls, model, D=None, B=None, K=None, u0=None, fresh: bool = False, forcing: Forcing = NO_FORCING
+    ) -> GeneratedSystem:
         """Pack a ``ClosedFormModel`` instance with its parameter values; no forces unless given.
 
-        ``D``: the friction matrix, or its diagonal as a vector."""
+        ``D``: the friction matrix, or its diagonal as a vector; ``forcing``: f(t)."""
         k = kernel(type(model), fresh=fresh)
         n = model.nv
         names = tuple(f.name for f in dataclasses.fields(model.params_type))
@@ -125,20 +139,22 @@ class GeneratedSystem:
         D = np.zeros((n, n)) if D is None else np.asarray(D, float)
         D = np.ascontiguousarray(np.diag(D) if D.ndim == 1 else D.reshape(n, n))
         anchors = np.array([np.asarray(q, float).reshape(n) for q in model.special_states().values()])
-        return cls(k, params, D, np.ascontiguousarray(B), np.ascontiguousarray(K), u0, anchors.reshape(-1, n))
+        B, K = np.ascontiguousarray(B), np.ascontiguousarray(K)
+        return cls(k, params, D, B, K, u0, anchors.reshape(-1, n), forcing)
 
     @classmethod
     def from_dynamics(cls, dyn, source: str = "<fast path>") -> GeneratedSystem:
         """The force law of a built scene (``simulation.dynamics.Dynamics``), or a FastPathError."""
         n = dyn.nv
-        if dyn.w_of is not None:
-            raise FastPathError(source, "effects.disturbance", dyn.w_of.kind, "not compiled: time-varying")
+        sine_u0, forcing = forcing_of(dyn, source)
         D = dyn.D
         B = K = u0 = None
         law = dyn.u_of
         if law is not None:
             B = dyn.model.input_matrix()
-            if law.kind == "constant":
+            if law.kind == "sine":
+                u0 = sine_u0
+            elif law.kind == "constant":
                 u0 = law.value
             elif law.kind == "pd":
                 K = np.hstack([np.diag(law.kp), np.diag(law.kd)])
@@ -150,24 +166,29 @@ class GeneratedSystem:
                     source,
                     "effects.actuation",
                     law.kind,
-                    "compiled laws are constant, pd and lqr without saturation (u affine in x)",
+                    "compiled laws are constant, sine, pd and lqr without saturation",
                 )
             K = np.zeros((B.shape[1], 2 * n)) if K is None else K
-        return cls.from_model(dyn.model, D, B, K, u0)
+        return cls.from_model(dyn.model, D, B, K, u0, forcing=forcing)
 
     # --- evaluations -----------------------------------------------------------------
-    def rhs(self, x: np.ndarray) -> np.ndarray:
+    def rhs(self, x: np.ndarray, t: float | None = None) -> np.ndarray:
+        """ẋ at x: at time t (``_rhs_t``), or the autonomous ``_rhs`` (t = 0) without one."""
         out = np.empty_like(x, dtype=float)
-        self.kernel.rhs(self.packed(), np.ascontiguousarray(x, dtype=float), out)
+        x = np.ascontiguousarray(x, dtype=float)
+        if t is None:
+            self.kernel.rhs(self.packed(), x, out)
+        else:
+            self.module._rhs_t(self.packed(), float(t), x, out)
         return out
 
     def scipy_rhs(self):
         """fun(t, x) for ``solve_ivp`` calling the compiled right-hand side."""
-        P, rhs = self.packed(), self.kernel.rhs
+        P, rhs = self.packed(), self.module._rhs_t
 
         def fun(t, x):
             out = np.empty(x.shape[0])
-            rhs(P, x, out)
+            rhs(P, float(t), x, out)
             return out
 
         return fun

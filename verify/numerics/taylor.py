@@ -168,6 +168,9 @@ def _numbers(fast, number) -> dict:
     error = fast.module.FIELD_ERROR
     if error:
         raise PendverifyError(f"{fast.model}: no Taylor reference: {error}")
+    if fast.forcing:
+        why = "the forcing is time-varying, and the references integrate a time-invariant field"
+        raise PendverifyError(f"{fast.model}: no Taylor reference: {why}")
 
     def conv(values):
         return [number(float(v)) for v in values]

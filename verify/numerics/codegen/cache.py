@@ -25,6 +25,7 @@ import sys
 import sysconfig
 import time
 import types
+import weakref
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -73,7 +74,15 @@ def _generator_files() -> set[str]:
 def model_key(model_cls) -> str | None:
     """SHA-256 of everything the generated source depends on, without reading the model (docstring).
 
-    None when a class has no source file (the generator then always runs)."""
+    None when a class has no source file (the generator then runs once per process).  Computed
+    once per class and process (resolving and hashing the files costs ≈ 40 ms): a source file
+    edited while a process runs is seen after ``forget()``."""
+    if model_cls not in _MODEL_KEYS:
+        _MODEL_KEYS[model_cls] = _model_key(model_cls)
+    return _MODEL_KEYS[model_cls]
+
+
+def _model_key(model_cls) -> str | None:
     files: set[str] = set()
     try:
         classes = [
@@ -97,8 +106,11 @@ def model_key(model_cls) -> str | None:
     # not the module's name: a plug-in's is salted per process (pendverify.analytic.plugin)
     version = importlib.metadata.version("sympy")
     h = hashlib.sha256(f"{_module.GENERATOR}|{version}|{model_cls.__qualname__}".encode())
-    for path in sorted(files):
-        h.update(f"|{Path(path).name}:{_file_digest(path)}".encode())
+    try:
+        for path in sorted(files):
+            h.update(f"|{Path(path).name}:{_file_digest(path)}".encode())
+    except OSError:  # a class loaded from a file that is gone (a certificate's source, on a new process)
+        return None
     return h.hexdigest()
 
 
@@ -130,12 +142,17 @@ class GeneratedKernel:
 
 _MEMORY: dict[str, types.ModuleType] = {}  # digest → module
 _KEYS: dict[str, str] = {}  # model key → digest
+_MODEL_KEYS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # model class → its model key
+_KEYLESS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # class without a key → digest
 
 
 def forget() -> None:
-    """Forget the modules this process loaded: the next ``kernel`` call reads the disk (tests)."""
+    """Forget the modules and model keys this process holds: the next ``kernel`` call reads the
+    disk (tests)."""
     _MEMORY.clear()
     _KEYS.clear()
+    _MODEL_KEYS.clear()
+    _KEYLESS.clear()
 
 
 def _import(path: Path, digest: str) -> types.ModuleType:
@@ -167,8 +184,11 @@ def kernel(model_cls, fresh: bool = False) -> GeneratedKernel:
     start = time.perf_counter()
     key = None if fresh else model_key(model_cls)
     index = cache_dir() / f"index_{key[:24]}.txt" if key else None
-    if key and key in _KEYS:
-        digest = _KEYS[key]
+    if fresh:
+        digest = None
+    else:
+        digest = _KEYS.get(key) if key else _KEYLESS.get(model_cls)
+    if digest is not None:
         module = _MEMORY[digest]
         return GeneratedKernel(module, digest, Path(module.__file__), "memory", time.perf_counter() - start)
     if index is not None and index.is_file():
@@ -187,4 +207,6 @@ def kernel(model_cls, fresh: bool = False) -> GeneratedKernel:
     if key:
         write_atomic(index, digest + "\n")
         _KEYS[key] = digest
+    elif not fresh:  # a class loaded from a file that is gone (a certificate's model source)
+        _KEYLESS[model_cls] = digest
     return GeneratedKernel(module, digest, path, "generated", time.perf_counter() - start)

@@ -1,7 +1,10 @@
-"""The numba functions of a generated module: ``_rhs``, ``_hamilton`` and ``_to_momentum``.
+"""The numba functions of a generated module: ``_rhs_t``, ``_rhs``, ``_hamilton`` and ``_to_momentum``.
 
-``_rhs(P, x, out)``: ẋ = (q̇, q̈) for x = (q, q̇[, W_in, W_diss]), M q̈ = τ − bias by the
-unrolled LDLᵀ solve; with the work integrals, dW_in/dt = q̇ᵀ B u, dW_diss/dt = q̇ᵀ D q̇.
+``_rhs_t(P, t, x, out)``: ẋ = (q̇, q̈) at time t for x = (q, q̇[, W_in, W_diss]), M q̈ = τ − bias
+by the unrolled LDLᵀ solve, τ = B (u0 − K x) − D q̇ + f(t) with f(t) the packed forcing (a
+sum of sinusoids per channel, ``pendverify.numerics.generate``); with the work integrals,
+dW_in/dt = q̇ᵀ (B u + f(t)), dW_diss/dt = q̇ᵀ D q̇.  ``_rhs(P, x, out)`` is ``_rhs_t`` at t = 0,
+for the callers of an autonomous field.
 
 ``_hamilton(P, y, out)``: (q̇, ṗ) at y = (q, p), p = M(q) q̇ (the canonical momentum).
 q̇ = M(q)⁻¹ p by the same LDLᵀ solve.  ṗ: differentiating p = M(q) q̇ along a solution,
@@ -15,6 +18,9 @@ Hamilton's ṗ = −∂H/∂q + τ = ½ q̇ᵀ (∂M/∂q) q̇ − ∂V/∂q + �
 cancels the shared terms (``expressions.momentum_rate``).
 
 ``_to_momentum(P, x, y)``: y = (q, M(q) q̇).
+
+``_hamilton`` has no time argument: it leaves the forcing out (``fixedstep``, its only
+caller, refuses a system with forcing).
 
 All three read the packed array P (layout in ``pendverify.numerics.generate``).
 """
@@ -102,11 +108,25 @@ def _cse(exprs, prefix: str):
     return sp.cse(exprs, symbols=sp.numbered_symbols(prefix), order="canonical")
 
 
+def _forcing(ex: Expressions) -> list[str]:
+    """ti += f(t): after u0, [channels] then per channel g (n), amplitude, m, m × (ω, φ), when packed."""
+    n = ex.n
+    lines = ["# forcing f(t) = sum over channels c of g_c a_c sum_k sin(w_ck t + phi_ck)", "oc = ou + nu"]
+    lines += ["if P.shape[0] > oc:", "    o = oc + 1", "    for c in range(int(P[oc])):"]
+    lines += [f"        m = int(P[o + {n + 1}])", "        s = 0.0", "        for k in range(m):"]
+    lines += [f"            s += math.sin(P[o + {n + 2} + 2*k]*t + P[o + {n + 3} + 2*k])"]
+    lines += [f"        s *= P[o + {n}]"] + [f"        ti{i} += P[o + {i}]*s" for i in range(n)]
+    lines += [f"        o += {n + 2} + 2*m"]
+    return lines
+
+
 def render_rhs(ex: Expressions) -> list[str]:
+    """``_rhs_t(P, t, x, out)`` and the autonomous ``_rhs(P, x, out)`` (t = 0)."""
     n, pr = ex.n, numba_printer()
     pairs = lower(n)
     replacements, reduced = _cse([ex.mass[i, j] for i, j in pairs] + list(ex.bias), "e")
-    body = _reads(ex, "x", True) + _tau(ex) + ["# M (lower triangle) and the bias C(q, v) v + H(q)"]
+    body = _reads(ex, "x", True) + _tau(ex) + _forcing(ex)
+    body += ["# M (lower triangle) and the bias C(q, v) v + H(q)"]
     body += [f"{pr.doprint(s)} = {pr.doprint(e)}" for s, e in replacements]
     mass, zero = mass_lines(ex, reduced[: len(pairs)], pr)
     body += mass
@@ -119,7 +139,8 @@ def render_rhs(ex: Expressions) -> list[str]:
         f"    out[{2 * n}] = " + " + ".join(f"v{i}*ti{i}" for i in range(n)),
         f"    out[{2 * n + 1}] = -(" + " + ".join(f"v{i}*td{i}" for i in range(n)) + ")",
     ]
-    return _function("_rhs", "P, x, out", body, inline=True)
+    autonomous = _function("_rhs", "P, x, out", ["_rhs_t(P, 0.0, x, out)"], inline=True)
+    return [*_function("_rhs_t", "P, t, x, out", body, inline=True), "", *autonomous]
 
 
 def render_hamilton(ex: Expressions) -> list[str]:

@@ -1,0 +1,193 @@
+"""The battery's invariant items: one short run per effect (``pendverify.certify.scenes``), on the fast path.
+
+Engines, recorded in each invariant item's ``engine``:
+
+* ``compiled`` — the compiled DOP853 on the model's generated closed form
+  (``pendverify.numerics.fast_scene``), the invariants evaluated on its own accepted steps
+  with the model's generated energy (``pendverify.numerics.energies``).  Every battery
+  scene compiles: gravity, damping, the sine input and the seeded noise
+  (``pendverify.numerics.forcing``).  It is the engine of every item the battery issues,
+  unless the fast path cannot take the model (its closed forms unreadable by SymPy);
+* ``aba`` — scipy's DOP853 on Pinocchio's ABA on the URDF being certified, with
+  Pinocchio's energy (``pendverify.simulation.simulate``): the engine of every invariant
+  item issued before the fast path, so an item that records no engine ran on it.
+
+``recheck`` runs each item on the engine its certificate records, so it reproduces the
+figures of certificates from before as well as after.
+
+What changed in meaning.  On ``aba`` the run and the energy were both Pinocchio's: the
+items judged the integrator and Pinocchio's physics, which conserve Pinocchio's energy
+whatever the hand derivation says.  On ``compiled`` they are both the closed form's: the
+items judge the derivation's own consistency — a C that is not Christoffel-consistent with
+M, or an H that is not ∇V, makes the closed form gain or lose energy, and the drift or
+balance fails (``tests/test_fast_battery.py`` plants both).  That the closed form is the
+URDF's dynamics is what the core checks establish (ε-level, 2000 states).
+
+Cross-check, decided.  A full ABA run of the gravity scene as well would cost ≈ 0.15–0.3 s
+a set (measured on the seeds at the default settings, as much as the whole per-set budget)
+and would compare two chaotic trajectories, which separate for reasons that are not model
+errors.  Instead ``invariant:gravity:engines`` compares the compiled q̈ with Pinocchio's
+ABA on the URDF being certified at ``CROSS_CHECK_STATES`` of the gravity run's own
+accepted steps (evenly spread, first and last included), each state judged as the core
+``aba`` check judges one (``cross_check``): it ties the very trajectory the invariants
+judged — the generated code, not only the Python closed form the core checks read — to
+the URDF, for ≈ 3–5 ms a set.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from pendverify.certify.scenes import effect_scenes
+from pendverify.errors import FastPathError, PendverifyError
+
+COMPILED, ABA = "compiled", "aba"
+ENGINES = {
+    COMPILED: "compiled DOP853 on the generated closed form",
+    ABA: "scipy DOP853 on Pinocchio's ABA",
+}
+UNRECORDED = ABA  # the engine of an invariant item that records none (issued before the fast path)
+CROSS_CHECK_STATES = 8
+
+
+def invariant_items(model_cls, params, urdf: str, settings, engines=None, system=None) -> list:
+    """One simulation per effect the model has, on the fast path where it compiles, else ABA on ``urdf``.
+
+    ``engines``: effect → engine, to run each on a given engine (``recheck``: the certificate's);
+    ``system``: the ``PinocchioSystem`` of ``urdf`` at the set's g, if the caller has it.
+    """
+    from pendverify.simulation.scene import parse_scene
+
+    items = []
+    scenes = effect_scenes(model_cls, params, settings.sim_duration, settings.sim_rtol, settings.seed)
+    for effect, doc in scenes.items():
+        scene = parse_scene(doc, f"<battery {effect}>")
+        engine, run, steps, failure = _run(scene, urdf, (engines or {}).get(effect))
+        if run is None:  # a run that diverges or dies is a failed item, not a crash of the battery
+            items.append(_item(f"invariant:{effect}", None, 0, settings, engine, failure))
+            continue
+        for inv in run.invariants:
+            name = f"invariant:{effect}:{inv.name.split(' ')[0]}"
+            name += ":no-increase" if inv.name.startswith("energy never") else ""
+            items.append(_item(name, inv, steps, settings, engine))
+        if effect == "gravity" and engine == COMPILED:
+            if system is None:
+                from pendverify.robot.system import PinocchioSystem
+
+                system = PinocchioSystem.for_model(model_cls, urdf, params.g)
+            check, states = cross_check(run, system), min(CROSS_CHECK_STATES, steps + 1)
+            items.append(_item(f"invariant:{effect}:engines", check, states, settings, engine))
+    return items
+
+
+def _run(scene, urdf: str, engine: str | None):
+    """(engine, run or None, accepted steps, why it failed): on the fast path unless ``engine`` says aba
+    or (``engine`` None) the scene does not compile."""
+    from pendverify.numerics import fast_scene
+    from pendverify.simulation.simulate import simulate
+
+    if engine not in (None, *ENGINES):
+        return engine, None, 0, f"unknown battery engine {engine!r}; expected one of {', '.join(ENGINES)}"
+    compiled = None
+    if engine in (None, COMPILED):
+        try:
+            compiled = fast_scene.compile_scene(scene)
+        except (FastPathError, PendverifyError) as exc:
+            if engine == COMPILED:
+                return COMPILED, None, 0, str(exc)
+    try:
+        with np.errstate(over="ignore", invalid="ignore"):  # a diverging run is judged by its items
+            if compiled is not None:
+                run = fast_scene.simulate(scene, compiled)
+                return COMPILED, run, len(run.result.steps_t) - 1, ""
+            run = simulate(scene, "aba", urdf)
+            return ABA, run, len(run.integration.steps_t) - 1, ""
+    except (PendverifyError, RuntimeError, FloatingPointError) as exc:
+        return (ABA if compiled is None else COMPILED), None, 0, str(exc)
+
+
+class _CompiledModel:
+    """The closed-form model with q̈ from its generated code (friction and inputs included)."""
+
+    def __init__(self, model):
+        from pendverify.numerics.generate import GeneratedSystem
+
+        self._model = model
+        self._compiled = GeneratedSystem.from_model(model, D=model.damping_matrix(), B=model.input_matrix())
+
+    def __getattr__(self, name):
+        return getattr(self._model, name)
+
+    def acceleration(self, q, v, u, w):
+        if np.any(w):  # the gravity run's states have none
+            raise ValueError("the compiled cross-check takes states without disturbance")
+        compiled = replace(self._compiled, u0=np.asarray(u, float).reshape(-1))
+        return compiled.rhs(np.concatenate([q, v]))[self._model.nv :]
+
+
+def cross_check(run, system):
+    """The compiled q̈ against ABA on ``system`` at ``CROSS_CHECK_STATES`` of the run's accepted steps.
+
+    Each state is judged as the core ``aba`` check judges one (``pendverify.checks``: its
+    quantity, scale, K, c_T, world-frame amplification A and model-form allowance), with
+    the generated code in place of the hand-written q̈; a state beyond the trust limit fails.
+    """
+    from pendverify.checks.catalogue import CHECKS
+    from pendverify.checks.quantities import aba
+    from pendverify.checks.sampling import State
+    from pendverify.checks.scaling import world_lever
+    from pendverify.checks.trust import EPS, REFUSE_REL
+    from pendverify.simulation.invariants import figures_of
+
+    steps_t, steps_x = run.result.steps_t, run.result.steps_x
+    rows = np.unique(np.linspace(0, len(steps_t) - 1, CROSS_CHECK_STATES).round().astype(int))
+    model = _CompiledModel(run.dynamics.model)
+    n, K, c_T = model.nv, next(c.K for c in CHECKS if c.name == "aba"), system.cmap.amplification
+    zeros = (np.zeros(len(model.inputs)), np.zeros(len(model.disturbances)))
+    errors, tolerances = [], []
+    for t, x in zip(steps_t[rows], steps_x[rows], strict=True):
+        state = State(f"t = {t:.6g} s", x[:n], x[n : 2 * n], *zeros)
+        angle = float(np.max(np.abs(state.q[np.array(model.angular)]), initial=0.0))
+        rounding = K * EPS * ((1.0 + angle) * c_T + (world_lever(model, system, state.q) - 1.0))
+        sample = aba(model, system, state)
+        refused = not rounding <= REFUSE_REL
+        errors.append(np.inf if refused else sample.error / sample.scale)
+        tolerances.append(rounding + sample.allowance / sample.scale)
+    name = f"engines agree: compiled q̈ vs ABA on the URDF at {len(rows)} of the run's {len(steps_t)} states"
+    result = figures_of(name, np.array(errors), np.array(tolerances), steps_t[rows], 1.0, "as the aba check")
+    return replace(result, scale=float("nan"))  # each state's error is relative to its own scale
+
+
+def _item(name: str, inv, samples: int, settings, engine: str, failure: str = ""):
+    """A battery item from an ``InvariantResult`` (or a failed run's message, ``inv`` None)."""
+    from pendverify.certify.battery import BatteryItem
+
+    if inv is None:
+        return BatteryItem(
+            name, "invariant", np.inf, 0.0, 0, settings.seed, False, failure, max_error=np.inf, engine=engine
+        )
+    return BatteryItem(
+        name,
+        "invariant",
+        inv.error,
+        inv.tolerance,
+        samples,
+        settings.seed,
+        inv.passed,
+        f"{inv.name} [{ENGINES[engine]}]",
+        at=f"t = {inv.worst_t:.6g} s",
+        max_error=inv.max_error,
+        max_error_at=f"t = {inv.max_error_t:.6g} s",
+        engine=engine,
+    )
+
+
+def recorded_engines(items: list[dict]) -> dict[str, str]:
+    """effect → engine of a certificate's invariant items (``UNRECORDED`` where an item names none)."""
+    return {
+        item["name"].split(":")[1]: item.get("engine", UNRECORDED)
+        for item in items
+        if item.get("kind") == "invariant"
+    }
