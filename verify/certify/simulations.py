@@ -77,8 +77,12 @@ def invariant_items(model_cls, params, urdf: str, settings, engines=None, system
                 from pendverify.robot.system import PinocchioSystem
 
                 system = PinocchioSystem.for_model(model_cls, urdf, params.g)
-            check, states = cross_check(run, system), min(CROSS_CHECK_STATES, steps + 1)
-            items.append(_item(f"invariant:{effect}:engines", check, states, settings, engine))
+            name, states = f"invariant:{effect}:engines", min(CROSS_CHECK_STATES, steps + 1)
+            try:
+                with np.errstate(over="ignore", invalid="ignore"):
+                    items.append(_item(name, cross_check(run, system), states, settings, engine))
+            except (PendverifyError, ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
+                items.append(_item(name, None, 0, settings, engine, f"{type(exc).__name__}: {exc}"))
     return items
 
 
