@@ -19,30 +19,13 @@ import pinocchio as pin
 
 from pendverify.errors import UrdfShapeError
 from pendverify.robot.mjcf_strict import MjcfReading, read_mjcf_strictly
-from pendverify.robot.urdfdom import capture_output, log_records
+from pendverify.robot.urdfdom import build_from_file, capture_output
 
 
 def build_mjcf_model(text: str, source: str) -> tuple[pin.Model, MjcfReading, list[str]]:
     """(model, strict reading, Pinocchio's printed lines) of an MJCF document; errors name ``source``."""
     reading = read_mjcf_strictly(text, source)
-    with tempfile.TemporaryDirectory(prefix="pendverify-mjcf-") as folder:
-        path = os.path.join(folder, "model.xml")
-        with open(path, "w", encoding="utf-8") as handle:
-            handle.write(text)
-        with capture_output((1, 2)) as captured:
-            try:
-                model = pin.buildModelFromMJCF(path)
-            except (RuntimeError, ValueError, IndexError) as exc:
-                failure: Exception | None = exc
-            else:
-                failure = None
-    log = log_records(captured.text)
-    if failure is not None:
-        lines = [line.strip() for line in str(failure).splitlines() if line.strip()]
-        reason = lines[-1] if lines else type(failure).__name__
-        raise UrdfShapeError(
-            source, f"Pinocchio cannot parse it as MJCF: {reason.removeprefix('message:').strip()}"
-        )
+    model, log = build_from_file(pin.buildModelFromMJCF, text, "model.xml", source, "MJCF")
     _same_as_read(model, reading, source)
     return model, reading, log
 

@@ -16,8 +16,6 @@ Conventions:
 
 from __future__ import annotations
 
-import os
-import tempfile
 import xml.etree.ElementTree as ET
 
 import pinocchio as pin
@@ -26,7 +24,7 @@ from pendverify.errors import UrdfShapeError
 from pendverify.robot.inertia_rounding import check_inertia_tensor
 from pendverify.robot.strict import DescriptionFacts, JointDynamics, parse_xml
 from pendverify.robot.urdf_numbers import NOT_A_NUMBER, parse_number, why_not
-from pendverify.robot.urdfdom import capture_output, log_records
+from pendverify.robot.urdfdom import build_from_file
 
 #: element tag → how many numbers its text holds
 NUMBERS: dict[str, tuple[int, ...]] = {
@@ -64,23 +62,7 @@ def build_sdf_model(text: str, source: str) -> tuple[pin.Model, DescriptionFacts
     if not getattr(pin, "WITH_SDFORMAT", False):
         raise UrdfShapeError(source, NO_SDFORMAT)
     facts = read_sdf_strictly(text, source)
-    with tempfile.TemporaryDirectory(prefix="pendverify-sdf-") as folder:
-        path = os.path.join(folder, "model.sdf")
-        with open(path, "w", encoding="utf-8") as handle:
-            handle.write(text)
-        with capture_output((1, 2)) as captured:
-            try:
-                built = pin.buildModelsFromSdf(path)
-            except (RuntimeError, ValueError, IndexError) as exc:
-                failure: Exception | None = exc
-            else:
-                failure = None
-    log = log_records(captured.text)
-    if failure is not None:
-        lines = [line.strip() for line in str(failure).splitlines() if line.strip()]
-        raise UrdfShapeError(
-            source, f"Pinocchio cannot parse it as SDFormat: {lines[-1] if lines else failure!r}"
-        )
+    built, log = build_from_file(pin.buildModelsFromSdf, text, "model.sdf", source, "SDFormat")
     model, constraints = (built[0], built[1]) if isinstance(built, tuple) else (built, [])
     if len(constraints):
         raise UrdfShapeError(source, f"has {len(constraints)} constraint(s) (a closed chain); refused")

@@ -105,3 +105,30 @@ def capture_output(fds: tuple[int, ...] = (2,)) -> Iterator[_Captured]:
 def _capture_fd2():
     """``capture_output`` of file descriptor 2, where urdfdom's C++ ``std::cerr`` writes."""
     return capture_output((2,))
+
+
+def build_from_file(builder, text: str, filename: str, source: str, kind: str):
+    """``builder(path)`` on ``text`` written to a temporary ``filename`` (Pinocchio's Python
+    bindings read MJCF and SDFormat from files only), its printed lines captured.
+
+    Returns (what the builder built, the lines it printed); a failure is one ``UrdfShapeError``
+    naming ``source`` and the last line of Pinocchio's message.
+    """
+    with tempfile.TemporaryDirectory(prefix="pendverify-") as folder:
+        path = os.path.join(folder, filename)
+        with open(path, "w", encoding="utf-8") as handle:
+            handle.write(text)
+        with capture_output((1, 2)) as captured:
+            try:
+                built = builder(path)
+            except (RuntimeError, ValueError, IndexError) as exc:
+                failure: Exception | None = exc
+            else:
+                failure = None
+    if failure is not None:
+        lines = [line.strip() for line in str(failure).splitlines() if line.strip()]
+        reason = lines[-1] if lines else type(failure).__name__
+        raise UrdfShapeError(
+            source, f"Pinocchio cannot parse it as {kind}: {reason.removeprefix('message:').strip()}"
+        )
+    return built, log_records(captured.text)
