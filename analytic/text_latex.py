@@ -77,7 +77,7 @@ def parse_latex_equation(reader, latex: LatexReader, key: str, value, rows: int,
             reader.fail(
                 key, f"wrong shape: the LaTeX gives {given}; with {rows} coordinates {key} must be {kind}"
             )
-    stray = _free(parsed) - set(allowed.values())
+    stray = parsed.free_symbols - set(allowed.values())
     if stray:
         names = ", ".join(sorted(s.name for s in stray))
         reader.fail(key, f"depends on {names}, which {key} may not (its arguments: {_args(allowed)})")
@@ -86,10 +86,6 @@ def parse_latex_equation(reader, latex: LatexReader, key: str, value, rows: int,
 
 def _shape(m) -> str:
     return f"{m.rows} row{'s' if m.rows != 1 else ''} of {m.cols} entr{'ies' if m.cols != 1 else 'y'}"
-
-
-def _free(expr) -> set:
-    return set(expr.free_symbols)
 
 
 def _args(allowed: dict) -> str:

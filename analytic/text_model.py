@@ -131,11 +131,11 @@ def _split_f(reader: Reader, spec: TextModelSpec) -> None:
         reader.fail(
             "f", f"its part linear in q̇ (the damping −D·q̇) depends on the coordinates: D = {D.tolist()}"
         )
-    Cqdot = sp.expand(-(velocity + D * v))
+    Cqdot = -(velocity + D * v)  # kept as written: the homogeneity test below expands a copy
     lam = sp.Dummy("lam")
     if not all(_is_zero(x) for x in Cqdot.xreplace({s: lam * s for s in v}) - lam**2 * Cqdot):
         reader.fail("f", "its velocity part is not −D·q̇ − C(q, q̇)·q̇ (linear plus quadratic in q̇)")
-    eq["H"], eq["Cqdot"] = H, -(velocity + D * v)
+    eq["H"], eq["Cqdot"] = H, Cqdot
     if any(x != 0 for x in D):
         eq["D"] = D
     spec.derived.update({k: f"from f: {how}" for k, how in _F_PARTS.items() if k in eq})

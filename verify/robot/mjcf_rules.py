@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 from typing import NoReturn
 
 from pendverify.errors import UrdfShapeError
-from pendverify.robot.urdf_numbers import NOT_A_NUMBER, parse_number, why_not
+from pendverify.robot.urdf_numbers import NOT_A_NUMBER, parse_number, parse_pieces, why_not
 
 ORIENTATIONS = ("quat", "axisangle", "euler", "xyaxes", "zaxis")
 _FRAME = {"pos": (3,), "quat": (4,), "axisangle": (4,), "euler": (3,), "xyaxes": (6,), "zaxis": (3,)}
@@ -120,13 +120,7 @@ class Numbers:
         if len(pieces) not in counts:
             need = " or ".join(str(c) for c in counts)
             fail(f"{raw!r}: needs exactly {need} numbers, found {len(pieces)}")
-        numbers = []
-        for i, piece in enumerate(pieces, 1):
-            number = parse_number(piece)
-            if number is None:
-                fail(f"{raw!r}: number {i}, {piece!r}, is {NOT_A_NUMBER}{why_not(piece)}")
-            numbers.append(number)
-        return tuple(numbers)
+        return parse_pieces(raw, pieces, fail)
 
 
 @dataclass

@@ -52,6 +52,11 @@ def parse_vector(raw: str, count: int, fail: Callable[[str], NoReturn]) -> tuple
     pieces = [p for p in raw.split(" ") if p]
     if len(pieces) != count:
         fail(f"{raw!r}: needs exactly {count} numbers separated by spaces, found {len(pieces)}")
+    return parse_pieces(raw, pieces, fail)
+
+
+def parse_pieces(raw: str, pieces: list[str], fail: Callable[[str], NoReturn]) -> tuple[float, ...]:
+    """Each piece of ``raw`` (already split and counted) as a number, or ``fail`` naming the first bad one."""
     numbers = []
     for i, piece in enumerate(pieces, 1):
         number = parse_number(piece)
