@@ -115,23 +115,29 @@ def test_each_command_on_a_model_written_here(command, tmp_path, capsys):
         assert main(argv) == 0, (argv, capsys.readouterr())
 
 
-@pytest.mark.parametrize("command", list(COMMANDS))
-def test_each_command_on_a_text_model(command, tmp_path, capsys):
-    """The equations as text (TOML, SymPy syntax), no Python: every command takes them too."""
-    text = EXAMPLES / "minimal_double_pendulum_text.toml"
-    urdf = EXAMPLES.parent / "urdf" / "double_pendulum.urdf"
-    model = Model(text, "minimal_double_pendulum", tmp_path, urdf)
-    for argv in COMMANDS[command](model):
-        assert main(argv) == 0, (argv, capsys.readouterr())
+#: the equations as text, no Python: (model file, stem of STEMS, URDF, parameter file)
+TEXT_MODELS = {
+    "sympy syntax": (
+        "minimal_double_pendulum_text.toml",
+        "minimal_double_pendulum",
+        "double_pendulum.urdf",
+        None,
+    ),
+    "seed 001 in LaTeX": (
+        "cart_double_pendulum_latex.toml",
+        "cart_double_pendulum",
+        "cart_double_pendulum.urdf",
+        EXAMPLES.parent / "analytic" / "params" / "cart_double_pendulum.toml",
+    ),
+}
 
 
 @pytest.mark.parametrize("command", list(COMMANDS))
-def test_each_command_on_a_latex_model(command, tmp_path, capsys):
-    """Seed 001's equations as the document prints them in LaTeX: every command takes them too."""
-    latex = EXAMPLES / "cart_double_pendulum_latex.toml"
-    urdf = EXAMPLES.parent / "urdf" / "cart_double_pendulum.urdf"
-    params = EXAMPLES.parent / "analytic" / "params" / "cart_double_pendulum.toml"
-    model = Model(latex, "cart_double_pendulum", tmp_path, urdf, params)
+@pytest.mark.parametrize("kind", list(TEXT_MODELS))
+def test_each_command_on_a_text_model(kind, command, tmp_path, capsys):
+    """A model written as text (TOML, SymPy syntax or LaTeX): every command takes it too."""
+    text, stem, urdf, params = TEXT_MODELS[kind]
+    model = Model(EXAMPLES / text, stem, tmp_path, EXAMPLES.parent / "urdf" / urdf, params)
     for argv in COMMANDS[command](model):
         assert main(argv) == 0, (argv, capsys.readouterr())
 
