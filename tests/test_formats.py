@@ -390,3 +390,18 @@ def test_the_animation_draws_each_formats_visuals_where_the_urdfs_are(fmt):
         return [(o.parentJoint, type(o.geometry).__name__, o.placement.translation.tolist()) for o in objects]
 
     assert shapes(FORMATS[fmt]) == shapes(URDF)
+
+
+def test_systems_on_one_read_description_leave_it_as_it_was():
+    """``for_model`` on a description already read (the battery reads its URDF once): each
+    system its own model copy at its own g; the description neither re-read nor changed."""
+    loaded = load_description(MJCF)
+    before = (loaded.model.gravity.linear.copy(), list(loaded.reading_notes))
+    at_g = PinocchioSystem.for_model(SEED_MODEL, loaded, 9.81)
+    at_zero = PinocchioSystem.for_model(SEED_MODEL, loaded, 0.0)
+    assert at_g.model is not loaded.model and at_zero.model is not at_g.model
+    assert np.array_equal(loaded.model.gravity.linear, before[0]) and loaded.reading_notes == before[1]
+    q = np.array([0.3, -0.7])
+    fresh = PinocchioSystem.for_model(SEED_MODEL, MJCF, 9.81)
+    assert np.array_equal(at_g.gravity(q), fresh.gravity(q))
+    assert np.array_equal(at_zero.gravity(q), np.zeros(2)) and at_g.notes == fresh.notes

@@ -31,6 +31,7 @@ from pendverify.checks.verdict import REFUSED
 from pendverify.checks.verification import guarded_checks
 from pendverify.progress import bar
 from pendverify.robot.system import PinocchioSystem
+from pendverify.robot.urdf import LoadedUrdf, load_urdf
 
 
 @dataclass(frozen=True)
@@ -110,7 +111,9 @@ def invariant_items(
     return simulations.invariant_items(model_cls, params, urdf, settings, engines, system)
 
 
-def stress_items(model_cls, params, settings: BatterySettings, urdf: str | None = None) -> list[BatteryItem]:
+def stress_items(
+    model_cls, params, settings: BatterySettings, urdf: str | LoadedUrdf | None = None
+) -> list[BatteryItem]:
     """The stress cases that apply to any parameter set, run on this one.
 
     Large angles (|θ| ≈ 1e6 rad, with the θ + 2πk invariance; states beyond the
@@ -118,7 +121,8 @@ def stress_items(model_cls, params, settings: BatterySettings, urdf: str | None 
     (|q̇| ≤ 1e3), zero gravity, and the conditioning guard of
     ``pendverify.checks.trust`` over the sampled states: a set whose
     comparisons would need refusing (near-singular M) is not certified.  They run
-    on ``urdf``, the URDF being certified (the project's own for the set if None).
+    on ``urdf``, the URDF being certified (text, path or as read by ``load_urdf``; the
+    project's own for the set if None).
     """
     from pendverify.stress import cases, framework
     from pendverify.stress import catalogue as stress
@@ -165,10 +169,11 @@ def run_battery(
 
     ``engines``: effect → the engine its invariant items ran on (``recheck``: the certificate's)."""
     cls = model_class(model)
-    system = PinocchioSystem.for_model(cls, urdf, params.g, f"<URDF being certified: {cls.name}>")
+    loaded = load_urdf(urdf, f"<URDF being certified: {cls.name}>")  # read once for every part
+    system = PinocchioSystem.for_model(cls, loaded, params.g)
     parts = (
         lambda: check_items(cls(params), system, settings),
-        lambda: stress_items(cls, params, settings, urdf),
+        lambda: stress_items(cls, params, settings, loaded),
         lambda: invariant_items(cls, params, urdf, settings, engines, system),
     )
     items = []

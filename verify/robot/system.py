@@ -58,15 +58,30 @@ class PinocchioSystem:
         self._no_gravity_data = self._no_gravity.createData()
 
     @classmethod
-    def for_model(cls, model_cls, urdf: str | Path, g: float | None = None, source: str | None = None):
+    def for_model(
+        cls,
+        model_cls,
+        urdf: str | Path | LoadedUrdf,
+        g: float | None = None,
+        source: str | None = None,
+    ):
         """The one constructor: a description (path or XML text; URDF, xacro, MJCF) seen in model
         class ``model_cls``'s coordinates.
 
         ``g`` is the gravity of the closed form; if None, the description's own (an MJCF's
         ``<option gravity>``), else Pinocchio's default 9.81 m/s².  A description whose own g
         differs from ``g`` is evaluated with ``g``, and its notes say so.
+
+        ``urdf`` may also be a description already read (``load_urdf``'s result): systems
+        on the same description at several g then read it once.  Each system takes its own
+        copy of the Pinocchio model (it sets the model's gravity), so the description given
+        is left as it was and ``source`` is its own.
         """
-        loaded = load_urdf(urdf, source)
+        if isinstance(urdf, LoadedUrdf):
+            notes = list(urdf.reading_notes)
+            loaded = dataclasses.replace(urdf, model=urdf.model.copy(), reading_notes=notes)
+        else:
+            loaded = load_urdf(urdf, source)
         own = loaded.facts.gravity
         if g is not None and own is not None and g != own:
             loaded.reading_notes.append(

@@ -27,6 +27,7 @@ from pendverify.checks.verdict import WARN
 from pendverify.checks.verification import batch_verdicts
 from pendverify.errors import IllConditionedError
 from pendverify.robot.system import PinocchioSystem
+from pendverify.robot.urdf import LoadedUrdf, load_urdf
 from pendverify.stress.trust_study import StudyResult, cart_study
 from pendverify.validate import model_state
 
@@ -113,8 +114,9 @@ class Context:
     settings: Settings = FULL
     seed: int = SEED
     study: StudyResult | None = None
-    #: the URDF (text or path) the cases compare with; None: the one the project writes for each set
-    urdf: str | None = None
+    #: the URDF (text, path, or as read by ``load_urdf``) the cases compare with; None: the one
+    #: the project writes for each set
+    urdf: str | LoadedUrdf | None = None
     #: the model class of the sets (a plug-in's); None: the built-in model each set names
     model_cls: type | None = None
     #: the systems made so far, by parameter set (cases on the same set share one)
@@ -129,9 +131,10 @@ class Context:
         if self.urdf is None:
             system = system_for(params)
         else:
+            if not isinstance(self.urdf, LoadedUrdf):  # read once: the cases' sets differ in g only
+                self.urdf = load_urdf(self.urdf, "<URDF being compared>")
             cls = self.model_cls or MODELS[params.model]
-            g = getattr(params, "g", None)
-            system = PinocchioSystem.for_model(cls, self.urdf, g, "<URDF being compared>")
+            system = PinocchioSystem.for_model(cls, self.urdf, getattr(params, "g", None))
         with contextlib.suppress(TypeError):  # a set that cannot be a key is not kept
             self.systems[params] = system
         return system
