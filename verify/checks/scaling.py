@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from pendverify.checks.spectral import norms2
 from pendverify.checks.trust import term_amplification
 
 
@@ -69,7 +70,8 @@ def rate_scale(model, q, v) -> float:
 
 
 def norm2(A) -> float:
-    return float(np.linalg.norm(A, 2))
+    """‖A‖₂ of one matrix (``checks.spectral``)."""
+    return float(norms2(A))
 
 
 def world_lever(model, system, q) -> float:
@@ -83,11 +85,6 @@ def world_lever(model, system, q) -> float:
     (``pendverify.checks.trust.term_amplification``.)
     """
     return term_amplification(model, system, q)
-
-
-def norms2(A):
-    """The 2-norm of a matrix, or of each matrix of a batch (LAPACK's SVD, once per matrix)."""
-    return np.linalg.norm(A, 2, axis=(-2, -1))
 
 
 def force_scale_of(rate, v, w, g_scale, B, W, D, u, w_in):

@@ -82,6 +82,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pendverify.checks.amplification import term_amplification
+from pendverify.checks.spectral import conds2
 from pendverify.errors import IllConditionedError
 
 EPS = float(np.finfo(float).eps)
@@ -115,8 +116,7 @@ class Conditioning:
 def _cond(A: np.ndarray) -> float:
     if not np.all(np.isfinite(A)):
         return math.inf
-    with np.errstate(all="ignore"):
-        kappa = float(np.linalg.cond(A))
+    kappa = conds2(A)
     return kappa if math.isfinite(kappa) else math.inf
 
 

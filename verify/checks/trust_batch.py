@@ -3,8 +3,8 @@
 ``assess`` judges one state from three mass matrices' conditioning (the closed form's M
 with the model's scale S, the same with Pinocchio's term amplification A, and Pinocchio's
 M with its own diagonal); ``assess_batch`` forms the same numbers for a whole batch —
-the matrices and A from ``pendverify.checks.batch.BatchContext``, κ by one SVD per
-matrix (as ``np.linalg.cond``), the bounds elementwise, Python's ``max`` and tuple
+the matrices and A from ``pendverify.checks.batch.BatchContext``, κ matrix by matrix
+as ``trust`` forms it (``checks.spectral``), the bounds elementwise, Python's ``max`` and tuple
 comparisons written out — and returns the very ``Conditioning`` each state's ``assess``
 returns.  A state whose numbers are not all finite is assessed by ``assess`` itself.
 The rule and its argument are in ``pendverify.checks.trust``.
@@ -14,16 +14,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from pendverify.checks.spectral import conds2
 from pendverify.checks.trust import EPS, KAPPA_K, REFUSE_REL, WARN_REL, Conditioning, assess
 
 
 def _cond(M: np.ndarray) -> np.ndarray:
-    """``trust._cond`` of each matrix: κ₂ by SVD, inf for a matrix not finite or singular."""
+    """``trust._cond`` of each matrix: κ₂ (``checks.spectral``), inf for a matrix not finite or singular."""
     finite = np.all(np.isfinite(M), axis=(-2, -1))
-    safe = np.where(finite[:, None, None], M, np.eye(M.shape[-1]))
-    s = np.linalg.svd(safe, compute_uv=False)
-    with np.errstate(all="ignore"):
-        kappa = s[:, 0] / s[:, -1]
+    kappa = conds2(np.where(finite[:, None, None], M, np.eye(M.shape[-1])))
     return np.where(finite & np.isfinite(kappa), kappa, np.inf)
 
 
