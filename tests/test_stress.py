@@ -341,3 +341,27 @@ def test_fit_slope():
     t = np.linspace(0, 10, 11)
     slope, r2 = si.fit_slope(t, 3 * t + 1)
     assert slope == pytest.approx(3.0) and r2 == pytest.approx(1.0)
+
+
+@pytest.mark.parametrize(
+    "bad, key, rule",
+    [
+        ({"v": np.array([0.0, math.nan])}, "v[1]", "finite"),
+        ({"q": np.array([0.0, 1.0, 2.0])}, "q", "must have 2 entries"),
+        ({"q": [0.0, math.inf]}, "q[1]", "finite"),  # a list, not an array: checked one by one
+    ],
+)
+def test_compare_refuses_a_bad_state_by_name_among_good_ones(bad, key, rule):
+    """The states are checked all at once when they are clean; a bad one still raises its
+    own error, naming the case, the state, the key and the rule."""
+    import dataclasses
+
+    from pendverify.checks.sampling import sample_states
+
+    model = DoublePendulum(default_params("double_pendulum"))
+    states = sample_states(model, 8, 1)
+    states[5] = dataclasses.replace(states[5], **bad)
+    with pytest.raises(InputError) as exc:
+        framework.compare("case", model, framework.system_for(model.params), states, 1)
+    text = str(exc.value)
+    assert f"<case: {states[5].label}>" in text and f"'{key}'" in text and rule in text, text

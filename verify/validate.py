@@ -64,3 +64,21 @@ def model_state(model, q, v=None, u=None, w=None, source: str = STATE_SOURCE):
     u = np.zeros(nu) if u is None else finite_state("u", u, nu, source)
     w = np.zeros(nw) if w is None else finite_state("w", w, nw, source)
     return q, v, u, w
+
+
+def model_states(model, states, source_of) -> None:
+    """``model_state`` for every state (objects with ``q``, ``v``, ``u``, ``w``); nothing returned.
+
+    States that are already float vectors of the model's sizes are checked all at once;
+    otherwise, or if any entry is not finite, each state is checked in turn, so the first
+    bad one raises its own ``InputError`` (``source_of(state)`` names its source).
+    """
+    sizes = (model.nv, model.nv, len(model.inputs), len(model.disturbances))
+    parts = [[getattr(s, key) for s in states] for key in "qvuw"]
+    if all(
+        all(type(x) is np.ndarray and x.dtype == np.float64 and x.shape == (n,) for x in column)
+        for column, n in zip(parts, sizes, strict=True)
+    ) and all(np.isfinite(np.array(column)).all() for column in parts if column):
+        return
+    for s in states:
+        model_state(model, s.q, s.v, s.u, s.w, source=source_of(s))

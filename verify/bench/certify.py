@@ -193,7 +193,7 @@ def measure_set(params_file: str, settings: BatterySettings, repeats: int, refer
 
 
 def measure(
-    params_files=None, settings: BatterySettings | None = None, repeats: int = 3, reference_repeats=1
+    params_files=None, settings: BatterySettings | None = None, repeats: int = 7, reference_repeats=1
 ):
     """``SetCost`` for each parameter file (default: every built-in model's own set)."""
     files = params_files or [str(default_parameter_file(name)) for name in MODELS]

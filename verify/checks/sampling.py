@@ -78,7 +78,7 @@ def sample_states(model: ClosedFormModel, n_random: int = DEFAULT_RANDOM_STATES,
         states.append(State(f"{name} at rest", q, np.zeros(nv), zero_u, zero_w))
         states.append(State(f"{name} moving", q, x[:nv], x[nv : nv + nu], x[nv + nu :]))
     qs, vuw = randoms[:, :nv] * q_range, randoms[:, nv:] * scale
-    for i in range(n_random):
-        x = vuw[i]
-        states.append(State(f"random #{i}", qs[i], x[:nv], x[nv : nv + nu], x[nv + nu :]))
+    labels = [f"random #{i}" for i in range(n_random)]
+    # each state's vectors are rows of the blocks (views, as the slices of a row were)
+    states += map(State, labels, qs, vuw[:, :nv], vuw[:, nv : nv + nu], vuw[:, nv + nu :])
     return states

@@ -46,7 +46,7 @@ def register(sub) -> None:
         help="the certification battery's cost per parameter set on one core: batch, per-state path, floor",
     )
     c.add_argument("--quick", action="store_true", help="100 states, short simulations, one run each")
-    c.add_argument("--repeats", type=positive_int, default=None, help="runs per figure, least kept (3)")
+    c.add_argument("--repeats", type=positive_int, default=None, help="runs per figure, least kept (7)")
     c.add_argument(
         "--reference-repeats",
         type=positive_int,
@@ -136,7 +136,7 @@ def run_certify(args: argparse.Namespace) -> int:
         from pendverify.certify.battery import BatterySettings
 
         settings = quick_settings() if args.quick else BatterySettings()
-        repeats = args.repeats or (1 if args.quick else 3)
+        repeats = args.repeats or (1 if args.quick else 7)
         costs = measure(args.params, settings, repeats, args.reference_repeats)
     print(table(costs, settings, repeats, args.reference_repeats, blas))
     if args.json:

@@ -29,7 +29,7 @@ from pendverify.errors import IllConditionedError
 from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.urdf import LoadedUrdf, load_urdf
 from pendverify.stress.trust_study import StudyResult, cart_study
-from pendverify.validate import model_state
+from pendverify.validate import model_states
 
 SEED = DEFAULT_SEED
 TINY = float(np.finfo(float).tiny)
@@ -180,8 +180,8 @@ def compare(name: str, model, system, states: list[State], seed: int) -> _Compar
     level = "ok"
     batch = BatchContext.of(model, system, states)
     verdicts = batch_verdicts(model, system, states, batch)
+    model_states(model, states, lambda s: f"<{name}: {s.label}>")
     for i, s in enumerate(states):
-        model_state(model, s.q, s.v, s.u, s.w, source=f"<{name}: {s.label}>")
         try:
             verdict = None if verdicts is None else verdicts[i]
             c = check_conditioning(model, s.q, system, what=name, verdict=verdict)
