@@ -2,7 +2,9 @@
 
 For each built-in parameter set (``analytic/params``; or the sets given), measured in one
 run as process time (CPU seconds of this process, BLAS held to one thread), the least of
-``repeats`` runs:
+``repeats`` runs taken in rounds over every figure (``least_in_rounds``: on a shared
+machine a slow spell lasts seconds, and rounds spread each figure's runs over the
+whole measurement instead of putting them all into one spell):
 
 * the battery (``certify.battery.run_battery``) and its parts: ``checks`` (the trust
   guard and every check on the sampled states), ``stress`` (the four generic cases) and
@@ -63,20 +65,41 @@ class SetCost:
         return dict(self.__dict__)
 
 
-def cpu_seconds(fn, repeats: int) -> float:
-    """The least process time of ``repeats`` calls of ``fn`` (after one untimed call)."""
-    fn()
-    best = float("inf")
+def cpu_once(fn) -> float:
+    """The process time of one call of ``fn``, the garbage collector held off meanwhile."""
     enabled = gc.isenabled()
     gc.disable()
     try:
-        for _ in range(max(1, repeats)):
-            start = time.process_time()
-            fn()
-            best = min(best, time.process_time() - start)
+        start = time.process_time()
+        fn()
+        return time.process_time() - start
     finally:
         if enabled:
             gc.enable()
+
+
+def cpu_seconds(fn, repeats: int) -> float:
+    """The least process time of ``repeats`` calls of ``fn`` in a row (after one untimed call)."""
+    fn()
+    return min(cpu_once(fn) for _ in range(max(1, repeats)))
+
+
+def least_in_rounds(figures: dict, repeats: int, between=None) -> dict:
+    """{key: the least process time of ``figures[key]()``}, each timed once per round, ``repeats`` rounds.
+
+    On a shared machine a slow spell lasts seconds: ``repeats`` calls in a row can all
+    fall into one, while rounds over every figure spread each figure's calls across the
+    whole run.  ``between()`` (the slow per-state path) runs after half of the rounds.
+    """
+    for fn in figures.values():
+        fn()  # untimed: caches, generated code
+    best = dict.fromkeys(figures, float("inf"))
+    rounds = max(1, repeats)
+    for r in range(rounds):
+        if between is not None and r == rounds // 2:
+            between()
+        for key, fn in figures.items():
+            best[key] = min(best[key], cpu_once(fn))
     return best
 
 
@@ -142,8 +165,8 @@ def _pinocchio_floor(ctx) -> list:
     return loops
 
 
-def floor_seconds(contexts, repeats: int) -> float:
-    """The bare Pinocchio calls and closed-form evaluations of the batches ``contexts``, timed alone."""
+def floor_work(contexts):
+    """A function running the bare Pinocchio calls and closed-form evaluations of the batches ``contexts``."""
     import pinocchio as pin  # noqa: F401  (loaded before timing)
 
     work = []
@@ -166,11 +189,21 @@ def floor_seconds(contexts, repeats: int) -> float:
             for args in zip(*rows, strict=True):
                 f(pm, data, *args)
 
-    return cpu_seconds(run, repeats)
+    return run
 
 
-def measure_set(params_file: str, settings: BatterySettings, repeats: int, reference_repeats: int) -> SetCost:
-    """One parameter set: every figure of the table, measured in this run."""
+@dataclass
+class _SetRun:
+    """One parameter set's timed callables: its parts, its battery and its parts' floors."""
+
+    name: str
+    parts: dict
+    battery: object
+    floors: dict
+    contexts: dict
+
+
+def _prepare(params_file: str, settings: BatterySettings) -> _SetRun:
     source = certification_input(params_file=params_file)
     cls, params, urdf = source.model.load(), source.params, source.urdf
     system = PinocchioSystem.for_model(cls, urdf, params.g, f"<URDF being certified: {cls.name}>")
@@ -179,26 +212,53 @@ def measure_set(params_file: str, settings: BatterySettings, repeats: int, refer
         "stress": lambda: stress_items(cls, params, settings, urdf),
         "invariants": lambda: invariant_items(cls, params, urdf, settings),
     }
-    batch = {part: cpu_seconds(fn, repeats) for part, fn in parts.items()}
-    battery = cpu_seconds(lambda: run_battery(cls, params, urdf, settings), repeats)
-    with per_state_only():
-        per_state = {part: cpu_seconds(parts[part], reference_repeats) for part in ("checks", "stress")}
-    floor, contexts = {}, {}
+    floors, contexts = {}, {}
     for part in ("checks", "stress"):
         recorded: list = []
         with recorded_batches(recorded):
             parts[part]()
-        floor[part], contexts[part] = floor_seconds(recorded, repeats), len(recorded)
-    return SetCost(source.name, battery, batch, per_state, floor, settings.samples, contexts)
+        floors[part], contexts[part] = floor_work(recorded), len(recorded)
+    return _SetRun(source.name, parts, lambda: run_battery(cls, params, urdf, settings), floors, contexts)
 
 
 def measure(
     params_files=None, settings: BatterySettings | None = None, repeats: int = 7, reference_repeats=1
 ):
-    """``SetCost`` for each parameter file (default: every built-in model's own set)."""
+    """``SetCost`` for each parameter file (default: every built-in model's own set).
+
+    Each batch, battery and floor figure is the least of ``repeats`` rounds over every
+    set and figure (``least_in_rounds``); the per-state path runs once between the
+    rounds, the least of ``reference_repeats`` calls in a row kept.
+    """
     files = params_files or [str(default_parameter_file(name)) for name in MODELS]
     settings = settings or BatterySettings()
-    return [measure_set(f, settings, repeats, reference_repeats) for f in files]
+    runs = [_prepare(f, settings) for f in files]
+    figures = {}
+    for i, run in enumerate(runs):
+        figures.update({(i, "batch", part): fn for part, fn in run.parts.items()})
+        figures[(i, "battery")] = run.battery
+        figures.update({(i, "floor", part): fn for part, fn in run.floors.items()})
+    per_state: dict = {}
+
+    def reference():
+        with per_state_only():
+            for i, run in enumerate(runs):
+                for part in ("checks", "stress"):
+                    per_state[(i, part)] = cpu_seconds(run.parts[part], reference_repeats)
+
+    best = least_in_rounds(figures, repeats, reference)
+    return [
+        SetCost(
+            run.name,
+            best[(i, "battery")],
+            {part: best[(i, "batch", part)] for part in PARTS},
+            {part: per_state[(i, part)] for part in ("checks", "stress")},
+            {part: best[(i, "floor", part)] for part in ("checks", "stress")},
+            settings.samples,
+            run.contexts,
+        )
+        for i, run in enumerate(runs)
+    ]
 
 
 def quick_settings() -> BatterySettings:
