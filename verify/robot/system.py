@@ -75,7 +75,7 @@ class PinocchioSystem:
         ``urdf`` may also be a description already read (``load_urdf``'s result): systems
         on the same description at several g then read it once.  Each system takes its own
         copy of the Pinocchio model (it sets the model's gravity), so the description given
-        is left as it was and ``source`` is its own.
+        is left as it was; messages name the source it was read with (``source`` is unused).
         """
         if isinstance(urdf, LoadedUrdf):
             notes = list(urdf.reading_notes)

@@ -178,9 +178,9 @@ def compare(name: str, model, system, states: list[State], seed: int) -> _Compar
     kept, refused = [], []
     kappa_raw = kappa_scaled = amplification = 0.0
     level = "ok"
+    model_states(model, states, lambda s: f"<{name}: {s.label}>")
     batch = BatchContext.of(model, system, states)
     verdicts = batch_verdicts(model, system, states, batch)
-    model_states(model, states, lambda s: f"<{name}: {s.label}>")
     for i, s in enumerate(states):
         try:
             verdict = None if verdicts is None else verdicts[i]
