@@ -484,3 +484,38 @@ def test_benchmark_prints_ratios(capsys):
             label = what if "smallest" in what else f"{what}, largest"
             print(f"  {label}: {ratio:.3g} {unit}")
     assert {r["model"] for r in rows} == set(MODELS)
+
+
+# --- a certificate's embedded model: the key of its text, not of a file that is gone --------------
+_EMBEDDED_CHILD = """
+import json, sys
+from pathlib import Path
+from pendverify.analytic.params import load_parameter_file
+from pendverify.certify.model_source import load_from_text
+from pendverify.numerics.generate import GeneratedSystem
+path = Path(sys.argv[1])
+cls = load_from_text(path.read_text(encoding="utf-8"), path.name)  # as recheck loads it
+params = load_parameter_file(path.with_suffix(".toml"), {cls.name: cls.params_type})[2]
+print(json.dumps(GeneratedSystem.from_model(cls(params)).kernel.origin))
+"""
+
+
+def test_an_embedded_model_reuses_the_code_generated_for_its_file(fresh_cache, tmp_path):
+    """``recheck`` imports a certificate's model from a temporary copy that is deleted at
+    once; its generated code is keyed by the text, so it is the code generated when the
+    file was certified, in any process, and an edited text is never given that code."""
+    from pendverify.certify.model_source import load_from_text
+    from pendverify.numerics.codegen.cache import model_key
+
+    example = REPO / "examples" / "cart_pole.py"
+    text = example.read_text(encoding="utf-8")
+    from_file, from_text = load_model_class(example), load_from_text(text, example.name)
+    assert from_text is not from_file and model_key(from_text) is not None
+    assert model_key(from_text) == model_key(from_file)
+    edited = text.replace("p.I + p.mp * p.r**2", "p.I + 2 * p.mp * p.r**2")
+    assert edited != text and model_key(load_from_text(edited, example.name)) != model_key(from_file)
+    assert GeneratedSystem.from_model(_example(example)).kernel.origin == "generated"  # at certify
+    env = dict(os.environ, PENDVERIFY_CACHE=str(fresh_cache.parent))
+    argv = [sys.executable, "-c", _EMBEDDED_CHILD, str(example)]
+    done = subprocess.run(argv, env=env, capture_output=True, text=True, check=True)
+    assert json.loads(done.stdout.strip().splitlines()[-1]) == "disk"  # at recheck, a new process

@@ -19,6 +19,7 @@ from pathlib import Path
 from pendverify.analytic import MODELS, ClosedFormModel
 from pendverify.analytic.plugin import load_model_class
 from pendverify.errors import PendverifyError
+from pendverify.numerics.codegen.cache import remember_text
 
 _LOADED: dict[tuple[str, str], type[ClosedFormModel]] = {}  # (file name, sha256) -> class, per process
 
@@ -115,6 +116,7 @@ def load_from_text(text: str, file_name: str) -> type[ClosedFormModel]:
     with tempfile.TemporaryDirectory(prefix="pendverify-model-") as tmp:
         path = Path(tmp) / name
         path.write_text(text, encoding="utf-8")
+        remember_text(path, text)  # the generated code's key outlives the temporary copy
         try:
             return load_model_class(path)
         except PendverifyError as exc:

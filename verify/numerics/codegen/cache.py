@@ -44,7 +44,27 @@ def cache_dir() -> Path:
     return base() / "generated"
 
 
+#: {path: SHA-256} of model files imported from a text and deleted since (a certificate's
+#: embedded source, ``pendverify.certify.model_source``): their classes keep a key
+_TEXT_DIGESTS: dict[str, str] = {}
+
+
+def remember_text(path: str | Path, text: str) -> None:
+    """``path`` holds ``text`` while a model is imported from it, and will be gone afterwards.
+
+    The model's key is then the one the same text has in a file of the same name, so a
+    certificate's embedded model reuses the code generated when it was certified (and a
+    process, or Dask worker, that imports it generates once for all processes), while an
+    edited text has another key."""
+    digest = hashlib.sha256(text.encode()).hexdigest()
+    for name in {str(path), str(Path(path).resolve())}:
+        _TEXT_DIGESTS[name] = digest
+
+
 def _file_digest(path: str) -> str:
+    known = _TEXT_DIGESTS.get(str(path))
+    if known is not None:
+        return known
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
 
 
@@ -74,7 +94,8 @@ def _generator_files() -> set[str]:
 def model_key(model_cls) -> str | None:
     """SHA-256 of everything the generated source depends on, without reading the model (docstring).
 
-    None when a class has no source file (the generator then runs once per process).  Computed
+    None when a class has no source file, or one that is gone and whose text was not given to
+    ``remember_text`` (the generator then runs once per process).  Computed
     once per class and process (resolving and hashing the files costs ≈ 40 ms): a source file
     edited while a process runs is seen after ``forget()``."""
     if model_cls not in _MODEL_KEYS:
@@ -106,11 +127,12 @@ def _model_key(model_cls) -> str | None:
     # not the module's name: a plug-in's is salted per process (pendverify.analytic.plugin)
     version = importlib.metadata.version("sympy")
     h = hashlib.sha256(f"{_module.GENERATOR}|{version}|{model_cls.__qualname__}".encode())
-    try:
-        for path in sorted(files):
-            h.update(f"|{Path(path).name}:{_file_digest(path)}".encode())
-    except OSError:  # a class loaded from a file that is gone (a certificate's source, on a new process)
+    try:  # names and contents, in an order that does not depend on where the files are
+        entries = sorted(f"|{Path(path).name}:{_file_digest(path)}" for path in files)
+    except OSError:  # a class loaded from a file that is gone and whose text was not remembered
         return None
+    for entry in entries:
+        h.update(entry.encode())
     return h.hexdigest()
 
 
