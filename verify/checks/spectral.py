@@ -34,20 +34,24 @@ def _magnitudes(A: np.ndarray) -> np.ndarray:
     return np.sort(np.abs(np.linalg.eigvalsh(A)), axis=-1)
 
 
+def _measure(A, of_magnitudes, by_svd):
+    """``of_magnitudes(|λ| ascending)`` of each finite symmetric matrix, ``by_svd(matrices)`` of
+    the others; a float for one matrix, an array for a batch."""
+    A = np.asarray(A, dtype=float)
+    single = A.ndim == 2
+    batch = A[None] if single else A
+    ok = _eigen_ok(batch)
+    out = np.empty(batch.shape[:-2])
+    if np.any(ok):
+        out[ok] = of_magnitudes(_magnitudes(batch[ok]))
+    if not np.all(ok):
+        out[~ok] = by_svd(batch[~ok])
+    return float(out[0]) if single else out
+
+
 def norms2(A) -> np.ndarray | float:
     """‖A‖₂ of a matrix (a float), or of each matrix of a batch (an array)."""
-    A = np.asarray(A, dtype=float)
-    if A.ndim == 2:
-        if _eigen_ok(A):
-            return float(_magnitudes(A)[-1])
-        return float(np.linalg.norm(A, 2))
-    ok = _eigen_ok(A)
-    if np.all(ok):
-        return _magnitudes(A)[..., -1]
-    out = np.empty(A.shape[:-2])
-    out[ok] = _magnitudes(A[ok])[..., -1]
-    out[~ok] = np.linalg.norm(A[~ok], 2, axis=(-2, -1))
-    return out
+    return _measure(A, lambda s: s[..., -1], lambda B: np.linalg.norm(B, 2, axis=(-2, -1)))
 
 
 def conds2(A) -> np.ndarray | float:
@@ -55,15 +59,5 @@ def conds2(A) -> np.ndarray | float:
 
     A matrix that is not finite gets what ``np.linalg.cond`` gives it (callers map that
     to inf before using it)."""
-    A = np.asarray(A, dtype=float)
-    single = A.ndim == 2
-    batch = A[None] if single else A
-    ok = _eigen_ok(batch)
-    out = np.empty(batch.shape[:-2])
     with np.errstate(all="ignore"):
-        if np.any(ok):
-            s = _magnitudes(batch[ok])
-            out[ok] = s[..., -1] / s[..., 0]
-        if not np.all(ok):
-            out[~ok] = np.linalg.cond(batch[~ok])
-    return float(out[0]) if single else out
+        return _measure(A, lambda s: s[..., -1] / s[..., 0], np.linalg.cond)
