@@ -33,13 +33,11 @@ def batch_source(system):
     return (base, angles) if type(base) is PinocchioSystem else None
 
 
+_symmetric = PinocchioSystem._symmetric  # Pinocchio fills only the upper triangle of M and M⁻¹
+
+
 def _mv(A, x):
     return (A @ x[..., None])[..., 0]
-
-
-def _symmetric(upper: np.ndarray) -> np.ndarray:
-    # as PinocchioSystem._symmetric: Pinocchio fills only the upper triangle of M and M⁻¹
-    return np.triu(upper) + np.swapaxes(np.triu(upper, 1), -1, -2)
 
 
 class PinocchioBatch:

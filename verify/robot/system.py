@@ -163,8 +163,8 @@ class PinocchioSystem:
 
     @staticmethod
     def _symmetric(upper: np.ndarray) -> np.ndarray:
-        # Pinocchio's C++ fills only the upper triangle of M and M⁻¹.
-        return np.triu(upper) + np.triu(upper, 1).T
+        # Pinocchio's C++ fills only the upper triangle of M and M⁻¹ (one matrix, or a stack)
+        return np.triu(upper) + np.swapaxes(np.triu(upper, 1), -1, -2)
 
     def mass_matrix(self, theta) -> np.ndarray:
         q, _ = self._qv(theta)
