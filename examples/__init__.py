@@ -1,0 +1,1 @@
+"""Data shipped with pendverify: the examples folder (read with importlib.resources)."""

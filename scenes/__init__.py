@@ -1,0 +1,1 @@
+"""Data shipped with pendverify: the scenes folder (read with importlib.resources)."""

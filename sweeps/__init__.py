@@ -1,0 +1,1 @@
+"""Data shipped with pendverify: the sweeps folder (read with importlib.resources)."""
