@@ -62,7 +62,7 @@ from pendverify.numerics.codegen import expressions as codegen_expressions
 from pendverify.numerics.generate import GeneratedSystem
 
 REPO = Path(__file__).resolve().parents[1]
-EXAMPLES = sorted((REPO / "examples").glob("*.py"))
+EXAMPLES = sorted(p for p in (REPO / "examples").glob("*.py") if p.name != "__init__.py")
 SEED = 1234
 U = np.finfo(float).eps / 2
 STATES = 30  # random states per case, after the model's special states
