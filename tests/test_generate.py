@@ -71,12 +71,11 @@ OBSERVED: dict[str, float] = {}
 
 
 @pytest.fixture(scope="module", autouse=True)
-def _cache(tmp_path_factory):
-    """One cache for the module: each model is generated and compiled once."""
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setenv("PENDVERIFY_CACHE", str(tmp_path_factory.mktemp("cache")))
-        generate.forget()
-        yield
+def _cache():
+    """The run's cache (``conftest``), nothing from memory: each model is generated and compiled
+    once per run, and the module's kernels come from the disk or the generator, not another module."""
+    generate.forget()
+    yield
     generate.forget()
 
 
