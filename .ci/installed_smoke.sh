@@ -38,8 +38,10 @@ step() {
 src="$work/src"
 mkdir -p "$src"
 if git -C "$clone" rev-parse --is-inside-work-tree >/dev/null 2>&1; then
+    # (files deleted but not yet committed are skipped: the copy is the work tree as it is)
     git -C "$clone" ls-files -z --cached --others --exclude-standard \
-        | (cd "$clone" && xargs -0 cp --parents --no-dereference -t "$src" 2>/dev/null || true)
+        | (cd "$clone" && tar --null --files-from=- --ignore-failed-read -cf - 2>/dev/null) \
+        | tar -C "$src" -xf -
 else
     cp -R "$clone/." "$src"
     rm -rf "$src/build" "$src/.venv"

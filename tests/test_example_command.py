@@ -120,6 +120,14 @@ def test_force_replaces_the_existing_files(tmp_path, capsys):
     assert (tmp_path / "notes.txt").read_text(encoding="utf-8") == "kept\n"
 
 
+def test_a_folder_in_the_place_of_a_file_is_refused_even_with_force(tmp_path, capsys):
+    (tmp_path / "cart_pole.urdf").mkdir()
+    assert main(["example", "cart_pole", str(tmp_path), "--force"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "cart_pole.urdf" in err
+    assert [p.name for p in tmp_path.iterdir()] == ["cart_pole.urdf"]
+
+
 def test_a_folder_holding_other_files_is_accepted(tmp_path, capsys):
     (tmp_path / "notes.txt").write_text("kept\n", encoding="utf-8")
     assert main(["example", "triple_pendulum", str(tmp_path)]) == 0

@@ -169,13 +169,16 @@ def copy_example(example: WorkedExample, folder: Path, force: bool = False) -> l
     """Write the example's files into ``folder`` (created if missing); the paths written, in order.
 
     Refuses (``FileAccessError``, before writing anything) a ``folder`` that is a file or
-    cannot be written, and, unless ``force``, a folder that holds a file of the same name
-    as one to be written.  Each file is written atomically.
+    cannot be written, a folder in the place of a file to be written, and, unless ``force``,
+    a file of the same name as one to be written.  Each file is written atomically.
     """
     from pendverify.atomic import check_output, write_atomic
 
     check_output(folder, folder=True)
     targets = [folder / f.name for f in example.files]
+    for target in targets:
+        if target.is_dir():
+            raise FileAccessError(str(target), "write", "it is a folder, not a file")
     present = [t for t in targets if t.exists() or t.is_symlink()]
     if present and not force:
         more = f" (and {len(present) - 1} more of the example's files)" if len(present) > 1 else ""

@@ -24,7 +24,14 @@ def register(sub) -> None:
         epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("name", nargs="?", help="the example to show or copy (default: list them all)")
+    from pendverify.worked_examples import NAMES
+
+    p.add_argument(
+        "name",
+        nargs="?",
+        metavar="NAME",
+        help=f"the example to show or copy: {', '.join(NAMES)} (default: list them all)",
+    )
     p.add_argument(
         "folder",
         nargs="?",
