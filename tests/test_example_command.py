@@ -147,3 +147,15 @@ def test_a_file_in_place_of_the_folder_is_refused(tmp_path, capsys):
 def test_every_example_s_scene_is_a_shipped_scene():
     shipped = {p.name for p in shipped_folder("scenes").glob("*.toml")}
     assert {e.scene.name for e in EXAMPLES} <= shipped
+
+
+def test_check_on_a_copy_fails_when_its_latex_is_wrong(tmp_path, capsys):
+    """The copied files are what is checked: a sign flipped in the copied LaTeX C fails."""
+    assert main(["example", "cart_pole", str(tmp_path)]) == 0
+    latex = tmp_path / "cart_pole_latex.toml"
+    text = latex.read_text(encoding="utf-8")
+    right = r"-m_p r\sin(\theta)\dot{\theta}"
+    assert text.count(right) == 1
+    latex.write_text(text.replace(right, right[1:]), encoding="utf-8")
+    files = ["--urdf", str(tmp_path / "cart_pole.urdf"), "--params", str(tmp_path / "cart_pole.toml")]
+    assert main(["check", "--analytic", str(latex), *files, "--samples", "5", "--no-erd", "--quiet"]) == 1

@@ -65,13 +65,14 @@ class WorkedExample:
         return (self.model, self.written_model) if self.written_model else (self.model,)
 
 
-def _plugin(name: str, summary: str, dof: int, scene: str) -> WorkedExample:
-    """An example whose model, URDF and parameters are all ``examples/NAME.*``."""
+def _plugin(name: str, summary: str, dof: int, scene: str, latex: bool = False) -> WorkedExample:
+    """An example whose model, URDF and parameters are all ``examples/NAME.*`` (``NAME_latex.toml``)."""
     return WorkedExample(
         name,
         summary,
         dof,
         model=ShippedFile("examples", f"{name}.py", "model (Python)"),
+        written_model=ShippedFile("examples", f"{name}_latex.toml", "model (LaTeX)") if latex else None,
         urdf=ShippedFile("examples", f"{name}.urdf", "URDF"),
         params=ShippedFile("examples", f"{name}.toml", "parameters"),
         scene=ShippedFile("scenes", scene, "scene"),
@@ -84,6 +85,7 @@ EXAMPLES: tuple[WorkedExample, ...] = (
         "a cart-pole with an inertial pole, friction on the cart and at the pivot",
         2,
         "cart_pole_lqr_push.toml",
+        latex=True,
     ),
     _plugin(
         "furuta_pendulum",
