@@ -70,6 +70,7 @@ step pendverify keygen -o keys
 step pendverify example double_pendulum reference
 step pendverify certify reference/double_pendulum.toml -o certs --key keys/pendverify-signing.key.pem
 step pendverify recheck certs/double_pendulum.cert.json --trust keys/pendverify-signing.pub.pem
+step python -c 'import pendverify, sys; sys.exit(not pendverify.certify_set("api-certs", "reference/double_pendulum.toml", samples=200).certified)'
 
 sed 's/^count = 200$/count = 20/' "$sweep_200" >sweep_20.toml
 grep -q '^count = 20$' sweep_20.toml || { echo "FAILED: could not set count = 20 in $sweep_200"; exit 1; }
