@@ -66,7 +66,7 @@ def test_a_copied_example_runs_as_the_printed_commands_say(name, tmp_path, capsy
     assert robot.nv == example.dof
 
     checks = printed_commands(out, "check")
-    assert len(checks) == len(example.models)
+    assert len(checks) == len(example.models) + len(example.descriptions)
     for args in checks:
         assert main([*args, "--samples", "5", "--no-erd", "--quiet"]) == 0, args
         capsys.readouterr()

@@ -195,13 +195,18 @@ def copy_example(example: WorkedExample, folder: Path, force: bool = False) -> l
 
 
 def next_commands(example: WorkedExample, folder: str) -> list[str]:
-    """The commands that run the copied example in ``folder`` (as the user named it)."""
+    """The commands that run the copied example in ``folder`` (as the user named it).
+
+    ``check`` of each model file on the URDF, of the Python model on each xacro or MJCF
+    version, then ``simulate`` of the scene.
+    """
 
     def at(f: ShippedFile) -> str:
         return shlex.quote(str(Path(folder) / f.name))
 
+    pairs = [(m, example.urdf) for m in example.models] + [(example.model, d) for d in example.descriptions]
     checks = [
-        f"pendverify check --analytic {at(m)} --urdf {at(example.urdf)} --params {at(example.params)}"
-        for m in example.models
+        f"pendverify check --analytic {at(model)} --urdf {at(robot)} --params {at(example.params)}"
+        for model, robot in pairs
     ]
     return [*checks, f"pendverify simulate {at(example.scene)}"]
