@@ -1,14 +1,14 @@
 """What to verify: pairs of a closed-form model and a URDF loaded in Pinocchio.
 
 * the default parameter sets against their committed URDFs (``urdf/``);
-* example-robot-data's double-pendulum URDFs against the seed-000 closed form
+* example-robot-data's double-pendulum URDFs against the double-pendulum reference system's closed form
   with parameters read off the URDF itself;
 * a user's URDF against a user's parameter set, or (double pendulum) against
   the parameters read off that URDF;
 * a user's own model file (``--analytic``, ``pendverify.analytic.plugin``) against a URDF.
 
 Built-in and plug-in models take one path: the URDF is loaded, the model class's
-geometry reader (or declared map) gives the coordinate map (the seeds read it off the
+geometry reader (or declared map) gives the coordinate map (the two reference systems read it off the
 geometry, a plug-in declares it), and ``model_target`` pairs the two.  A parameter set
 with no URDF is checked against the URDF the project writes for it (``params_target``).
 ``user_target`` and ``plugin_target`` read the CLI's options into these; the Python API
