@@ -90,12 +90,14 @@ def build_parser() -> argparse.ArgumentParser:
 
 def refuse_unaccepted(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
     """A usage error (status 2) for a global option given before a command that does not take it."""
+    accepts = getattr(args, "accepts", frozenset({"debug"}))  # set by commands.add_command
     given = {"quiet": args.quiet, "json": args.json is not None}
     for name, present in given.items():
-        if present and name not in args.accepts:
-            takes = ", ".join(f"--{n}" for n in sorted(args.accepts))
+        if present and name not in accepts:
+            takes = ", ".join(f"--{n}" for n in sorted(accepts))
             what = "writes no report" if name == "json" else "has no verdict line to keep"
-            parser.error(f"--{name}: `{args.prog}` {what}; it takes {takes}")
+            prog = getattr(args, "prog", f"pendverify {args.command}")
+            parser.error(f"--{name}: `{prog}` {what}; it takes {takes}")
 
 
 def utf8_streams() -> None:
