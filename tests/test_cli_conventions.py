@@ -69,7 +69,9 @@ def test_every_command_help_has_a_description_each_default_and_examples(names, c
     summary = parser.description.splitlines()[0]
     assert summary.strip() and len(summary) <= 100, summary
     assert f"\n{summary}\n" in text  # the one-line description, printed as one line
-    for entry in entries(text, "options"):
+    options = entries(text, "options")
+    assert any(e.startswith("--debug ") for e in options), f"{' '.join(names)}: no --debug (use add_command)"
+    for entry in options:
         if not entry.startswith("-h, --help"):
             assert "(default" in entry or "default:" in entry, f"{' '.join(names)}: no default in {entry!r}"
     optional_positionals = [a.dest for a in parser._actions if not a.option_strings and a.nargs == "?"]
@@ -79,7 +81,7 @@ def test_every_command_help_has_a_description_each_default_and_examples(names, c
     examples = text.split("\nexamples:\n", 1)[1].split("\n\n", 1)[0].splitlines()
     assert examples, f"{' '.join(names)}: no example"
     for example in examples:
-        line = re.split(r" [|>] ", example.strip())[0]  # a shell pipe or redirection is not ours
+        line = re.split(r" [|>] |\s{2,}", example.strip())[0]  # not a pipe, redirection or comment
         argv = shlex.split(line)
         assert argv[0] == "pendverify" and argv[1 : 1 + len(names)] == list(names), example
         args = parse(argv[1:])  # every example is a valid command line

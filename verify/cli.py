@@ -55,7 +55,7 @@ def pinocchio_version() -> str:
 
 
 def version_line() -> str:
-    """``pendverify 0.1.0 (Pinocchio 3.4.0, Python 3.11.7)``."""
+    """``pendverify 0.1.0 (Pinocchio 4.1.0, Python 3.11.7)``."""
     return f"pendverify {__version__} (Pinocchio {pinocchio_version()}, Python {platform.python_version()})"
 
 

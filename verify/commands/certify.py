@@ -26,7 +26,7 @@ def register(sub) -> None:
             "pendverify certify analytic/params/double_pendulum.toml -o certified",
             "pendverify certify --sweep sweeps/double_pendulum_200.toml --workers 2 -o certified",
             "pendverify certify --urdf robot.urdf --model double_pendulum --params mine.toml -o certified "
-            "--key keys/pendverify.key",
+            "--key keys/pendverify-signing.key.pem",
         ],
         json="the battery's items and the verdict (with --sweep: the summary)",
     )
@@ -74,7 +74,8 @@ def register(sub) -> None:
         "verify a certificate's digest and re-run its battery",
         [
             "pendverify recheck certified/double_pendulum.cert.json",
-            "pendverify recheck certified/double_pendulum.cert.json --trust keys/pendverify.pub --quiet",
+            "pendverify recheck certified/double_pendulum.cert.json "
+            "--trust keys/pendverify-signing.pub.pem --quiet",
         ],
         json="the re-run items, the differences and the verdict",
     )
