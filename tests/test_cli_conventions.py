@@ -329,3 +329,37 @@ def test_building_the_command_line_imports_neither_pinocchio_nor_sympy():
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "[]"
+
+
+TINY_SWEEP = """
+model = "double_pendulum"
+mode = "random"
+count = 2
+seed = 3
+samples = 20
+duration = 0.3
+[ranges]
+m1 = [0.5, 2.0]
+"""
+
+
+def test_certify_sweep_json_dash_is_the_summary(tmp_path, capsys):
+    sweep = tmp_path / "sweep.toml"
+    sweep.write_text(TINY_SWEEP)
+    out = tmp_path / "certified"
+    argv = ["certify", "--sweep", str(sweep), "-o", str(out), "--workers", "1", "--json", "-", "--quiet"]
+    assert main(argv) == 0
+    stdout, stderr = capsys.readouterr()
+    summary = json.loads(stdout)
+    assert (summary["sets"], summary["passed"], summary["failed"], summary["written"]) == (2, 2, 0, 2)
+    assert summary["certified"] is True and summary["worst_ratio"]
+    assert all(0 <= w["ratio"] < 1 for w in summary["worst_ratio"].values())
+    assert len(list(out.glob("*.cert.json"))) == 2
+    assert stderr.splitlines()[-1] == f"2 certificate(s) written to {out}"
+
+
+def test_keygen_quiet_prints_the_fingerprint_alone(tmp_path, capsys):
+    assert main(["keygen", "-o", str(tmp_path / "keys"), "--quiet"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("fingerprint: ")
+    assert len(list((tmp_path / "keys").iterdir())) == 2
