@@ -60,3 +60,10 @@ class CheckResult:
 
     def as_dict(self) -> dict:
         return dict(self.__dict__)
+
+    def __repr__(self) -> str:
+        where = str(self.worst_state.get("label", ""))[:60]
+        return (
+            f"<CheckResult {self.model[:80]} {self.check}: {self.status}, error {self.max_error:.2e} "
+            f"vs tolerance {self.tolerance:.2e} at {where}>"
+        )

@@ -15,6 +15,7 @@ import numpy as np
 import pinocchio as pin
 
 from pendverify.analytic import MODELS
+from pendverify.display import listed, shortened
 from pendverify.robot import seed_geometry  # noqa: F401  (registers the seeds' readers)
 from pendverify.robot.coordinates import CoordinateMap
 from pendverify.robot.geometry import MODEL_FORM_RTOL, UrdfGeometry, reader
@@ -33,7 +34,13 @@ def geometry_for(cls, pin_model: pin.Model, source: str, g: float | None) -> Urd
 
 
 class PinocchioSystem:
-    """A Pinocchio model evaluated in a closed-form model's coordinates."""
+    """A Pinocchio model evaluated in a closed-form model's coordinates.
+
+    ``mass_matrix``, ``coriolis_matrix``, ``gravity``, ``bias``, ``acceleration``, the energies
+    and the rest take and return the model's coordinates (``cmap`` maps them to the URDF's
+    joints); ``geometry`` is what the model's reader saw in the URDF (its parameters, where it
+    reads them), ``notes`` what loading noticed, ``source`` where the URDF came from.
+    """
 
     def __init__(
         self,
@@ -56,6 +63,14 @@ class PinocchioSystem:
         self._no_gravity = model.copy()
         self._no_gravity.gravity.linear = np.zeros(3)
         self._no_gravity_data = self._no_gravity.createData()
+
+    def __repr__(self) -> str:
+        joints = listed(self.model.names[1:], 80)
+        g = -float(self.model.gravity.linear[2])
+        return (
+            f"<PinocchioSystem {shortened(self.source, 120)}: {self.model.nv} dof (joints {joints}), "
+            f"g = {g:g} m/s²>"
+        )
 
     @classmethod
     def for_model(
