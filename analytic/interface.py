@@ -134,6 +134,7 @@ class ClosedFormModel(metaclass=ModelClass):
 
     @property
     def nv(self) -> int:
+        """The number of coordinates (degrees of freedom)."""
         return len(self.coordinates)
 
     def __repr__(self) -> str:
@@ -213,6 +214,7 @@ class ClosedFormModel(metaclass=ModelClass):
         return self.coriolis_matrix(q, v) @ v + self.gravity(q)
 
     def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> float:
+        """T(q, q̇) = ½ q̇ᵀ M(q) q̇."""
         return 0.5 * float(v @ self.mass_matrix(q) @ v)
 
     def diagonal_scale(self, q: np.ndarray) -> np.ndarray:

@@ -45,6 +45,7 @@ class CheckRows:
 
     @property
     def models(self) -> tuple[str, ...]:
+        """The labels of the models that ran this check, in the table's order."""
         return tuple(r.model for r in self.results)
 
     @property
@@ -54,6 +55,7 @@ class CheckRows:
 
     @property
     def passed(self) -> bool:
+        """Whether every row passes (pass, or pass with warnings)."""
         return all(r.passed for r in self.results)
 
     @property
@@ -63,10 +65,12 @@ class CheckRows:
 
     @property
     def max_error(self) -> float:
+        """The error of the ``worst`` row (relative, at that row's worst state)."""
         return self.worst.max_error
 
     @property
     def tolerance(self) -> float:
+        """The tolerance of the ``worst`` row, at the same state."""
         return self.worst.tolerance
 
     def __len__(self) -> int:
@@ -127,9 +131,11 @@ class Report:
         return self.status in (PASS, WARN)
 
     def failures(self) -> list[CheckResult]:
+        """The results that fail."""
         return [r for r in self.results if r.status == FAIL]
 
     def refusals(self) -> list[CheckResult]:
+        """The results refused by the trust rule (states beyond double precision's reach: not verified)."""
         return [r for r in self.results if r.status == REFUSED]
 
     @property
@@ -164,6 +170,7 @@ class Report:
         return iter(self.checks)
 
     def keys(self) -> tuple[str, ...]:
+        """The check names (``checks``): ``dict(report)`` maps each to its ``CheckRows``."""
         return self.checks
 
     def __repr__(self) -> str:
@@ -183,6 +190,7 @@ class Report:
         return html_table(HEADER, rows, failing=failing) + html_lines(lines[:-1]) + verdict
 
     def as_dict(self) -> dict:
+        """The report as the JSON document's mapping (versions, seed, states, verdict, notes, results)."""
         return {
             **versions(),
             "seed": self.seed,
@@ -200,6 +208,7 @@ class Report:
         }
 
     def to_json(self) -> str:
+        """The JSON document ``pendverify check --json`` writes."""
         return to_json(self.as_dict())
 
 

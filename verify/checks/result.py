@@ -59,6 +59,7 @@ class CheckResult:
             self.status = PASS if self.passed else FAIL
 
     def as_dict(self) -> dict:
+        """Every field, as the JSON report's entry for this result."""
         return dict(self.__dict__)
 
     def __repr__(self) -> str:

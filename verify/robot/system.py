@@ -182,6 +182,7 @@ class PinocchioSystem:
         return np.triu(upper) + np.swapaxes(np.triu(upper, 1), -1, -2)
 
     def mass_matrix(self, theta) -> np.ndarray:
+        """M(θ) by CRBA, in the model's coordinates."""
         q, _ = self._qv(theta)
         return self.cmap.matrix_to_model(self._symmetric(pin.crba(self.model, self.data, q)))
 
@@ -193,18 +194,22 @@ class PinocchioSystem:
         )
 
     def inverse_mass_matrix(self, theta) -> np.ndarray:
+        """M(θ)⁻¹ by Pinocchio's computeMinverse, in the model's coordinates."""
         q, _ = self._qv(theta)
         return self.cmap.inverse_to_model(self._symmetric(pin.computeMinverse(self.model, self.data, q)))
 
     def bias(self, theta, theta_dot) -> np.ndarray:
+        """C(θ, θ̇)·θ̇ + H(θ) by RNEA at zero acceleration, in the model's coordinates."""
         q, v = self._qv(theta, theta_dot)
         return self.cmap.force_to_model(pin.rnea(self.model, self.data, q, v, np.zeros(self.model.nv)))
 
     def gravity(self, theta) -> np.ndarray:
+        """H(θ) by computeGeneralizedGravity, in the model's coordinates."""
         q, _ = self._qv(theta)
         return self.cmap.force_to_model(pin.computeGeneralizedGravity(self.model, self.data, q))
 
     def coriolis_matrix(self, theta, theta_dot) -> np.ndarray:
+        """Pinocchio's Coriolis matrix C(θ, θ̇) (computeCoriolisMatrix), in the model's coordinates."""
         q, v = self._qv(theta, theta_dot)
         return self.cmap.matrix_to_model(pin.computeCoriolisMatrix(self.model, self.data, q, v))
 
@@ -232,9 +237,11 @@ class PinocchioSystem:
         return self.cmap.acceleration_to_model(a)
 
     def kinetic_energy(self, theta, theta_dot) -> float:
+        """T(θ, θ̇) by computeKineticEnergy."""
         q, v = self._qv(theta, theta_dot)
         return float(pin.computeKineticEnergy(self.model, self.data, q, v))
 
     def potential_energy(self, theta) -> float:
+        """V(θ) by computePotentialEnergy (Pinocchio's zero)."""
         q, _ = self._qv(theta)
         return float(pin.computePotentialEnergy(self.model, self.data, q))

@@ -69,12 +69,13 @@ class Run:
 
     @property
     def passed(self) -> bool:
+        """Whether every invariant (and, with engine ``both``, the engines' comparison) holds."""
         return all(c.passed for c in self.checks)
 
     @property
     def engine(self) -> str:
-        """aba, closed_form or both: the engine that ran."""
-        return self.dynamics.engine
+        """aba, closed_form or both (ABA integrated, compared with the closed form): what ran."""
+        return "both" if self.engine_comparison is not None else self.dynamics.engine
 
     def __repr__(self) -> str:
         held = sum(c.passed for c in self.checks)
