@@ -485,6 +485,8 @@ def test_certify_set_writes_a_bundle_that_recheck_accepts(tmp_path):
 
     issued = pendverify.certify_set(tmp_path, default_parameter_file("double_pendulum"), samples=40)
     assert issued.certified and issued.path == tmp_path / "double_pendulum.cert.json"
+    text = repr(issued)  # short: the items and the certificate are in the fields, not the repr
+    assert text == f"<Issued certified: {len(issued.items)} items pass; {issued.path}>" and len(text) <= 300
     assert recheck(str(issued.path)).passed
     with pytest.raises(pendverify.PendverifyError, match="exists"):
         pendverify.certify_set(tmp_path, default_parameter_file("double_pendulum"), samples=40)

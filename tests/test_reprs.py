@@ -299,3 +299,19 @@ def test_every_public_object_has_a_docstring(obj):
         for name, member in vars(obj).items():
             if not name.startswith("_") and (inspect.isfunction(member) or isinstance(member, property)):
                 assert inspect.getdoc(member), f"{obj.__name__}.{name}"
+
+
+def test_a_refused_certificate_names_the_failing_items_in_a_short_repr(tmp_path):
+    wrong = tmp_path / "heavier.toml"
+    wrong.write_text(
+        Path(default_parameter_file("double_pendulum")).read_text().replace("m2 = 0.8", "m2 = 0.9")
+    )
+    issued = pendverify.certify_set(
+        tmp_path / "out", urdf=committed_urdf("double_pendulum"), urdf_params=wrong, samples=10
+    )
+    failed = [i.name for i in issued.items if not i.passed]
+    assert not issued.certified and failed
+    text = short(repr(issued))
+    assert text.startswith(
+        f"<Issued not certified: {len(failed)} of {len(issued.items)} items fail: {failed[0]}"
+    )
