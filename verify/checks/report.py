@@ -179,6 +179,8 @@ class Report:
             f"<{type(self).__name__} {self.status}: {len(self.results)} checks on "
             f"{len(self.models)} model(s), {total} states, seed {self.seed}"
         )
+        if not self.models:
+            return f"{head}>"
         return f"{head}: {listed(self.models, REPR_LIMIT - len(head) - 4)}>"
 
     def _repr_html_(self) -> str:
