@@ -25,8 +25,8 @@ C q̇ − H)), ``special_states`` (the zero state only), and the tolerance scale
 SymPy from the model's own H and M).  ``hand_written()`` names the methods a model
 writes itself; a derived det M or M⁻¹ is not checked (nothing to check), and a
 derived q̈ is checked by ``aba`` as the composition of the parts, with a note.
-A hand-written ``acceleration`` must be the model's *own* closed form (the seed's
-f + g·u, or M⁻¹·f), not a re-assembly from the other methods, so that a typo in
+A hand-written ``acceleration`` must be the model's *own* closed form (as the
+reference systems' f + g·u, or M⁻¹·f), not a re-assembly from the other methods, so that a typo in
 any single place shows up in some check.
 
 Writing your own model (a plug-in)
@@ -187,7 +187,7 @@ class ClosedFormModel(metaclass=ModelClass):
     def acceleration(self, q: np.ndarray, v: np.ndarray, u: np.ndarray, w: np.ndarray) -> np.ndarray:
         """q̈.  Derived by default: M⁻¹ (B u + W w − D q̇ − C q̇ − H) from the model's own parts.
 
-        A model with its own closed form (the seed's f + g·u, or M⁻¹·f) writes it
+        A model with its own closed form (as the reference systems' f + g·u, or M⁻¹·f) writes it
         here, *not* as a re-assembly of the other methods, so that a typo in any
         single place shows up in some check.
         """

@@ -18,9 +18,9 @@ exactly one concrete subclass of ``pendverify.analytic.ClosedFormModel``
 ``validate_model_class`` checks these rules on any class (the Python API applies it to a
 class written in the caller's own code).  ``examples/cart_pole.py`` is a complete
 plug-in.  The built-in models are plug-ins of the same kind: ``--analytic
-analytic/double_pendulum.py`` loads the seed through this same path.  Every problem is
-a ``PendverifyError`` naming the file (and the line, for an exception raised while
-importing it).
+analytic/double_pendulum.py`` loads the double-pendulum reference system through this
+same path.  Every problem is a ``PendverifyError`` naming the file (and the line, for an
+exception raised while importing it).
 """
 
 from __future__ import annotations

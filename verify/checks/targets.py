@@ -5,16 +5,16 @@ turn their arguments (a model, a URDF or ``erd:NAME``, parameters, the erd flag)
 targets through it, so the same arguments verify the same targets.  The targets are
 
 * the default parameter sets against their committed URDFs (``urdf/``);
-* example-robot-data's double-pendulum URDFs against the double pendulum's closed form
-  with parameters read off the URDF itself (skipped, with a sentence, when example-robot-data
-  is not installed);
+* example-robot-data's double-pendulum URDFs against the double-pendulum reference system's
+  closed form with parameters read off the URDF itself (skipped, with a sentence, when
+  example-robot-data is not installed);
 * a user's URDF against a user's parameter set, or (double pendulum) against
   the parameters read off that URDF;
 * a user's own model file (``--analytic``, ``pendverify.analytic.plugin``) against a URDF.
 
 Built-in and plug-in models take one path: the URDF is loaded, the model class's
-geometry reader (or declared map) gives the coordinate map (the built-in models read it off
-the geometry, a plug-in declares it), and ``model_target`` pairs the two.  A parameter set
+geometry reader (or declared map) gives the coordinate map (the two reference systems read it
+off the geometry, a plug-in declares it), and ``model_target`` pairs the two.  A parameter set
 with no URDF is checked against the URDF the project writes for it (``params_target``).
 """
 

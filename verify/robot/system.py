@@ -16,7 +16,7 @@ import pinocchio as pin
 
 from pendverify.analytic import MODELS
 from pendverify.display import listed, shortened
-from pendverify.robot import seed_geometry  # noqa: F401  (registers the seeds' readers)
+from pendverify.robot import seed_geometry  # noqa: F401  (registers the reference systems' readers)
 from pendverify.robot.coordinates import CoordinateMap
 from pendverify.robot.geometry import MODEL_FORM_RTOL, UrdfGeometry, reader
 from pendverify.robot.joint_map import declared_geometry
