@@ -5,24 +5,27 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-EPILOG = """\
-examples:
-  pendverify example                       list the worked examples
-  pendverify example cart_pole             what the cart_pole example holds
-  pendverify example cart_pole my_model    copy it into my_model/ and print the commands that run it
+from pendverify.commands import add_command
 
-Each example is a model written by hand (Python, and LaTeX or text where one exists), its URDF
-(xacro and MJCF where they exist), its parameters and a scene whose paths point at the copies.
-Files already in DIR are not replaced unless --force is given."""
+DETAILS = (
+    "Each example is a model written by hand (Python, and LaTeX or text where one exists), its URDF "
+    "(xacro and MJCF where they exist), its parameters and a scene whose paths point at the copies. "
+    "Files already in DIR are not replaced unless --force is given."
+)
 
 
 def register(sub) -> None:
-    p = sub.add_parser(
+    p = add_command(
+        sub,
         "example",
-        help="list the worked examples, or copy one into a folder, ready to run",
-        description="List the worked examples installed with pendverify, or copy one into a folder.",
-        epilog=EPILOG,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        "list the worked examples, or copy one into a folder, ready to run",
+        [
+            "pendverify example                       list the worked examples",
+            "pendverify example cart_pole             what the cart_pole example holds",
+            "pendverify example cart_pole my_model    copy it into my_model/, print how to run it",
+        ],
+        quiet=False,
+        details=DETAILS,
     )
     from pendverify.worked_examples import NAMES
 

@@ -19,21 +19,37 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from pendverify.commands import non_negative_int
+from pendverify.commands import add_command, non_negative_int
 
 
 def register(sub) -> None:
-    p = sub.add_parser("report", help="write a review page: check table, scene animations, energy plots")
-    p.add_argument("-o", "--output", required=True, help="the directory to write (index.html and its files)")
+    p = add_command(
+        sub,
+        "report",
+        "write a review page: check table, scene animations, energy plots",
+        ["pendverify report -o review", "pendverify report -o review --scenes my-scenes --no-erd --force"],
+    )
+    p.add_argument(
+        "-o", "--output", required=True, help="the directory to write (index.html and its files) (required)"
+    )
     p.add_argument(
         "--scenes",
         default=None,
         metavar="DIR",
         help="the folder of scene files (*.toml) to review (default: the scenes installed with pendverify)",
     )
-    p.add_argument("--samples", type=non_negative_int, default=None, help="random states per model")
-    p.add_argument("--seed", type=non_negative_int, default=None, help="seed of the state sampler")
-    p.add_argument("--no-erd", dest="erd", action="store_false", help="skip example-robot-data's URDFs")
+    p.add_argument(
+        "--samples", type=non_negative_int, default=None, help="random states per model (default: 400)"
+    )
+    p.add_argument(
+        "--seed", type=non_negative_int, default=None, help="seed of the state sampler (default: 20260301)"
+    )
+    p.add_argument(
+        "--no-erd",
+        dest="erd",
+        action="store_false",
+        help="skip example-robot-data's URDFs (default: checked when installed)",
+    )
     p.add_argument("--trace", action="store_true", help="draw the tip's path in the animations")
     p.add_argument("--force", action="store_true", help="replace an existing output folder")
     p.set_defaults(func=run)
@@ -65,7 +81,7 @@ def run(args: argparse.Namespace) -> int:
         DEFAULT_SEED if args.seed is None else args.seed,
         args.erd,
         args.trace,
-        log=lambda line: print(line, flush=True),
+        log=(lambda line: None) if args.quiet else (lambda line: print(line, flush=True)),
         force=args.force,
     )
     print(f"review page written to {folder.index}")
