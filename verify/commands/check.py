@@ -39,7 +39,11 @@ def register(sub) -> None:
         help="your own closed-form model: a Python file defining one ClosedFormModel subclass "
         "(see examples/cart_pole.py); needs --urdf",
     )
-    p.add_argument("--urdf", help="a URDF, xacro or MJCF file to check (with --model, or with --params)")
+    p.add_argument(
+        "--urdf",
+        help="a URDF, xacro or MJCF file to check (with --model, --analytic or --params), "
+        "or erd:NAME for example-robot-data's",
+    )
     p.add_argument("--params", help="a parameter file (TOML) giving the closed form")
     p.add_argument(
         "--samples", type=non_negative_int, default=None, help="random states per model (default: 400)"
@@ -73,30 +77,29 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from pendverify.analytic import MODELS
+    from pendverify.analytic.plugin import load_model_class
     from pendverify.atomic import check_output, check_report_output, write_atomic
     from pendverify.checks.junit import to_junit
     from pendverify.checks.report import format_table
     from pendverify.checks.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
-    from pendverify.checks.targets import default_target, erd_targets, plugin_target, user_target
+    from pendverify.checks.targets import select_targets
     from pendverify.checks.verification import build_report
-    from pendverify.robot.erd import MODEL as ERD_MODEL
     from pendverify.robot.geometry import MODEL_FORM_RTOL
 
     check_report_output(args.json)
     check_output(args.junit)
     samples = DEFAULT_RANDOM_STATES if args.samples is None else args.samples
     seed = DEFAULT_SEED if args.seed is None else args.seed
-    names = builtin_models(args.model, args.analytic)
+    builtin_models(args.model, args.analytic)  # refuses --model with --analytic, and unknown names
     if args.analytic:
-        targets = [plugin_target(args.analytic, args.urdf, args.params)]
-    elif args.urdf or args.params:
-        targets = [user_target(args.model, args.urdf, args.params)]
+        model_cls = load_model_class(args.analytic)
     else:
-        targets = [default_target(name) for name in names]
-        if args.erd and (args.model in (None, ERD_MODEL)):
-            targets += erd_targets()
+        model_cls = MODELS[args.model] if args.model else None
+    selection = select_targets(model_cls, args.urdf, args.params, erd_urdfs=args.erd)
     rtol = MODEL_FORM_RTOL if args.model_form_rtol is None else args.model_form_rtol
-    report = build_report(targets, samples, seed, strict=args.strict, model_form_rtol=rtol)
+    report = build_report(selection.targets, samples, seed, strict=args.strict, model_form_rtol=rtol)
+    report.skipped = selection.skipped
     report.elapsed_s = time.perf_counter() - args.started
     table = format_table(report)
     print(table.splitlines()[-1] if args.quiet else table)
