@@ -3,7 +3,8 @@
 An example is a model written by hand (a Python model file, and a LaTeX or text model
 where one exists), the URDF it is checked against (with xacro and MJCF versions where
 they exist), its parameter file and a scene that simulates it.  The files come from the
-shipped folders (``pendverify.shipped``).  ``copy_example`` writes them side by side into
+shipped folders (``pendverify.shipped``) and are listed in the shipped catalogue
+``examples/catalogue.toml``.  ``copy_example`` writes them side by side into
 one folder; the scene's relative paths (``../examples/cart_pole.py``) become the copies'
 names, so the folder runs on its own.
 """
@@ -12,10 +13,16 @@ from __future__ import annotations
 
 import re
 import shlex
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
 from pendverify.errors import FileAccessError, UnknownNameError
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - exercised on Python 3.10 only
+    import tomli as tomllib
 from pendverify.shipped import shipped_file
 
 #: a scene's keys that name a file relative to the scene
@@ -65,82 +72,48 @@ class WorkedExample:
         return (self.model, self.written_model) if self.written_model else (self.model,)
 
 
-def _plugin(name: str, summary: str, dof: int, scene: str, latex: bool = False) -> WorkedExample:
-    """An example whose model, URDF and parameters are all ``examples/NAME.*`` (``NAME_latex.toml``)."""
+#: the catalogue's roles of a file, by its key
+ROLES = {
+    "model": "model (Python)",
+    "latex": "model (LaTeX)",
+    "text": "model (text)",
+    "urdf": "URDF",
+    "params": "parameters",
+    "scene": "scene",
+}
+#: a description's role, by the end of its name
+DESCRIPTION_ROLES = {".xacro": "xacro", ".xml": "MJCF"}
+
+
+def _file(spec: str, role: str) -> ShippedFile:
+    kind, _, name = spec.partition("/")
+    return ShippedFile(kind, name, role)
+
+
+def _entry(table: dict) -> WorkedExample:
+    """One ``[[example]]`` table of the catalogue as a ``WorkedExample``."""
+    written = [key for key in ("latex", "text") if key in table]
     return WorkedExample(
-        name,
-        summary,
-        dof,
-        model=ShippedFile("examples", f"{name}.py", "model (Python)"),
-        written_model=ShippedFile("examples", f"{name}_latex.toml", "model (LaTeX)") if latex else None,
-        urdf=ShippedFile("examples", f"{name}.urdf", "URDF"),
-        params=ShippedFile("examples", f"{name}.toml", "parameters"),
-        scene=ShippedFile("scenes", scene, "scene"),
+        table["name"],
+        table["summary"],
+        table["dof"],
+        **{key: _file(table[key], ROLES[key]) for key in ("model", "urdf", "params", "scene")},
+        written_model=_file(table[written[0]], ROLES[written[0]]) if written else None,
+        descriptions=tuple(
+            _file(spec, DESCRIPTION_ROLES[Path(spec).suffix]) for spec in table.get("descriptions", ())
+        ),
     )
 
 
-EXAMPLES: tuple[WorkedExample, ...] = (
-    _plugin(
-        "cart_pole",
-        "a cart-pole with an inertial pole, friction on the cart and at the pivot",
-        2,
-        "cart_pole_lqr_push.toml",
-        latex=True,
-    ),
-    _plugin(
-        "furuta_pendulum",
-        "a Furuta (rotary inverted) pendulum with full body inertias: not planar",
-        2,
-        "furuta_arm_turning.toml",
-    ),
-    _plugin(
-        "triple_pendulum",
-        "a triple pendulum in absolute angles from hanging, with joint friction",
-        3,
-        "damped_triple_pendulum.toml",
-    ),
-    _plugin(
-        "hanging_double_pendulum",
-        "a double pendulum in absolute angles from hanging (non-diagonal D and B)",
-        2,
-        "hanging_double_pendulum_swing.toml",
-    ),
-    WorkedExample(
-        "minimal_double_pendulum",
-        "the least a hand derivation gives (M, C, H, V, D, B) of a double pendulum",
-        2,
-        model=ShippedFile("examples", "minimal_double_pendulum.py", "model (Python)"),
-        written_model=ShippedFile("examples", "minimal_double_pendulum_text.toml", "model (text)"),
-        urdf=ShippedFile("urdf", "double_pendulum.urdf", "URDF"),
-        params=ShippedFile("examples", "minimal_double_pendulum.toml", "parameters"),
-        scene=ShippedFile("scenes", "minimal_double_pendulum_release.toml", "scene"),
-    ),
-    WorkedExample(
-        "double_pendulum",
-        "reference system: the fixed-base actuated double pendulum",
-        2,
-        model=ShippedFile("models", "double_pendulum.py", "model (Python)"),
-        written_model=ShippedFile("examples", "double_pendulum_latex.toml", "model (LaTeX)"),
-        urdf=ShippedFile("urdf", "double_pendulum.urdf", "URDF"),
-        descriptions=(
-            ShippedFile("examples", "double_pendulum.xacro", "xacro"),
-            ShippedFile("examples", "double_pendulum.mjcf.xml", "MJCF"),
-        ),
-        params=ShippedFile("params", "double_pendulum.toml", "parameters"),
-        scene=ShippedFile("scenes", "damped_double_pendulum.toml", "scene"),
-    ),
-    WorkedExample(
-        "cart_double_pendulum",
-        "reference system: the double inverted pendulum on a cart",
-        3,
-        model=ShippedFile("models", "cart_double_pendulum.py", "model (Python)"),
-        written_model=ShippedFile("examples", "cart_double_pendulum_latex.toml", "model (LaTeX)"),
-        urdf=ShippedFile("urdf", "cart_double_pendulum.urdf", "URDF"),
-        params=ShippedFile("params", "cart_double_pendulum.toml", "parameters"),
-        scene=ShippedFile("scenes", "cart_lqr_push.toml", "scene"),
-    ),
-)
+def load_catalogue() -> tuple[WorkedExample, ...]:
+    """The worked examples of the shipped catalogue (``examples/catalogue.toml``), in its order."""
+    text = shipped_file("examples", CATALOGUE).read_text(encoding="utf-8")
+    return tuple(_entry(table) for table in tomllib.loads(text)["example"])
 
+
+#: the shipped file that lists the worked examples
+CATALOGUE = "catalogue.toml"
+EXAMPLES: tuple[WorkedExample, ...] = load_catalogue()
 NAMES = tuple(e.name for e in EXAMPLES)
 
 
