@@ -1,4 +1,4 @@
-"""Double inverted pendulum on a cart (seed ``001_cd8cb0dc0c0701d3``).
+"""Double inverted pendulum on a cart: the cart reference system.
 
 Conventions
 -----------
@@ -15,7 +15,7 @@ Conventions
 
 Positions: q0 = (q, 0), q1 = q0 + l1 (sin θ1, cos θ1), q2 = q1 + l2 (sin θ2, cos θ2).
 Friction −d1 q̇ on the cart [N·s/m], −d2 θ̇1 and −d3 θ̇2 [N·m·s/rad] on the
-*absolute* angular rates, exactly as the seed models them.  Disturbances
+*absolute* angular rates, exactly as the derivation models them.  Disturbances
 w = (w1, w2, w3) act as generalized forces on (q, θ1, θ2).  y = (q, θ1, θ2).
 
 Equations::
@@ -32,11 +32,11 @@ Equations::
     M(y) ÿ = f,     det M = l1² l2² m2 (m m1 + (m1² + m1 m2) sin² θ1 + m m2 sin²(θ1−θ2)),
     ẋ = F(x, u, w) = (ẏ, M⁻¹ f),  x = (y, ẏ).
 
-The seed's typeset M lost its third row; it is derived here from the kinetic
+The derivation's typeset M lost its third row; it is derived here from the kinetic
 energy K = ½ (m‖q̇0‖² + m1‖q̇1‖² + m2‖q̇2‖²): ∂²K/∂θ̇2∂ẏ gives
 (m2 l2 cos θ2, l1 l2 m2 cos(θ1−θ2), l2² m2), consistent with the symmetry of the
-first two rows.  The seed's intermediate lines carry typos; its f and det M are
-used verbatim.  The seed gives no C matrix: the Christoffel form of M is
+first two rows.  The derivation's intermediate lines carry typos; its f and det M are
+used verbatim.  The derivation gives no C matrix: the Christoffel form of M is
 
     C(y, ẏ) = [ 0   −l1 (m1+m2) sin θ1 θ̇1   −m2 l2 sin θ2 θ̇2      ]
               [ 0    0                       l1 l2 m2 sin(θ1−θ2) θ̇2 ]
@@ -45,7 +45,7 @@ used verbatim.  The seed gives no C matrix: the Christoffel form of M is
 and H = ∂V/∂y = (0, −g (m1+m2) l1 sin θ1, −g m2 l2 sin θ2) with
 V = g (m1 l1 cos θ1 + m2 (l1 cos θ1 + l2 cos θ2)), so that f = −C ẏ − H − D ẏ + B u + w.
 
-Lagrangian (for ``pendverify sympy``): the seed's K and P verbatim, the Rayleigh
+Lagrangian (for ``pendverify sympy``): the derivation's K and P verbatim, the Rayleigh
 function R = ½ (d1 q̇² + d2 θ̇1² + d3 θ̇2²) and the input power
 P_in = (u + w1) q̇ + w2 θ̇1 + w3 θ̇2.
 """
@@ -96,7 +96,7 @@ class CartDoublePendulum(ClosedFormModel):
         damping_floor=0.05,
     )
     disturbances = ("w1", "w2", "w3")
-    # The seed's own right-hand side f is a closed form too.
+    # The derivation's own right-hand side f is a closed form too.
     closed_forms: ClassVar[dict[str, ClosedForm]] = {
         **STANDARD_CLOSED_FORMS,
         "f": ClosedForm("qvuw", "-C*v - H - D*v + B*u + W*w"),
@@ -160,7 +160,7 @@ class CartDoublePendulum(ClosedFormModel):
         return np.eye(3)
 
     def f(self, y, yd, u, w):
-        """The seed's right-hand side f(y, ẏ, u, w) of M(y) ÿ = f, verbatim."""
+        """The derivation's right-hand side f(y, ẏ, u, w) of M(y) ÿ = f, verbatim."""
         p = self.params
         s1, s2, s12 = self.math.sin(y[1]), self.math.sin(y[2]), self.math.sin(y[1] - y[2])
         return (

@@ -1,4 +1,4 @@
-"""Fixed-base actuated double pendulum (seed ``000_f9503cae7b675462``).
+"""Fixed-base actuated double pendulum: the double-pendulum reference system.
 
 Conventions
 -----------
@@ -12,7 +12,7 @@ Conventions
 * b1, b2 [N·m·s/rad] are viscous joint frictions; u = (τ1, τ2) [N·m] are joint
   torques.  State x = (θ1, θ2, θ̇1, θ̇2).
 
-Equations (the seed's, verbatim)::
+Equations (the derivation's, verbatim)::
 
     M(q) = [ α + 2β cos θ2    δ + β cos θ2 ]
            [ δ + β cos θ2     δ            ]
@@ -26,10 +26,10 @@ Equations (the seed's, verbatim)::
     M q̈ + C q̇ + H = u,       ẋ = f(x) + g(x) u,
     f(x) = [ θ̇ ;  −M⁻¹ (C q̇ + H) ],   g(x) = [ 0 ; M⁻¹ ].
 
-The seed cites an appendix that is not included.  Its constants are taken as
+The derivation takes its constants from an appendix not at hand.  They are taken as
 α = I1 + I2 + m1 r1² + m2 (l1² + r2²),  β = m2 l1 r2,  δ = I2 + m2 r2²
 (inertias about the centres of mass, parallel-axis terms written out).  The
-seed's C carries the friction on its diagonal; ``coriolis_matrix`` returns it
+derivation's C carries the friction on its diagonal; ``coriolis_matrix`` returns it
 without, ``seed_coriolis_matrix`` with.  V(q) = g (m1 r1 + m2 l1) sin θ1 +
 g m2 r2 sin(θ1 + θ2), so H = ∂V/∂q.
 
@@ -98,18 +98,18 @@ class DoublePendulum(ClosedFormModel):
     battery_motion = BatteryMotion(
         q=(0.4, 1.1), v=(0.5, -0.5), input_amplitude=(1.0, 0.4), input_frequency=0.7, damping_floor=0.05
     )
-    # The seed writes C with the friction on its diagonal: that is the formula to mutate.
+    # The derivation writes C with the friction on its diagonal: that is the formula to mutate.
     closed_forms: ClassVar[dict[str, ClosedForm]] = {
         **{k: f for k, f in STANDARD_CLOSED_FORMS.items() if k != "coriolis_matrix"},
         "seed_coriolis_matrix": ClosedForm("qv", "C + D"),
     }
 
-    #: the map, the offsets and the seed's parameters are read off the URDF
+    #: the map, the offsets and the parameters are read off the URDF
     #: (``pendverify.robot.seed_geometry``)
     geometry_reader = "double_pendulum"
 
     def derived_constants(self) -> dict[str, float]:
-        """α, β, δ of the seed's appendix."""
+        """α, β, δ of the derivation."""
         return {"alpha": self.alpha, "beta": self.beta, "delta": self.delta}
 
     # --- the appendix constants ------------------------------------------------------
@@ -128,14 +128,14 @@ class DoublePendulum(ClosedFormModel):
         p = self.params
         return p.I2 + p.m2 * p.r2**2
 
-    # --- the seed's matrices -----------------------------------------------------------
+    # --- the derivation's matrices -----------------------------------------------------------
     def mass_matrix(self, q):
         a, b, d = self.alpha, self.beta, self.delta
         c2 = self.math.cos(q[1])
         return np.array([[a + 2 * b * c2, d + b * c2], [d + b * c2, d]])
 
     def seed_coriolis_matrix(self, q, v):
-        """C exactly as the seed prints it: friction b1, b2 on the diagonal."""
+        """C exactly as the derivation prints it: friction b1, b2 on the diagonal."""
         b, p = self.beta, self.params
         s2 = self.math.sin(q[1])
         return np.array(
@@ -146,7 +146,7 @@ class DoublePendulum(ClosedFormModel):
         )
 
     def coriolis_matrix(self, q, v):
-        # the seed's own C, less its friction; the checks' scales include |D| for this subtraction
+        # the derivation's own C, less its friction; the checks' scales include |D| for this subtraction
         return self.seed_coriolis_matrix(q, v) - self.damping_matrix()
 
     def gravity(self, q):

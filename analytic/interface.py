@@ -25,8 +25,8 @@ C q̇ − H)), ``special_states`` (the zero state only), and the tolerance scale
 SymPy from the model's own H and M).  ``hand_written()`` names the methods a model
 writes itself; a derived det M or M⁻¹ is not checked (nothing to check), and a
 derived q̈ is checked by ``aba`` as the composition of the parts, with a note.
-A hand-written ``acceleration`` must be the model's *own* closed form (the seed's
-f + g·u, or M⁻¹·f), not a re-assembly from the other methods, so that a typo in
+A hand-written ``acceleration`` must be the model's *own* closed form (as the
+reference systems' f + g·u, or M⁻¹·f), not a re-assembly from the other methods, so that a typo in
 any single place shows up in some check.
 
 Writing your own model (a plug-in)
@@ -65,16 +65,40 @@ too) and keep ``__init__`` free of arithmetic on the parameters.
 from __future__ import annotations
 
 import types
-from abc import ABC, abstractmethod
+from abc import ABCMeta, abstractmethod
 from typing import Any, ClassVar
 
 import numpy as np
 
 from pendverify.analytic.forms import NUMERIC_MATH, STANDARD_CLOSED_FORMS, BatteryMotion, ClosedForm, Energies
 from pendverify.analytic.params import ParameterSet
+from pendverify.display import REPR_LIMIT, listed, shortened
 
 
-class ClosedFormModel(ABC):
+def _shape(cls) -> str:
+    """ "2 dof (theta1, theta2), 1 input": a model class's coordinates, inputs and disturbances."""
+    coordinates = tuple(str(c) for c in getattr(cls, "coordinates", ()) or ())
+    parts = [f"{len(coordinates)} dof ({listed(coordinates, 60)})"]
+    for what in ("input", "disturbance"):
+        names = tuple(getattr(cls, f"{what}s", ()) or ())
+        if names:
+            parts.append(f"{len(names)} {what}{'s' if len(names) > 1 else ''}")
+    return ", ".join(parts)
+
+
+class ModelClass(ABCMeta):
+    """The type of every closed-form model class: an ABC whose classes show their model's name,
+    module and coordinates (``<model class DoublePendulum 'double_pendulum' in ...: 2 dof ...>``)."""
+
+    def __repr__(cls) -> str:
+        name = getattr(cls, "name", None)
+        if not isinstance(name, str):  # the interface itself, or a class that names no model
+            return f"<model interface {cls.__qualname__} in {cls.__module__}>"
+        title = f"{shortened(cls.__qualname__, 60)} {shortened(name, 60)!r}"
+        return f"<model class {title} in {shortened(cls.__module__, 80)}: {_shape(cls)}>"
+
+
+class ClosedFormModel(metaclass=ModelClass):
     """Hand-derived equations of motion of one system, for one parameter set."""
 
     name: ClassVar[str]
@@ -110,7 +134,14 @@ class ClosedFormModel(ABC):
 
     @property
     def nv(self) -> int:
+        """The number of coordinates (degrees of freedom)."""
         return len(self.coordinates)
+
+    def __repr__(self) -> str:
+        head = f"<{shortened(type(self).__qualname__, 60)} {shortened(self.name, 60)!r}: {_shape(type(self))}"
+        values = self.params.as_dict() if isinstance(self.params, ParameterSet) else {}
+        text = ", ".join(f"{k}={v:.6g}" if isinstance(v, float) else f"{k}={v}" for k, v in values.items())
+        return f"{head}; {shortened(text, REPR_LIMIT - len(head) - 3)}>"
 
     # --- the equations -------------------------------------------------------------
     @abstractmethod
@@ -156,7 +187,7 @@ class ClosedFormModel(ABC):
     def acceleration(self, q: np.ndarray, v: np.ndarray, u: np.ndarray, w: np.ndarray) -> np.ndarray:
         """q̈.  Derived by default: M⁻¹ (B u + W w − D q̇ − C q̇ − H) from the model's own parts.
 
-        A model with its own closed form (the seed's f + g·u, or M⁻¹·f) writes it
+        A model with its own closed form (as the reference systems' f + g·u, or M⁻¹·f) writes it
         here, *not* as a re-assembly of the other methods, so that a typo in any
         single place shows up in some check.
         """
@@ -183,6 +214,7 @@ class ClosedFormModel(ABC):
         return self.coriolis_matrix(q, v) @ v + self.gravity(q)
 
     def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> float:
+        """T(q, q̇) = ½ q̇ᵀ M(q) q̇."""
         return 0.5 * float(v @ self.mass_matrix(q) @ v)
 
     def diagonal_scale(self, q: np.ndarray) -> np.ndarray:

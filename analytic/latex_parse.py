@@ -24,7 +24,7 @@ What is read
   ``x_1`` and ``x_{1}``; spacing (``\\, \\; \\quad`` …) is ignored.
 * A chain ``LABEL = A = B``: a leading label of the form ``NAME(args)`` (such as
   ``\\mathbf{M}(\\mathbf{x})`` or ``f(y,\\dot{y},u,w)``) is dropped, a leading ``=``
-  too, and every right-hand side must be read and be *equal* (seed 000 prints each
+  too, and every right-hand side must be read and be *equal* (the double-pendulum reference system prints each
   matrix in θ and in x = (θ, θ̇) notation: both are read and compared).
 
 Anything else is an error that shows the LaTeX and where reading stopped.

@@ -1,6 +1,8 @@
 """Load a user's closed-form model from a Python file (``--analytic FILE``).
 
-The file is imported by path under a private module name.  It must define
+The file is imported by path as ``pendverify.plugins.<stem>`` (``module_name``: its stem
+made a valid identifier, a second file of the same stem ``<stem>_2``; the same file
+keeps its name).  It must define
 exactly one concrete subclass of ``pendverify.analytic.ClosedFormModel``
 (classes it merely imports do not count) with
 
@@ -16,9 +18,9 @@ exactly one concrete subclass of ``pendverify.analytic.ClosedFormModel``
 ``validate_model_class`` checks these rules on any class (the Python API applies it to a
 class written in the caller's own code).  ``examples/cart_pole.py`` is a complete
 plug-in.  The built-in models are plug-ins of the same kind: ``--analytic
-analytic/double_pendulum.py`` loads the seed through this same path.  Every problem is
-a ``PendverifyError`` naming the file (and the line, for an exception raised while
-importing it).
+analytic/double_pendulum.py`` loads the double-pendulum reference system through this
+same path.  Every problem is a ``PendverifyError`` naming the file (and the line, for an
+exception raised while importing it).
 """
 
 from __future__ import annotations
@@ -26,6 +28,8 @@ from __future__ import annotations
 import dataclasses
 import importlib.util
 import inspect
+import keyword
+import re
 import sys
 import traceback
 from pathlib import Path
@@ -78,9 +82,36 @@ def _resolved(filename: str) -> str:
         return filename
 
 
+#: the package name model files are imported under (not a package on disk: the modules are made here)
+NAMESPACE = "pendverify.plugins"
+#: resolved path of each model file imported so far → its module name
+_MODULE_NAMES: dict[str, str] = {}
+
+
+def module_name(path: str | Path) -> str:
+    """The module name model file ``path`` is imported under: ``pendverify.plugins.<stem>``.
+
+    The stem is made a valid identifier (other characters become ``_``; a leading digit or a
+    keyword gets an ``_``); a file at another resolved path with the same stem gets ``<stem>_2``,
+    ``<stem>_3``, ...; the same resolved path always gets the same name.
+    """
+    resolved = str(Path(path).resolve())
+    if resolved in _MODULE_NAMES:
+        return _MODULE_NAMES[resolved]
+    stem = re.sub(r"[^0-9A-Za-z_]", "_", Path(path).stem) or "model"
+    if stem[0].isdigit() or keyword.iskeyword(stem):
+        stem = f"_{stem}"
+    taken = {*_MODULE_NAMES.values(), *sys.modules}
+    name, n = f"{NAMESPACE}.{stem}", 2
+    while name in taken:
+        name, n = f"{NAMESPACE}.{stem}_{n}", n + 1
+    _MODULE_NAMES[resolved] = name
+    return name
+
+
 def _import(path: Path):
     resolved = str(path.resolve())
-    name = f"pendverify_plugin_{abs(hash(resolved))}"
+    name = module_name(path)
     spec = importlib.util.spec_from_file_location(name, path)
     if spec is None or spec.loader is None:
         raise PendverifyError(f"{path}: not a Python file that can be imported")

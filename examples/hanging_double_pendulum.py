@@ -51,7 +51,7 @@ from pendverify.analytic.params import ParameterSet, quantity
 
 @dataclasses.dataclass(frozen=True)
 class HangingDoublePendulumParams(ParameterSet):
-    """Parameters, SI units (the same physical quantities as the seed-000 double pendulum)."""
+    """Parameters, SI units (the same physical quantities as the reference double pendulum)."""
 
     model = "hanging_double_pendulum"
 

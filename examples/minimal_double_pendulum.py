@@ -1,6 +1,6 @@
 """The least a hand derivation has to give: M, C, H, V, D, B of a double pendulum.
 
-Verify it against the seed's URDF::
+Verify it against the reference double pendulum's URDF::
 
     pendverify check --analytic examples/minimal_double_pendulum.py \\
         --urdf urdf/double_pendulum.urdf --params examples/minimal_double_pendulum.toml
@@ -8,7 +8,7 @@ Verify it against the seed's URDF::
     pendverify mutate --analytic examples/minimal_double_pendulum.py \\
         --urdf urdf/double_pendulum.urdf --params examples/minimal_double_pendulum.toml
 
-The formulas are the seed-000 double pendulum's (``pendverify.analytic.double_pendulum``):
+The formulas are the reference double pendulum's (``pendverify.analytic.double_pendulum``):
 θ1 from the horizontal, θ2 relative to link 1, the URDF's own joint angles, so the
 coordinate map is the identity.  Only M, C, H, V, D and B are written (and the
 energies, for ``pendverify sympy``).  Everything else is derived by the interface:
@@ -31,7 +31,7 @@ from pendverify.analytic.params import ParameterSet, quantity
 
 @dataclasses.dataclass(frozen=True)
 class MinimalDoublePendulumParams(ParameterSet):
-    """Parameters, SI units (those of the seed-000 double pendulum)."""
+    """Parameters, SI units (those of the reference double pendulum)."""
 
     model = "minimal_double_pendulum"
 

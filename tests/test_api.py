@@ -7,6 +7,7 @@ input is a one-line ``PendverifyError``; ``import pendverify`` does not load Pin
 
 from __future__ import annotations
 
+import json
 import re
 import subprocess
 import sys
@@ -52,7 +53,7 @@ def cli_table(capsys, *argv: str) -> tuple[int, str]:
 
 # --- check --------------------------------------------------------------------------------------------
 def test_check_builtin_name_gives_the_cli_table(capsys):
-    report = pendverify.check("double_pendulum")
+    report = pendverify.check("double_pendulum", erd=False)
     assert isinstance(report, pendverify.CheckReport) and isinstance(report, Report)
     assert report.passed and report.status == "pass"
     assert str(report) == report.table()
@@ -70,6 +71,87 @@ def test_check_builtin_name_gives_the_cli_table(capsys):
     assert TIMING.search(cli_lines[-1]) and TIMING.search(api_lines[-1])
     assert api_lines[:-1] == cli_lines[:-1]  # every line but the timing line, verbatim
     assert comparable(report.table()) == comparable(cli)
+
+
+DEFAULT_PARAMS = str(default_parameter_file("double_pendulum"))
+ERD_SIMPLE = "erd:double_pendulum_simple"
+#: (the API's arguments, the CLI's) that must select the same targets and give the same table
+SAME_ARGUMENTS = {
+    "everything": ((), {}, []),
+    "the double pendulum, with example-robot-data": (
+        ("double_pendulum",),
+        {},
+        ["--model", "double_pendulum"],
+    ),
+    "the double pendulum, erd=False": (
+        ("double_pendulum",),
+        {"erd": False},
+        ["--model", "double_pendulum", "--no-erd"],
+    ),
+    "the cart": (("cart_double_pendulum",), {}, ["--model", "cart_double_pendulum"]),
+    "erd:NAME as the model": ((ERD_SIMPLE,), {}, ["--urdf", ERD_SIMPLE]),
+    "erd:NAME as the urdf": (
+        ("double_pendulum",),
+        {"urdf": ERD_SIMPLE},
+        ["--urdf", ERD_SIMPLE, "--model", "double_pendulum"],
+    ),
+    "erd:NAME with parameters": (
+        (),
+        {"urdf": ERD_SIMPLE, "params": DEFAULT_PARAMS},
+        ["--urdf", ERD_SIMPLE, "--params", DEFAULT_PARAMS],
+    ),
+    "a parameter file alone": ((), {"params": DEFAULT_PARAMS}, ["--params", DEFAULT_PARAMS]),
+    "a model file": (
+        (str(CART_POLE[0]), str(CART_POLE[1]), str(CART_POLE[2])),
+        {},
+        ["--analytic", str(CART_POLE[0]), "--urdf", str(CART_POLE[1]), "--params", str(CART_POLE[2])],
+    ),
+}
+
+
+@pytest.mark.parametrize("case", SAME_ARGUMENTS, ids=list(SAME_ARGUMENTS))
+def test_the_api_and_the_cli_check_the_same_targets_with_the_same_numbers(capsys, tmp_path, case):
+    args, kwargs, argv = SAME_ARGUMENTS[case]
+    report = pendverify.check(*args, **kwargs, samples=FEW)
+    out = tmp_path / "cli.json"
+    status, cli = cli_table(capsys, *argv, "--samples", str(FEW), "--json", str(out))
+    cli = cli.removesuffix(f"\nreport written to {out}")
+    assert status == (0 if report.passed else 1)
+    assert comparable(report.table()) == comparable(cli)
+    document = json.loads(out.read_text())
+    assert document["states"] == report.states and document["skipped"] == report.skipped
+    fields = ("model", "check", "max_error", "tolerance", "max_abs_error", "status")
+    assert [tuple(r[f] for f in fields) for r in document["results"]] == [
+        tuple(getattr(r, f) for f in fields) for r in report.results
+    ]
+
+
+def test_a_built_in_name_checks_what_check_model_checks():
+    """check("double_pendulum") is `check --model double_pendulum`: the default set and
+    example-robot-data's URDFs (installed with the test extra); erd=False is --no-erd."""
+    with_erd = pendverify.check("double_pendulum", samples=FEW)
+    assert with_erd.models == (
+        "double_pendulum",
+        "erd:double_pendulum",
+        "erd:double_pendulum_continuous",
+        "erd:double_pendulum_simple",
+    )
+    assert with_erd.passed and not with_erd.skipped
+    assert pendverify.check("double_pendulum", samples=FEW, erd=False).models == ("double_pendulum",)
+    assert pendverify.check("cart_double_pendulum", samples=FEW).models == ("cart_double_pendulum",)
+    assert pendverify.check(samples=FEW).models == (
+        "double_pendulum",
+        "cart_double_pendulum",
+        "erd:double_pendulum",
+        "erd:double_pendulum_continuous",
+        "erd:double_pendulum_simple",
+    )
+    # an erd:NAME target alone is the very row of the default check
+    alone = pendverify.check(ERD_SIMPLE, samples=FEW)
+    assert alone.models == (ERD_SIMPLE,) == pendverify.check(urdf=ERD_SIMPLE, samples=FEW).models
+    assert [(r.check, r.max_error) for r in alone.results] == [
+        (r.check, r.max_error) for r in with_erd.results if r.model == ERD_SIMPLE
+    ]
 
 
 def test_plugin_file_with_its_urdf_and_parameters_passes_as_on_the_cli(capsys):
@@ -259,7 +341,26 @@ BAD_INPUTS = {
     ),
     "not a model": (lambda tmp: pendverify.load_model(42), "got a int"),
     "not a model class": (lambda tmp: pendverify.load_model(dict), "not a subclass"),
-    "plug-in without a URDF": (lambda tmp: pendverify.check(CART_POLE[0]), "give urdf"),
+    "plug-in without a URDF": (
+        lambda tmp: pendverify.check(CART_POLE[0]),
+        "cart_pole.py: give --urdf (urdf= in the Python API): the URDF to verify cart_pole against",
+    ),
+    "unknown example-robot-data URDF": (
+        lambda tmp: pendverify.check("erd:double_pendulum_triple"),
+        "erd:double_pendulum_triple: example-robot-data has no 'double_pendulum_triple'; it has",
+    ),
+    "erd:NAME as the model and a urdf": (
+        lambda tmp: pendverify.check("erd:double_pendulum", committed_urdf("double_pendulum")),
+        "give it as model or as urdf, not both",
+    ),
+    "erd not a bool": (
+        lambda tmp: pendverify.check("double_pendulum", erd="no"),
+        "key 'erd' = 'no': must be True or False",
+    ),
+    "a mapping of parameters without a model": (
+        lambda tmp: pendverify.check(params=default_values()),
+        "name the model of these parameters",
+    ),
     "negative samples": (lambda tmp: pendverify.check("double_pendulum", samples=-1), "'samples' = -1"),
     "zero model-form rtol": (
         lambda tmp: pendverify.check("double_pendulum", model_form_rtol=0.0),
@@ -384,6 +485,8 @@ def test_certify_set_writes_a_bundle_that_recheck_accepts(tmp_path):
 
     issued = pendverify.certify_set(tmp_path, default_parameter_file("double_pendulum"), samples=40)
     assert issued.certified and issued.path == tmp_path / "double_pendulum.cert.json"
+    text = repr(issued)  # short: the items and the certificate are in the fields, not the repr
+    assert text == f"<Issued certified: {len(issued.items)} items pass; {issued.path}>" and len(text) <= 300
     assert recheck(str(issued.path)).passed
     with pytest.raises(pendverify.PendverifyError, match="exists"):
         pendverify.certify_set(tmp_path, default_parameter_file("double_pendulum"), samples=40)

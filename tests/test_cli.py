@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 
+import pytest
+
 from pendverify.checks.catalogue import CHECK_NAMES
 from pendverify.cli import main
 from pendverify.robot.erd import double_pendulum_urdfs
@@ -109,3 +111,27 @@ def test_check_reports_the_largest_error_apart_from_the_worst_ratio(tmp_path, ca
     assert f"largest relative error: {top['largest_error']:.2e} (cart_double_pendulum {top['check']}" in text
     # on this sample the largest error and the worst ratio fall at different states for some check
     assert any(r["largest_state"]["label"] != r["worst_state"]["label"] for r in results)
+
+
+@pytest.mark.parametrize(
+    "argv, verdict",
+    [
+        (["sympy", "--model", "double_pendulum"], "every closed form equals its derivation"),
+        (["stress", "--quick", "--case", "double pendulum g = 0"], "all cases pass"),
+        (
+            ["mutate", "--model", "double_pendulum", "--samples", "10", "--method", "mass_matrix"],
+            "non-equivalent mutants",
+        ),
+    ],
+    ids=lambda v: v[0] if isinstance(v, list) else "",
+)
+def test_json_dash_is_the_whole_of_stdout_and_quiet_keeps_the_verdict(
+    argv, verdict, tmp_path, monkeypatch, capsys
+):
+    """``--json -``: the JSON on stdout, nothing else; with --quiet the verdict line alone on stderr."""
+    monkeypatch.chdir(tmp_path)
+    assert main([*argv, "--json", "-", "--quiet"]) == 0
+    out, err = capsys.readouterr()
+    json.loads(out)
+    assert len(err.splitlines()) == 1 and verdict in err
+    assert list(tmp_path.iterdir()) == [], "a file was written for --json -"

@@ -2,12 +2,23 @@
 
 from __future__ import annotations
 
+import importlib.metadata
+import json
 import math
+from pathlib import Path
 
 import pytest
 
+import pendverify
+from pendverify.cli import main
+from pendverify.errors import PendverifyError
+from pendverify.robot import erd
 from pendverify.robot.erd import double_pendulum_urdfs
 from pendverify.robot.system import PinocchioSystem
+from pendverify.simulation.scene import load_scene
+from pendverify.viz.review_folder import scene_targets
+
+REPO = Path(__file__).resolve().parents[1]
 
 
 def test_urdfs_are_found_in_the_installed_distribution():
@@ -47,3 +58,103 @@ def test_continuous_joints_are_read_like_revolute_ones():
     a = PinocchioSystem.from_urdf("double_pendulum", found["double_pendulum"]).geometry.params
     b = PinocchioSystem.from_urdf("double_pendulum", found["double_pendulum_continuous"]).geometry.params
     assert a == b
+
+
+# --- example-robot-data not installed: an optional extra -------------------------------------------------
+def _without_erd(monkeypatch):
+    """Make importlib.metadata find no example-robot-data distribution, as in an install without the extra."""
+    real = importlib.metadata.distribution
+
+    def distribution(name):
+        if name == erd.DISTRIBUTION:
+            raise importlib.metadata.PackageNotFoundError(name)
+        return real(name)
+
+    monkeypatch.setattr(importlib.metadata, "distribution", distribution)
+
+
+SKIPPED_LINE = (
+    "note: example-robot-data is not installed: its double-pendulum URDFs are skipped "
+    "(pip install 'pendverify[erd]')"
+)
+
+
+def test_installed_finds_the_distribution_or_says_none(monkeypatch):
+    assert erd.installed() is not None
+    _without_erd(monkeypatch)
+    assert erd.installed() is None
+
+
+def test_default_check_without_erd_skips_its_urdfs_in_one_note_line(monkeypatch, capsys, tmp_path):
+    _without_erd(monkeypatch)
+    out = tmp_path / "report.json"
+    assert main(["check", "--samples", "5", "--json", str(out)]) == 0  # exit status unchanged
+    text = capsys.readouterr().out
+    assert text.count("example-robot-data") == 1 and SKIPPED_LINE in text.splitlines()
+    assert "erd:" not in text
+    document = json.loads(out.read_text())
+    assert set(document["states"]) == {"double_pendulum", "cart_double_pendulum"}
+    assert document["skipped"] == [SKIPPED_LINE.removeprefix("note: ")]
+
+    assert main(["check", "--model", "double_pendulum", "--samples", "5"]) == 0
+    assert SKIPPED_LINE in capsys.readouterr().out.splitlines()
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["--no-erd"],
+        ["--model", "cart_double_pendulum"],
+        ["--params", str(REPO / "analytic" / "params" / "double_pendulum.toml")],
+    ],
+    ids=["--no-erd", "the cart", "a parameter file"],
+)
+def test_no_note_where_example_robot_data_would_not_be_checked(monkeypatch, capsys, argv):
+    _without_erd(monkeypatch)
+    assert main(["check", *argv, "--samples", "5"]) == 0
+    assert "example-robot-data" not in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["check", "--urdf", "erd:double_pendulum"],
+        ["check", "--model", "double_pendulum", "--urdf", "erd:double_pendulum"],
+        ["certify", "--model", "double_pendulum", "--urdf", "erd:double_pendulum", "-o", "OUT"],
+    ],
+    ids=["check", "check --model", "certify"],
+)
+def test_naming_an_erd_urdf_without_it_is_a_one_line_error(monkeypatch, capsys, tmp_path, argv):
+    _without_erd(monkeypatch)
+    argv = [str(tmp_path / "out") if a == "OUT" else a for a in argv]
+    assert main(argv) == 2
+    captured = capsys.readouterr()
+    assert captured.err == (
+        "pendverify: error: erd:double_pendulum: example-robot-data is not installed "
+        "(pip install 'pendverify[erd]')\n"
+    )
+    assert not (tmp_path / "out").exists()
+
+
+def test_the_api_skips_and_says_so_and_erd_false_says_nothing(monkeypatch):
+    _without_erd(monkeypatch)
+    report = pendverify.check("double_pendulum", samples=5)
+    assert report.models == ("double_pendulum",) and report.passed
+    assert report.skipped == [erd.SKIPPED] and SKIPPED_LINE in report.table().splitlines()
+    assert "example-robot-data is not installed" in report._repr_html_()
+    quiet = pendverify.check("double_pendulum", samples=5, erd=False)
+    assert quiet.skipped == [] and "example-robot-data" not in quiet.table()
+    with pytest.raises(PendverifyError, match=r"^erd:double_pendulum_simple: example-robot-data is not"):
+        pendverify.check("erd:double_pendulum_simple")
+
+
+def test_the_review_folder_skips_them_too(monkeypatch):
+    scene = load_scene(REPO / "scenes" / "damped_double_pendulum.toml")
+    assert [t.label for t in scene_targets([scene]).targets][1:] == [
+        f"erd:{stem}" for stem in double_pendulum_urdfs()
+    ]
+    _without_erd(monkeypatch)
+    selection = scene_targets([scene])
+    assert [t.label for t in selection.targets] == ["double_pendulum"]
+    assert selection.skipped == [erd.SKIPPED]
+    assert scene_targets([scene], erd=False).skipped == []

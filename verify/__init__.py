@@ -5,7 +5,8 @@ The Python API (``pendverify.api``, ``pendverify.testing``)::
     import pendverify
 
     report = pendverify.check("double_pendulum")     # a CheckReport; print(report) gives the CLI's table
-    run = pendverify.simulate("scenes/damped_double_pendulum.toml")
+    report["crba"]                                   # one check's rows (CheckRows), one per model
+    run = pendverify.simulate("scenes/damped_double_pendulum.toml")   # a Run
 
 The names below are imported on first use, so ``import pendverify`` stays cheap: it imports
 neither Pinocchio nor SymPy.
@@ -27,13 +28,17 @@ _LAZY = {
     "simulate": "pendverify.api",
     "certify_set": "pendverify.api",
     "CheckReport": "pendverify.checks.report",
+    "CheckRows": "pendverify.checks.report",
+    "Run": "pendverify.simulation.simulate",
     "assert_verified": "pendverify.testing",
     "PendverifyError": "pendverify.errors",
 }
 
 __all__ = [
     "CheckReport",
+    "CheckRows",
     "PendverifyError",
+    "Run",
     "__version__",
     "assert_verified",
     "certify_set",
@@ -46,8 +51,9 @@ __all__ = [
 
 if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
     from pendverify.api import certify_set, check, load_model, load_params, load_urdf, simulate
-    from pendverify.checks.report import CheckReport
+    from pendverify.checks.report import CheckReport, CheckRows
     from pendverify.errors import PendverifyError
+    from pendverify.simulation.simulate import Run
     from pendverify.testing import assert_verified
 
 

@@ -6,13 +6,17 @@ a report made here has the same results, verdicts and table as the command line:
 
     import pendverify
 
-    report = pendverify.check("double_pendulum")                 # the default set vs its URDF
+    report = pendverify.check("double_pendulum")      # as `pendverify check --model double_pendulum`
     report = pendverify.check("examples/cart_pole.py", "examples/cart_pole.urdf",
                               "examples/cart_pole.toml")        # a model file, as --analytic
     report.passed, report.status                                  # True, "pass"
+    report["crba"]                                                # that check's rows, one per model
     print(report)                                                 # the table `pendverify check` prints
     run = pendverify.simulate("scenes/damped_double_pendulum.toml")
     run.t, run.q, run.v, run.passed
+
+``check`` and ``pendverify check`` choose their targets through one dispatcher
+(``pendverify.checks.targets.select_targets``), so the same arguments check the same models.
 
 Models are given as a built-in name (``pendverify.analytic.MODELS``), a model file (``.py``,
 one ``ClosedFormModel`` subclass, as ``--analytic``) or a ``ClosedFormModel`` subclass.  Bad
@@ -31,15 +35,16 @@ from typing import TYPE_CHECKING, Any
 
 from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
 from pendverify.analytic.params import check_value
-from pendverify.analytic.plugin import load_model_class, plugin_parameters, validate_model_class, where
+from pendverify.analytic.plugin import load_model_class, validate_model_class
 from pendverify.certify.battery import BatterySettings
 from pendverify.certify.issue import certification_input, issue
 from pendverify.certify.signing import load_private_key
 from pendverify.checks.report import CheckReport
 from pendverify.checks.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
-from pendverify.checks.targets import Target, default_target, model_target, params_target
+from pendverify.checks.targets import is_builtin, parameter_values, select_targets
 from pendverify.checks.verification import build_report
 from pendverify.errors import InputError, PendverifyError, UnknownNameError
+from pendverify.robot import erd as erd_data
 from pendverify.robot.geometry import MODEL_FORM_RTOL
 from pendverify.robot.system import PinocchioSystem
 
@@ -56,8 +61,6 @@ UrdfLike = str | Path
 
 #: ``source`` of the errors about the arguments of these functions.
 OPTIONS_SOURCE = "<pendverify API arguments>"
-#: ``source`` of an in-memory parameter mapping.
-INLINE = "<inline>"
 
 __all__ = [
     "ModelLike",
@@ -73,10 +76,6 @@ __all__ = [
 
 
 # --- loading ----------------------------------------------------------------------------------------
-def _is_builtin(cls: type[ClosedFormModel]) -> bool:
-    return MODELS.get(getattr(cls, "name", None)) is cls
-
-
 def load_model(source: ModelLike) -> type[ClosedFormModel]:
     """A closed-form model class.
 
@@ -90,7 +89,7 @@ def load_model(source: ModelLike) -> type[ClosedFormModel]:
             raise PendverifyError(
                 f"{source.__name__} is not a subclass of pendverify.analytic.ClosedFormModel"
             )
-        if not _is_builtin(source):
+        if not is_builtin(source):
             validate_model_class(source)
         return source
     if isinstance(source, (str, Path)):
@@ -129,22 +128,7 @@ def load_params(model_cls: ModelLike, source: ParamsLike) -> ParameterSet:
     Every value is checked against its quantity's rule (masses and lengths finite and > 0, the
     rest finite and ≥ 0); an error names the file (or ``<inline>``), the key, the value and the rule.
     """
-    cls = load_model(model_cls)
-    if isinstance(source, ParameterSet):
-        if not isinstance(source, cls.params_type):
-            raise PendverifyError(
-                f"{cls.name} needs {cls.params_type.__name__} parameters, got {type(source).__name__}; "
-                "pass a parameter file or a mapping of values (params.as_dict())"
-            )
-        return source
-    if isinstance(source, Mapping):
-        return cls.params_type.from_mapping(dict(source), INLINE)
-    if isinstance(source, (str, Path)):
-        return plugin_parameters(cls, where(cls), str(source))
-    raise PendverifyError(
-        f"parameters are a TOML file, a mapping of values or a {cls.params_type.__name__}; "
-        f"got a {type(source).__name__}"
-    )
+    return parameter_values(load_model(model_cls), source)
 
 
 def load_urdf(model_cls: ModelLike, urdf: UrdfLike, g: float | None = None) -> PinocchioSystem:
@@ -174,25 +158,18 @@ def _count(key: str, value: Any) -> int:
     return value
 
 
-def _target(cls: type[ClosedFormModel], urdf: UrdfLike | None, params: ParamsLike | None) -> Target:
-    """The one target ``check`` verifies: the parameters loaded once, then the CLI's target functions."""
-    if urdf is None and not _is_builtin(cls):
-        raise PendverifyError(f"{where(cls)}: give urdf: the URDF to verify {cls.name} against")
-    values = None if params is None else load_params(cls, params)
-    if urdf is not None:  # --model/--analytic with --urdf [--params]
-        return model_target(cls, _urdf_arg(urdf), values)
-    if values is None:  # pendverify check --model NAME
-        return default_target(cls.name)
-    if isinstance(params, (str, Path)):  # pendverify check --params P
-        return params_target(values, Path(params).stem, str(params))
-    return params_target(values)  # a mapping or a set: against the URDF the project writes for it
+def _flag(key: str, value: Any) -> bool:
+    if not isinstance(value, bool):
+        raise InputError(OPTIONS_SOURCE, key, value, "must be True or False")
+    return value
 
 
 def check(
-    model: ModelLike,
+    model: ModelLike | None = None,
     urdf: UrdfLike | None = None,
     params: ParamsLike | None = None,
     *,
+    erd: bool = True,
     samples: int = DEFAULT_RANDOM_STATES,
     seed: int = DEFAULT_SEED,
     strict: bool = False,
@@ -200,33 +177,56 @@ def check(
 ) -> CheckReport:
     """Compare Pinocchio on a URDF with a hand-derived closed form: ``pendverify check``.
 
-    * ``check("double_pendulum")``: the built-in model's default parameter set against its
-      committed URDF (``pendverify check --model double_pendulum --no-erd``);
-    * ``check(name, params=P)``: the closed form of P against the URDF the project writes for P;
+    The arguments select the same targets as the command line's (one dispatcher,
+    ``pendverify.checks.targets.select_targets``):
+
+    * ``check()``: every built-in model's default parameter set against its committed URDF,
+      and example-robot-data's double-pendulum URDFs (``pendverify check``);
+    * ``check("double_pendulum")``: that model's default set, and example-robot-data's URDFs
+      (``pendverify check --model double_pendulum``); ``erd=False`` leaves them out
+      (``--no-erd``).  When example-robot-data is not installed they are skipped and
+      ``report.skipped`` says so;
+    * ``check("erd:double_pendulum")`` or ``check(urdf="erd:double_pendulum")``: one of
+      example-robot-data's URDFs, with its parameters read off it (``--urdf erd:NAME``);
+    * ``check(name, params=P)``: the closed form of P against the URDF the project writes for P
+      (``--params``); ``check(params="file.toml")`` takes the model the file names;
     * ``check(model, urdf, params)``: the URDF against the closed form of the parameters
       (``--model``/``--analytic`` with ``--urdf`` and ``--params``); without ``params``, a
       built-in model reads its parameters off the URDF.  A model file or class needs ``urdf``.
 
     ``model``, ``params`` and ``urdf`` are taken as ``load_model``, ``load_params`` and
-    ``load_urdf`` take them.  ``samples`` random states are drawn with ``seed`` (plus each model's
-    special states); ``strict`` counts warnings as failures; ``model_form_rtol`` is the largest
-    relative size of a URDF term the closed form cannot express (``--model-form-rtol``).
+    ``load_urdf`` take them (``urdf`` may also be ``erd:NAME``).  ``samples`` random states are
+    drawn with ``seed`` (plus each model's special states); ``strict`` counts warnings as
+    failures; ``model_form_rtol`` is the largest relative size of a URDF term the closed form
+    cannot express (``--model-form-rtol``).
 
-    Returns a ``CheckReport``; a failing check is a result, not an exception (see
+    Returns a ``CheckReport``: ``report["crba"]`` is one check's rows, ``print(report)`` the
+    CLI's table.  A failing check is a result, not an exception (see
     ``pendverify.testing.assert_verified`` for that).  Bad input raises ``PendverifyError``.
     """
     started = time.perf_counter()
     samples, seed = _count("samples", samples), _count("seed", seed)
-    if not isinstance(strict, bool):
-        raise InputError(OPTIONS_SOURCE, "strict", strict, "must be True or False")
+    strict, erd = _flag("strict", strict), _flag("erd", erd)
     if (
         isinstance(model_form_rtol, bool)
         or not isinstance(model_form_rtol, (int, float))
         or not (0 < model_form_rtol < math.inf)
     ):
         raise InputError(OPTIONS_SOURCE, "model_form_rtol", model_form_rtol, "must be a finite number > 0")
-    target = _target(load_model(model), urdf, params)
-    report = build_report([target], samples, seed, strict=strict, model_form_rtol=float(model_form_rtol))
+    if erd_data.is_erd_spec(model):  # check("erd:NAME"): the target the default check labels so
+        if urdf is not None:
+            raise PendverifyError(
+                f"{model}: names example-robot-data's URDF; give it as model or as urdf, not both"
+            )
+        model, urdf = None, model
+    model_cls = None if model is None else load_model(model)
+    if urdf is not None and not erd_data.is_erd_spec(urdf):
+        urdf = _urdf_arg(urdf)
+    selection = select_targets(model_cls, urdf, params, erd_urdfs=erd)
+    report = build_report(
+        selection.targets, samples, seed, strict=strict, model_form_rtol=float(model_form_rtol)
+    )
+    report.skipped = selection.skipped
     report.elapsed_s = time.perf_counter() - started
     return CheckReport.from_report(report)
 

@@ -1,8 +1,9 @@
 """File output: checked before the work starts, written atomically, always UTF-8.
 
 ``check_output`` is called by every command on its output paths before any
-computation, so that an unwritable output costs nothing; ``write_atomic`` leaves
-the old file or nothing, never half a file.  Both raise ``FileAccessError`` (exit
+computation, so that an unwritable output costs nothing (``check_report_output``
+for a report, where ``-`` is standard output); ``write_atomic`` leaves the old file or
+nothing, never half a file.  Both raise ``FileAccessError`` (exit
 status 2) naming the path and the operating system's reason.
 """
 
@@ -57,6 +58,16 @@ def check_output(path: str | Path | None, folder: bool = False) -> None:
         raise FileAccessError(str(path), "write", f"{base}: {_reason(exc)}") from None
     os.close(fd)
     os.unlink(probe)
+
+
+#: the path that names standard output (``--json -``)
+STDOUT = "-"
+
+
+def check_report_output(path: str | None) -> None:
+    """``check_output`` for a report path that may be ``-`` (standard output: nothing to check)."""
+    if path != STDOUT:
+        check_output(path)
 
 
 def utf8_bytes(text: str) -> bytes:

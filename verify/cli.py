@@ -4,37 +4,100 @@
 good, 1 a verification failed, 2 bad input or usage (one line naming the file, key,
 value and rule), 3 an internal error (a bug: one line, the traceback with
 ``--debug``), 130 interrupted.  Text goes out as UTF-8 whatever the locale.
+
+The global options ``--debug``, ``--quiet`` and ``--json PATH`` may come before or after
+the command's name; a command refuses those it does not take (status 2).  With
+``--json -`` the JSON report is the only thing on standard output: the command's text
+goes to standard error.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
+import importlib.metadata
 import os
 import pkgutil
+import platform
 import sys
 import time
 import traceback
 
 from pendverify import __version__, commands
+from pendverify.atomic import STDOUT
+from pendverify.commands import HelpFormatter, add_global_options
+
+EXAMPLES = (
+    "pendverify check",
+    "pendverify check --model double_pendulum --samples 200 --quiet",
+    "pendverify check --json - --quiet > report.json",
+    "pendverify --debug simulate scenes/damped_double_pendulum.toml",
+    "pendverify certify analytic/params/double_pendulum.toml -o certified",
+)
+EXIT_STATUS = (
+    "exit status: 0 passed, 1 a verification failed, 2 bad input or usage, "
+    "3 internal error (a bug), 130 interrupted"
+)
+
+
+def pinocchio_version() -> str:
+    """The installed Pinocchio's version: its distribution's metadata, else the module's own."""
+    try:
+        return importlib.metadata.version("pin")
+    except importlib.metadata.PackageNotFoundError:
+        pass
+    try:
+        import pinocchio
+    except ImportError:
+        return "not installed"
+    return pinocchio.__version__
+
+
+def version_line() -> str:
+    """``pendverify 0.1.0 (Pinocchio 4.1.0, Python 3.11.7)``."""
+    return f"pendverify {__version__} (Pinocchio {pinocchio_version()}, Python {platform.python_version()})"
+
+
+class VersionAction(argparse.Action):
+    """``--version``: the versions of pendverify, Pinocchio and Python, looked up only when asked."""
+
+    def __init__(self, option_strings, dest=argparse.SUPPRESS, default=argparse.SUPPRESS, help=None):
+        super().__init__(option_strings, dest=dest, default=default, nargs=0, help=help)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        print(version_line())
+        parser.exit()
 
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="pendverify",
         description="Check hand-derived pendulum dynamics against their URDF in Pinocchio.",
-        epilog="exit status: 0 passed, 1 a verification failed, 2 bad input or usage, "
-        "3 internal error (a bug), 130 interrupted",
+        epilog="examples:\n" + "\n".join(f"  {line}" for line in EXAMPLES) + "\n\n" + EXIT_STATUS,
+        formatter_class=HelpFormatter,
     )
-    parser.add_argument("--version", action="version", version=f"pendverify {__version__}")
     parser.add_argument(
-        "--debug", action="store_true", help="on an internal error, print the traceback as well"
+        "--version", action=VersionAction, help="print the versions of pendverify, Pinocchio and Python"
     )
-    sub = parser.add_subparsers(dest="command", required=True)
+    add_global_options(parser, top=True)
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for info in sorted(pkgutil.iter_modules(commands.__path__), key=lambda m: m.name):
         if not info.name.startswith("_"):
             importlib.import_module(f"{commands.__name__}.{info.name}").register(sub)
     return parser
+
+
+def refuse_unaccepted(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    """A usage error (status 2) for a global option given before a command that does not take it."""
+    accepts = getattr(args, "accepts", frozenset({"debug"}))  # set by commands.add_command
+    given = {"quiet": args.quiet, "json": args.json is not None}
+    for name, present in given.items():
+        if present and name not in accepts:
+            takes = ", ".join(f"--{n}" for n in sorted(accepts))
+            what = "writes no report" if name == "json" else "has no verdict line to keep"
+            prog = getattr(args, "prog", f"pendverify {args.command}")
+            parser.error(f"--{name}: `{prog}` {what}; it takes {takes}")
 
 
 def utf8_streams() -> None:
@@ -51,27 +114,33 @@ def utf8_streams() -> None:
             reconfigure(encoding="utf-8", errors="surrogateescape")
 
 
+def parse(argv: list[str] | None) -> argparse.Namespace:
+    """The parsed command line; argparse exits on a usage error (2), --help and --version (0)."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    refuse_unaccepted(parser, args)
+    return args
+
+
 def main(argv: list[str] | None = None) -> int:
     started = time.perf_counter()
     utf8_streams()
-    debug = False
     try:
-        args = build_parser().parse_args(argv)
-        args.started = started
-        debug = args.debug
-        return args.func(args)
-    except SystemExit as exc:
-        if args_parsed(exc):
-            return _fail(exc, debug)
-        raise  # argparse: usage errors (status 2), --help and --version (0)
+        args = parse(argv)
+    except SystemExit:
+        raise  # argparse's own exits: usage errors (status 2), --help and --version (0)
+    except BaseException as exc:  # a bug in a parser, or Ctrl-C while building them
+        return _fail(exc, debug=False)
+    args.started = started
+    args.stdout = sys.stdout  # where --json - writes; the text goes to stderr meanwhile
+    text_to_stderr = (
+        contextlib.redirect_stdout(sys.stderr) if args.json == STDOUT else contextlib.nullcontext()
+    )
+    try:
+        with text_to_stderr:
+            return args.func(args)
     except BaseException as exc:  # the contract: every outcome is an exit status and one line
-        return _fail(exc, debug)
-
-
-def args_parsed(exc: SystemExit) -> bool:
-    """Whether a SystemExit came from running a command (a model file exiting), not from argparse."""
-    frames = traceback.extract_tb(exc.__traceback__)
-    return not any(f.filename.endswith("argparse.py") for f in frames)
+        return _fail(exc, args.debug)
 
 
 def _fail(exc: BaseException, debug: bool) -> int:

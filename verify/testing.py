@@ -34,7 +34,7 @@ def assert_verified(
     Passing means ``report.passed``: every check passes, or passes with warnings (a warning
     fails with ``strict=True``); a failure or a refusal (a state beyond the trust limit) raises
     ``AssertionError`` whose message is the full check table, the same text as the CLI's.
-    ``check_options`` are ``check``'s keywords: ``samples``, ``seed``, ``strict``,
+    ``check_options`` are ``check``'s keywords: ``erd``, ``samples``, ``seed``, ``strict``,
     ``model_form_rtol``.  Returns the report when it passes.
     """
     __tracebackhide__ = True  # pytest: show the caller's line, not this helper's

@@ -12,8 +12,9 @@ and parameter set among them (``scene_targets``):
   before any work.
 
 example-robot-data's double pendulums join the table when ``erd`` is on and a
-scene simulates their model.  The folder holds ``index.html``, ``report.json``,
-``scenes/<stem>.html`` and ``plots/<stem>.svg``.
+scene simulates their model (when it is not installed, the report says they were
+skipped).  The folder holds ``index.html``, ``report.json``, ``scenes/<stem>.html``
+and ``plots/<stem>.svg``.
 
 The folder is built as a temporary folder beside ``out`` and renamed to ``out``
 at the end, so an interruption or an error leaves neither a half-written folder
@@ -35,11 +36,18 @@ from pathlib import Path
 
 from pendverify.analytic.params import default_parameter_file, load_parameter_file
 from pendverify.atomic import write_atomic
-from pendverify.checks.targets import Target, default_target, erd_targets, model_target, params_target
+from pendverify.checks.targets import (
+    Selection,
+    Target,
+    default_target,
+    erd_selection,
+    model_target,
+    params_target,
+)
 from pendverify.checks.verification import build_report
 from pendverify.errors import InputError, SceneError
 from pendverify.progress import bar
-from pendverify.robot.erd import MODEL as ERD_MODEL
+from pendverify.robot import erd as erd_data
 from pendverify.simulation.scene import Scene, load_scene
 from pendverify.simulation.simulate import simulate
 from pendverify.viz.animation import Trajectory, render_html
@@ -72,8 +80,9 @@ def _target(scene: Scene) -> Target:
     return params_target(scene.params, Path(scene.params_source).stem, scene.params_source, scene.model_cls)
 
 
-def scene_targets(scenes: list[Scene], erd: bool = True) -> list[Target]:
-    """One target per distinct (model, URDF, parameters) the scenes use."""
+def scene_targets(scenes: list[Scene], erd: bool = True) -> Selection:
+    """One target per distinct (model, URDF, parameters) the scenes use, and example-robot-data's
+    (``erd``) when a scene simulates their model; ``skipped`` says when it is not installed."""
     targets, seen = [], set()
     for scene in scenes:
         key = (scene.model, scene.model_file, scene.urdf, repr(scene.params))
@@ -88,9 +97,10 @@ def scene_targets(scenes: list[Scene], erd: bool = True) -> list[Target]:
                 f"a review checks and draws {scene.model} against its URDF: give one",
             )
         targets.append(_target(scene))
-    if erd and any(s.model == ERD_MODEL and s.model_file is None for s in scenes):
-        targets += erd_targets()
-    return targets
+    selection = Selection(targets)
+    if erd and any(s.model == erd_data.MODEL and s.model_file is None for s in scenes):
+        selection.extend(erd_selection())
+    return selection
 
 
 def _shown(path: Path) -> str:
@@ -167,10 +177,13 @@ def write_review(
     out = Path(out)
     refuse_existing_folder(out, force)
     scenes = [load_scene(path) for path in scene_paths]
-    targets = scene_targets(scenes, erd)
+    selection = scene_targets(scenes, erd)
+    for sentence in selection.skipped:
+        log(f"note: {sentence}")
     with staged_folder(out) as work, bar(1 + len(scenes), "report", "step") as progress:
         start = time.perf_counter()
-        report = build_report(targets, samples, seed)
+        report = build_report(selection.targets, samples, seed)
+        report.skipped = selection.skipped
         report.elapsed_s = time.perf_counter() - start
         write_atomic(work / "report.json", report.to_json())
         progress.update(1)

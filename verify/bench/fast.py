@@ -7,7 +7,7 @@ comparison (min and median wall time, nfev).  The share of the time spent
 outside the right-hand side is 1 − nfev · (cost per call) / (wall time): scipy's
 stage bookkeeping, array allocation and the Python calls themselves.
 
-Single trajectory.  On the anchor problem (``Config.anchor``: the seeds' chaotic one,
+Single trajectory.  On the anchor problem (``Config.anchor``: the reference systems' chaotic one,
 T = 2 s, or a user's scene's state problem) the target is a final-state error ≤
 ``target_error``.  From the sweeps, each method's point at the loosest
 tolerance that reaches it is taken (the tolerance a user would pick; both

@@ -8,15 +8,15 @@ URDF (or the URDF the project writes for a built-in parameter set) for scipy's `
 Every problem carries its ``metric``: "state" (states against a Taylor reference) or
 "energy" (relative energy error only; conservative scenes).
 
-Where problems come from: the seeds' table (``seed_problems``, the default run), or a
+Where problems come from: the reference systems' table (``seed_problems``, the default run), or a
 user's scene (``scene_problems``, ``pendverify bench accuracy --scene``):
 
 * a state problem over min(the scene's duration, ``Config.scene_horizon``: 10 s full,
   3 s quick) — the references are Taylor series in decimal arithmetic, whose cost grows
   with the horizon, and a chaotic scene's double-precision solutions stop agreeing with
-  any reference a few seconds in (the seeds' chaotic problem is compared over 2 s);
+  any reference a few seconds in (the reference systems' chaotic problem is compared over 2 s);
 * when the scene is conservative (no damping, actuation or disturbance), an energy-only
-  long run of ``Config.scene_long`` seconds (1000 s full, 200 s quick), as the seeds' ``long``.
+  long run of ``Config.scene_long`` seconds (1000 s full, 200 s quick), as the reference systems' ``long``.
 
 The state problem is the scene's anchor: the single-trajectory ratio, the engine study
 and the ensemble run on it.  Each problem's scene keeps its model, parameters, URDF and
@@ -56,7 +56,7 @@ INVARIANT_INTEGRATOR = Integrator("DOP853", 1e-10, 1e-10)
 class ProblemSpec:
     key: str
     title: str
-    scene: dict | Scene  # a scene document (the seeds') or a parsed scene (a user's)
+    scene: dict | Scene  # a scene document (the reference systems') or a parsed scene (a user's)
     metric: str = "state"  # "state" or "energy"
 
 

@@ -6,7 +6,7 @@
    functions, timed apart;
 3. the sweeps (``pendverify.bench.workprecision``), the observed orders;
 4. the fast path against scipy on the configuration's anchor problem (``Config.anchor``:
-   the seeds' chaotic one, or a user's scene's state problem): the single-trajectory
+   the reference systems' chaotic one, or a user's scene's state problem): the single-trajectory
    ratio from the sweeps, the engine costs and the ensemble at the tolerance where scipy
    DOP853 first reaches the target error (``pendverify.bench.fast``);
 5. the fast path's invariant checks on the state problems.

@@ -1,4 +1,4 @@
-"""The seeds' benchmark problems: the default run of ``pendverify bench accuracy`` (data only).
+"""The reference systems' benchmark problems: the default run of ``pendverify bench accuracy`` (data only).
 
 ==========  =====================================================================  ==========
 key         what                                                                   compared
@@ -14,7 +14,7 @@ long        the mild swing over T = 1e3 s (full) — energy only, never states  
 
 The horizons are the configuration's (``workprecision.FULL``, ``QUICK``); the anchor of
 the single-trajectory ratio, engine study and ensemble is ``chaotic`` (``Config.anchor``).
-This is the one bench module that names the seeds: every other one takes any model
+This is the one bench module that names the two reference systems: every other one takes any model
 (``tests/test_no_name_branching.py``).
 """
 
@@ -66,5 +66,5 @@ METRICS = {"mild": "state", "chaotic": "state", "cart_lqr": "state", "long": "en
 
 
 def specs() -> dict[str, ProblemSpec]:
-    """The seeds' problems by key (documents; parsed when a problem is made)."""
+    """The reference systems' problems by key (documents; parsed when a problem is made)."""
     return {key: ProblemSpec(key, TITLES[key], SCENES[key], METRICS[key]) for key in SCENES}

@@ -1,7 +1,7 @@
 """Work–precision benchmark: how much wall time each digit of accuracy costs.
 
 Problems (``pendverify.bench.problems``): scenes, so the fast path's invariant checks run
-on the very same dynamics; by default the seeds' table (``pendverify.bench.seed_problems``:
+on the very same dynamics; by default the reference systems' table (``pendverify.bench.seed_problems``:
 mild, chaotic, cart_lqr, long), or a user's scene, any model (``--scene``).  Each carries
 its metric: "state" problems are compared against references, "energy" ones by the
 relative energy error alone.
@@ -129,13 +129,13 @@ QUICK = replace(
 
 # --- problems --------------------------------------------------------------------------------
 def make_problem(spec: ProblemSpec | str, duration: float, grid_intervals: int = 64) -> Problem:
-    """A problem over ``duration``: a ``ProblemSpec``, or the key of one of the seeds' problems."""
+    """A problem over ``duration``: a ``ProblemSpec``, or the key of a reference system's problem."""
     spec = seed_problems.specs()[spec] if isinstance(spec, str) else spec
     return build_problem(spec, duration, grid_intervals)
 
 
 def make_problems(config: Config, specs: dict | None = None) -> list[Problem]:
-    """The problems of ``config.horizons`` from ``specs`` (default: the seeds' table)."""
+    """The problems of ``config.horizons`` from ``specs`` (default: the reference systems' table)."""
     specs = seed_problems.specs() if specs is None else specs
     return [make_problem(specs[k], T, config.grid_intervals) for k, T in config.horizons.items()]
 

@@ -32,6 +32,7 @@ from pendverify.certify.schema import check_derived, check_schema
 from pendverify.certify.signing import fingerprint
 from pendverify.certify.simulations import recorded_engines
 from pendverify.checks.targets import PARAMS_HINT
+from pendverify.display import listed, shortened
 from pendverify.errors import CertificateError, ParameterError, PendverifyError
 from pendverify.robot.description import load_description
 from pendverify.robot.erd import resolve_urdf
@@ -125,13 +126,23 @@ def check_sweep_names(sweep, source: str) -> None:
 
 @dataclass(frozen=True)
 class Issued:
+    """What ``issue`` (``pendverify.certify_set``) did: every battery item's evidence and, when all
+    of them pass, the certificate written and its path."""
+
     items: list[BatteryItem]
     certificate: dict | None = None
     path: Path | None = None
 
     @property
     def certified(self) -> bool:
+        """Whether every item passed and the certificate was written."""
         return self.certificate is not None
+
+    def __repr__(self) -> str:
+        failed = [i.name for i in self.items if not i.passed]
+        if self.certified:
+            return f"<Issued certified: {len(self.items)} items pass; {shortened(str(self.path), 200)}>"
+        return f"<Issued not certified: {len(failed)} of {len(self.items)} items fail: {listed(failed, 200)}>"
 
 
 def issue(

@@ -4,7 +4,7 @@ Gravity alone always (energy drift); damping when the model's D is not zero
 (dissipation balance, energy never rises); actuation when it declares inputs B
 (work–energy balance); a seeded noise disturbance when it declares disturbances W
 (work–energy balance).  The motion is the model's own ``battery_motion`` when it
-states one (the seeds do), else derived from its scales (``derived_motion``).  The
+states one (the two reference systems do), else derived from its scales (``derived_motion``).  The
 scenes are documents for ``pendverify.simulation.scene.parse_scene``, the path every
 scene file takes, with the model class itself as ``model``.
 """

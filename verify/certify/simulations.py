@@ -24,7 +24,7 @@ balance fails (``tests/test_fast_battery.py`` plants both).  That the closed for
 URDF's dynamics is what the core checks establish (ε-level, 2000 states).
 
 Cross-check, decided.  A full ABA run of the gravity scene as well would cost ≈ 0.15–0.3 s
-a set (measured on the seeds at the default settings, as much as the whole per-set budget)
+a set (measured on the two reference systems at the default settings, as much as the whole per-set budget)
 and would compare two chaotic trajectories, which separate for reasons that are not model
 errors.  Instead ``invariant:gravity:engines`` compares the compiled q̈ with Pinocchio's
 ABA on the URDF being certified at ``CROSS_CHECK_STATES`` of the gravity run's own

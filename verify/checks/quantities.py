@@ -17,7 +17,7 @@ The scales:
 
 * ``crba``: 1 (M̃ has entries of order one); ``gravity``: max w·(Σ|terms| of H).
 * ``rnea``: (rates + max|D̃|)·Σ|ż| + the gravity scale: a hand C written with friction
-  inside (C + D, as seed 000) rounds at the size of D̃ too.
+  inside (C + D, as the double pendulum's derivation) rounds at the size of D̃ too.
 * ``coriolis``, ``skew``: max(rates + max|D̃|, 1); Ṁ for ``skew`` comes from Pinocchio's
   analytic RNEA derivatives with gravity off, Ṁ e_j = ∂τ/∂q(q, 0, e_j)·q̇, which does
   not use its Coriolis matrix.

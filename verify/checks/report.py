@@ -1,17 +1,105 @@
 """The verification report: one table for people, one JSON document for machines.
 
 ``Report`` is what ``build_report`` returns; ``CheckReport``, what ``pendverify.check``
-returns, is the same report printing as the CLI's table (``format_table``).
+returns, is the same report printing as the CLI's table (``format_table``).  A report reads
+like a mapping from check name to that check's rows: ``report["crba"]`` is a ``CheckRows``
+(one ``CheckResult`` per model), ``report["crba"]["double_pendulum"]`` or
+``report["double_pendulum", "crba"]`` one result.  In a notebook a report shows as an HTML
+table with the CLI table's rows (``_repr_html_``).
 """
 
 from __future__ import annotations
 
 import dataclasses
+import html
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 
 from pendverify.checks.catalogue import CheckResult
 from pendverify.checks.verdict import FAIL, LABELS, PASS, REFUSED, WARN, worst
+from pendverify.display import REPR_LIMIT, html_lines, html_table, listed
 from pendverify.jsonio import to_json, versions
+
+#: the columns of the check table, in the CLI and in a notebook
+HEADER = ("model", "check", "error", "tolerance", "worst state", "result")
+
+
+def _ratio(result: CheckResult) -> float:
+    """error/tolerance of a row (NaN, a refused row, sorts below every number)."""
+    ratio = result.max_error / result.tolerance if result.tolerance else float("inf")
+    return ratio if ratio == ratio else -1.0
+
+
+@dataclass(frozen=True)
+class CheckRows:
+    """The rows of one check in a report: one ``CheckResult`` per model, in the table's order.
+
+    ``report["crba"]`` gives it.  ``rows["double_pendulum"]`` (a model's label) or ``rows[0]``
+    is one result; ``len``, iteration, ``models``; ``status`` and ``passed`` are the worst
+    row's verdict; ``worst`` is the row with the largest error/tolerance, and ``max_error``
+    and ``tolerance`` are that row's.
+    """
+
+    check: str
+    results: tuple[CheckResult, ...]
+
+    @property
+    def models(self) -> tuple[str, ...]:
+        """The labels of the models that ran this check, in the table's order."""
+        return tuple(r.model for r in self.results)
+
+    @property
+    def status(self) -> str:
+        """pass, warn, fail or refused: the worst of the rows."""
+        return worst([r.status for r in self.results])
+
+    @property
+    def passed(self) -> bool:
+        """Whether every row passes (pass, or pass with warnings)."""
+        return all(r.passed for r in self.results)
+
+    @property
+    def worst(self) -> CheckResult:
+        """The row whose error is the largest fraction of its tolerance."""
+        return max(self.results, key=_ratio)
+
+    @property
+    def max_error(self) -> float:
+        """The error of the ``worst`` row (relative, at that row's worst state)."""
+        return self.worst.max_error
+
+    @property
+    def tolerance(self) -> float:
+        """The tolerance of the ``worst`` row, at the same state."""
+        return self.worst.tolerance
+
+    def __len__(self) -> int:
+        return len(self.results)
+
+    def __iter__(self) -> Iterator[CheckResult]:
+        return iter(self.results)
+
+    def __getitem__(self, key: str | int) -> CheckResult:
+        if isinstance(key, int):
+            return self.results[key]
+        for r in self.results:
+            if r.model == key:
+                return r
+        raise KeyError(f"check {self.check!r} has no row for model {key!r}; models: {', '.join(self.models)}")
+
+    def __repr__(self) -> str:
+        top = self.worst
+        return (
+            f"<CheckRows {self.check}: {self.status} on {len(self)} model(s) "
+            f"({listed(self.models, 120)}); worst {top.max_error:.2e} vs tolerance {top.tolerance:.2e} "
+            f"({top.model})>"
+        )
+
+    def _repr_html_(self) -> str:
+        rows = [table_row(r) for r in self.results]
+        return html_table(
+            HEADER, rows, f"check {self.check}: {self.status}", [not r.passed for r in self.results]
+        )
 
 
 @dataclass
@@ -28,6 +116,8 @@ class Report:
     warnings: dict[str, list[str]] = field(default_factory=dict)
     #: --strict: warnings count as failures.
     strict: bool = False
+    #: What was left out of the report and why, one sentence each (example-robot-data not installed).
+    skipped: list[str] = field(default_factory=list)
 
     @property
     def status(self) -> str:
@@ -41,12 +131,68 @@ class Report:
         return self.status in (PASS, WARN)
 
     def failures(self) -> list[CheckResult]:
+        """The results that fail."""
         return [r for r in self.results if r.status == FAIL]
 
     def refusals(self) -> list[CheckResult]:
+        """The results refused by the trust rule (states beyond double precision's reach: not verified)."""
         return [r for r in self.results if r.status == REFUSED]
 
+    @property
+    def checks(self) -> tuple[str, ...]:
+        """The names of the checks in the report, in the table's order of first appearance."""
+        return tuple(dict.fromkeys(r.check for r in self.results))
+
+    @property
+    def models(self) -> tuple[str, ...]:
+        """The labels of the models (targets) in the report, in the table's order."""
+        return tuple(dict.fromkeys([*self.states, *(r.model for r in self.results)]))
+
+    def __getitem__(self, key: str | tuple[str, str]) -> CheckRows | CheckResult:
+        """``report["crba"]``: that check's rows (``CheckRows``, one per model);
+        ``report["double_pendulum", "crba"]``: one model's result.  An unknown name is a
+        ``KeyError`` listing the valid ones."""
+        if isinstance(key, tuple):
+            if len(key) != 2:
+                raise KeyError(f"a report's key is a check name or (model, check); got {key!r}")
+            model, check = key
+            return self[check][model]
+        rows = tuple(r for r in self.results if r.check == key)
+        if not rows:
+            raise KeyError(f"no check {key!r} in this report; its checks: {', '.join(self.checks) or 'none'}")
+        return CheckRows(key, rows)
+
+    def __contains__(self, key: object) -> bool:
+        return key in self.checks
+
+    def __iter__(self) -> Iterator[str]:
+        """The check names, as a mapping's keys."""
+        return iter(self.checks)
+
+    def keys(self) -> tuple[str, ...]:
+        """The check names (``checks``): ``dict(report)`` maps each to its ``CheckRows``."""
+        return self.checks
+
+    def __repr__(self) -> str:
+        total = sum(self.states.values())
+        head = (
+            f"<{type(self).__name__} {self.status}: {len(self.results)} checks on "
+            f"{len(self.models)} model(s), {total} states, seed {self.seed}"
+        )
+        if not self.models:
+            return f"{head}>"
+        return f"{head}: {listed(self.models, REPR_LIMIT - len(head) - 4)}>"
+
+    def _repr_html_(self) -> str:
+        """The check table as HTML, then its notes, warnings, diagnoses and verdict (as the CLI's)."""
+        lines = trailing_lines(self)
+        rows = [table_row(r) for r in self.results]
+        failing = [r.status in (FAIL, REFUSED) for r in self.results]
+        verdict = f"<p><strong>{html.escape(lines[-1])}</strong></p>"
+        return html_table(HEADER, rows, failing=failing) + html_lines(lines[:-1]) + verdict
+
     def as_dict(self) -> dict:
+        """The report as the JSON document's mapping (versions, seed, states, verdict, notes, results)."""
         return {
             **versions(),
             "seed": self.seed,
@@ -59,10 +205,12 @@ class Report:
             "notes": self.notes,
             "diagnoses": self.diagnoses,
             "warnings": self.warnings,
+            "skipped": self.skipped,
             "results": [r.as_dict() for r in self.results],
         }
 
     def to_json(self) -> str:
+        """The JSON document ``pendverify check --json`` writes."""
         return to_json(self.as_dict())
 
 
@@ -81,28 +229,27 @@ def _state_text(state: dict) -> str:
     return f"{state['label']} q=({q})"
 
 
-def format_table(report: Report) -> str:
-    header = ("model", "check", "error", "tolerance", "worst state", "result")
-    rows = [
-        (
-            r.model,
-            r.check,
-            f"{r.max_error:.2e}",
-            f"{r.tolerance:.2e}",
-            _state_text(r.worst_state),
-            LABELS[r.status],
-        )
-        for r in report.results
-    ]
-    out = text_table(header, rows)
-    out.append("")
-    out.append(
-        "error and tolerance are relative, in diagonally scaled coordinates: "
-        "tolerance = K·ε·((1 + |θ|max)·cond(T)² + (A − 1)) (+ model-form allowance)."
+def table_row(r: CheckResult) -> tuple[str, ...]:
+    """One row of the check table: ``HEADER``'s cells as text."""
+    return (
+        r.model,
+        r.check,
+        f"{r.max_error:.2e}",
+        f"{r.tolerance:.2e}",
+        _state_text(r.worst_state),
+        LABELS[r.status],
     )
+
+
+def trailing_lines(report: Report) -> list[str]:
+    """The lines under the table: the notes, warnings, failures' notes, diagnoses, what was
+    skipped, the largest relative error and, last, the verdict line."""
+    out = []
     for model, notes in report.notes.items():
         for note in notes:
             out.append(f"note [{model}]: {note}")
+    for sentence in report.skipped:
+        out.append(f"note: {sentence}")
     for model, sentences in report.warnings.items():
         for sentence in sentences:
             out.append(f"warning [{model}]: {sentence}")
@@ -125,7 +272,18 @@ def format_table(report: Report) -> str:
         f"{len(report.results)} checks on {len(report.states)} model(s), {total} states "
         f"(seed {report.seed}), {report.elapsed_s:.2f} s: {verdict_sentence(report)}"
     )
-    return "\n".join(out)
+    return out
+
+
+def format_table(report: Report) -> str:
+    """The text ``pendverify check`` prints: the table, the tolerance's formula, ``trailing_lines``."""
+    out = text_table(HEADER, [table_row(r) for r in report.results]) if report.results else []
+    out.append("")
+    out.append(
+        "error and tolerance are relative, in diagonally scaled coordinates: "
+        "tolerance = K·ε·((1 + |θ|max)·cond(T)² + (A − 1)) (+ model-form allowance)."
+    )
+    return "\n".join(out + trailing_lines(report))
 
 
 def verdict_sentence(report: Report) -> str:
@@ -153,8 +311,10 @@ class CheckReport(Report):
     The evidence is in the fields of ``Report``: ``results`` (one ``CheckResult`` per model and
     check: ``max_error``, ``tolerance``, ``max_abs_error``, ``worst_state``, ``status``, ``notes``),
     ``notes``, ``warnings`` and ``diagnoses`` (per model label), ``states``, ``sources``, ``seed``,
-    ``strict``, ``elapsed_s``; ``passed``, ``status``, ``failures()``, ``refusals()``, ``as_dict()``
-    and ``to_json()`` (the document ``check --json`` writes).
+    ``strict``, ``elapsed_s``, ``skipped``; ``passed``, ``status``, ``failures()``, ``refusals()``,
+    ``as_dict()`` and ``to_json()`` (the document ``check --json`` writes).  ``report["crba"]``
+    gives one check's rows (``CheckRows``), ``report["double_pendulum", "crba"]`` one result;
+    ``checks`` and ``models`` name what is there.
     """
 
     def table(self) -> str:
@@ -164,13 +324,10 @@ class CheckReport(Report):
     def __str__(self) -> str:
         return self.table()
 
-    def __repr__(self) -> str:
-        models = ", ".join(self.states)
-        return f"<CheckReport {self.status}: {len(self.results)} checks on {models}, seed {self.seed}>"
-
     def _repr_pretty_(self, printer, cycle: bool) -> None:  # IPython / Jupyter: show the table
         printer.text(repr(self) if cycle else self.table())
 
     @classmethod
     def from_report(cls, report: Report) -> CheckReport:
+        """The same report, as a ``CheckReport``."""
         return cls(**{f.name: getattr(report, f.name) for f in dataclasses.fields(Report)})

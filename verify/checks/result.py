@@ -59,4 +59,12 @@ class CheckResult:
             self.status = PASS if self.passed else FAIL
 
     def as_dict(self) -> dict:
+        """Every field, as the JSON report's entry for this result."""
         return dict(self.__dict__)
+
+    def __repr__(self) -> str:
+        where = str(self.worst_state.get("label", ""))[:60]
+        return (
+            f"<CheckResult {self.model[:80]} {self.check}: {self.status}, error {self.max_error:.2e} "
+            f"vs tolerance {self.tolerance:.2e} at {where}>"
+        )

@@ -96,5 +96,5 @@ def force_scale_of(rate, v, w, g_scale, B, W, D, u, w_in):
 
 
 def damping_rate_of(D, w):
-    """max |D̃| in 1/s per state: a hand C with friction inside (C + D, as seed 000) rounds at this size."""
+    """max |D̃| in 1/s per state: a hand C with friction inside (C + D) rounds at this size."""
     return np.max(np.abs(scaled_matrix(D, w)), axis=(-2, -1), initial=0.0)

@@ -1,34 +1,36 @@
 """What to verify: pairs of a closed-form model and a URDF loaded in Pinocchio.
 
+``select_targets`` is the one dispatcher: ``pendverify check`` and ``pendverify.check``
+turn their arguments (a model, a URDF or ``erd:NAME``, parameters, the erd flag) into
+targets through it, so the same arguments verify the same targets.  The targets are
+
 * the default parameter sets against their committed URDFs (``urdf/``);
-* example-robot-data's double-pendulum URDFs against the seed-000 closed form
-  with parameters read off the URDF itself;
+* example-robot-data's double-pendulum URDFs against the double-pendulum reference system's
+  closed form with parameters read off the URDF itself (skipped, with a sentence, when
+  example-robot-data is not installed);
 * a user's URDF against a user's parameter set, or (double pendulum) against
   the parameters read off that URDF;
 * a user's own model file (``--analytic``, ``pendverify.analytic.plugin``) against a URDF.
 
 Built-in and plug-in models take one path: the URDF is loaded, the model class's
-geometry reader (or declared map) gives the coordinate map (the seeds read it off the
-geometry, a plug-in declares it), and ``model_target`` pairs the two.  A parameter set
+geometry reader (or declared map) gives the coordinate map (the two reference systems read it
+off the geometry, a plug-in declares it), and ``model_target`` pairs the two.  A parameter set
 with no URDF is checked against the URDF the project writes for it (``params_target``).
-``user_target`` and ``plugin_target`` read the CLI's options into these; the Python API
-(``pendverify.api``) calls ``default_target``, ``params_target`` and ``model_target``
-directly.
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from importlib.resources import files
 from pathlib import Path
 
 from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
 from pendverify.analytic.params import default_parameter_file, load_parameter_file
-from pendverify.analytic.plugin import check_model_outputs, load_model_class, plugin_parameters
-from pendverify.errors import PendverifyError, UnknownNameError
+from pendverify.analytic.plugin import check_model_outputs, load_model_class, plugin_parameters, where
+from pendverify.errors import ParameterError, PendverifyError, UnknownNameError
+from pendverify.robot import erd
 from pendverify.robot.description import description_stem, is_description_text
-from pendverify.robot.erd import MODEL as ERD_MODEL
-from pendverify.robot.erd import double_pendulum_urdfs
 from pendverify.robot.seed_geometry import DEFAULT_G
 from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
@@ -36,18 +38,44 @@ from pendverify.robot.writer import urdf_for
 PARAMETER_MATCH_RTOL = 1e-9
 #: How a library error asks for the parameter set: it may reach a user of the CLI or of the Python API.
 PARAMS_HINT = "--params on the command line, params= in the Python API"
+#: ``source`` of a parameter set given as a mapping of values.
+INLINE = "<inline>"
 
 
 @dataclass
 class Target:
+    """One closed-form model and the Pinocchio system it is verified against.
+
+    ``label`` names it in the report (``model:name``, or ``erd:NAME``); ``source`` is where its
+    URDF came from; ``notes`` are what choosing the pair noticed (parameters read off the URDF,
+    a parameter set that differs from the URDF's).
+    """
+
     label: str
     model: ClosedFormModel
     system: PinocchioSystem
     source: str
     notes: list[str] = field(default_factory=list)
 
+    def __repr__(self) -> str:
+        return f"<Target {self.label}: {self.model.name}, {self.model.nv} dof, URDF {self.system.source}>"
+
+
+@dataclass
+class Selection:
+    """What ``select_targets`` chose: the targets, and what it left out (one sentence each)."""
+
+    targets: list[Target]
+    skipped: list[str] = field(default_factory=list)
+
+    def extend(self, other: Selection) -> None:
+        """Add another selection's targets and skipped sentences to this one."""
+        self.targets += other.targets
+        self.skipped += other.skipped
+
 
 def committed_urdf(model: str) -> Path:
+    """The URDF the project commits for a built-in model's default parameter set."""
     return Path(str(files("pendverify.urdf") / f"{model}.urdf"))
 
 
@@ -64,14 +92,24 @@ def default_target(model_name: str) -> Target:
     return Target(model_name, cls(params), PinocchioSystem.for_model(cls, path, params.g), str(path))
 
 
+def erd_target(stem: str, path: Path) -> Target:
+    """example-robot-data's URDF ``stem`` against the double pendulum's closed form, with the
+    parameters read off the URDF; labelled ``erd:{stem}``."""
+    cls = _model_class(erd.MODEL)
+    system = PinocchioSystem.for_model(cls, path)
+    return Target(f"{erd.PREFIX}{stem}", cls(system.geometry.params), system, str(path))
+
+
 def erd_targets() -> list[Target]:
-    targets = []
-    cls = _model_class(ERD_MODEL)
-    for stem, path in double_pendulum_urdfs().items():
-        system = PinocchioSystem.for_model(cls, path)
-        model = cls(system.geometry.params)
-        targets.append(Target(f"erd:{stem}", model, system, str(path)))
-    return targets
+    """Every double-pendulum URDF example-robot-data ships (an error when it is not installed)."""
+    return [erd_target(stem, path) for stem, path in erd.double_pendulum_urdfs().items()]
+
+
+def erd_selection() -> Selection:
+    """example-robot-data's targets, or none and ``erd.SKIPPED`` when it is not installed."""
+    if erd.installed() is None:
+        return Selection([], [erd.SKIPPED])
+    return Selection(erd_targets())
 
 
 def parameter_differences(urdf_params: ParameterSet, given: ParameterSet) -> list[str]:
@@ -141,25 +179,112 @@ def params_target(
     return Target(f"{cls.name}:{name}", cls(params), system, system.source)
 
 
-def user_target(model_name: str | None, urdf: str | None, params_file: str | None) -> Target:
-    """A target from the CLI's --model / --urdf / --params."""
-    params = None
-    if params_file:
-        file_model, _, params = load_parameter_file(params_file)
-        if model_name and model_name != file_model:
-            raise PendverifyError(f"{params_file}: model is {file_model!r}, but --model says {model_name!r}")
-        model_name = file_model
-    if model_name is None:
-        raise PendverifyError("name the model with --model, or give --params")
-    if urdf is None:  # the URDF of this parameter set, as the project writes it
-        return params_target(params, Path(params_file).stem, params_file)
-    return model_target(_model_class(model_name), urdf, params)
+def is_builtin(cls: type[ClosedFormModel]) -> bool:
+    """Whether ``cls`` is one of the built-in models (``pendverify.analytic.MODELS``)."""
+    return MODELS.get(getattr(cls, "name", None)) is cls
+
+
+def parameter_values(cls: type[ClosedFormModel], source) -> ParameterSet:
+    """A parameter set of model class ``cls`` from a parameter file (TOML, whose ``model`` must be
+    ``cls.name``), a flat mapping of the values (``{"m1": 1.0, ...}``) or a set of its
+    ``params_type`` (returned as is).  Every value is checked against its quantity's rule."""
+    if isinstance(source, ParameterSet):
+        if not isinstance(source, cls.params_type):
+            raise PendverifyError(
+                f"{cls.name} needs {cls.params_type.__name__} parameters, got {type(source).__name__}; "
+                "pass a parameter file or a mapping of values (params.as_dict())"
+            )
+        return source
+    if isinstance(source, Mapping):
+        return cls.params_type.from_mapping(dict(source), INLINE)
+    if isinstance(source, (str, Path)):
+        if not is_builtin(cls):
+            return plugin_parameters(cls, where(cls), str(source))
+        file_model, _, params = load_parameter_file(str(source))
+        if file_model != cls.name:
+            raise ParameterError(
+                str(source), "model", file_model, f"must be {cls.name!r}, the model named with it"
+            )
+        return params
+    raise PendverifyError(
+        f"parameters are a TOML file, a mapping of values or a {cls.params_type.__name__}; "
+        f"got a {type(source).__name__}"
+    )
+
+
+def _parameters_model(source) -> type[ClosedFormModel]:
+    """The built-in model that parameters given without a model belong to."""
+    if isinstance(source, (str, Path)):
+        return _model_class(load_parameter_file(str(source))[0])
+    if isinstance(source, ParameterSet) and source.model in MODELS:
+        return _model_class(source.model)
+    raise PendverifyError(
+        "name the model of these parameters (--model on the command line, model= in the Python API)"
+    )
+
+
+def select_targets(
+    model_cls: type[ClosedFormModel] | None = None,
+    urdf: str | Path | None = None,
+    params=None,
+    *,
+    erd_urdfs: bool = True,
+) -> Selection:
+    """The targets ``pendverify check`` and ``pendverify.check`` verify, from their arguments.
+
+    ``model_cls`` is a model class (built-in, a model file's or the caller's), or None: every
+    built-in model, or the one a parameter file names.  ``urdf`` is a description's path, its
+    XML text, or ``erd:NAME`` (example-robot-data's URDF NAME).  ``params`` is a parameter file,
+    a flat mapping of values or a parameter set (``parameter_values``).  ``erd_urdfs`` adds
+    example-robot-data's double-pendulum URDFs wherever the double pendulum's default set is
+    checked (``--no-erd``, ``erd=False`` turn it off); when example-robot-data is not installed
+    they are skipped and ``Selection.skipped`` says so.
+
+    * no URDF, no parameters: each built-in model named (all by default) with its default set
+      against its committed URDF, and example-robot-data's URDFs as above;
+    * ``erd:NAME`` without parameters, with the double pendulum (named or not): the target the
+      default check labels ``erd:NAME``;
+    * a URDF (or ``erd:NAME`` with another model or with parameters): the model against it, with
+      the parameters given, or read off the URDF;
+    * parameters without a URDF: a built-in model's set against the URDF the project writes for it.
+
+    A model file or class needs a URDF; bad input raises ``PendverifyError``.
+    """
+    name = None
+    if erd.is_erd_spec(urdf):
+        stem, path = erd.erd_urdf(urdf)
+        if model_cls is None and params is None:
+            model_cls = _model_class(erd.MODEL)
+        if params is None and model_cls is MODELS[erd.MODEL]:
+            return Selection([erd_target(stem, path)])
+        urdf, name = path, f"erd_{stem}"
+    if urdf is None and model_cls is not None and not is_builtin(model_cls):
+        raise PendverifyError(
+            f"{where(model_cls)}: give --urdf (urdf= in the Python API): "
+            f"the URDF to verify {model_cls.name} against"
+        )
+    values = None
+    if params is not None:
+        model_cls = model_cls or _parameters_model(params)
+        values = parameter_values(model_cls, params)
+    if urdf is not None:
+        if model_cls is None:
+            raise PendverifyError(
+                "with a URDF, name the model (--model or --analytic on the command line, the model "
+                f"argument in the Python API) or give the parameter set ({PARAMS_HINT})"
+            )
+        return Selection([model_target(model_cls, urdf, values, name)])
+    if values is not None:
+        if isinstance(params, (str, Path)):
+            return Selection([params_target(values, Path(params).stem, str(params), model_cls)])
+        return Selection([params_target(values, model_cls=model_cls)])
+    names = [model_cls.name] if model_cls is not None else list(MODELS)
+    selection = Selection([default_target(n) for n in names])
+    if erd_urdfs and erd.MODEL in names:
+        selection.extend(erd_selection())
+    return selection
 
 
 def plugin_target(model_file: str, urdf: str | None, params_file: str | None) -> Target:
-    """A target from the CLI's --analytic / --urdf / --params."""
-    cls = load_model_class(model_file)
-    if urdf is None:
-        raise PendverifyError(f"{model_file}: give --urdf: the URDF to verify {cls.name} against")
-    params = plugin_parameters(cls, model_file, params_file) if params_file else None
-    return model_target(cls, urdf, params)
+    """The target of a model file, its URDF and (optionally) its parameter file, as ``check --analytic``."""
+    return select_targets(load_model_class(model_file), urdf, params_file, erd_urdfs=False).targets[0]

@@ -1,6 +1,6 @@
 """The trust rule: how far a comparison with a (near-singular) mass matrix can be trusted.
 
-The cart seed's mass matrix loses rank as the middle bob vanishes::
+The cart reference system's mass matrix loses rank as the middle bob vanishes::
 
     det M = l1² l2² m2 (m m1 + (m1² + m1 m2) sin² θ1 + m m2 sin²(θ1 − θ2)),
 

@@ -1,16 +1,122 @@
 """Subcommands of ``pendverify``: one module each, found automatically.
 
-A module here defines ``register(subparsers)``, which adds its parser and sets
-``func`` to a function taking the parsed arguments and returning an exit status
-(0 success, 1 a check or invariant failed; bad input raises a PendverifyError,
-which the CLI turns into status 2; anything else is an internal error, status 3:
-``pendverify.exitcodes``).  Output paths go through ``pendverify.atomic.check_output``
-before any work.  Heavy imports belong inside ``func``.
+A module here defines ``register(subparsers)``, which adds its parser with
+``add_command`` (a one-line description, examples, the defaults shown, the global
+options it takes) and sets ``func`` to a function taking the parsed arguments and
+returning an exit status (0 success, 1 a check or invariant failed; bad input raises a
+PendverifyError, which the CLI turns into status 2; anything else is an internal error,
+status 3: ``pendverify.exitcodes``).  Output paths go through
+``pendverify.atomic.check_output`` (``check_report_output`` for ``--json``) before any
+work.  Heavy imports belong inside ``func``.
+
+The global options, accepted before or after the command's name:
+
+* ``--debug`` (every command): on an internal error, the traceback as well;
+* ``--quiet`` (the commands that give ``quiet=True``): only the verdict line and errors;
+* ``--json PATH`` (the commands that give ``json=WHAT``): the report as JSON to PATH,
+  or to standard output for ``-`` (``write_json_report``); the text then goes to stderr.
 """
 
 from __future__ import annotations
 
 import argparse
+
+#: what each global option does, as its help says it
+GLOBAL_HELP = {
+    "debug": "on an internal error, print the traceback as well (default: off)",
+    "quiet": "print only the verdict line and errors (default: off)",
+    "json": "also write {what} as JSON to PATH; with - the JSON goes to standard output and the text "
+    "to standard error (default: none)",
+}
+
+
+class HelpFormatter(argparse.RawDescriptionHelpFormatter):
+    """The help of a pendverify command: the examples kept line by line, every option's default shown.
+
+    An option whose help already says its default is left as written; a flag shows "off", an
+    option without a value "none", any other the value argparse would give it.
+    """
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        positional_required = not action.option_strings and action.nargs not in ("?", "*")
+        nothing_to_default = action.nargs == 0 and action.default is argparse.SUPPRESS
+        if "default" in text or positional_required or nothing_to_default:
+            return text  # said already; a required positional; -h, --version
+        if action.nargs == 0 and isinstance(action.const, bool):
+            return f"{text} (default: {'on' if action.default else 'off'})"
+        if action.default is None or action.default is argparse.SUPPRESS:
+            return f"{text} (default: none)"
+        return f"{text} (default: %(default)s)"
+
+
+def add_global_options(
+    parser: argparse.ArgumentParser, names=tuple(GLOBAL_HELP), what: str = "the report", top: bool = False
+) -> None:
+    """Add the global options ``names`` to ``parser`` (``what``: what its ``--json`` writes).
+
+    On the top-level parser (``top``) they carry the defaults; on a command's parser they
+    are SUPPRESSed, so that a value given before the command's name is not overwritten.
+    """
+    for name in names:
+        help_text = GLOBAL_HELP[name].format(what=what)
+        if top and name != "debug":
+            help_text = (
+                f"({'commands with a report' if name == 'json' else 'commands with a verdict'}) {help_text}"
+            )
+        if name == "json":
+            default = None if top else argparse.SUPPRESS
+            parser.add_argument("--json", metavar="PATH", default=default, help=help_text)
+        else:
+            default = False if top else argparse.SUPPRESS
+            parser.add_argument(f"--{name}", action="store_true", default=default, help=help_text)
+
+
+def add_command(
+    sub,
+    name: str,
+    summary: str,
+    examples: list[str],
+    *,
+    json: str | None = None,
+    quiet: bool = True,
+    details: str | None = None,
+) -> argparse.ArgumentParser:
+    """A command's parser, as every command's help must be.
+
+    ``summary`` is the one-line description (also the line in ``pendverify --help``),
+    ``examples`` full command lines (``pendverify NAME ...``) shown in the help's epilog,
+    ``json`` what ``--json`` writes (None: the command takes no ``--json``), ``quiet``
+    whether it takes ``--quiet``, ``details`` an optional paragraph after the summary.
+    """
+    if "\n" in summary or not summary.strip():
+        raise ValueError(f"{name}: the summary must be one line")
+    parser = sub.add_parser(
+        name,
+        help=summary,
+        description=summary if details is None else f"{summary}\n\n{details}",
+        epilog="examples:\n" + "\n".join(f"  {line}" for line in examples),
+        formatter_class=HelpFormatter,
+    )
+    names = ("debug", *(("quiet",) if quiet else ()), *(("json",) if json else ()))
+    add_global_options(parser, names, what=json or "")
+    parser.set_defaults(accepts=frozenset(names), prog=parser.prog)
+    return parser
+
+
+def write_json_report(args: argparse.Namespace, text: str) -> None:
+    """``--json``: ``text`` to the file ``args.json`` (atomically, then "report written to" unless
+    ``--quiet``), or with ``-`` to the standard output the command started with (``args.stdout``;
+    the CLI sends the command's text to standard error meanwhile)."""
+    from pendverify.atomic import STDOUT, write_atomic
+
+    if args.json == STDOUT:
+        args.stdout.write(text)
+        args.stdout.flush()
+        return
+    write_atomic(args.json, text)
+    if not args.quiet:
+        print(f"report written to {args.json}")
 
 
 def _int_at_least(minimum: int, text: str) -> int:

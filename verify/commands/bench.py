@@ -17,17 +17,29 @@ from __future__ import annotations
 
 import argparse
 
-from pendverify.atomic import check_output
-from pendverify.commands import positive_int
+from pendverify.atomic import check_output, check_report_output
+from pendverify.commands import add_command, positive_int, write_json_report
 
 BLAS_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
 
 def register(sub) -> None:
-    p = sub.add_parser("bench", help="benchmarks (never asserted in tests)")
-    what = p.add_subparsers(dest="benchmark", required=True)
-    a = what.add_parser(
-        "accuracy", help="work–precision: error against wall time for each integrator and engine"
+    p = add_command(
+        sub,
+        "bench",
+        "benchmarks: work–precision of the integrators, cost of the certification battery",
+        ["pendverify bench accuracy --quick -o bench-out", "pendverify bench certify --quick"],
+        json="the report (bench certify)",
+    )
+    what = p.add_subparsers(dest="benchmark", required=True, metavar="BENCHMARK")
+    a = add_command(
+        what,
+        "accuracy",
+        "work–precision: error against wall time for each integrator and engine",
+        [
+            "pendverify bench accuracy --quick",
+            "pendverify bench accuracy --scene scenes/damped_double_pendulum.toml -o bench-out --svg",
+        ],
     )
     a.add_argument(
         "--quick", action="store_true", help="fewer tolerances and shorter runs (well under a minute)"
@@ -36,22 +48,33 @@ def register(sub) -> None:
         "--scene",
         default=None,
         help="benchmark this scene (any model, a model file with its params and URDF) "
-        "instead of the seeds' problems",
+        "instead of the problems of the two reference systems (default: those problems)",
     )
-    a.add_argument("-o", "--output", default="bench-out", help="output folder (default: bench-out)")
+    a.add_argument("-o", "--output", default="bench-out", help="output folder")
     a.add_argument("--svg", action="store_true", help="also write the plot as SVG")
     a.set_defaults(func=run)
-    c = what.add_parser(
+    c = add_command(
+        what,
         "certify",
-        help="the certification battery's cost per parameter set on one core: batch, per-state path, floor",
+        "the certification battery's cost per parameter set on one core: batch, per-state path, floor",
+        [
+            "pendverify bench certify --quick",
+            "pendverify bench certify --params analytic/params/double_pendulum.toml --json bench.json",
+        ],
+        json="every figure",
     )
     c.add_argument("--quick", action="store_true", help="100 states, short simulations, one run each")
-    c.add_argument("--repeats", type=positive_int, default=None, help="runs per figure, least kept (7)")
+    c.add_argument(
+        "--repeats",
+        type=positive_int,
+        default=None,
+        help="runs per figure, least kept (default: 7; 1 with --quick)",
+    )
     c.add_argument(
         "--reference-repeats",
         type=positive_int,
         default=1,
-        help="runs of the slow per-state path, least kept (1)",
+        help="runs of the slow per-state path, least kept",
     )
     c.add_argument(
         "--params",
@@ -59,7 +82,6 @@ def register(sub) -> None:
         metavar="FILE",
         help="a parameter set to measure (repeat for more; default: each built-in model's own set)",
     )
-    c.add_argument("--json", metavar="PATH", help="also write every figure as JSON")
     c.set_defaults(func=run_certify)
 
 
@@ -96,7 +118,8 @@ def run(args: argparse.Namespace) -> int:
         config, specs = QUICK if args.quick else FULL, None
         if args.scene is not None:
             config, specs = scene_problems(args.scene, config)
-        results = run_benchmark(config, log=lambda msg: print(msg, flush=True), blas=blas, specs=specs)
+        log = (lambda msg: None) if args.quiet else (lambda msg: print(msg, flush=True))
+        results = run_benchmark(config, log=log, blas=blas, specs=specs)
         out = Path(args.output)
         markdown = to_markdown(results)
         write_atomic(out / "work_precision.csv", to_csv(results))
@@ -104,8 +127,9 @@ def run(args: argparse.Namespace) -> int:
         write_atomic(out / "work_precision.png", render(results, "png"))
         if args.svg:
             write_atomic(out / "work_precision.svg", render(results, "svg"))
-    print()
-    print(markdown)
+    if not args.quiet:
+        print()
+        print(markdown)
     for name, (r, rm, met) in ratios(results).items():
         target = "1/8" if name == "single" else "1/50"
         print(
@@ -119,7 +143,7 @@ def run(args: argparse.Namespace) -> int:
 
 def run_certify(args: argparse.Namespace) -> int:
     """``bench certify``: the battery per set, its per-state path and its floor, in one run."""
-    check_output(args.json)
+    check_report_output(args.json)
     guard, blas = limit_blas()
     with guard:
         import json
@@ -129,7 +153,6 @@ def run_certify(args: argparse.Namespace) -> int:
         import numpy as np
         import pinocchio
 
-        from pendverify.atomic import write_atomic
         from pendverify.bench.certify import measure, quick_settings
         from pendverify.bench.certify_report import table, to_json
         from pendverify.bench.timing import cpu_model
@@ -138,7 +161,8 @@ def run_certify(args: argparse.Namespace) -> int:
         settings = quick_settings() if args.quick else BatterySettings()
         repeats = args.repeats or (1 if args.quick else 7)
         costs = measure(args.params, settings, repeats, args.reference_repeats)
-    print(table(costs, settings, repeats, args.reference_repeats, blas))
+    lines = table(costs, settings, repeats, args.reference_repeats, blas).splitlines()
+    print("\n".join(line for line in lines if line.startswith("target ")) if args.quiet else "\n".join(lines))
     if args.json:
         machine = {
             "cpu": cpu_model(),
@@ -149,6 +173,5 @@ def run_certify(args: argparse.Namespace) -> int:
             "pinocchio": pinocchio.__version__,
         }
         text = json.dumps(to_json(costs, settings, repeats, args.reference_repeats, machine), indent=2)
-        write_atomic(args.json, text + "\n")
-        print(f"written: {args.json}")
+        write_json_report(args, text + "\n")
     return 0

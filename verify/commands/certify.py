@@ -4,15 +4,33 @@ from __future__ import annotations
 
 import argparse
 
-from pendverify.atomic import check_output
-from pendverify.commands import add_analytic_option, non_negative_int, positive_int, refuse_together
+from pendverify.atomic import check_output, check_report_output
+from pendverify.commands import (
+    add_analytic_option,
+    add_command,
+    non_negative_int,
+    positive_int,
+    refuse_together,
+    write_json_report,
+)
 
 DEFAULT_MAX_SETS = 100_000  # pendverify.certify.sweep.DEFAULT_MAX_SETS, without importing NumPy here
 
 
 def register(sub) -> None:
-    p = sub.add_parser("certify", help="run the full battery on a parameter set and certify it")
-    p.add_argument("params_file", nargs="?", help="a parameter file (TOML)")
+    p = add_command(
+        sub,
+        "certify",
+        "run the full battery on a parameter set and certify it",
+        [
+            "pendverify certify analytic/params/double_pendulum.toml -o certified",
+            "pendverify certify --sweep sweeps/double_pendulum_200.toml --workers 2 -o certified",
+            "pendverify certify --urdf robot.urdf --model double_pendulum --params mine.toml -o certified "
+            "--key keys/pendverify-signing.key.pem",
+        ],
+        json="the battery's items and the verdict (with --sweep: the summary)",
+    )
+    p.add_argument("params_file", nargs="?", help="a parameter file (TOML) (default: none; or --sweep)")
     p.add_argument("--model", help="with --urdf: the model the URDF describes")
     add_analytic_option(p, "certify it on --urdf with --params")
     p.add_argument(
@@ -20,8 +38,13 @@ def register(sub) -> None:
     )
     p.add_argument("--params", dest="params_option", help="with --urdf: the parameter set it must match")
     p.add_argument("--sweep", help="a sweep file: certify many sets in parallel")
-    p.add_argument("--scheduler", help="with --sweep: a Dask scheduler address, tcp://HOST:PORT")
-    p.add_argument("--workers", type=positive_int, help="with --sweep: local worker processes")
+    p.add_argument(
+        "--scheduler",
+        help="with --sweep: a Dask scheduler address, tcp://HOST:PORT (default: local processes)",
+    )
+    p.add_argument(
+        "--workers", type=positive_int, help="with --sweep: local worker processes (default: one per core)"
+    )
     p.add_argument(
         "--resume",
         action="store_true",
@@ -31,18 +54,36 @@ def register(sub) -> None:
         "--max-sets",
         type=positive_int,
         default=DEFAULT_MAX_SETS,
-        help=f"with --sweep: refuse a sweep of more sets than this (default {DEFAULT_MAX_SETS:,})",
+        help=f"with --sweep: refuse a sweep of more sets than this (default: {DEFAULT_MAX_SETS:,})",
     )
-    p.add_argument("-o", "--output", required=True, help="directory for the certificate, URDF and parameters")
-    p.add_argument("--samples", type=positive_int, help="random states for the core checks (default 2000)")
-    p.add_argument("--seed", type=non_negative_int, help="seed of the state sampler")
+    p.add_argument(
+        "-o", "--output", required=True, help="directory for the certificate, URDF and parameters (required)"
+    )
+    p.add_argument("--samples", type=positive_int, help="random states for the core checks (default: 2000)")
+    p.add_argument("--seed", type=non_negative_int, help="seed of the state sampler (default: 20260301)")
     p.add_argument("--force", action="store_true", help="replace existing files")
-    p.add_argument("--key", help="sign the certificate(s) with this Ed25519 private key (pendverify keygen)")
+    p.add_argument(
+        "--key",
+        help="sign the certificate(s) with this Ed25519 private key (pendverify keygen) (default: unsigned)",
+    )
     p.set_defaults(func=run_certify)
 
-    r = sub.add_parser("recheck", help="verify a certificate's digest and re-run its battery")
+    r = add_command(
+        sub,
+        "recheck",
+        "verify a certificate's digest and re-run its battery",
+        [
+            "pendverify recheck certified/double_pendulum.cert.json",
+            "pendverify recheck certified/double_pendulum.cert.json "
+            "--trust keys/pendverify-signing.pub.pem --quiet",
+        ],
+        json="the re-run items, the differences and the verdict",
+    )
     r.add_argument("certificate", help="a NAME.cert.json")
-    r.add_argument("--trust", help="accept only a certificate signed by this public key (PEM)")
+    r.add_argument(
+        "--trust",
+        help="accept only a certificate signed by this public key (PEM) (default: any signature or none)",
+    )
     r.set_defaults(func=run_recheck)
 
 
@@ -72,6 +113,7 @@ def run_certify(args: argparse.Namespace) -> int:
     if args.sweep and args.params_file:
         refuse_together("--sweep", "a parameter file", "a sweep file names its own sets; give one of them")
     check_output(args.output, folder=True)  # before any work
+    check_report_output(args.json)
     if args.sweep:
         return _run_sweep(args)
     settings = BatterySettings()
@@ -81,16 +123,33 @@ def run_certify(args: argparse.Namespace) -> int:
         settings = replace(settings, seed=args.seed)
     target = certification_input(args.params_file, args.urdf, args.model, args.params_option, args.analytic)
     issued = issue(target, settings, args.output, args.force, _key(args))
-    _print_items(issued.items)
+    if not args.quiet:
+        _print_items(issued.items)
+    if args.json:
+        write_json_report(args, _certify_json(issued))
     if not issued.certified:
         failed = [i for i in issued.items if not i.passed]
         print(f"NOT certified: {len(failed)} item(s) failed: {', '.join(i.name for i in failed)}")
         return 1
     print(f"certified: {issued.path} (digest {issued.certificate['digest']['value'][:16]}…)")
-    if "signature" in issued.certificate:
+    if "signature" in issued.certificate and not args.quiet:
         signature = issued.certificate["signature"]
         print(f"signed: {signature['envelope']} (key {signature['keyid']})")
     return 0
+
+
+def _certify_json(issued) -> str:
+    from pendverify.jsonio import to_json, versions
+
+    return to_json(
+        {
+            **versions(),
+            "certified": issued.certified,
+            "certificate": str(issued.path) if issued.path else None,
+            "digest": issued.certificate["digest"]["value"] if issued.certified else None,
+            "items": [i.as_dict() for i in issued.items],
+        }
+    )
 
 
 def _run_sweep(args) -> int:
@@ -118,24 +177,68 @@ def _run_sweep(args) -> int:
             file=sys.stderr,
         )
         return INTERRUPTED
-    print(run.summary.table())
-    if args.resume:  # how many it skipped, zero included
-        print(f"{run.skipped} set(s) already certified in {args.output} (--resume): not recomputed")
+    if not args.quiet:
+        print(run.summary.table())
+        if args.resume:  # how many it skipped, zero included
+            print(f"{run.skipped} set(s) already certified in {args.output} (--resume): not recomputed")
+    if args.json:
+        write_json_report(args, _sweep_json(run))
     print(f"{run.written} certificate(s) written to {args.output}")
     return 0 if certified == run.total else 1
+
+
+def _sweep_json(run) -> str:
+    from pendverify.jsonio import to_json, versions
+
+    worst = {
+        item: {"ratio": ratio, "set": name} for item, (ratio, _, name) in sorted(run.summary.worst.items())
+    }
+    return to_json(
+        {
+            **versions(),
+            "sets": run.total,
+            "computed": run.summary.sets,
+            "passed": run.summary.passed,
+            "failed": run.summary.failed,
+            "written": run.written,
+            "skipped": run.skipped,
+            "certified": run.written + run.skipped == run.total,
+            "worst_ratio": worst,
+        }
+    )
 
 
 def run_recheck(args: argparse.Namespace) -> int:
     from pendverify.certify.issue import recheck
 
+    check_report_output(args.json)
     result = recheck(args.certificate, args.trust)
-    print(f"digest ok: {result.certificate['digest']['value']}")
-    print(result.signature)
-    _print_items(result.items)
-    for d in result.differences:
-        print(f"differs: {d}")
+    if not args.quiet:
+        print(f"digest ok: {result.certificate['digest']['value']}")
+        print(result.signature)
+        _print_items(result.items)
+        for d in result.differences:
+            print(f"differs: {d}")
+    if args.json:
+        write_json_report(args, _recheck_json(args.certificate, result))
     if not result.passed:
         print("recheck FAILED")
         return 1
     print(f"recheck passed: {len(result.items)} items reproduce the certificate's figures")
     return 0
+
+
+def _recheck_json(path: str, result) -> str:
+    from pendverify.jsonio import to_json, versions
+
+    return to_json(
+        {
+            **versions(),
+            "certificate": path,
+            "digest": result.certificate["digest"]["value"],
+            "signature": result.signature,
+            "passed": result.passed,
+            "differences": result.differences,
+            "items": [i.as_dict() for i in result.items],
+        }
+    )

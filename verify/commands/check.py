@@ -5,28 +5,61 @@ from __future__ import annotations
 import argparse
 import time
 
-from pendverify.commands import builtin_models, non_negative_int, positive_float
+from pendverify.commands import (
+    add_command,
+    builtin_models,
+    non_negative_int,
+    positive_float,
+    write_json_report,
+)
 
 
 def register(sub) -> None:
-    p = sub.add_parser("check", help="compare Pinocchio with the hand-derived closed forms")
-    p.add_argument("--model", help="double_pendulum or cart_double_pendulum")
+    p = add_command(
+        sub,
+        "check",
+        "compare Pinocchio with the hand-derived closed forms, one table",
+        [
+            "pendverify check",
+            "pendverify check --model double_pendulum --samples 1000 --seed 7",
+            "pendverify check --analytic examples/cart_pole.py --urdf examples/cart_pole.urdf "
+            "--params examples/cart_pole.toml",
+            "pendverify check --json - --quiet > report.json",
+        ],
+        json="the report",
+    )
+    p.add_argument(
+        "--model",
+        help="double_pendulum or cart_double_pendulum (default: both reference systems, and "
+        "example-robot-data's URDFs)",
+    )
     p.add_argument(
         "--analytic",
         metavar="FILE",
         help="your own closed-form model: a Python file defining one ClosedFormModel subclass "
         "(see examples/cart_pole.py); needs --urdf",
     )
-    p.add_argument("--urdf", help="a URDF, xacro or MJCF file to check (with --model, or with --params)")
+    p.add_argument(
+        "--urdf",
+        help="a URDF, xacro or MJCF file to check (with --model, --analytic or --params), "
+        "or erd:NAME for example-robot-data's",
+    )
     p.add_argument("--params", help="a parameter file (TOML) giving the closed form")
-    p.add_argument("--samples", type=non_negative_int, default=None, help="random states per model")
-    p.add_argument("--seed", type=non_negative_int, default=None, help="seed of the state sampler")
-    p.add_argument("--json", help="also write the report as JSON to this path")
+    p.add_argument(
+        "--samples", type=non_negative_int, default=None, help="random states per model (default: 400)"
+    )
+    p.add_argument(
+        "--seed", type=non_negative_int, default=None, help="seed of the state sampler (default: 20260301)"
+    )
     p.add_argument(
         "--junit", metavar="PATH", help="also write the report as JUnit XML (one test case per check)"
     )
-    p.add_argument("--quiet", action="store_true", help="print only the verdict line (and errors)")
-    p.add_argument("--no-erd", dest="erd", action="store_false", help="skip example-robot-data's URDFs")
+    p.add_argument(
+        "--no-erd",
+        dest="erd",
+        action="store_false",
+        help="skip example-robot-data's URDFs (default: checked when installed)",
+    )
     p.add_argument(
         "--strict",
         action="store_true",
@@ -38,42 +71,42 @@ def register(sub) -> None:
         default=None,
         metavar="R",
         help="largest relative size of a URDF term the closed form cannot express, e.g. a centre of "
-        "mass off the seed's joint line (default 1e-4)",
+        "mass off the reference system's joint line (default: 1e-4)",
     )
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    from pendverify.atomic import check_output, write_atomic
+    from pendverify.analytic import MODELS
+    from pendverify.analytic.plugin import load_model_class
+    from pendverify.atomic import check_output, check_report_output, write_atomic
     from pendverify.checks.junit import to_junit
     from pendverify.checks.report import format_table
     from pendverify.checks.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
-    from pendverify.checks.targets import default_target, erd_targets, plugin_target, user_target
+    from pendverify.checks.targets import select_targets
     from pendverify.checks.verification import build_report
-    from pendverify.robot.erd import MODEL as ERD_MODEL
     from pendverify.robot.geometry import MODEL_FORM_RTOL
 
-    check_output(args.json)
+    check_report_output(args.json)
     check_output(args.junit)
     samples = DEFAULT_RANDOM_STATES if args.samples is None else args.samples
     seed = DEFAULT_SEED if args.seed is None else args.seed
-    names = builtin_models(args.model, args.analytic)
+    builtin_models(args.model, args.analytic)  # refuses --model with --analytic, and unknown names
     if args.analytic:
-        targets = [plugin_target(args.analytic, args.urdf, args.params)]
-    elif args.urdf or args.params:
-        targets = [user_target(args.model, args.urdf, args.params)]
+        model_cls = load_model_class(args.analytic)
     else:
-        targets = [default_target(name) for name in names]
-        if args.erd and (args.model in (None, ERD_MODEL)):
-            targets += erd_targets()
+        model_cls = MODELS[args.model] if args.model else None
+    selection = select_targets(model_cls, args.urdf, args.params, erd_urdfs=args.erd)
     rtol = MODEL_FORM_RTOL if args.model_form_rtol is None else args.model_form_rtol
-    report = build_report(targets, samples, seed, strict=args.strict, model_form_rtol=rtol)
+    report = build_report(selection.targets, samples, seed, strict=args.strict, model_form_rtol=rtol)
+    report.skipped = selection.skipped
     report.elapsed_s = time.perf_counter() - args.started
     table = format_table(report)
     print(table.splitlines()[-1] if args.quiet else table)
-    for path, text in ((args.json, report.to_json), (args.junit, lambda: to_junit(report))):
-        if path:
-            write_atomic(path, text())
-            if not args.quiet:
-                print(f"report written to {path}")
+    if args.junit:
+        write_atomic(args.junit, to_junit(report))
+        if not args.quiet:
+            print(f"report written to {args.junit}")
+    if args.json:
+        write_json_report(args, report.to_json())
     return 0 if report.passed else 1

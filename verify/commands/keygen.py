@@ -4,10 +4,19 @@ from __future__ import annotations
 
 import argparse
 
+from pendverify.commands import add_command
+
 
 def register(sub) -> None:
-    p = sub.add_parser("keygen", help="write an Ed25519 key pair for signing certificates")
-    p.add_argument("-o", "--output", required=True, help="directory for the private and public key (PEM)")
+    p = add_command(
+        sub,
+        "keygen",
+        "write an Ed25519 key pair for signing certificates",
+        ["pendverify keygen -o keys", "pendverify keygen -o keys --force --quiet"],
+    )
+    p.add_argument(
+        "-o", "--output", required=True, help="directory for the private and public key (PEM) (required)"
+    )
     p.add_argument("--force", action="store_true", help="replace an existing key pair")
     p.set_defaults(func=run)
 
@@ -18,7 +27,8 @@ def run(args: argparse.Namespace) -> int:
 
     check_output(args.output, folder=True)
     private, public, keyid = generate_keys(args.output, args.force)
-    print(f"private key: {private} (mode 0600: keep it secret; certify --key {private})")
-    print(f"public key:  {public} (give it to whoever rechecks: recheck --trust {public})")
+    if not args.quiet:
+        print(f"private key: {private} (mode 0600: keep it secret; certify --key {private})")
+        print(f"public key:  {public} (give it to whoever rechecks: recheck --trust {public})")
     print(f"fingerprint: {keyid}")
     return 0

@@ -4,22 +4,33 @@ from __future__ import annotations
 
 import argparse
 
-from pendverify.commands import builtin_models, non_negative_int
+from pendverify.commands import add_command, builtin_models, non_negative_int, write_json_report
 
 
 def register(sub) -> None:
-    p = sub.add_parser(
+    p = add_command(
+        sub,
         "mutate",
-        help="mutation sensitivity: mutate the closed forms, run the checks, report the detection rate",
+        "mutation sensitivity: mutate the closed forms, run the checks, report the detection rate",
+        [
+            "pendverify mutate --model double_pendulum",
+            "pendverify mutate --analytic examples/cart_pole.py --urdf examples/cart_pole.urdf "
+            "--params examples/cart_pole.toml --method mass_matrix --json mutants.json",
+        ],
+        json="the mutants and their verdicts",
     )
-    p.add_argument("--model", help="double_pendulum or cart_double_pendulum (default: both)")
+    p.add_argument(
+        "--model", help="double_pendulum or cart_double_pendulum (default: both reference systems)"
+    )
     p.add_argument("--analytic", metavar="FILE", help="your own model file instead (with --urdf, --params)")
     p.add_argument("--urdf", help="the URDF (or xacro, MJCF) of --analytic")
     p.add_argument("--params", help="the parameter file of --analytic")
     p.add_argument(
         "--samples", type=non_negative_int, default=None, help="random states per model (default 40)"
     )
-    p.add_argument("--seed", type=non_negative_int, default=None, help="seed of the state sampler")
+    p.add_argument(
+        "--seed", type=non_negative_int, default=None, help="seed of the state sampler (default: 20260301)"
+    )
     p.add_argument(
         "--all-checks",
         action="store_true",
@@ -29,15 +40,14 @@ def register(sub) -> None:
         "--method",
         action="append",
         metavar="NAME",
-        help="mutate only this closed form (e.g. mass_matrix); repeatable",
+        help="mutate only this closed form (e.g. mass_matrix); repeatable (default: every closed form)",
     )
-    p.add_argument("--json", help="also write the mutants and their verdicts as JSON to this path")
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
 
-    from pendverify.atomic import check_output, write_atomic
+    from pendverify.atomic import check_report_output
     from pendverify.checks.sampling import DEFAULT_SEED
     from pendverify.checks.targets import default_target, plugin_target
     from pendverify.errors import PendverifyError
@@ -45,7 +55,7 @@ def run(args: argparse.Namespace) -> int:
     from pendverify.symbolic.mutate import DEFAULT_MUTATION_STATES, run_mutation
     from pendverify.symbolic.mutation_report import format_report
 
-    check_output(args.json)
+    check_report_output(args.json)
     names = builtin_models(args.model, args.analytic)
     if args.analytic:
         targets = [plugin_target(args.analytic, args.urdf, args.params)]
@@ -57,8 +67,8 @@ def run(args: argparse.Namespace) -> int:
     seed = DEFAULT_SEED if args.seed is None else args.seed
     methods = tuple(args.method) if args.method else None
     reports = [run_mutation(t, samples, seed, args.all_checks, methods) for t in targets]
-    print("\n\n".join(format_report(r) for r in reports))
+    texts = [format_report(r) for r in reports]  # each ends with its verdict line
+    print("\n".join(t.splitlines()[-1] for t in texts) if args.quiet else "\n\n".join(texts))
     if args.json:
-        write_atomic(args.json, to_json([r.as_dict() for r in reports]))
-        print(f"report written to {args.json}")
+        write_json_report(args, to_json([r.as_dict() for r in reports]))
     return 0 if all(r.passed for r in reports) else 1

@@ -10,21 +10,34 @@ from __future__ import annotations
 
 import argparse
 
+from pendverify.commands import add_command
+
 
 def register(sub) -> None:
-    p = sub.add_parser(
+    p = add_command(
+        sub,
         "render",
-        help="write a self-contained HTML animation of a scene (meshcat, plays from file://)",
+        "write a self-contained HTML animation of a scene (meshcat, plays from file://)",
+        [
+            "pendverify render scenes/chaotic_double_pendulum.toml -o chaos.html --trace",
+            "pendverify render --trajectory run.npz -o run.html",
+        ],
     )
-    p.add_argument("scene", nargs="?", help="a scene file (TOML) to simulate")
-    p.add_argument("-o", "--output", required=True, help="the HTML file to write")
+    p.add_argument(
+        "scene", nargs="?", help="a scene file (TOML) to simulate (default: none; or --trajectory)"
+    )
+    p.add_argument("-o", "--output", required=True, help="the HTML file to write (required)")
     p.add_argument("--trajectory", help="render a saved run (npz of `pendverify simulate -o`) instead")
     p.add_argument("--trace", action="store_true", help="draw the path of the tip as it moves")
-    p.add_argument("--engine", choices=("aba", "closed_form", "both"), help="override the scene's engine")
+    p.add_argument(
+        "--engine",
+        choices=("aba", "closed_form", "both"),
+        help="override the scene's engine (default: the scene's)",
+    )
     p.add_argument(
         "--urdf",
-        help="the URDF (or xacro, MJCF) ABA integrates and the animation draws, instead of the scene's urdf "
-        "or the project's URDF of the parameter set",
+        help="the URDF (or xacro, MJCF) ABA integrates and the animation draws (default: the scene's urdf, "
+        "or the project's URDF of the parameter set)",
     )
     p.set_defaults(func=run)
 

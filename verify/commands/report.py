@@ -10,9 +10,8 @@ The check report is also written as ``DIR/report.json``.  The folder is built
 beside ``DIR`` and renamed into place at the end; an existing ``DIR`` is
 refused unless ``--force``.
 
-The shipped scenes live in the checkout's ``scenes/`` folder, which is not part
-of the installed package: ``report`` runs from a checkout (an editable
-install), or is given ``--scenes DIR``.
+Without ``--scenes DIR`` it reviews the scenes installed with pendverify
+(``pendverify.shipped``).
 """
 
 from __future__ import annotations
@@ -20,35 +19,51 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from pendverify.commands import non_negative_int
-
-CHECKOUT_SCENES = Path(__file__).resolve().parents[2] / "scenes"
+from pendverify.commands import add_command, non_negative_int
 
 
 def register(sub) -> None:
-    p = sub.add_parser("report", help="write a review page: check table, scene animations, energy plots")
-    p.add_argument("-o", "--output", required=True, help="the directory to write (index.html and its files)")
-    p.add_argument("--scenes", default=None, help=f"the folder of scenes (default: {CHECKOUT_SCENES})")
-    p.add_argument("--samples", type=non_negative_int, default=None, help="random states per model")
-    p.add_argument("--seed", type=non_negative_int, default=None, help="seed of the state sampler")
-    p.add_argument("--no-erd", dest="erd", action="store_false", help="skip example-robot-data's URDFs")
+    p = add_command(
+        sub,
+        "report",
+        "write a review page: check table, scene animations, energy plots",
+        ["pendverify report -o review", "pendverify report -o review --scenes my-scenes --no-erd --force"],
+    )
+    p.add_argument(
+        "-o", "--output", required=True, help="the directory to write (index.html and its files) (required)"
+    )
+    p.add_argument(
+        "--scenes",
+        default=None,
+        metavar="DIR",
+        help="the folder of scene files (*.toml) to review (default: the scenes installed with pendverify)",
+    )
+    p.add_argument(
+        "--samples", type=non_negative_int, default=None, help="random states per model (default: 400)"
+    )
+    p.add_argument(
+        "--seed", type=non_negative_int, default=None, help="seed of the state sampler (default: 20260301)"
+    )
+    p.add_argument(
+        "--no-erd",
+        dest="erd",
+        action="store_false",
+        help="skip example-robot-data's URDFs (default: checked when installed)",
+    )
     p.add_argument("--trace", action="store_true", help="draw the tip's path in the animations")
     p.add_argument("--force", action="store_true", help="replace an existing output folder")
     p.set_defaults(func=run)
 
 
 def shipped_scenes(folder: str | None) -> list[Path]:
+    """The scene files ``report`` reviews: those in ``folder``, or the installed ones when None."""
     from pendverify.errors import InputError
+    from pendverify.shipped import shipped_folder
 
-    path = Path(folder) if folder else CHECKOUT_SCENES
+    path = Path(folder) if folder else shipped_folder("scenes")
     scenes = sorted(path.glob("*.toml")) if path.is_dir() else []
     if not scenes:
-        raise InputError(
-            "<command line>",
-            "scenes",
-            str(path),
-            "no scene files (*.toml) there; `report` runs from a checkout, or give --scenes DIR",
-        )
+        raise InputError("<command line>", "--scenes", str(path), "no scene files (*.toml) in that folder")
     return scenes
 
 
@@ -66,7 +81,7 @@ def run(args: argparse.Namespace) -> int:
         DEFAULT_SEED if args.seed is None else args.seed,
         args.erd,
         args.trace,
-        log=lambda line: print(line, flush=True),
+        log=(lambda line: None) if args.quiet else (lambda line: print(line, flush=True)),
         force=args.force,
     )
     print(f"review page written to {folder.index}")

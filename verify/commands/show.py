@@ -4,10 +4,19 @@ from __future__ import annotations
 
 import argparse
 
+from pendverify.commands import add_command
+
 
 def register(sub) -> None:
-    p = sub.add_parser(
-        "show", help="print each equation of a model file (.toml or .py) as parsed, to confirm the reading"
+    p = add_command(
+        sub,
+        "show",
+        "print each equation of a model file (.toml or .py) as parsed, to confirm the reading",
+        [
+            "pendverify show examples/minimal_double_pendulum_text.toml",
+            "pendverify show examples/cart_pole.py --pretty",
+        ],
+        quiet=False,
     )
     p.add_argument("model", metavar="MODEL", help="a model file: a text model (.toml) or Python (.py)")
     p.add_argument("--pretty", action="store_true", help="SymPy's two-dimensional pretty form")

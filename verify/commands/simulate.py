@@ -5,17 +5,33 @@ from __future__ import annotations
 import argparse
 import math
 
+from pendverify.commands import add_command, write_json_report
+
 
 def register(sub) -> None:
-    p = sub.add_parser("simulate", help="simulate a scene and check the physics invariants its effects imply")
+    p = add_command(
+        sub,
+        "simulate",
+        "simulate a scene and check the physics invariants its effects imply",
+        [
+            "pendverify simulate scenes/damped_double_pendulum.toml",
+            "pendverify simulate scenes/cart_lqr_push.toml -o run.npz --csv --html run.html",
+            "pendverify simulate scenes/damped_double_pendulum.toml --engine both --json - --quiet",
+        ],
+        json="the run's metadata and invariant results",
+    )
     p.add_argument("scene", help="a scene file (TOML)")
     p.add_argument("-o", "--output", help="write the trajectory (npz)")
     p.add_argument("--csv", action="store_true", help="also write a CSV beside the npz")
-    p.add_argument("--engine", choices=("aba", "closed_form", "both"), help="override the scene's engine")
+    p.add_argument(
+        "--engine",
+        choices=("aba", "closed_form", "both"),
+        help="override the scene's engine (default: the scene's)",
+    )
     p.add_argument(
         "--urdf",
-        help="the URDF (or xacro, MJCF) ABA integrates and the animation draws, instead of the scene's urdf "
-        "or the project's URDF of the parameter set",
+        help="the URDF (or xacro, MJCF) ABA integrates and the animation draws (default: the scene's urdf, "
+        "or the project's URDF of the parameter set)",
     )
     p.add_argument("--html", help="also write a self-contained HTML animation (as `pendverify render`)")
     p.set_defaults(func=run)
@@ -59,7 +75,7 @@ def _joules(value: float) -> str:
 def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from pendverify.atomic import check_output, write_atomic
+    from pendverify.atomic import check_output, check_report_output, write_atomic
     from pendverify.commands import refuse_together
     from pendverify.simulation.scene import load_scene
     from pendverify.simulation.simulate import simulate
@@ -71,21 +87,34 @@ def run(args: argparse.Namespace) -> int:
     csv = Path(args.output).with_suffix(".csv") if args.csv else None
     for path in (args.output, csv, args.html):
         check_output(path)
+    check_report_output(args.json)
     scene = load_scene(args.scene)
     result = simulate(scene, args.engine, urdf_argument(args.urdf))
-    print(summary(result))
+    text = summary(result)
+    print(text.splitlines()[-1] if args.quiet else text)  # its last line is the verdict
+    say = (lambda line: None) if args.quiet else print
     if args.output:
         write_atomic(args.output, result.to_npz_bytes())
-        print(f"trajectory written to {args.output}")
+        say(f"trajectory written to {args.output}")
         if csv is not None:
             write_atomic(csv, result.to_csv())
-            print(f"CSV written to {csv}")
+            say(f"CSV written to {csv}")
     if args.html:
         from pendverify.viz.animation import Trajectory, render_html
 
         write_atomic(args.html, render_html(Trajectory.from_run(result)))
-        print(f"animation written to {args.html}")
+        say(f"animation written to {args.html}")
+    if args.json:
+        write_json_report(args, _json(result))
     return 0 if result.passed else 1
+
+
+def _json(run) -> str:
+    """The run's metadata (scene, model, engine, integrator, invariants), engine comparison, notes."""
+    from pendverify.jsonio import to_json
+
+    comparison = run.engine_comparison.as_dict() if run.engine_comparison else None
+    return to_json({**run.metadata(), "engine_comparison": comparison, "notes": run.notes})
 
 
 def urdf_argument(path: str | None) -> str | None:

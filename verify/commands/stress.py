@@ -12,15 +12,32 @@ from __future__ import annotations
 import argparse
 import time
 
-from pendverify.commands import add_analytic_option, non_negative_int
+from pendverify.commands import add_analytic_option, add_command, non_negative_int, write_json_report
 
 
 def register(sub) -> None:
-    p = sub.add_parser("stress", help="run the catalogue of numerically hard cases")
+    p = add_command(
+        sub,
+        "stress",
+        "run the catalogue of numerically hard cases",
+        [
+            "pendverify stress --quick",
+            "pendverify stress --case 'double pendulum g = 0' --json stress.json",
+            "pendverify stress --quick --analytic examples/cart_pole.py --urdf examples/cart_pole.urdf "
+            "--params examples/cart_pole.toml",
+        ],
+        json="the report",
+    )
     p.add_argument("--quick", action="store_true", help="fewer states and shorter horizons (same cases)")
-    p.add_argument("--case", action="append", metavar="NAME", help="run only this case (repeatable)")
-    p.add_argument("--seed", type=non_negative_int, default=None, help="seed of the state sampler")
-    p.add_argument("--json", help="also write the report as JSON to this path")
+    p.add_argument(
+        "--case",
+        action="append",
+        metavar="NAME",
+        help="run only this case (repeatable) (default: every case)",
+    )
+    p.add_argument(
+        "--seed", type=non_negative_int, default=None, help="seed of the state sampler (default: 20260301)"
+    )
     add_analytic_option(p, "run hard cases derived from its parameters' kinds; needs --urdf, --params")
     p.add_argument("--urdf", help="with --analytic: the model's URDF or xacro file")
     p.add_argument("--params", help="with --analytic: its parameter file (TOML)")
@@ -161,13 +178,13 @@ def report_dict(report) -> dict:
 
 
 def run(args: argparse.Namespace) -> int:
-    from pendverify.atomic import check_output, write_atomic
+    from pendverify.atomic import check_report_output
     from pendverify.errors import PendverifyError, UnknownNameError
     from pendverify.jsonio import to_json
     from pendverify.stress.catalogue import CASE_NAMES, run_catalogue
     from pendverify.stress.framework import FULL, QUICK, SEED
 
-    check_output(args.json)
+    check_report_output(args.json)
     seed = SEED if args.seed is None else args.seed
     settings = QUICK if args.quick else FULL
     if args.analytic:
@@ -183,14 +200,15 @@ def run(args: argparse.Namespace) -> int:
             if name not in CASE_NAMES:
                 raise UnknownNameError("stress case", name, CASE_NAMES)
         report = run_catalogue(settings, names=args.case, seed=seed)
-    print(format_table(report))
-    if report.study is not None:
+    if not args.quiet:
+        print(format_table(report))
+        if report.study is not None:
+            print()
+            print(format_study(report.study))
         print()
-        print(format_study(report.study))
     elapsed = time.perf_counter() - args.started
     failures = [r for r in report.results if not r.passed]
     verdict = "all cases pass" if not failures else f"{len(failures)} case(s) FAIL"
-    print()
     print(
         f"{len(report.results)} stress cases ({'quick' if args.quick else 'full'}, seed {seed}), "
         f"{elapsed:.1f} s: {verdict}"
@@ -198,9 +216,5 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         document = report_dict(report)
         document["elapsed_s"] = round(elapsed, 3)
-        write_atomic(
-            args.json,
-            to_json(document),
-        )
-        print(f"report written to {args.json}")
+        write_json_report(args, to_json(document))
     return 0 if not failures else 1

@@ -224,7 +224,7 @@ class GeneratedSystem:
         minimum V's error is quadratic in the position error, so the value is good to
         rounding; a global minimum missed between grid points could only enlarge the
         scale, and the scale only normalises the energy error (no check depends on more).
-        The seeds' minimum is known in closed form; the tests compare.
+        The reference systems' minimum is known in closed form; the tests compare.
         """
         from scipy.optimize import minimize
 

@@ -1,1 +1,1 @@
-"""URDFs in Pinocchio: strict reading, the coordinate maps, the seed geometry readers, the writer."""
+"""URDFs in Pinocchio: strict reading, coordinate maps, the reference systems' geometry, the writer."""

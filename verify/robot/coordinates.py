@@ -13,7 +13,7 @@ fixes every other transform:
     q̈     = T θ̈               θ̈  = T⁻¹ q̈
     M_θ⁻¹ = T⁻¹ M_q⁻¹ T⁻ᵀ     det M_θ = det(T)² det M_q
 
-Example: the cart seed's absolute angles against Pinocchio's chain, whose second
+Example: the cart reference system's absolute angles against Pinocchio's chain, whose second
 revolute joint measures θ2 − θ1:  T = [[1, 0, 0], [0, 1, 0], [0, −1, 1]].
 
 Continuous (unbounded) joints take two configuration entries (cos φ, sin φ) in

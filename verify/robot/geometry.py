@@ -6,7 +6,7 @@ parameters read off the URDF where the model's family fixes them, notes, and a
 ``ModelForm`` for a term of the URDF the closed form cannot express.
 
 Readers are looked up in a registry, never chosen by a model's name: a model
-class names its reader in ``geometry_reader`` (the seeds' readers live in
+class names its reader in ``geometry_reader`` (the reference systems' readers live in
 ``pendverify.robot.seed_geometry``); a model without one declares its map
 (``urdf_joints``, ``joint_transform``, ``joint_offset``; ``pendverify.robot.joint_map``).
 """

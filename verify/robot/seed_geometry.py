@@ -1,4 +1,5 @@
-"""The seeds' geometry readers: their coordinate maps (and the seed-000 parameters) read off a URDF.
+"""The geometry readers of the two reference systems: their coordinate maps (and the double pendulum's
+parameters) read off a URDF.
 
 Shape rules (anything else is a ``UrdfShapeError`` naming the file and the rule):
 
@@ -93,7 +94,7 @@ def _up(model: pin.Model) -> np.ndarray:
 
 @register_reader("double_pendulum")
 def double_pendulum_geometry(model: pin.Model, source: str, g: float | None = None) -> UrdfGeometry:
-    """Read the seed-000 parameters and coordinate map off a two-revolute-joint URDF."""
+    """Read the double pendulum's parameters and coordinate map off a two-revolute-joint URDF."""
     _check_chain(model, source, ["revolute", "revolute"])
     data = _frames_at_zero(model)
     up = _up(model)
@@ -125,7 +126,7 @@ def double_pendulum_geometry(model: pin.Model, source: str, g: float | None = No
     com1 = plane(R1 @ model.inertias[1].lever)
     r1_along = float(com1 @ along)
     d1 = float(com1 @ across)  # centre of mass off the joint line
-    r1 = math.hypot(r1_along, d1)  # the seed's r1 is the distance, which is all M sees
+    r1 = math.hypot(r1_along, d1)  # the closed form's r1 is the distance, which is all M sees
     com2 = plane(R2 @ model.inertias[2].lever)
     r2 = float(np.linalg.norm(com2))
     psi2 = math.atan2(com2[1], com2[0]) if r2 > 0 else gamma1
@@ -158,14 +159,14 @@ def double_pendulum_geometry(model: pin.Model, source: str, g: float | None = No
     notes = []
     model_form = None
     if d1 != 0.0:
-        # |ΔH1| = m1·g·|(r1 − r_along) cos θ1 + d1 sin θ1| ≤ m1·g·|c1 − seed's c1|
+        # |ΔH1| = m1·g·|(r1 − r_along) cos θ1 + d1 sin θ1| ≤ m1·g·|c1 − the closed form's c1|
         offset = math.hypot(r1 - r1_along, d1)
         allowance = np.array([params.m1 * g * offset, 0.0])
         # relative to H1's size g·(m1 r1 + m2 (l1 + r2)); g cancels, so g = 0 is no special case
         relative = params.m1 * offset / (params.m1 * params.r1 + params.m2 * (params.l1 + params.r2))
         model_form = ModelForm(
             f"link 1's centre of mass is {abs(d1):.3g} m off the joint-1→joint-2 line "
-            f"({math.atan2(d1, r1_along):.2g} rad); the seed's H has no term for it: "
+            f"({math.atan2(d1, r1_along):.2g} rad); the closed form's H has no term for it: "
             f"up to m1·g·|offset| = {allowance[0]:.3g} N·m on H1",
             float(relative),
             allowance,

@@ -15,7 +15,8 @@ import numpy as np
 import pinocchio as pin
 
 from pendverify.analytic import MODELS
-from pendverify.robot import seed_geometry  # noqa: F401  (registers the seeds' readers)
+from pendverify.display import listed, shortened
+from pendverify.robot import seed_geometry  # noqa: F401  (registers the reference systems' readers)
 from pendverify.robot.coordinates import CoordinateMap
 from pendverify.robot.geometry import MODEL_FORM_RTOL, UrdfGeometry, reader
 from pendverify.robot.joint_map import declared_geometry
@@ -33,7 +34,13 @@ def geometry_for(cls, pin_model: pin.Model, source: str, g: float | None) -> Urd
 
 
 class PinocchioSystem:
-    """A Pinocchio model evaluated in a closed-form model's coordinates."""
+    """A Pinocchio model evaluated in a closed-form model's coordinates.
+
+    ``mass_matrix``, ``coriolis_matrix``, ``gravity``, ``bias``, ``acceleration``, the energies
+    and the rest take and return the model's coordinates (``cmap`` maps them to the URDF's
+    joints); ``geometry`` is what the model's reader saw in the URDF (its parameters, where it
+    reads them), ``notes`` what loading noticed, ``source`` where the URDF came from.
+    """
 
     def __init__(
         self,
@@ -56,6 +63,14 @@ class PinocchioSystem:
         self._no_gravity = model.copy()
         self._no_gravity.gravity.linear = np.zeros(3)
         self._no_gravity_data = self._no_gravity.createData()
+
+    def __repr__(self) -> str:
+        joints = listed(self.model.names[1:], 80)
+        g = -float(self.model.gravity.linear[2])
+        return (
+            f"<PinocchioSystem {shortened(self.source, 120)}: {self.model.nv} dof (joints {joints}), "
+            f"g = {g:g} m/s²>"
+        )
 
     @classmethod
     def for_model(
@@ -167,6 +182,7 @@ class PinocchioSystem:
         return np.triu(upper) + np.swapaxes(np.triu(upper, 1), -1, -2)
 
     def mass_matrix(self, theta) -> np.ndarray:
+        """M(θ) by CRBA, in the model's coordinates."""
         q, _ = self._qv(theta)
         return self.cmap.matrix_to_model(self._symmetric(pin.crba(self.model, self.data, q)))
 
@@ -178,18 +194,22 @@ class PinocchioSystem:
         )
 
     def inverse_mass_matrix(self, theta) -> np.ndarray:
+        """M(θ)⁻¹ by Pinocchio's computeMinverse, in the model's coordinates."""
         q, _ = self._qv(theta)
         return self.cmap.inverse_to_model(self._symmetric(pin.computeMinverse(self.model, self.data, q)))
 
     def bias(self, theta, theta_dot) -> np.ndarray:
+        """C(θ, θ̇)·θ̇ + H(θ) by RNEA at zero acceleration, in the model's coordinates."""
         q, v = self._qv(theta, theta_dot)
         return self.cmap.force_to_model(pin.rnea(self.model, self.data, q, v, np.zeros(self.model.nv)))
 
     def gravity(self, theta) -> np.ndarray:
+        """H(θ) by computeGeneralizedGravity, in the model's coordinates."""
         q, _ = self._qv(theta)
         return self.cmap.force_to_model(pin.computeGeneralizedGravity(self.model, self.data, q))
 
     def coriolis_matrix(self, theta, theta_dot) -> np.ndarray:
+        """Pinocchio's Coriolis matrix C(θ, θ̇) (computeCoriolisMatrix), in the model's coordinates."""
         q, v = self._qv(theta, theta_dot)
         return self.cmap.matrix_to_model(pin.computeCoriolisMatrix(self.model, self.data, q, v))
 
@@ -217,9 +237,11 @@ class PinocchioSystem:
         return self.cmap.acceleration_to_model(a)
 
     def kinetic_energy(self, theta, theta_dot) -> float:
+        """T(θ, θ̇) by computeKineticEnergy."""
         q, v = self._qv(theta, theta_dot)
         return float(pin.computeKineticEnergy(self.model, self.data, q, v))
 
     def potential_energy(self, theta) -> float:
+        """V(θ) by computePotentialEnergy (Pinocchio's zero)."""
         q, _ = self._qv(theta)
         return float(pin.computePotentialEnergy(self.model, self.data, q))

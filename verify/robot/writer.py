@@ -4,12 +4,12 @@ Frames and conventions (they fix the coordinate maps in ``pendverify.robot.syste
 
 * ``double_pendulum``: the links swing in the world's y–z plane about +x.  At
   q = 0 both links point along +y (horizontal); a positive joint angle turns +y
-  towards +z (up), so the seed's θ1 (from the horizontal) and θ2 (relative)
+  towards +z (up), so the reference system's θ1 (from the horizontal) and θ2 (relative)
   are the joint angles themselves.  Joint dampers carry b1 and b2.
 * ``cart_double_pendulum``: the cart slides along +x; the rods turn about +y, so
   a positive angle leans a rod from +z (upright) towards +x.  At q = 0 both rods
   stand upright.  Pinocchio's joint 2 angle is *relative* (θ2 − θ1).  No URDF
-  dampers are written: the seed's d3 acts on the absolute rate θ̇2, which a
+  dampers are written: the cart reference system's d3 acts on the absolute rate θ̇2, which a
   joint damper (acting on θ̇2 − θ̇1) cannot express.
 
 Inertials sit at the centres of mass with the inertia about them, as URDF
@@ -180,7 +180,7 @@ def cart_double_pendulum_urdf(p: CartDoublePendulumParams, name: str = "cart_dou
 
 
 def urdf_for(params: ParameterSet, name: str | None = None) -> str:
-    """The URDF text of a parameter set whose model has a writer (the seeds); the robot is ``name``."""
+    """The URDF text of a parameter set whose model has a writer (the reference systems); robot ``name``."""
     model = getattr(params, "model", type(params).__name__)
     if model not in WRITERS:
         raise PendverifyError(f"no URDF writer for model {model!r}: give the URDF that describes it")

@@ -13,7 +13,7 @@ Engines, both fed the same generalized force τ (model coordinates):
   built-in model, on the URDF the project writes for the scene's parameter set; a model file
   (plug-in) has no such writer, so it needs a URDF for ``aba`` and ``both``;
 * ``closed_form``: the hand model's control-affine form,
-  q̈ = f₀(x) + g(x) τ with f₀ = −M⁻¹ (C q̇ + H) and g(x) = M⁻¹ — the seed's f
+  q̈ = f₀(x) + g(x) τ with f₀ = −M⁻¹ (C q̇ + H) and g(x) = M⁻¹ — the reference systems' f
   and g, with friction entering τ as −D q̇ only when damping is on.
 
 Besides (q, q̇) the integrated state carries the work integrals, so that the

@@ -16,6 +16,7 @@ import numpy as np
 
 from pendverify.checks.scaling import norm2, rate_scale, scaled_matrix, weights
 from pendverify.checks.trust import EPS
+from pendverify.display import html_table, shortened
 from pendverify.errors import IntegrationError
 from pendverify.jsonio import to_json, versions
 from pendverify.simulation.dynamics import Dynamics, build_dynamics
@@ -34,8 +35,20 @@ from pendverify.simulation.scene import Integrator, Scene
 ENGINE_K = 16.0  # as the aba check: K·ε·(1 + |θ|max)
 
 
-@dataclass
+@dataclass(repr=False)
 class Run:
+    """One simulated scene: the samples, the integrator's record and the invariants' verdicts.
+
+    ``t`` (s, the scene's sample times), ``q``, ``v`` (one row per sample, the model's
+    coordinates), ``u``, ``w`` (inputs and disturbances), ``energy`` (J) are arrays;
+    ``invariants`` holds one ``InvariantResult`` per invariant (name, error, tolerance,
+    passed, detail), ``engine_comparison`` the ABA-vs-closed-form comparison (engine
+    ``both``), ``notes`` what the run noticed.  ``passed`` is every invariant (and the
+    comparison) passing.  ``scene``, ``dynamics`` and ``integration`` are what was run and how.
+    ``metadata()``, ``to_npz_bytes()`` and ``to_csv()`` are the files ``pendverify simulate``
+    writes.
+    """
+
     scene: Scene
     dynamics: Dynamics
     integration: Integration
@@ -50,12 +63,51 @@ class Run:
     notes: list[str] = field(default_factory=list)
 
     @property
+    def checks(self) -> list[InvariantResult]:
+        """The invariants and, with engine ``both``, the engines' comparison."""
+        return [*self.invariants, *([self.engine_comparison] if self.engine_comparison else [])]
+
+    @property
     def passed(self) -> bool:
-        checks = [*self.invariants, *([self.engine_comparison] if self.engine_comparison else [])]
-        return all(c.passed for c in checks)
+        """Whether every invariant (and, with engine ``both``, the engines' comparison) holds."""
+        return all(c.passed for c in self.checks)
+
+    @property
+    def engine(self) -> str:
+        """aba, closed_form or both (ABA integrated, compared with the closed form): what ran."""
+        return "both" if self.engine_comparison is not None else self.dynamics.engine
+
+    def __repr__(self) -> str:
+        held = sum(c.passed for c in self.checks)
+        return (
+            f"<Run {shortened(self.scene.name, 80)!r} ({shortened(self.scene.model, 60)}): "
+            f"engine {self.engine}, {self.scene.duration:g} s, {len(self.t)} samples, "
+            f"{held}/{len(self.checks)} invariants hold: {'pass' if self.passed else 'FAIL'}>"
+        )
+
+    def _repr_html_(self) -> str:
+        """A table of the invariants under a caption naming the scene, engine, duration and samples."""
+        caption = (
+            f"scene {self.scene.name} ({self.scene.model}): engine {self.engine}, "
+            f"{self.scene.duration:g} s, {len(self.t)} samples, "
+            f"{int(len(self.integration.steps_t) - 1)} steps: {'pass' if self.passed else 'FAIL'}"
+        )
+        header = ("invariant", "error", "tolerance", "worst t (s)", "result", "detail")
+        rows = [
+            (
+                c.name,
+                f"{c.error:.2e}",
+                f"{c.tolerance:.2e}",
+                f"{c.worst_t:.4g}",
+                "pass" if c.passed else "FAIL",
+                c.detail,
+            )
+            for c in self.checks
+        ]
+        return html_table(header, rows, caption, [not c.passed for c in self.checks])
 
     def metadata(self) -> dict:
-
+        """The run's description: scene, model, parameters, engine, integrator, invariants, versions."""
         s = self.scene
         return {
             "scene": s.name,
@@ -65,7 +117,7 @@ class Run:
             **({"urdf": self.dynamics.urdf} if self.dynamics.urdf else {}),
             "parameters": s.params.as_dict(),
             "parameters_source": s.params_source,
-            "engine": self.dynamics.engine if s.engine != "both" else "both",
+            "engine": self.engine,
             "integrator": s.integrator.describe(),
             "steps": int(len(self.integration.steps_t) - 1),
             "rhs_evaluations": int(self.integration.nfev),
@@ -76,6 +128,7 @@ class Run:
         }
 
     def to_npz_bytes(self) -> bytes:
+        """The samples and ``metadata()`` as an ``.npz`` file's bytes."""
         buf = io.BytesIO()
         np.savez(
             buf,
@@ -90,6 +143,7 @@ class Run:
         return buf.getvalue()
 
     def to_csv(self) -> str:
+        """The samples as CSV: t, the coordinates, their rates, inputs, disturbances, energy."""
         coords = self.dynamics.model.coordinates
         cols = (
             ["t"]
@@ -139,6 +193,8 @@ def _engine_comparison(dyn: Dynamics, steps_t, steps_x) -> InvariantResult:
 
 
 def simulate(scene: Scene, engine: str | None = None, urdf: str | None = None) -> Run:
+    """Integrate ``scene`` (with ``engine`` instead of the scene's, and ``urdf`` instead of the
+    URDF the project writes for its parameters, when given) and check its invariants."""
     engine = engine or scene.engine
     dyn = build_dynamics(scene, engine, urdf)
     x0 = np.concatenate([scene.q0, scene.v0, [0.0, 0.0]])

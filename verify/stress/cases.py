@@ -1,4 +1,4 @@
-"""The seeds' stress cases on states and parameters.
+"""The reference systems' stress cases on states and parameters.
 
 Large angles, high speeds, the near-singular cart and the trust study, bad input.
 """

@@ -1,4 +1,4 @@
-"""The seeds' stress catalogue: hard cases that must stay numerically stable, or be refused.
+"""The reference systems' stress catalogue: hard cases that must stay numerically stable, or be refused.
 
 These cases are about the two seed models (``pendverify stress`` without ``--analytic``);
 any model file gets the generic cases of ``pendverify.stress.generic``.

@@ -140,7 +140,7 @@ class Context:
         return system
 
     def trust_study(self) -> StudyResult:
-        """The cart seed's m1 → 0 study (``pendverify.stress.trust_study``), run once per context."""
+        """The cart reference system's m1 → 0 study (``pendverify.stress.trust_study``), run once."""
         if self.study is None:
             self.study = cart_study(self.settings.study_masses)
         return self.study

@@ -1,4 +1,4 @@
-"""The seeds' hard parameter sets: the default sets, scaled, for the seed-specific stress cases.
+"""The reference systems' hard parameter sets: the default sets, scaled, for their own stress cases.
 
 Lengths scale with their inertias (I ∝ m·l², so a link k times longer has k² its
 inertia); a mass ratio scales link 1's mass and its inertia together.  The generic

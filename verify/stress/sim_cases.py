@@ -1,4 +1,4 @@
-"""The seeds' stress cases that simulate: stiff damping, a 1e4 s horizon, zero gravity (closed form)."""
+"""The reference systems' simulated stress cases: stiff damping, a 1e4 s horizon, g = 0 (closed form)."""
 
 from __future__ import annotations
 

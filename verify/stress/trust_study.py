@@ -6,7 +6,7 @@ For m1 = 1, 0.1, ..., 1e-16 kg and three aligned states it compares with a
 50-digit mpmath reference built from the *same* float parameters and state
 (M, f, det M, M⁻¹ and q̈ = M⁻¹f evaluated in ``REFERENCE_DIGITS`` digits):
 
-* det M: the seed's closed form (a sum of non-negative terms) and the LU
+* det M: the cart's closed form (a sum of non-negative terms) and the LU
   determinant of Pinocchio's CRBA;
 * q̈: the closed form (an LU solve with M) and Pinocchio's ABA;
 * M⁻¹: the closed form (adjugate / closed-form det) and ``computeMinverse``.
@@ -43,7 +43,7 @@ def _mpf(x) -> mp.mpf:
 
 
 def reference_mass_matrix(params, q) -> mp.matrix:
-    """M(q) of either seed in ``REFERENCE_DIGITS`` digits (call inside ``mp.workdps``)."""
+    """M(q) of either reference system in ``REFERENCE_DIGITS`` digits (call inside ``mp.workdps``)."""
     if isinstance(params, CartDoublePendulumParams):
         m, m1, m2, l1, l2 = (_mpf(x) for x in (params.m, params.m1, params.m2, params.l1, params.l2))
         t1, t2 = _mpf(q[1]), _mpf(q[2])
@@ -68,7 +68,7 @@ def reference_mass_matrix(params, q) -> mp.matrix:
 
 
 def reference_cart_rhs(p: CartDoublePendulumParams, y, yd, u, w) -> mp.matrix:
-    """The cart seed's f(y, ẏ, u, w) in ``REFERENCE_DIGITS`` digits."""
+    """The cart reference system's f(y, ẏ, u, w) in ``REFERENCE_DIGITS`` digits."""
     m1, m2, l1, l2, g = (_mpf(x) for x in (p.m1, p.m2, p.l1, p.l2, p.g))
     d = [_mpf(x) for x in (p.d1, p.d2, p.d3)]
     t1, t2 = _mpf(y[1]), _mpf(y[2])
@@ -225,7 +225,7 @@ def zero_mass_demo(base: CartDoublePendulumParams):
 
 
 def trust_study(base: CartDoublePendulumParams, masses=STUDY_MASSES) -> StudyResult:
-    """The m1 → 0 sweep of the cart seed at the study states."""
+    """The m1 → 0 sweep of the cart reference system at the study states."""
     rows = [
         _measure(base.replace(m1=m1), label, *state)
         for m1 in masses
@@ -264,5 +264,5 @@ def det_accuracy(params, q) -> tuple[float, float]:
 
 
 def cart_study(masses=STUDY_MASSES) -> StudyResult:
-    """``trust_study`` on the cart seed's default parameter set."""
+    """``trust_study`` on the cart reference system's default parameter set."""
     return trust_study(load_parameter_file(default_parameter_file("cart_double_pendulum"))[2], masses)

@@ -20,7 +20,7 @@ det_mass_matrix                det M
 inverse_mass_matrix            M_hand⁻¹ · M − I = 0
 acceleration                   M q̈_hand + (C + D) q̇ + H − B u − W w = 0, when the
                                code can be read symbolically (not np.linalg.solve)
-extra closed forms             what their ``equals`` says, e.g. the cart seed's
+extra closed forms             what their ``equals`` says, e.g. the cart reference system's
                                f = −C ẏ − H − D ẏ + B u + W w
 =============================  =============================================
 

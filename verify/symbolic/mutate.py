@@ -246,7 +246,7 @@ def unseen_methods(cls) -> list[str]:
     """Hand-written closed forms no Pinocchio check can see: B and W when q̈ is derived.
 
     The URDF defines no input map, so B and W reach a check only through a
-    hand-written q̈ (the seed's f + g·u); a derived q̈ applies the model's own B
+    hand-written q̈ (the reference systems' f + g·u); a derived q̈ applies the model's own B
     and W on both sides of ``aba``.  They are compared by ``pendverify sympy``
     (the input power) instead, and not mutated here.
     """
