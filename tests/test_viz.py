@@ -293,6 +293,8 @@ def test_review_tables_sit_in_boxes_that_scroll_sideways():
     tables = page.count("<table>")
     assert tables == 2 and page.count('<div class="table-box"><table>') == tables
     assert page.count("</table></div>") == tables
+    # a long model name may wrap in its column's head, after "_" (and ":")
+    assert "<th>model_<wbr>number_<wbr>0_<wbr>with_<wbr>a_<wbr>long_<wbr>name</th>" in page
 
 
 # --- in a real browser -------------------------------------------------------------------

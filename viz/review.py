@@ -75,6 +75,11 @@ def _boxed(table: str) -> str:
     return f'<div class="table-box">{table}</div>\n'
 
 
+def _breakable(name: str) -> str:
+    """A model's name, escaped, that may wrap after "_" and ":" (a long name makes a narrow column)."""
+    return _e(name).replace("_", "_<wbr>").replace(":", ":<wbr>")
+
+
 def check_matrix(report) -> str:
     """One row per check, one column per model: error / tolerance and the verdict."""
     models = list(dict.fromkeys(r.model for r in report.results))
@@ -92,7 +97,7 @@ def check_matrix(report) -> str:
             f"{'✓' if r.passed else '✗ FAIL'}</td>"
         )
 
-    head = "".join(f"<th>{_e(m).replace('_', '_<wbr>')}</th>" for m in models)  # long names may wrap
+    head = "".join(f"<th>{_breakable(m)}</th>" for m in models)
     rows = "\n".join(f"<tr><th>{_e(c)}</th>{''.join(td(c, m) for m in models)}</tr>" for c in checks)
     return _boxed(f"<table><tr><th>check \\ model</th>{head}</tr>\n{rows}\n</table>")
 
