@@ -38,13 +38,14 @@ import numpy as np
 
 from pendverify.analytic import ClosedFormModel, ParameterSet
 from pendverify.analytic.params import parse_parameter_document, read_toml
+from pendverify.analytic.source_file import defining_file
 from pendverify.errors import FileAccessError, ParameterError, PendverifyError, UserCodeError
 
 
 def where(cls: type) -> str:
     """The file that defines a class (for error messages), or its module's name."""
     try:
-        return inspect.getfile(cls)
+        return defining_file(cls)
     except (TypeError, OSError):  # pragma: no cover - classes built at run time
         return cls.__module__
 

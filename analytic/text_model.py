@@ -12,8 +12,9 @@ complex functions for the LQR's complex step), and as the SymPy expressions
 themselves when ``self.math`` is SymPy's (``pendverify.symbolic.model``), so that
 ``sympy``, ``mutate`` and the code generator read the text model as they read a
 Python one.  Only the methods whose equations the file gives are defined, so
-``hand_written()`` tells the truth.  The class's module is a stand-in whose
-``__file__`` is the text file (messages and the generated-code cache name it).
+``hand_written()`` tells the truth.  The class's module is a stand-in that names
+the text file in ``pendverify.analytic.source_file.TEXT_FILE`` (messages and the
+generated-code cache name it) and has no ``__file__``, which would claim Python source.
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ import sympy as sp
 from pendverify.analytic.forms import Energies
 from pendverify.analytic.interface import BiasOnlyModel, ClosedFormModel
 from pendverify.analytic.params import ParameterSet
+from pendverify.analytic.source_file import TEXT_FILE
 from pendverify.analytic.text_parse import Reader, TextModelSpec, read_text_model
 
 #: equation key → (method, its arguments)
@@ -210,7 +212,7 @@ def build_model_class(spec: TextModelSpec) -> type[ClosedFormModel]:
     class_name = "".join(part.capitalize() for part in spec.name.split("_")) or "TextModel"
     digest = hashlib.sha256(str(spec.path.resolve()).encode()).hexdigest()[:16]
     module = types.ModuleType(f"pendverify_textmodel_{digest}")
-    module.__file__ = str(spec.path)
+    setattr(module, TEXT_FILE, str(spec.path))
     fields = [
         (p, float, dataclasses.field(metadata={"kind": kind, "unit": unit, "doc": f"{p} in [{unit}]"}))
         for p, (kind, unit) in spec.parameters.items()

@@ -1,6 +1,18 @@
-"""Shared fixtures: default models, their Pinocchio systems, seeded states."""
+"""Shared fixtures: default models, their Pinocchio systems, seeded states; the run's code cache.
+
+The generated-code cache (``PENDVERIFY_CACHE``) of a test run is one empty folder
+under pytest's base temporary folder, shared by the run's xdist workers
+(``pytest-N/pendverify-cache``), so that the suite neither reads nor writes the
+user's ``~/.cache/pendverify`` and each model is generated and compiled about once
+per run, whichever worker gets there first (the cache's files are written
+atomically).  A ``PENDVERIFY_CACHE`` set in the environment is used instead (a warm
+cache for repeated runs).  Tests that need an empty cache of their own make one.
+"""
 
 from __future__ import annotations
+
+import os
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,6 +24,25 @@ from pendverify.robot.system import PinocchioSystem
 
 SEED = 1234
 MODEL_NAMES = tuple(MODELS)
+
+
+def _run_folder(tmp_path_factory) -> Path:
+    """pytest's base temporary folder of this run: each xdist worker's own is one level below."""
+    base = tmp_path_factory.getbasetemp()
+    return base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _generated_code_cache(tmp_path_factory):
+    """``PENDVERIFY_CACHE`` for the whole run (module docstring), also for the subprocesses tests start."""
+    if os.environ.get("PENDVERIFY_CACHE"):
+        yield Path(os.environ["PENDVERIFY_CACHE"])
+        return
+    folder = _run_folder(tmp_path_factory) / "pendverify-cache"
+    folder.mkdir(exist_ok=True)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("PENDVERIFY_CACHE", str(folder))
+        yield folder
 
 
 def default_params(name: str):

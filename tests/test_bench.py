@@ -47,9 +47,9 @@ SMALL = replace(
 )
 
 
-def run_quick(argv: list[str], config, cache: str | None = None):
+def run_quick(argv: list[str], config):
     """(exit status, the Results it measured) of ``pendverify bench accuracy --quick ARGV`` with
-    ``config`` in place of QUICK (and ``cache`` as PENDVERIFY_CACHE when given)."""
+    ``config`` in place of QUICK (on the run's generated-code cache, ``conftest``)."""
     captured = {}
     real = benchrun.run_benchmark
 
@@ -58,8 +58,6 @@ def run_quick(argv: list[str], config, cache: str | None = None):
         return captured["results"]
 
     with pytest.MonkeyPatch.context() as mp:
-        if cache is not None:
-            mp.setenv("PENDVERIFY_CACHE", cache)
         mp.setattr(workprecision, "QUICK", config)
         mp.setattr(benchrun, "run_benchmark", keep)
         status = main(["bench", "accuracy", "--quick", *argv])
@@ -70,7 +68,7 @@ def run_quick(argv: list[str], config, cache: str | None = None):
 def bench(tmp_path_factory):
     """Run the CLI once in --quick mode, with the small configuration; keep what it measured."""
     out = tmp_path_factory.mktemp("bench")
-    status, results = run_quick(["-o", str(out)], SMALL, str(out / "cache"))
+    status, results = run_quick(["-o", str(out)], SMALL)
     return status, out, results
 
 

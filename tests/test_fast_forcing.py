@@ -40,11 +40,6 @@ NOISY_CART = {
 }
 
 
-@pytest.fixture(autouse=True)
-def _cache(tmp_path_factory, monkeypatch):
-    monkeypatch.setenv("PENDVERIFY_CACHE", str(tmp_path_factory.getbasetemp() / "forcing-cache"))
-
-
 def _scenes():
     sine = load_scene(REPO / "scenes" / "torque_driven_double_pendulum.toml")
     return {"sine": sine, "sine+noise": parse_scene(NOISY_CART, "<noisy cart>")}

@@ -279,7 +279,10 @@ SDF = """<?xml version="1.0"?>
 """
 
 
-@pytest.mark.skipif(pin.WITH_SDFORMAT, reason="this Pinocchio has SDFormat: the refusal does not apply")
+@pytest.mark.skipif(
+    pin.WITH_SDFORMAT,
+    reason="depends on the installed Pinocchio: this build has SDFormat, so there is no refusal to test",
+)
 def test_an_sdf_is_refused_without_sdformat(tmp_path, capsys):
     path = tmp_path / "double_pendulum.sdf"
     path.write_text(SDF)
@@ -293,7 +296,8 @@ def test_an_sdf_is_refused_without_sdformat(tmp_path, capsys):
 
 
 @pytest.mark.skipif(
-    not pin.WITH_SDFORMAT, reason="this Pinocchio build has no SDFormat (WITH_SDFORMAT is False)"
+    not pin.WITH_SDFORMAT,
+    reason="depends on the installed Pinocchio: this build has no SDFormat (WITH_SDFORMAT is False)",
 )
 def test_an_sdf_builds_the_urdfs_model(tmp_path):
     path = tmp_path / "double_pendulum.sdf"

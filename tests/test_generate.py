@@ -62,7 +62,7 @@ from pendverify.numerics.codegen import expressions as codegen_expressions
 from pendverify.numerics.generate import GeneratedSystem
 
 REPO = Path(__file__).resolve().parents[1]
-EXAMPLES = sorted((REPO / "examples").glob("*.py"))
+EXAMPLES = sorted(p for p in (REPO / "examples").glob("*.py") if p.name != "__init__.py")
 SEED = 1234
 U = np.finfo(float).eps / 2
 STATES = 30  # random states per case, after the model's special states
@@ -71,12 +71,11 @@ OBSERVED: dict[str, float] = {}
 
 
 @pytest.fixture(scope="module", autouse=True)
-def _cache(tmp_path_factory):
-    """One cache for the module: each model is generated and compiled once."""
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setenv("PENDVERIFY_CACHE", str(tmp_path_factory.mktemp("cache")))
-        generate.forget()
-        yield
+def _cache():
+    """The run's cache (``conftest``), nothing from memory: each model is generated and compiled
+    once per run, and the module's kernels come from the disk or the generator, not another module."""
+    generate.forget()
+    yield
     generate.forget()
 
 

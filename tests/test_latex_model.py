@@ -20,20 +20,21 @@ from pendverify.analytic.latex_parse import LatexError, LatexReader, SymbolTable
 from pendverify.cli import main
 
 REPO = Path(__file__).resolve().parents[1]
-SEEDS = REPO.parent / "shared" / "seeds"
+#: the source documents of the two reference systems, copied into the repository
+DOCUMENTS = Path(__file__).resolve().parent / "data" / "reference_systems"
 ROW = re.compile(r"^(\S+)\s+(\w+)\s+([0-9.e+-]+)\s+([0-9.e+-]+)\s+.*\s(pass|FAIL|fail)\s*$")
 SEED = {
     "double_pendulum": (
         REPO / "examples" / "double_pendulum_latex.toml",
         REPO / "urdf" / "double_pendulum.urdf",
         REPO / "analytic" / "params" / "double_pendulum.toml",
-        "000_f9503cae7b675462.txt",
+        "double_pendulum.txt",
     ),
     "cart_double_pendulum": (
         REPO / "examples" / "cart_double_pendulum_latex.toml",
         REPO / "urdf" / "cart_double_pendulum.urdf",
         REPO / "analytic" / "params" / "cart_double_pendulum.toml",
-        "001_cd8cb0dc0c0701d3.txt",
+        "cart_double_pendulum.txt",
     ),
 }
 
@@ -127,13 +128,10 @@ def test_every_way_of_giving_a_seed_yields_the_same_check_table(model, tmp_path,
         assert latex[check][0] <= latex[check][1] and builtin[check][0] <= builtin[check][1]
 
 
-@pytest.mark.skipif(
-    not SEEDS.is_dir(), reason="the seed documents (../shared/seeds) are not beside this clone"
-)
 @pytest.mark.parametrize("model", list(SEED))
 def test_the_example_latex_is_the_seed_documents_own_text(model):
     latex_file, _, _, seed = SEED[model]
-    document = (SEEDS / seed).read_text()
+    document = (DOCUMENTS / seed).read_text()
     equations = _latex_equations(latex_file.read_text())
     assert equations
     for key, latex in equations.items():
@@ -151,8 +149,7 @@ def test_seed_001s_printed_M_is_refused_for_having_two_rows(tmp_path, capsys):
         r"\begin{bmatrix} m+m_1+m_2 & l_1(m_1+m_2)\cos\theta_1 & m_2l_2\cos\theta_2 \\ "
         r"l_1(m_1+m_2)\cos\theta_1 & l_1^2(m_1+m_2) & l_1l_2m_2\cos(\theta_1-\theta_2) \end{bmatrix}"
     )
-    if SEEDS.is_dir():
-        assert printed in (SEEDS / SEED["cart_double_pendulum"][3]).read_text()
+    assert printed in (DOCUMENTS / SEED["cart_double_pendulum"][3]).read_text()
     bad = tmp_path / "printed_M.toml"
     bad.write_text(re.sub(r"^M = '''\n.*?'''", lambda _: f"M = '''\n{printed}\n'''", text, flags=re.S | re.M))
     code, _, err = _check(capsys, bad, "cart_double_pendulum")

@@ -153,3 +153,27 @@ def test_a_certified_text_model_keeps_its_text_as_model_toml_and_rechecks(tmp_pa
     assert copy.read_text() == (examples / "minimal_double_pendulum_text.toml").read_text()
     assert not (tmp_path / "double_pendulum.model.py").exists()
     assert main(["recheck", str(tmp_path / "double_pendulum.cert.json")]) == 0
+
+
+def test_a_text_models_module_does_not_claim_its_text_as_python_source():
+    """Tools that read a module's ``__file__`` as Python (inspect, Hypothesis) must not parse LaTeX."""
+    import inspect
+    import sys
+    import warnings
+
+    from pendverify.analytic.plugin import where
+    from pendverify.analytic.source_file import defining_file
+    from pendverify.numerics.codegen.cache import model_key
+
+    latex = REPO / "examples" / "double_pendulum_latex.toml"
+    cls = load_model_class(latex)
+    module = sys.modules[cls.__module__]
+    assert getattr(module, "__file__", None) is None
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(TypeError):
+            inspect.getsourcefile(module)
+    # the text file is still the class's file: for messages and for the generated-code key
+    assert defining_file(cls) == defining_file(cls.params_type) == str(latex)
+    assert where(cls) == str(latex)
+    assert model_key(cls) is not None

@@ -11,7 +11,7 @@ import pytest
 
 from pendverify.errors import UrdfShapeError
 from pendverify.robot.erd import double_pendulum_urdfs
-from pendverify.robot.inertia_rounding import inertia_tolerance, resolution
+from pendverify.robot.inertia_rounding import FLOAT_SLACK, check_inertia_tensor, inertia_tolerance, resolution
 from pendverify.robot.strict import JointDynamics, UrdfFacts, read_urdf_strictly
 from pendverify.robot.urdfdom import build_pinocchio_model
 
@@ -249,6 +249,16 @@ def test_written_zeros_take_the_grid_of_their_tensor():
     assert inertia_tolerance(rod) == pytest.approx(1.5e-4, rel=1e-9)
     zero = dict.fromkeys(rod, "0")
     assert inertia_tolerance(zero) == 0.0
+
+
+def test_a_huge_tensor_keeps_a_finite_tolerance_and_a_negative_moment_is_still_refused():
+    big = "1.00000e300"  # written to 6 digits: each entry within 5e294
+    huge = {"ixx": big, "ixy": "0", "ixz": "0", "iyy": big, "iyz": "0", "izz": big}
+    # ‖R‖_F = √3·5e294 (the written zeros: 0.5 each) and ‖I‖_F = √3·1e300, although the squares overflow
+    expected = 3**0.5 * resolution(big) + FLOAT_SLACK * np.finfo(float).eps * 3**0.5 * 1e300
+    assert inertia_tolerance(huge) == pytest.approx(expected, rel=1e-12)
+    with pytest.raises(UrdfShapeError, match="include a negative one"):
+        check_inertia_tensor({**huge, "izz": "-" + big}, "link1", SOURCE)
 
 
 # --------------------------------------------------------------------------- XML

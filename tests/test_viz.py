@@ -13,6 +13,7 @@ from __future__ import annotations
 import colorsys
 import json
 import os
+import re
 import time
 from pathlib import Path
 
@@ -22,14 +23,17 @@ import pytest
 import umsgpack
 from PIL import Image
 
+from pendverify.analytic import MODELS
+from pendverify.checks.report import Report
+from pendverify.checks.result import CheckResult
 from pendverify.cli import main
 from pendverify.errors import TrajectoryError
-from pendverify.robot.writer import COLOURS
+from pendverify.robot.writer import COLOURS, urdf_for
 from pendverify.simulation.scene import load_scene, parse_scene
 from pendverify.simulation.simulate import simulate
 from pendverify.viz.animation import DEFAULT_FPS, Trajectory, build_scene, render_html
 from pendverify.viz.browser import Chromium, find_chromium
-from pendverify.viz.geometry import VisualSystem
+from pendverify.viz.geometry import LINK_COLOURS, VisualSystem
 from pendverify.viz.plots import energy_plot_svg
 from pendverify.viz.recorder import VIEWER_JS
 from pendverify.viz.review import SceneReview, review_page
@@ -218,7 +222,6 @@ def test_energy_plot_and_review_page_escape_user_strings():
     )
     svg = energy_plot_svg(run)
     assert svg.lstrip().startswith("<?xml") and "t [s]" in svg and "energy [J]" in svg
-    from pendverify.checks.report import Report
 
     evil = '<script>alert("x")</script>'
     scene = SceneReview(
@@ -228,6 +231,70 @@ def test_energy_plot_and_review_page_escape_user_strings():
     assert "<script>" not in page
     assert "&lt;script&gt;alert(&quot;x&quot;)&lt;/script&gt;" in page
     assert 'src="plots/p%20q.svg"' in page
+
+
+def test_a_urdf_without_materials_is_drawn_in_one_visible_colour_per_link():
+    params = default_params("double_pendulum")
+    bare = re.sub(r"<material[^>]*/>|<material[^>]*>.*?</material>", "", urdf_for(params), flags=re.S)
+    assert "<material" not in bare and "<visual" in bare
+    run = simulate(parse_scene(short_scene("double_pendulum"), "<test>"))
+    traj = Trajectory(
+        np.asarray(run.t), np.asarray(run.q), params, "bare", model_cls=run.scene.model_cls, urdf=bare
+    )
+    commands = decoded(build_scene(traj))
+    objects = {c["path"]: c["object"] for c in commands if c["type"] == "set_object"}
+    visual = VisualSystem.for_model(run.scene.model_cls, bare, params.g)
+    link_of = {o.name: visual.system.model.frames[o.parentFrame].name for o in visual.objects}
+    sent = {o.name: objects["/meshcat/" + visual.node(o)]["materials"][0]["color"] for o in visual.objects}
+    palette = {hex_colour(" ".join(str(x) for x in rgba)) for rgba in LINK_COLOURS}
+    for name, colour in sent.items():
+        assert colour in palette, f"{name} ({link_of[name]}) is drawn {colour:06x}, not a link colour"
+        channels = (colour >> 16, (colour >> 8) & 255, colour & 255)
+        assert min(channels) < 200, f"{name}: near-white {colour:06x} on the light grey background"
+    per_link = {}
+    for name, colour in sent.items():
+        per_link.setdefault(link_of[name], set()).add(colour)
+    assert {"link1", "link2"} <= per_link.keys()
+    assert all(len(c) == 1 for c in per_link.values()), f"one colour per link: {per_link}"
+    distinct = {c for colours in per_link.values() for c in colours}
+    assert len(distinct) == len(per_link), f"links share a colour: {per_link}"
+
+
+def test_a_urdf_material_is_kept_beside_the_default_colours():
+    params = default_params("double_pendulum")
+    urdf = urdf_for(params)
+    link1 = re.compile(r'(<link name="link1">.*?</link>)', re.S)
+    text = link1.sub(lambda m: re.sub(r"<material[^>]*/>", "", m.group(1)), urdf)
+    visual = VisualSystem.for_model(MODELS["double_pendulum"], text, params.g)
+    for obj in visual.objects:
+        link = visual.system.model.frames[obj.parentFrame].name
+        rgba = " ".join(str(x) for x in obj.meshColor)
+        if link == "link1":
+            assert tuple(obj.meshColor) in LINK_COLOURS, f"{obj.name}: {rgba}"
+        elif link == "link2":
+            assert hex_colour(rgba) == hex_colour(COLOURS["link2"]), f"{obj.name}: {rgba}"
+
+
+def eight_model_report() -> Report:
+    models = [f"model_number_{k}_with_a_long_name" for k in range(8)]
+    state = {"label": "random 7", "q": [0.123456, -1.2345, 2.34567]}
+    results = [
+        CheckResult(m, c, c, 1.2e-13, 5.7e-11, 1e-13, 60, 1, state, True)
+        for c in ("crba", "rnea", "gravity", "aba", "energy", "M inverse")
+        for m in models
+    ]
+    return Report(seed=1, states=dict.fromkeys(models, 60), results=results)
+
+
+def test_review_tables_sit_in_boxes_that_scroll_sideways():
+    page = review_page(eight_model_report(), [])
+    style = re.search(r"<style>(.*)</style>", page, re.S).group(1)
+    assert re.search(r"\.table-box \{[^}]*overflow-x: auto", style)
+    tables = page.count("<table>")
+    assert tables == 2 and page.count('<div class="table-box"><table>') == tables
+    assert page.count("</table></div>") == tables
+    # a long model name may wrap in its column's head, after "_" (and ":")
+    assert "<th>model_<wbr>number_<wbr>0_<wbr>with_<wbr>a_<wbr>long_<wbr>name</th>" in page
 
 
 # --- in a real browser -------------------------------------------------------------------
@@ -371,3 +438,22 @@ def test_review_page_shows_table_plots_and_a_playing_animation(tmp_path, browser
         tab.close()
     masks = colour_masks(shot)
     assert masks["link1"].sum() >= MIN_LINK_PIXELS // 2, "the embedded animation shows no rod"
+
+
+@needs_chromium
+def test_review_page_with_eight_models_fits_1280_px_and_its_table_scrolls_in_its_box(tmp_path, browser):
+    page = tmp_path / "index.html"
+    page.write_text(review_page(eight_model_report(), []))
+    tab = browser.open(page, (1280, 900))
+    try:
+        page_width = tab.evaluate("document.documentElement.scrollWidth")
+        box = tab.evaluate(
+            "(function () { var b = document.querySelector('.table-box');"
+            " return [b.scrollWidth, b.clientWidth, b.getBoundingClientRect().right]; })()"
+        )
+    finally:
+        tab.close()
+    assert page_width <= 1280, f"the page is {page_width} px wide at 1280 px"
+    scroll, client, right = box
+    assert right <= 1280, f"the table's box ends at {right} px"
+    assert scroll > client, "eight long model names should need the box's scroll bar at 1280 px"

@@ -10,6 +10,11 @@ meshcat object at ``<root>/visuals/<geometry name>``.  Poses come from
 ``forwardKinematics`` + ``updateGeometryPlacements`` at the Pinocchio
 configuration ``cmap.configuration(θ)`` of the model coordinates θ.
 
+A URDF visual without a material (Pinocchio would draw it near-white, unseen on
+the light grey background) takes the colour of its link from ``LINK_COLOURS``:
+one colour per link, in the order the links' visuals come, so that neighbouring
+links differ.  MJCF geoms keep their own colours (MuJoCo's default is mid grey).
+
 Only the poses of geometries attached to a moving joint are animated; those on
 the world (the pendulum's pivot block, the cart's rail) are placed once.
 """
@@ -32,6 +37,41 @@ ROOT = "pendverify"
 
 UP = np.array([0.0, 0.0, 1.0])
 
+#: RGBA of the links whose URDF visuals name no material, one per link in turn (blue, orange,
+#: green, red, violet, brown, pink, olive, teal): all dark enough to stand out on light grey
+LINK_COLOURS = (
+    (0.12, 0.47, 0.71, 1.0),
+    (0.89, 0.47, 0.13, 1.0),
+    (0.17, 0.63, 0.17, 1.0),
+    (0.84, 0.15, 0.16, 1.0),
+    (0.58, 0.40, 0.74, 1.0),
+    (0.55, 0.34, 0.29, 1.0),
+    (0.89, 0.47, 0.76, 1.0),
+    (0.50, 0.50, 0.13, 1.0),
+    (0.09, 0.75, 0.81, 1.0),
+)
+
+
+def colour_links_without_material(visual_model: pin.GeometryModel) -> None:
+    """Give every visual that has no URDF material its link's colour from ``LINK_COLOURS``.
+
+    Pinocchio's URDF reader marks a visual whose material it read (given colour or a
+    named one defined in the file) with ``overrideMaterial``; the others keep
+    Pinocchio's default near-white and are painted here, the same colour for every
+    visual of one link."""
+    link_index: dict[int, int] = {}
+    for obj in visual_model.geometryObjects:
+        if obj.overrideMaterial:
+            continue
+        k = link_index.setdefault(obj.parentFrame, len(link_index))
+        obj.meshColor = np.array(LINK_COLOURS[k % len(LINK_COLOURS)])
+
+
+def _urdf_visuals(model: pin.Model, urdf: str) -> pin.GeometryModel:
+    visual_model = pin.buildGeomFromUrdfString(model, urdf, pin.GeometryType.VISUAL)
+    colour_links_without_material(visual_model)
+    return visual_model
+
 
 @dataclass
 class VisualSystem:
@@ -47,7 +87,7 @@ class VisualSystem:
         """The system whose URDF ``urdf_for(params)`` writes, with its visuals."""
         urdf = urdf_for(params)
         system = PinocchioSystem.from_urdf(params.model, urdf, params.g, f"<URDF of {params.model}>")
-        visual_model = pin.buildGeomFromUrdfString(system.model, urdf, pin.GeometryType.VISUAL)
+        visual_model = _urdf_visuals(system.model, urdf)
         return cls(system, visual_model, visual_model.createData(), urdf)
 
     @classmethod
@@ -62,7 +102,7 @@ class VisualSystem:
         if loaded.format == "mjcf":
             visual_model = mjcf_visuals(system.model, loaded.text)
         else:
-            visual_model = pin.buildGeomFromUrdfString(system.model, loaded.text, pin.GeometryType.VISUAL)
+            visual_model = _urdf_visuals(system.model, loaded.text)
         return cls(system, visual_model, visual_model.createData(), loaded.text)
 
     @property

@@ -26,10 +26,12 @@ h2 { font-size: 18px; margin: 28px 0 6px; border-top: 1px solid #ccc; padding-to
 .pass { color: #17621c; } .fail { color: #b00020; }
 .verdict.pass { background: #e3f4e4; } .verdict.fail { background: #fbe3e6; }
 table { border-collapse: collapse; font-size: 12px; margin: 6px 0 10px; }
+.table-box { max-width: 100%; overflow-x: auto; }
 th, td { border-bottom: 1px solid #e2e2e2; padding: 3px 8px; text-align: left; }
 th { background: #f4f4f4; }
 td.num { text-align: right; font-family: monospace; white-space: nowrap; }
 .scene { display: grid; grid-template-columns: 560px 1fr; gap: 16px; align-items: start; }
+.scene > div { min-width: 0; }
 iframe { width: 560px; height: 380px; border: 1px solid #ccc; }
 .scene img { width: 100%; max-width: 620px; border: 1px solid #eee; }
 .notes { font-size: 12px; color: #555; }
@@ -68,6 +70,16 @@ def _state(state: dict) -> str:
     return f"{state['label']} q=({q})"
 
 
+def _boxed(table: str) -> str:
+    """A table in its own box, which scrolls sideways when the table is wider than the page."""
+    return f'<div class="table-box">{table}</div>\n'
+
+
+def _breakable(name: str) -> str:
+    """A model's name, escaped, that may wrap after "_" and ":" (a long name makes a narrow column)."""
+    return _e(name).replace("_", "_<wbr>").replace(":", ":<wbr>")
+
+
 def check_matrix(report) -> str:
     """One row per check, one column per model: error / tolerance and the verdict."""
     models = list(dict.fromkeys(r.model for r in report.results))
@@ -85,9 +97,9 @@ def check_matrix(report) -> str:
             f"{'✓' if r.passed else '✗ FAIL'}</td>"
         )
 
-    head = "".join(f"<th>{_e(m)}</th>" for m in models)
+    head = "".join(f"<th>{_breakable(m)}</th>" for m in models)
     rows = "\n".join(f"<tr><th>{_e(c)}</th>{''.join(td(c, m) for m in models)}</tr>" for c in checks)
-    return f"<table><tr><th>check \\ model</th>{head}</tr>\n{rows}\n</table>\n"
+    return _boxed(f"<table><tr><th>check \\ model</th>{head}</tr>\n{rows}\n</table>")
 
 
 def check_table(report) -> str:
@@ -114,8 +126,11 @@ def check_table(report) -> str:
         f"(seed {report.seed}); each cell: largest error / tolerance, relative, in diagonally scaled "
         "coordinates: tolerance = K·ε·(1 + |θ|max)·cond(T)² (+ model-form allowance).</p>\n"
         "<details><summary>the full table, with the worst states</summary>\n"
-        "<table><tr><th>model</th><th>check</th><th>error</th><th>tolerance</th>"
-        f"<th>worst state</th><th>result</th></tr>\n{rows}\n</table>\n</details>\n"
+        + _boxed(
+            "<table><tr><th>model</th><th>check</th><th>error</th><th>tolerance</th>"
+            f"<th>worst state</th><th>result</th></tr>\n{rows}\n</table>"
+        )
+        + "</details>\n"
         + (f'<ul class="notes">{notes}</ul>\n' if notes else "")
     )
 
@@ -128,7 +143,7 @@ def invariant_table(scene: SceneReview) -> str:
         "</tr>"
         for i in scene.invariants
     )
-    return (
+    return _boxed(
         "<table><tr><th>invariant</th><th>error</th><th>tolerance</th><th>result</th><th>where</th></tr>\n"
         f"{rows}\n</table>"
     )

@@ -33,6 +33,8 @@ correct but rounded file.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from pendverify.errors import UrdfShapeError
@@ -61,7 +63,12 @@ def inertia_tolerance(literals: dict[str, str]) -> float:
     r = {k: own[k] if values[k] != 0.0 else min(own[k], grid) for k in literals}
     R = _tensor(r)
     I = _tensor(values)  # noqa: E741 (the inertia tensor's usual name)
-    return float(np.linalg.norm(R, "fro") + FLOAT_SLACK * _EPS * np.linalg.norm(I, "fro"))
+    return _frobenius(R) + FLOAT_SLACK * _EPS * _frobenius(I)
+
+
+def _frobenius(tensor: np.ndarray) -> float:
+    """‖T‖_F without overflow in the squares (``math.hypot`` scales): finite for entries near 1e300."""
+    return math.hypot(*tensor.ravel().tolist())
 
 
 def _tensor(v: dict[str, float]) -> np.ndarray:

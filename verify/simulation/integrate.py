@@ -5,6 +5,10 @@ dense output for the samples).  ``rk4`` is the classical fixed-step method; its
 samples come from cubic Hermite interpolation between steps.  Integration is
 split at the laws' breakpoints (steps, pulses, table knots) and into chunks
 that drive the progress bar.
+
+A state that leaves double's range ends the run with an ``IntegrationError``
+(``solve_ivp``'s failure, or the fixed step's finiteness guard), so the overflow
+on the way there is computed without NumPy's RuntimeWarnings (``np.errstate``).
 """
 
 from __future__ import annotations
@@ -56,6 +60,11 @@ def _finite(rhs, label: str):
     return guarded
 
 
+def _overflow_reported_as_failure():
+    """No RuntimeWarning for overflow, inf − inf or x/0: a non-finite state fails the run instead."""
+    return np.errstate(over="ignore", invalid="ignore", divide="ignore")
+
+
 def _rk4_segment(rhs, t0, t1, x0, h):
     n = max(1, int(np.ceil((t1 - t0) / h - 1e-9)))
     ts = np.linspace(t0, t1, n + 1)
@@ -94,15 +103,16 @@ def integrate(rhs, x0, duration, integrator, sample_times, breakpoints=(), label
         last = b == bounds[-1]
         inside = sample_times[(sample_times >= a) & ((sample_times < b) | (last & (sample_times <= b)))]
         if integrator.adaptive:
-            sol = solve_ivp(
-                rhs,
-                (a, b),
-                x,
-                method=integrator.method,
-                rtol=integrator.rtol,
-                atol=integrator.atol,
-                dense_output=True,
-            )
+            with _overflow_reported_as_failure():
+                sol = solve_ivp(
+                    rhs,
+                    (a, b),
+                    x,
+                    method=integrator.method,
+                    rtol=integrator.rtol,
+                    atol=integrator.atol,
+                    dense_output=True,
+                )
             if sol.status != 0:
                 raise IntegrationError(
                     label,
@@ -115,7 +125,8 @@ def integrate(rhs, x0, duration, integrator, sample_times, breakpoints=(), label
             if inside.size:
                 samples_x.append(sol.sol(inside).T)
         else:
-            ts, xs, fs, n = _rk4_segment(_finite(rhs, label), a, b, x, integrator.step)
+            with _overflow_reported_as_failure():
+                ts, xs, fs, n = _rk4_segment(_finite(rhs, label), a, b, x, integrator.step)
             nfev += n
             if inside.size:
                 samples_x.append(_hermite(ts, xs, fs, inside))

@@ -134,7 +134,10 @@ class SymbolicModel:
     def evaluate(self, method: str, args: str):
         """Call ``method`` on symbols; a clear error if the code cannot take them."""
         try:
-            return to_sympy(getattr(self.model, method)(*self.arguments(args)))
+            # NumPy's floating-point flags say nothing about object arrays of SymPy expressions
+            # (nan · [[m1 + m2, ...]] sets "invalid"): no RuntimeWarning from a symbolic reading
+            with np.errstate(all="ignore"):
+                return to_sympy(getattr(self.model, method)(*self.arguments(args)))
         except Exception as exc:
             raise PendverifyError(
                 f"{where(self.cls)}: {self.cls.__name__}.{method} cannot be read by SymPy "

@@ -19,7 +19,6 @@ import functools
 import hashlib
 import importlib.metadata
 import importlib.util
-import inspect
 import pkgutil
 import sys
 import sysconfig
@@ -29,6 +28,7 @@ import weakref
 from dataclasses import dataclass
 from pathlib import Path
 
+from pendverify.analytic.source_file import defining_file
 from pendverify.atomic import write_atomic
 from pendverify.numerics.codegen import expressions as _expressions
 from pendverify.numerics.codegen import module as _module
@@ -110,7 +110,7 @@ def _model_key(model_cls) -> str | None:
             c for c in (*model_cls.__mro__, *model_cls.params_type.__mro__) if c.__module__ != "builtins"
         ]
         for c in classes:
-            files.add(inspect.getfile(c))
+            files.add(defining_file(c))
             module = sys.modules.get(c.__module__)
             for obj in vars(module).values() if module else ():
                 target = (
