@@ -30,10 +30,11 @@ from pendverify.commands import HelpFormatter, add_global_options
 
 EXAMPLES = (
     "pendverify check",
+    "pendverify example double_pendulum double_pendulum",
     "pendverify check --model double_pendulum --samples 200 --quiet",
     "pendverify check --json - --quiet > report.json",
-    "pendverify --debug simulate scenes/damped_double_pendulum.toml",
-    "pendverify certify analytic/params/double_pendulum.toml -o certified",
+    "pendverify --debug simulate double_pendulum/damped_double_pendulum.toml",
+    "pendverify certify double_pendulum/double_pendulum.toml -o certified",
 )
 EXIT_STATUS = (
     "exit status: 0 passed, 1 a verification failed, 2 bad input or usage, "

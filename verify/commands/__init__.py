@@ -153,7 +153,8 @@ def add_analytic_option(parser, what: str) -> None:
     parser.add_argument(
         "--analytic",
         metavar="FILE",
-        help=f"your own closed-form model file (as check --analytic; see examples/cart_pole.py): {what}",
+        help="your own closed-form model file (as check --analytic; `pendverify example cart_pole DIR` "
+        f"copies one): {what}",
     )
 
 

@@ -38,7 +38,7 @@ def register(sub) -> None:
         "work–precision: error against wall time for each integrator and engine",
         [
             "pendverify bench accuracy --quick",
-            "pendverify bench accuracy --scene scenes/damped_double_pendulum.toml -o bench-out --svg",
+            "pendverify bench accuracy --scene double_pendulum/damped_double_pendulum.toml -o out --svg",
         ],
     )
     a.add_argument(
@@ -59,7 +59,7 @@ def register(sub) -> None:
         "the certification battery's cost per parameter set on one core: batch, per-state path, floor",
         [
             "pendverify bench certify --quick",
-            "pendverify bench certify --params analytic/params/double_pendulum.toml --json bench.json",
+            "pendverify bench certify --params double_pendulum/double_pendulum.toml --json bench.json",
         ],
         json="every figure",
     )

@@ -22,8 +22,8 @@ def register(sub) -> None:
         [
             "pendverify check",
             "pendverify check --model double_pendulum --samples 1000 --seed 7",
-            "pendverify check --analytic examples/cart_pole.py --urdf examples/cart_pole.urdf "
-            "--params examples/cart_pole.toml",
+            "pendverify check --analytic cart_pole/cart_pole.py --urdf cart_pole/cart_pole.urdf "
+            "--params cart_pole/cart_pole.toml",
             "pendverify check --json - --quiet > report.json",
         ],
         json="the report",
@@ -37,7 +37,7 @@ def register(sub) -> None:
         "--analytic",
         metavar="FILE",
         help="your own closed-form model: a Python file defining one ClosedFormModel subclass "
-        "(see examples/cart_pole.py); needs --urdf",
+        "(`pendverify example cart_pole DIR` copies one); needs --urdf",
     )
     p.add_argument(
         "--urdf",

@@ -14,8 +14,8 @@ def register(sub) -> None:
         "mutation sensitivity: mutate the closed forms, run the checks, report the detection rate",
         [
             "pendverify mutate --model double_pendulum",
-            "pendverify mutate --analytic examples/cart_pole.py --urdf examples/cart_pole.urdf "
-            "--params examples/cart_pole.toml --method mass_matrix --json mutants.json",
+            "pendverify mutate --analytic cart_pole/cart_pole.py --urdf cart_pole/cart_pole.urdf "
+            "--params cart_pole/cart_pole.toml --method mass_matrix --json mutants.json",
         ],
         json="the mutants and their verdicts",
     )

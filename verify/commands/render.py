@@ -19,7 +19,7 @@ def register(sub) -> None:
         "render",
         "write a self-contained HTML animation of a scene (meshcat, plays from file://)",
         [
-            "pendverify render scenes/chaotic_double_pendulum.toml -o chaos.html --trace",
+            "pendverify render double_pendulum/damped_double_pendulum.toml -o chaos.html --trace",
             "pendverify render --trajectory run.npz -o run.html",
         ],
     )

@@ -13,8 +13,8 @@ def register(sub) -> None:
         "show",
         "print each equation of a model file (.toml or .py) as parsed, to confirm the reading",
         [
-            "pendverify show examples/minimal_double_pendulum_text.toml",
-            "pendverify show examples/cart_pole.py --pretty",
+            "pendverify show minimal_double_pendulum/minimal_double_pendulum_text.toml",
+            "pendverify show cart_pole/cart_pole.py --pretty",
         ],
         quiet=False,
     )

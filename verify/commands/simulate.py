@@ -14,9 +14,9 @@ def register(sub) -> None:
         "simulate",
         "simulate a scene and check the physics invariants its effects imply",
         [
-            "pendverify simulate scenes/damped_double_pendulum.toml",
-            "pendverify simulate scenes/cart_lqr_push.toml -o run.npz --csv --html run.html",
-            "pendverify simulate scenes/damped_double_pendulum.toml --engine both --json - --quiet",
+            "pendverify simulate double_pendulum/damped_double_pendulum.toml",
+            "pendverify simulate cart_double_pendulum/cart_lqr_push.toml -o run.npz --csv --html run.html",
+            "pendverify simulate double_pendulum/damped_double_pendulum.toml --engine both --json - --quiet",
         ],
         json="the run's metadata and invariant results",
     )

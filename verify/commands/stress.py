@@ -23,8 +23,8 @@ def register(sub) -> None:
         [
             "pendverify stress --quick",
             "pendverify stress --case 'double pendulum g = 0' --json stress.json",
-            "pendverify stress --quick --analytic examples/cart_pole.py --urdf examples/cart_pole.urdf "
-            "--params examples/cart_pole.toml",
+            "pendverify stress --quick --analytic cart_pole/cart_pole.py --urdf cart_pole/cart_pole.urdf "
+            "--params cart_pole/cart_pole.toml",
         ],
         json="the report",
     )

@@ -14,7 +14,7 @@ def register(sub) -> None:
         "derive M, C, H, D, B, W from the model's energies with SymPy and compare term by term",
         [
             "pendverify sympy --model cart_double_pendulum",
-            "pendverify sympy --analytic examples/cart_pole.py --quiet",
+            "pendverify sympy --analytic cart_pole/cart_pole.py --quiet",
         ],
         json="the comparison",
     )
