@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import inspect
 import re
 from html.parser import HTMLParser
@@ -192,6 +193,22 @@ def test_run_repr_is_short_and_says_scene_engine_duration_samples_invariants(run
         f"{len(run.invariants)}/{len(run.invariants)} invariants hold: pass>"
     )
     assert len(run.t) == 1001
+
+
+def test_scene_and_invariant_reprs_are_short_and_say_what_they_hold(run):
+    from pendverify.simulation.scene import load_scene
+
+    scene = short(repr(load_scene(REPO / "scenes" / "cart_lqr_push.toml")))
+    assert scene == (
+        "<Scene 'cart LQR after a push' (cart_double_pendulum): engine aba, 8 s at 100 Hz, DOP853, "
+        "effects: gravity, damping, actuation, disturbance>"
+    )
+    invariant = run.invariants[0]
+    text = short(repr(invariant))
+    assert text.startswith(f"<InvariantResult {invariant.name!r}: error {invariant.error:.3g}, tolerance ")
+    assert text.endswith(": holds>")
+    failed = dataclasses.replace(invariant, passed=False)
+    assert repr(failed).endswith(": FAILS>")
 
 
 def test_run_html_lists_every_invariant(run):

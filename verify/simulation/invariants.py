@@ -70,6 +70,11 @@ class InvariantResult:
     def ratio(self) -> float:
         return self.error / self.tolerance if self.tolerance > 0 else float("inf")
 
+    def __repr__(self) -> str:
+        verdict = "holds" if self.passed else "FAILS"
+        figures = f"error {self.error:.3g}, tolerance {self.tolerance:.3g}"
+        return f"<InvariantResult {self.name!r}: {figures}: {verdict}>"
+
     def as_dict(self) -> dict:
         return {**self.__dict__, "max_error_abs": self.max_error_abs}
 

@@ -92,6 +92,9 @@ class Integrator:
 
 @dataclass(frozen=True)
 class Scene:
+    """A simulation scene as read from its TOML: the model and its parameters, the initial state,
+    the time span, the integrator and the effects it calls for (each None when off)."""
+
     name: str
     source: str
     model: str  # the model's name (a built-in name, or the plug-in class's ``name``)
@@ -123,6 +126,22 @@ class Scene:
     @property
     def conservative(self) -> bool:
         return self.damping is None and self.actuation is None and self.disturbance is None
+
+    def __repr__(self) -> str:
+        effects = [
+            name
+            for name, value in (
+                ("gravity", self.gravity),
+                ("damping", self.damping),
+                ("actuation", self.actuation),
+                ("disturbance", self.disturbance),
+            )
+            if value is not None
+        ]
+        return (
+            f"<Scene {self.name!r} ({self.model}): engine {self.engine}, {self.duration:g} s at "
+            f"{self.sample_rate:g} Hz, {self.integrator.method}, effects: {', '.join(effects) or 'none'}>"
+        )
 
 
 def _parameters(
