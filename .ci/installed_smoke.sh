@@ -81,7 +81,7 @@ step pendverify simulate "$scene" -o run.npz
 step pendverify render "$scene" -o animation.html
 step pendverify report -o review
 step pendverify stress --quick
-step pendverify bench certify --quick
+step pendverify bench certify
 step pendverify example cart_pole cart_pole
 step pendverify check --analytic cart_pole/cart_pole.py --urdf cart_pole/cart_pole.urdf --params cart_pole/cart_pole.toml
 step pendverify simulate cart_pole/cart_pole_lqr_push.toml
