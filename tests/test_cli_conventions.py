@@ -9,7 +9,6 @@ nothing but the JSON on standard output.
 
 from __future__ import annotations
 
-import argparse
 import json
 import re
 import shlex
@@ -20,18 +19,10 @@ from pathlib import Path
 import pytest
 
 from pendverify.cli import build_parser, main, parse
+from tests.cli_parsers import subcommands
 
 REPO = Path(__file__).resolve().parents[1]
 EXAMPLES = REPO / "examples"
-
-
-def subcommands(parser: argparse.ArgumentParser, prefix: tuple[str, ...] = ()):
-    """(names, parser) of every subcommand under ``parser``, depth first."""
-    for action in parser._actions:
-        if isinstance(action, argparse._SubParsersAction):
-            for name, sub in action.choices.items():
-                yield (*prefix, name), sub
-                yield from subcommands(sub, (*prefix, name))
 
 
 COMMANDS = [names for names, _ in subcommands(build_parser())]

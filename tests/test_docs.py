@@ -16,6 +16,7 @@ from pathlib import Path
 import pytest
 
 from pendverify.cli import build_parser
+from tests.cli_parsers import subcommands
 
 ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
@@ -44,15 +45,6 @@ def prose(text: str) -> str:
 def relative_links(path: Path) -> list[str]:
     targets = (m.group(1) for m in LINK.finditer(prose(path.read_text(encoding="utf-8"))))
     return [t for t in targets if not re.match(r"^(https?:|mailto:|#)", t)]
-
-
-def subcommands(parser: argparse.ArgumentParser, prefix: tuple[str, ...] = ()):
-    """(command path, parser) for every subcommand, nested ones (``bench accuracy``) included."""
-    for action in parser._actions:
-        if isinstance(action, argparse._SubParsersAction):
-            for name, sub in action.choices.items():
-                yield (*prefix, name), sub
-                yield from subcommands(sub, (*prefix, name))
 
 
 def option_strings(parser: argparse.ArgumentParser) -> list[str]:
