@@ -104,7 +104,7 @@ def run_benchmark(
 ) -> Results:
     """Everything ``pendverify bench accuracy`` reports, measured in this process.
 
-    ``specs``: the problems by key (``problems.ProblemSpec``; default: the seeds' table);
+    ``specs``: the problems by key (``problems.ProblemSpec``; default: the reference systems' table);
     ``config.horizons`` says which run and for how long, ``config.anchor`` which one anchors
     the single-trajectory ratio, the engine study and the ensemble."""
 

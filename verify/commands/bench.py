@@ -2,7 +2,7 @@
 ``pendverify bench certify [--quick] [--json PATH]``: the certification battery's cost
 (``pendverify.bench.certify``).
 
-Without ``--scene``, the seeds' problems (``pendverify.bench.seed_problems``); with it, a
+Without ``--scene``, the two reference systems' problems (``pendverify.bench.seed_problems``); with it, a
 user's scene, any model (``pendverify.bench.problems.scene_problems`` says which problems
 and refuses what the benchmark cannot run, exit status 2).
 
