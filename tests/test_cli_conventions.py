@@ -167,7 +167,10 @@ def test_nested_commands_take_the_global_options_at_every_level():
         (["--quiet", "show", "m.py"], "--quiet: `pendverify show` has no verdict line to keep"),
         (["--json", "x.json", "keygen", "-o", "k"], "--json: `pendverify keygen` writes no report"),
         (["--json", "-", "bench", "accuracy"], "--json: `pendverify bench accuracy` writes no report"),
-        (["show", "m.py", "--json", "x.json"], "unrecognized arguments: --json x.json"),
+        # after the command's name: the same sentence as before it
+        (["show", "m.py", "--json", "x.json"], "--json: `pendverify show` writes no report"),
+        (["example", "--quiet"], "--quiet: `pendverify example` has no verdict line to keep"),
+        (["bench", "accuracy", "--json", "-"], "--json: `pendverify bench accuracy` writes no report"),
     ],
 )
 def test_a_global_option_a_command_does_not_take_is_a_usage_error(argv, message, capsys):

@@ -51,15 +51,20 @@ class HelpFormatter(argparse.RawDescriptionHelpFormatter):
 
 
 def add_global_options(
-    parser: argparse.ArgumentParser, names=tuple(GLOBAL_HELP), what: str = "the report", top: bool = False
+    parser: argparse.ArgumentParser,
+    names=tuple(GLOBAL_HELP),
+    what: str = "the report",
+    top: bool = False,
+    hidden: bool = False,
 ) -> None:
     """Add the global options ``names`` to ``parser`` (``what``: what its ``--json`` writes).
 
     On the top-level parser (``top``) they carry the defaults; on a command's parser they
     are SUPPRESSed, so that a value given before the command's name is not overwritten.
+    ``hidden`` ones are left out of the help (a command that refuses them).
     """
     for name in names:
-        help_text = GLOBAL_HELP[name].format(what=what)
+        help_text = argparse.SUPPRESS if hidden else GLOBAL_HELP[name].format(what=what)
         if top and name != "debug":
             help_text = (
                 f"({'commands with a report' if name == 'json' else 'commands with a verdict'}) {help_text}"
@@ -100,6 +105,10 @@ def add_command(
     )
     names = ("debug", *(("quiet",) if quiet else ()), *(("json",) if json else ()))
     add_global_options(parser, names, what=json or "")
+    # the global options it does not take are parsed too, unlisted, so that one given after the
+    # command's name is refused with the same sentence as one given before it (cli.refuse_unaccepted)
+    refused = tuple(name for name in GLOBAL_HELP if name not in names)
+    add_global_options(parser, refused, hidden=True)
     parser.set_defaults(accepts=frozenset(names), prog=parser.prog)
     return parser
 
