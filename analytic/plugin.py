@@ -28,8 +28,6 @@ from __future__ import annotations
 import dataclasses
 import importlib.util
 import inspect
-import keyword
-import re
 import sys
 import traceback
 from pathlib import Path
@@ -37,6 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from pendverify.analytic import ClosedFormModel, ParameterSet
+from pendverify.analytic.module_names import module_name
 from pendverify.analytic.params import parse_parameter_document, read_toml
 from pendverify.analytic.source_file import defining_file
 from pendverify.errors import FileAccessError, ParameterError, PendverifyError, UserCodeError
@@ -80,33 +79,6 @@ def _resolved(filename: str) -> str:
         return str(Path(filename).resolve())
     except (OSError, ValueError):  # pragma: no cover - a frame of a file that is gone
         return filename
-
-
-#: the package name model files are imported under (not a package on disk: the modules are made here)
-NAMESPACE = "pendverify.plugins"
-#: resolved path of each model file imported so far → its module name
-_MODULE_NAMES: dict[str, str] = {}
-
-
-def module_name(path: str | Path) -> str:
-    """The module name model file ``path`` is imported under: ``pendverify.plugins.<stem>``.
-
-    The stem is made a valid identifier (other characters become ``_``; a leading digit or a
-    keyword gets an ``_``); a file at another resolved path with the same stem gets ``<stem>_2``,
-    ``<stem>_3``, ...; the same resolved path always gets the same name.
-    """
-    resolved = str(Path(path).resolve())
-    if resolved in _MODULE_NAMES:
-        return _MODULE_NAMES[resolved]
-    stem = re.sub(r"[^0-9A-Za-z_]", "_", Path(path).stem) or "model"
-    if stem[0].isdigit() or keyword.iskeyword(stem):
-        stem = f"_{stem}"
-    taken = {*_MODULE_NAMES.values(), *sys.modules}
-    name, n = f"{NAMESPACE}.{stem}", 2
-    while name in taken:
-        name, n = f"{NAMESPACE}.{stem}_{n}", n + 1
-    _MODULE_NAMES[resolved] = name
-    return name
 
 
 def _import(path: Path):

@@ -20,7 +20,6 @@ generated-code cache name it) and has no ``__file__``, which would claim Python 
 from __future__ import annotations
 
 import dataclasses
-import hashlib
 import sys
 import types
 from pathlib import Path
@@ -30,6 +29,7 @@ import sympy as sp
 
 from pendverify.analytic.forms import Energies
 from pendverify.analytic.interface import BiasOnlyModel, ClosedFormModel
+from pendverify.analytic.module_names import module_name
 from pendverify.analytic.params import ParameterSet
 from pendverify.analytic.source_file import TEXT_FILE
 from pendverify.analytic.text_parse import Reader, TextModelSpec, read_text_model
@@ -210,8 +210,7 @@ def _energies(self, q, v, u, w) -> Energies:
 def build_model_class(spec: TextModelSpec) -> type[ClosedFormModel]:
     """The ``ClosedFormModel`` (or ``BiasOnlyModel``) subclass of a parsed text model."""
     class_name = "".join(part.capitalize() for part in spec.name.split("_")) or "TextModel"
-    digest = hashlib.sha256(str(spec.path.resolve()).encode()).hexdigest()[:16]
-    module = types.ModuleType(f"pendverify_textmodel_{digest}")
+    module = types.ModuleType(module_name(spec.path))
     setattr(module, TEXT_FILE, str(spec.path))
     fields = [
         (p, float, dataclasses.field(metadata={"kind": kind, "unit": unit, "doc": f"{p} in [{unit}]"}))

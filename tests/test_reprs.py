@@ -13,8 +13,9 @@ import pytest
 import pendverify
 from pendverify.analytic import MODELS, ClosedFormModel, DoublePendulum
 from pendverify.analytic.interface import BiasOnlyModel
+from pendverify.analytic.module_names import NAMESPACE, module_name
 from pendverify.analytic.params import default_parameter_file, load_parameter_file
-from pendverify.analytic.plugin import NAMESPACE, load_model_class, module_name
+from pendverify.analytic.plugin import load_model_class
 from pendverify.checks.report import CheckRows, Report
 from pendverify.checks.result import CheckResult
 from pendverify.checks.targets import Selection, Target, committed_urdf, model_target, select_targets
@@ -300,6 +301,15 @@ def test_plugin_modules_are_named_after_their_file(tmp_path):
     keyword.write_text(source)
     assert module_name(keyword) == f"{NAMESPACE}._class"
     assert all(name.isidentifier() for name in a.__module__.split("."))
+
+
+def test_text_models_are_named_after_their_file_too(tmp_path):
+    text = tmp_path / "my arm.toml"
+    text.write_text((EXAMPLES / "minimal_double_pendulum_text.toml").read_text())
+    cls = load_model_class(text)
+    assert cls.__module__ == f"{NAMESPACE}.my_arm"
+    assert cls.params_type.__module__ == cls.__module__
+    assert load_model_class(text).__module__ == cls.__module__  # read again: the same name
 
 
 # --- docstrings ---------------------------------------------------------------------------------------
