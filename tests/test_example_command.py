@@ -144,6 +144,30 @@ def test_a_file_in_place_of_the_folder_is_refused(tmp_path, capsys):
     assert target.read_text(encoding="utf-8") == "x\n"
 
 
+def test_the_reference_systems_sweeps_are_copied_and_the_printed_sweep_certifies(tmp_path, capsys):
+    """Every copied sweep reads; the printed ``certify --sweep`` runs on the copy (its count cut to 2)."""
+    from pendverify.certify.sweep import load_sweep
+
+    with_sweeps = [e for e in EXAMPLES if e.sweeps]
+    assert {"double_pendulum", "cart_double_pendulum"} <= {e.name for e in with_sweeps}
+    for example in with_sweeps:
+        folder = tmp_path / example.name
+        assert main(["example", example.name, str(folder)]) == 0
+        out = capsys.readouterr().out
+        for sweep in example.sweeps:
+            assert load_sweep(folder / sweep.name).model.name == example.name
+        [certify] = printed_commands(out, "certify")
+        first = folder / example.sweeps[0].name
+        assert certify[:3] == ["certify", "--sweep", str(first)]
+    first = tmp_path / "double_pendulum" / "double_pendulum_200.toml"
+    text = first.read_text(encoding="utf-8")
+    assert text.count("count = 200") == 1
+    first.write_text(text.replace("count = 200", "count = 2"), encoding="utf-8")
+    args = ["certify", "--sweep", str(first), "--workers", "1", "-o", str(tmp_path / "certified"), "--quiet"]
+    assert main(args) == 0
+    assert len(list((tmp_path / "certified").glob("*.cert.json"))) == 2
+
+
 def test_every_example_s_scene_is_a_shipped_scene():
     shipped = {p.name for p in shipped_folder("scenes").glob("*.toml")}
     assert {e.scene.name for e in EXAMPLES} <= shipped

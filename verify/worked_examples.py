@@ -60,11 +60,13 @@ class WorkedExample:
     written_model: ShippedFile | None = None
     #: the URDF's robot as xacro or MJCF, where those are shipped
     descriptions: tuple[ShippedFile, ...] = ()
+    #: sweep files over the model's parameters (``certify --sweep``), where those are shipped
+    sweeps: tuple[ShippedFile, ...] = ()
 
     @property
     def files(self) -> tuple[ShippedFile, ...]:
         written = (self.written_model,) if self.written_model else ()
-        return (self.model, *written, self.urdf, *self.descriptions, self.params, self.scene)
+        return (self.model, *written, self.urdf, *self.descriptions, self.params, self.scene, *self.sweeps)
 
     @property
     def models(self) -> tuple[ShippedFile, ...]:
@@ -80,6 +82,7 @@ ROLES = {
     "urdf": "URDF",
     "params": "parameters",
     "scene": "scene",
+    "sweeps": "sweep",
 }
 #: a description's role, by the end of its name
 DESCRIPTION_ROLES = {".xacro": "xacro", ".xml": "MJCF"}
@@ -102,6 +105,7 @@ def _entry(table: dict) -> WorkedExample:
         descriptions=tuple(
             _file(spec, DESCRIPTION_ROLES[Path(spec).suffix]) for spec in table.get("descriptions", ())
         ),
+        sweeps=tuple(_file(spec, ROLES["sweeps"]) for spec in table.get("sweeps", ())),
     )
 
 
@@ -171,7 +175,8 @@ def next_commands(example: WorkedExample, folder: str) -> list[str]:
     """The commands that run the copied example in ``folder`` (as the user named it).
 
     ``check`` of each model file on the URDF, of the Python model on each xacro or MJCF
-    version, then ``simulate`` of the scene.
+    version, then ``simulate`` of the scene and, where the example has sweeps, ``certify``
+    of its first sweep into ``folder/certified``.
     """
 
     def at(f: ShippedFile) -> str:
@@ -182,4 +187,8 @@ def next_commands(example: WorkedExample, folder: str) -> list[str]:
         f"pendverify check --analytic {at(model)} --urdf {at(robot)} --params {at(example.params)}"
         for model, robot in pairs
     ]
-    return [*checks, f"pendverify simulate {at(example.scene)}"]
+    certified = shlex.quote(str(Path(folder) / "certified"))
+    sweeps = [
+        f"pendverify certify --sweep {at(sweep)} --workers 2 -o {certified}" for sweep in example.sweeps
+    ]
+    return [*checks, f"pendverify simulate {at(example.scene)}", *sweeps[:1]]

@@ -24,7 +24,7 @@ def register(sub) -> None:
         "run the full battery on a parameter set and certify it",
         [
             "pendverify certify double_pendulum/double_pendulum.toml -o certified",
-            "pendverify certify --sweep sweeps/double_pendulum_200.toml --workers 2 -o certified",
+            "pendverify certify --sweep double_pendulum/double_pendulum_200.toml --workers 2 -o certified",
             "pendverify certify --urdf robot.urdf --model double_pendulum --params mine.toml -o certified "
             "--key keys/pendverify-signing.key.pem",
         ],
