@@ -157,6 +157,21 @@ def positive_float(text: str) -> float:
     return value
 
 
+def add_sampling_options(parser: argparse.ArgumentParser, samples_default: int | None) -> None:
+    """``--seed N`` (the state sampler's seed) and, unless ``samples_default`` is None,
+    ``--samples N`` (random states per model; ``samples_default`` is what the help says)."""
+    if samples_default is not None:
+        parser.add_argument(
+            "--samples",
+            type=non_negative_int,
+            default=None,
+            help=f"random states per model (default: {samples_default})",
+        )
+    parser.add_argument(
+        "--seed", type=non_negative_int, default=None, help="seed of the state sampler (default: 20260301)"
+    )
+
+
 def add_analytic_option(parser, what: str) -> None:
     """``--analytic FILE``: a model file, as ``check --analytic`` takes it; ``what`` says what it does."""
     parser.add_argument(

@@ -7,8 +7,8 @@ import time
 
 from pendverify.commands import (
     add_command,
+    add_sampling_options,
     builtin_models,
-    non_negative_int,
     positive_float,
     write_json_report,
 )
@@ -45,12 +45,7 @@ def register(sub) -> None:
         "or erd:NAME for example-robot-data's",
     )
     p.add_argument("--params", help="a parameter file (TOML) giving the closed form")
-    p.add_argument(
-        "--samples", type=non_negative_int, default=None, help="random states per model (default: 400)"
-    )
-    p.add_argument(
-        "--seed", type=non_negative_int, default=None, help="seed of the state sampler (default: 20260301)"
-    )
+    add_sampling_options(p, samples_default=400)
     p.add_argument(
         "--junit", metavar="PATH", help="also write the report as JUnit XML (one test case per check)"
     )

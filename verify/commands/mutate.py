@@ -4,7 +4,12 @@ from __future__ import annotations
 
 import argparse
 
-from pendverify.commands import add_command, builtin_models, non_negative_int, write_json_report
+from pendverify.commands import (
+    add_command,
+    add_sampling_options,
+    builtin_models,
+    write_json_report,
+)
 
 
 def register(sub) -> None:
@@ -25,12 +30,7 @@ def register(sub) -> None:
     p.add_argument("--analytic", metavar="FILE", help="your own model file instead (with --urdf, --params)")
     p.add_argument("--urdf", help="the URDF (or xacro, MJCF) of --analytic")
     p.add_argument("--params", help="the parameter file of --analytic")
-    p.add_argument(
-        "--samples", type=non_negative_int, default=None, help="random states per model (default 40)"
-    )
-    p.add_argument(
-        "--seed", type=non_negative_int, default=None, help="seed of the state sampler (default: 20260301)"
-    )
+    add_sampling_options(p, samples_default=40)
     p.add_argument(
         "--all-checks",
         action="store_true",

@@ -19,7 +19,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from pendverify.commands import add_command, non_negative_int
+from pendverify.commands import add_command, add_sampling_options
 
 
 def register(sub) -> None:
@@ -38,12 +38,7 @@ def register(sub) -> None:
         metavar="DIR",
         help="the folder of scene files (*.toml) to review (default: the scenes installed with pendverify)",
     )
-    p.add_argument(
-        "--samples", type=non_negative_int, default=None, help="random states per model (default: 400)"
-    )
-    p.add_argument(
-        "--seed", type=non_negative_int, default=None, help="seed of the state sampler (default: 20260301)"
-    )
+    add_sampling_options(p, samples_default=400)
     p.add_argument(
         "--no-erd",
         dest="erd",

@@ -12,7 +12,12 @@ from __future__ import annotations
 import argparse
 import time
 
-from pendverify.commands import add_analytic_option, add_command, non_negative_int, write_json_report
+from pendverify.commands import (
+    add_analytic_option,
+    add_command,
+    add_sampling_options,
+    write_json_report,
+)
 
 
 def register(sub) -> None:
@@ -35,9 +40,7 @@ def register(sub) -> None:
         metavar="NAME",
         help="run only this case (repeatable) (default: every case)",
     )
-    p.add_argument(
-        "--seed", type=non_negative_int, default=None, help="seed of the state sampler (default: 20260301)"
-    )
+    add_sampling_options(p, samples_default=None)
     add_analytic_option(p, "run hard cases derived from its parameters' kinds; needs --urdf, --params")
     p.add_argument("--urdf", help="with --analytic: the model's URDF or xacro file")
     p.add_argument("--params", help="with --analytic: its parameter file (TOML)")
