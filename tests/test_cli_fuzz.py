@@ -341,3 +341,32 @@ def test_fuzz_render_trajectory(npz, output):
         False,
         lambda path, folder: ["render", "--trajectory", path, "-o", _output(folder, output, "x.html")],
     )
+
+
+#: certify's battery is heavier than a check: fewer examples, a few states each
+CERTIFY_FUZZ = settings(FUZZ, max_examples=25)
+
+
+def certify_fuzz(**strategies):
+    def wrap(test):
+        return seed(FUZZ_SEED)(CERTIFY_FUZZ(given(**strategies)(test)))
+
+    return wrap
+
+
+@certify_fuzz(params=PARAM_FILES, as_dir=AS_DIRECTORY, output=OUTPUTS)
+def test_fuzz_certify_params(params, as_dir, output):
+    def argv(path, folder):
+        return ["certify", path, "--samples", "4", "-o", _output(folder, output, "certified")]
+
+    contract_with_file("p.toml", params, as_dir, argv)
+
+
+@certify_fuzz(urdf=urdf_files(), as_dir=AS_DIRECTORY)
+def test_fuzz_certify_urdf(urdf, as_dir):
+    params = str(REPO / "analytic" / "params" / "double_pendulum.toml")
+
+    def argv(path, folder):
+        return ["certify", "--urdf", path, "--params", params, "--samples", "4", "-o", str(folder / "out")]
+
+    contract_with_file("u.urdf", urdf, as_dir, argv)
