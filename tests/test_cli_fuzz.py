@@ -3,12 +3,14 @@
 Hypothesis writes parameter files, URDFs, scenes, model files and saved trajectories —
 garbage bytes, byte-order marks, huge, tiny, NaN, negative and wrongly typed numbers,
 directories where files belong, outputs under regular files or in unwritable folders —
-and runs ``main([...])`` in-process.  Every run must end with status 0, 1 or 2 (a 3 is
-a bug to fix), no traceback, and at most one error line (exactly one for status 2).
+and runs ``main([...])`` in-process (check, certify, simulate, render).  Every run must
+end with status 0, 1 or 2 (a 3 is a bug to fix), no traceback, and at most one error
+line (exactly one for status 2).
 
 Seeded (``FUZZ_SEED``) and without an example database, so every run tries the same
-inputs; 80 examples per command keep the file well under a minute.  The scenes run
-with ``PENDVERIFY_MAX_SAMPLES`` lowered to 3000 so that no example integrates for long.
+inputs; 80 examples per command (25 for certify, whose battery is heavier) keep the
+file well under a minute.  The scenes run with ``PENDVERIFY_MAX_SAMPLES`` lowered to
+3000 so that no example integrates for long.
 """
 
 from __future__ import annotations
