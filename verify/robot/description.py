@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+from pendverify.display import shortened
 from pendverify.errors import UrdfShapeError
 from pendverify.robot.mjcf import build_mjcf_model
 from pendverify.robot.sdf import build_sdf_model
@@ -94,12 +95,13 @@ def description_format(text: str, path: Path | None, source: str) -> str:
     root = parse_xml(text, source)
     if (path is not None and path.name.lower().endswith(XACRO_SUFFIXES)) or uses_xacro(root):
         return "xacro"
+    local = root.tag.rsplit("}", 1)[-1]  # a default namespace (Drake's URDFs) names no format
     for fmt, tag in FORMATS.items():
-        if root.tag == tag:
+        if local == tag:
             return fmt
     raise UrdfShapeError(
         source,
-        f"the root element is <{root.tag}>: pendverify reads URDF (<robot>), xacro (*.xacro), "
+        f"the root element is <{shortened(root.tag, 60)}>: pendverify reads URDF (<robot>), xacro (*.xacro), "
         "MJCF (<mujoco>) and SDFormat (<sdf>)",
     )
 

@@ -56,7 +56,7 @@ from typing import NoReturn
 from pendverify.display import shortened
 from pendverify.errors import UrdfShapeError
 from pendverify.robot.inertia_rounding import check_inertia_tensor
-from pendverify.robot.urdf_numbers import NOT_A_NUMBER, parse_number, parse_vector, why_not
+from pendverify.robot.urdf_numbers import NOT_A_NUMBER, parse_number, parse_vector, quoted, why_not
 from pendverify.robot.xml_reading import parse_xml, parse_xml_as_urdfdom_reads
 
 __all__ = ["DescriptionFacts", "JointDynamics", "UrdfFacts", "parse_xml", "read_urdf_strictly"]
@@ -189,7 +189,7 @@ def _walk(root: ET.Element) -> Iterator[tuple[ET.Element, ET.Element, _Place]]:
                 continue  # comments and processing instructions
             if child.tag in OWNERS:
                 name = child.get("name")
-                child_owner = f"{child.tag} {name!r}" if name is not None else f"{child.tag} (unnamed)"
+                child_owner = f"{child.tag} {quoted(name)}" if name is not None else f"{child.tag} (unnamed)"
                 child_path = ""
             else:
                 child_owner, child_path = owner, f"{path}<{child.tag}>"
@@ -226,15 +226,15 @@ def _check_element(element: ET.Element, parent_element: ET.Element, place: _Plac
             raw = element.attrib[attr]
             number = parse_number(raw)
             if number is None:
-                fail(f" {attr} = {raw!r}: {NOT_A_NUMBER}{why_not(raw)}")
+                fail(f" {attr} = {quoted(raw)}: {NOT_A_NUMBER}{why_not(raw)}")
             values[attr] = (number,)
 
     for attr in NON_NEGATIVE.get(tag, ()):
         if attr in values and min(values[attr]) < 0:
-            fail(f" {attr} = {element.attrib[attr]!r}: must be ≥ 0")
+            fail(f" {attr} = {quoted(element.attrib[attr])}: must be ≥ 0")
     moves = parent_element.get("type") not in AXIS_IGNORED
     if tag == "axis" and parent == "joint" and moves and "xyz" in values and not any(values["xyz"]):
-        fail(f" xyz = {element.attrib['xyz']!r}: a joint axis must not be the zero vector")
+        fail(f" xyz = {quoted(element.attrib['xyz'])}: a joint axis must not be the zero vector")
     if tag == "dynamics" and parent == "joint" and not {"damping", "friction"} & element.attrib.keys():
         fail(": has neither 'damping' nor 'friction' (urdfdom refuses an empty <dynamics>)")
     if tag == "inertial":
@@ -256,7 +256,7 @@ def _facts(root: ET.Element, source: str) -> UrdfFacts:
         if name is None:
             raise UrdfShapeError(source, "a <joint> has no name attribute")
         if name in types:
-            raise UrdfShapeError(source, f"joint {name!r} is defined twice")
+            raise UrdfShapeError(source, f"joint {quoted(name)} is defined twice")
         types[name] = joint.get("type", "")
         element = joint.find("dynamics")
         if element is not None:
