@@ -658,3 +658,14 @@ def test_a_long_value_is_quoted_as_a_short_fragment():
     long_name = "n" * 4000
     message = refusal(urdf(axis="0 0 0").replace('name="j"', f'name="{long_name}"'))
     assert len(message) < 300 and "…" in message
+
+
+def test_a_xacro_error_quotes_a_long_expression_short():
+    expression = "1 + " * 1000 + "__import__('os')"
+    text = (
+        '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:property name="p" value="1"/>'
+        '<link name="base"><visual><geometry>'
+        f'<box size="${{{expression}}} 1 1"/></geometry></visual></link></robot>'
+    )
+    message = refusal(text)
+    assert message.startswith("xacro cannot expand it: ") and len(message) < 300 and "…" in message
