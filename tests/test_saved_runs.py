@@ -213,3 +213,12 @@ def test_a_long_scene_name_is_shortened_in_the_title(tmp_path, capsys):
     meta["scene"] = "x" * 4000
     np.savez(npz, t=t, q=q, metadata=np.array(json.dumps(meta)))
     assert len(Trajectory.from_npz(npz).title) <= 80
+
+
+def test_a_scene_too_long_to_animate_is_refused_before_it_is_simulated(tmp_path, monkeypatch, capsys):
+    scene = REPO / "scenes" / "damped_double_pendulum.toml"
+    monkeypatch.setenv(MAX_FRAMES_VARIABLE, "50")  # the scene runs for more than 1 s
+    assert main(["render", str(scene), "-o", str(tmp_path / "x.html")]) == 2
+    line = error_line(capsys)
+    assert "key 'time.duration'" in line and "limit of 50" in line
+    assert "trajectory" not in capsys.readouterr().out

@@ -234,19 +234,25 @@ def max_frames() -> int:
     return int(value)
 
 
-def check_frames(traj: Trajectory, fps: float) -> None:
+def check_frames(traj: Trajectory, fps: float = DEFAULT_FPS) -> None:
     """Refuse a trajectory whose animation would have more frames than ``max_frames()``."""
+    shown = f"{traj.t[0]:g} … {traj.t[-1]:g} s"
+    check_frame_count(traj.source, "t", shown, float(traj.t[-1] - traj.t[0]), fps)
+
+
+def check_frame_count(
+    source: str, key: str, shown: object, duration: float, fps: float = DEFAULT_FPS
+) -> None:
+    """Refuse an animation of ``duration`` seconds at ``fps`` beyond ``max_frames()``, naming ``key``."""
     limit = max_frames()
-    duration = float(traj.t[-1] - traj.t[0])
     frames = duration * fps + 1  # a float: the count of a 1e300 s run overflows nothing
     if frames > limit:
         raise TrajectoryError(
-            traj.source,
-            "t",
-            f"{traj.t[0]:g} … {traj.t[-1]:g} s",
+            source,
+            key,
+            shown,
             f"{duration:g} s at {fps:g} frames per second ≈ {frames:.3g} frames exceed the limit of "
-            f"{limit:g}; "
-            f"raise the limit with {MAX_FRAMES_VARIABLE}",
+            f"{limit:g}; raise the limit with {MAX_FRAMES_VARIABLE}",
         )
 
 

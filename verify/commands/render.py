@@ -54,7 +54,7 @@ def run(args: argparse.Namespace) -> int:
     from pendverify.commands.simulate import urdf_argument
     from pendverify.errors import InputError
     from pendverify.simulation.scene import load_scene
-    from pendverify.viz.animation import Trajectory, render_html
+    from pendverify.viz.animation import Trajectory, check_frame_count, render_html
 
     if args.scene is None and args.trajectory is None:
         raise InputError("<command line>", "scene", None, "give a scene file, or --trajectory FILE.npz")
@@ -75,7 +75,9 @@ def run(args: argparse.Namespace) -> int:
     else:
         from pendverify.simulation.simulate import simulate
 
-        result = simulate(load_scene(args.scene), args.engine, urdf_argument(args.urdf))
+        scene = load_scene(args.scene)
+        check_frame_count(scene.source, "time.duration", scene.duration, scene.duration)  # before simulating
+        result = simulate(scene, args.engine, urdf_argument(args.urdf))
         traj = Trajectory.from_run(result)
         if not result.passed:
             print(f"note: {traj.title}: an invariant FAILS (see `pendverify simulate {args.scene}`)")
