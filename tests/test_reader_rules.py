@@ -19,6 +19,7 @@ from pathlib import Path
 import pytest
 
 from pendverify.errors import UrdfShapeError
+from pendverify.robot import description
 from pendverify.robot.description import load_description
 from pendverify.robot.xml_reading import MAX_XML_DEPTH
 
@@ -669,3 +670,11 @@ def test_a_xacro_error_quotes_a_long_expression_short():
     )
     message = refusal(text)
     assert message.startswith("xacro cannot expand it: ") and len(message) < 300 and "…" in message
+
+
+def test_a_description_file_beyond_the_size_limit_is_refused_unread(tmp_path, monkeypatch):
+    monkeypatch.setattr(description, "MAX_XML_CHARACTERS", 1000)
+    path = tmp_path / "big.urdf"
+    path.write_text(urdf(link=NESTED_OK * 40))
+    with pytest.raises(UrdfShapeError, match="larger than the limit of 1000 bytes"):
+        load_description(path)

@@ -34,6 +34,7 @@ from pendverify.robot.sdf import build_sdf_model
 from pendverify.robot.strict import DescriptionFacts, parse_xml
 from pendverify.robot.urdfdom import build_pinocchio_model
 from pendverify.robot.xacro_expand import XACRO_SUFFIXES, expand_xacro, uses_xacro
+from pendverify.robot.xml_reading import MAX_XML_CHARACTERS
 
 #: format → the root element it has (xacro: the URDF's, after expansion)
 FORMATS = {"urdf": "robot", "xacro": "robot", "mjcf": "mujoco", "sdf": "sdf"}
@@ -177,9 +178,15 @@ def anchor_base(model: pin.Model) -> float:
 
 
 def read_text_file(path: Path, source: str) -> str:
-    """A user's text file as UTF-8 (a byte-order mark allowed); anything else is one clear error."""
+    """A user's text file as UTF-8 (a byte-order mark allowed), at most ``MAX_XML_CHARACTERS`` bytes
+    read (so at most that many characters); anything else is one clear error."""
     try:
-        return path.read_bytes().decode("utf-8-sig")
+        with path.open("rb") as handle:
+            data = handle.read(MAX_XML_CHARACTERS + 1)
+        if len(data) > MAX_XML_CHARACTERS:
+            limit = MAX_XML_CHARACTERS
+            raise UrdfShapeError(source, f"larger than the limit of {limit} bytes for a description")
+        return data.decode("utf-8-sig")
     except IsADirectoryError:
         raise UrdfShapeError(source, "is a directory, not a file") from None
     except UnicodeDecodeError as exc:
