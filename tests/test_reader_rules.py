@@ -199,6 +199,42 @@ URDF_RULES = [
         "link 'l' <inertial><inertia>: principal moments",
     ),
     ("joint names are unique", urdf(), urdf(tool_joint="j"), "joint 'j' is defined twice"),
+    (
+        "every joint named",
+        urdf(),
+        urdf().replace('<joint name="tool_joint"', "<joint"),
+        "a <joint> has no name",
+    ),
+    (
+        "a shape has its sizes",
+        urdf(link="<visual><geometry><cylinder radius='0.02' length='0.5'/></geometry></visual>"),
+        urdf(link="<visual><geometry><cylinder radius='0.02'/></geometry></visual>"),
+        "link 'l' <visual><geometry><cylinder>: the attribute 'length' is missing",
+    ),
+    (
+        "a material's colour has rgba",
+        urdf(
+            link="<visual><geometry><sphere radius='0.1'/></geometry><material name='m'>"
+            "<color rgba='1 0 0 1'/></material></visual>"
+        ),
+        urdf(
+            link="<visual><geometry><sphere radius='0.1'/></geometry><material name='m'><color/>"
+            "</material></visual>"
+        ),
+        "material 'm' <color>: the attribute 'rgba' is missing",
+    ),
+    (
+        "a mesh scale has 3 numbers",
+        urdf(link="<visual><geometry><mesh filename='a.stl' scale='0.001 0.001 0.001'/></geometry></visual>"),
+        urdf(link="<visual><geometry><mesh filename='a.stl' scale='0.001'/></geometry></visual>"),
+        "link 'l' <visual><geometry><mesh> scale = '0.001': needs exactly 3 numbers",
+    ),
+    (
+        "a shape's sizes are ≥ 0",
+        urdf(link="<collision><geometry><box size='0.1 0.1 0.1'/></geometry></collision>"),
+        urdf(link="<collision><geometry><box size='0.1 -0.1 0.1'/></geometry></collision>"),
+        "link 'l' <collision><geometry><box> size = '0.1 -0.1 0.1': must be ≥ 0",
+    ),
 ]
 
 
