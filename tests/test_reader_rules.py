@@ -262,6 +262,9 @@ def test_a_drake_urdf_reads_as_urdfdom_reads_it():
     drake = load_description(urdf(robot_attrs=DRAKE, link=DRAKE_EXTENSIONS))
     assert list(drake.model.names) == list(plain.model.names)
     assert drake.model.inertias[1] == plain.model.inertias[1]
+    assert not plain.notes()
+    (note,) = drake.notes()
+    assert note.endswith("so the model leaves them out: <drake:proximity_properties>"), note
 
 
 # --------------------------------------------------------------------------- MJCF

@@ -34,7 +34,7 @@ from pendverify.robot.sdf import build_sdf_model
 from pendverify.robot.strict import DescriptionFacts, parse_xml
 from pendverify.robot.urdfdom import build_pinocchio_model
 from pendverify.robot.xacro_expand import XACRO_SUFFIXES, expand_xacro, uses_xacro
-from pendverify.robot.xml_reading import MAX_XML_CHARACTERS
+from pendverify.robot.xml_reading import MAX_XML_CHARACTERS, ignored_extensions
 
 #: format → the root element it has (xacro: the URDF's, after expansion)
 FORMATS = {"urdf": "robot", "xacro": "robot", "mjcf": "mujoco", "sdf": "sdf"}
@@ -132,6 +132,12 @@ def load_description(description: str | Path, source: str | None = None) -> Load
         log = urdf_log
     elif fmt == "urdf":
         model, facts, log = build_pinocchio_model(text, source)
+        ignored = ignored_extensions(text, source)
+        if ignored:
+            listed = ", ".join(f"<{name}>" + (f" ×{n}" if n > 1 else "") for name, n in ignored.items())
+            notes.append(
+                f"extension elements urdfdom ignores, so the model leaves them out: {shortened(listed, 300)}"
+            )
     elif fmt == "mjcf":
         model, reading, log = build_mjcf_model(text, source)
         facts, notes, root_offset = reading.facts, reading.notes, reading.root_offset

@@ -10,7 +10,8 @@
   (TinyXML, which knows no namespaces) reads it: ``<robot xmlns="http://drake.mit.edu">`` is a
   ``<robot>``, and an element or attribute with a prefix (Drake's ``<drake:joint>``,
   ``drake:declare_convex``) is one urdfdom never looks at; both are dropped, with whatever an
-  element holds, as are the ``xmlns`` declarations.
+  element holds, as are the ``xmlns`` declarations; ``ignored_extensions`` lists such elements
+  for a note.
 """
 
 from __future__ import annotations
@@ -26,7 +27,13 @@ from pendverify.display import shortened
 from pendverify.errors import UrdfShapeError
 from pendverify.robot.urdf_numbers import RAW_WHITESPACE
 
-__all__ = ["MAX_XML_CHARACTERS", "MAX_XML_DEPTH", "parse_xml", "parse_xml_as_urdfdom_reads"]
+__all__ = [
+    "MAX_XML_CHARACTERS",
+    "MAX_XML_DEPTH",
+    "ignored_extensions",
+    "parse_xml",
+    "parse_xml_as_urdfdom_reads",
+]
 
 #: characters of a description's XML (published URDFs and MJCFs are at most a few MB; meshes are
 #: separate files)
@@ -120,6 +127,24 @@ def _names_as_written(text: str, source: str) -> ET.Element:
     parser.CharacterDataHandler = builder.data
     parser.Parse(text, True)
     return builder.close()
+
+
+def ignored_extensions(text: str, source: str) -> dict[str, int]:
+    """{name as written: count} of the prefixed elements a URDF holds (``drake:rotor_inertia``),
+    which urdfdom, and hence the model, leaves out; {} for a file without any."""
+    if "xmlns:" not in text:
+        return {}
+    parse_xml(text, source)
+    counts: dict[str, int] = {}
+    stack = [_names_as_written(text, source)]
+    while stack:
+        element = stack.pop()
+        for child in element:
+            if ":" in child.tag:
+                counts[child.tag] = counts.get(child.tag, 0) + 1
+            else:
+                stack.append(child)
+    return dict(sorted(counts.items()))
 
 
 def _drop_prefixed(element: ET.Element) -> None:
