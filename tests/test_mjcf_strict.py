@@ -137,7 +137,7 @@ REFUSED = {
         mjcf(
             f'<body name="r" quat="0.5 0.5 0.5 0.5">{INERTIAL}<body name="b"><joint/>{INERTIAL}</body></body>'
         ),
-        "body 'r': a fixed root body may not be rotated",
+        "body 'r' quat = '0.5 0.5 0.5 0.5': a fixed root body may not be rotated",
     ),
     "spring": (mjcf().replace('damping="0.1"', 'stiffness="2"'), "joint 'j' stiffness = '2': a joint spring"),
     "equality": (

@@ -213,11 +213,14 @@ def test_render_draws_a_plugin_scene_from_its_urdf(tmp_path, capsys):
     assert "cart-pole LQR after a push" in page and "cart_pole" in page
 
 
-def test_a_saved_plugin_run_renders_from_its_recorded_model_file_and_urdf(tmp_path, capsys):
+def test_a_saved_plugin_run_renders_with_its_model_file_given_and_its_recorded_urdf(tmp_path, capsys):
     run = tmp_path / "cart_pole.npz"
     assert main(["simulate", str(REPO / "scenes" / "cart_pole_lqr_push.toml"), "-o", str(run)]) == 0
     out = tmp_path / "replay.html"
-    assert main(["render", "--trajectory", str(run), "-o", str(out)]) == 0
+    assert main(["render", "--trajectory", str(run), "-o", str(out)]) == 2  # the npz does not run code
+    assert "--analytic FILE" in capsys.readouterr().err
+    model = str(EXAMPLES / "cart_pole.py")
+    assert main(["render", "--trajectory", str(run), "--analytic", model, "-o", str(out)]) == 0
     assert "cart-pole LQR after a push" in out.read_text()
 
 

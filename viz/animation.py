@@ -25,13 +25,18 @@ Size: the three.js viewer bundle (0.85 MB) dominates.  Only the visuals on a
 moving joint get keys (position + quaternion, float32), about 18 kB per second
 of animation for the double pendulum: a 10 s run is 1.04 MB (1.24 MB with the
 trace).  Each mesh is sent once, whatever the number of frames.
+
+Bounded work: an animation has at most ``PENDVERIFY_MAX_FRAMES`` frames (default
+``DEFAULT_MAX_FRAMES``, 30 min at 50 fps); a longer one is refused, naming the times and the
+limit, before any frame is computed.  A saved run's arrays are bounded before they are loaded
+(``pendverify.viz.saved_run``), and a saved run never imports the Python model file its
+metadata names (``Trajectory.from_npz``).
 """
 
 from __future__ import annotations
 
-import json
 import math
-import zipfile
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -42,9 +47,11 @@ from meshcat.animation import Animation
 
 from pendverify.analytic import MODELS, PARAMETER_TYPES, ParameterSet
 from pendverify.analytic.plugin import load_model_class
-from pendverify.errors import TrajectoryError
+from pendverify.display import shortened
+from pendverify.errors import InputError, TrajectoryError
 from pendverify.viz.geometry import ROOT, UP, VisualSystem
 from pendverify.viz.recorder import SceneRecorder
+from pendverify.viz.saved_run import read_saved_arrays
 
 DEFAULT_FPS = 50.0
 FPS_RANGE = (30.0, 60.0)
@@ -56,6 +63,12 @@ TRACE_COLOUR = 0x5B2C83  # dark purple: unlike every URDF material
 TRACE_CHUNK_S = 0.05  # s of motion per trace segment (at most MAX_TRACE_CHUNKS)
 MAX_TRACE_CHUNKS = 200
 REPETITIONS = 1_000_000  # loop for as long as anyone watches
+MAX_FRAMES_VARIABLE = "PENDVERIFY_MAX_FRAMES"
+#: 30 min at 50 fps: a page of about 35 MB, built in about 0.6 GB and 20 s (measured: 60 000 frames
+#: of the double pendulum, 22 MB, 0.4 GB, 14 s)
+DEFAULT_MAX_FRAMES = 90_000
+TITLE_WIDTH = 80  # characters of a saved run's scene name kept as its title
+FRAGMENT_WIDTH = 60  # characters of a metadata value quoted in a message
 
 
 @dataclass(frozen=True)
@@ -71,6 +84,8 @@ class Trajectory:
     #: (path or text; None: the one ``urdf_for(params)`` writes, built-in models only)
     model_cls: type | None = None
     urdf: str | None = None
+    #: what reading a saved run noticed (printed by ``render``)
+    notes: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if self.t.ndim != 1 or len(self.t) < 2:
@@ -100,40 +115,95 @@ class Trajectory:
         )
 
     @classmethod
-    def from_npz(cls, path: str | Path) -> Trajectory:
-        """A file of ``pendverify simulate -o FILE.npz``: t, q, and the metadata's model and parameters."""
+    def from_npz(cls, path: str | Path, analytic: str | Path | None = None) -> Trajectory:
+        """A file of ``pendverify simulate -o FILE.npz``: t, q, and the metadata's model and parameters.
+
+        The file is data: a run of a Python model file is drawn only with that file given as
+        ``analytic`` (``render --analytic FILE``), never by importing what the metadata names;
+        a text model (``.toml``) the metadata names is read, as it runs nothing.
+        """
         path = Path(path)
         source = str(path)
         if not path.is_file():
             raise TrajectoryError(source, "<file>", source, "trajectory file not found")
-        try:
-            with np.load(path, allow_pickle=False) as npz:
-                t, q, meta = npz["t"], npz["q"], json.loads(str(npz["metadata"]))
-        except KeyError as exc:
-            raise TrajectoryError(source, str(exc).strip("'"), None, "missing array in the npz") from None
-        except (ValueError, OSError, EOFError, zipfile.BadZipFile) as exc:  # JSON's errors are ValueErrors
-            reason = str(exc) or type(exc).__name__
-            raise TrajectoryError(source, "<file>", source, f"not a pendverify npz: {reason}") from None
+        t, q, meta = read_saved_arrays(path, source)
         if not isinstance(meta, dict):
             raise TrajectoryError(source, "metadata", type(meta).__name__, "must be a JSON object")
-        model = meta.get("model")
-        model_file = meta.get("model_file")
-        if model_file is not None:  # a plug-in run: its model file and URDF, as recorded
-            model_cls = load_model_class(str(model_file))
-            param_type, urdf = model_cls.params_type, meta.get("urdf")
-            if urdf is None:
-                raise TrajectoryError(source, "metadata.urdf", None, "a model file's run needs its URDF")
-        elif model in PARAMETER_TYPES:
-            model_cls, param_type, urdf = None, PARAMETER_TYPES[model], meta.get("urdf")
-        else:
-            known = ", ".join(PARAMETER_TYPES)
-            raise TrajectoryError(source, "metadata.model", model, f"expected one of {known} or a model_file")
+        model_cls, param_type, notes = _saved_model(meta, source, analytic)
+        urdf = meta.get("urdf")
+        if urdf is not None and not isinstance(urdf, str):
+            raise TrajectoryError(source, "metadata.urdf", _fragment(urdf), "must be a file name")
+        if model_cls is not None and urdf is None:
+            raise TrajectoryError(source, "metadata.urdf", None, "a model file's run needs its URDF")
         parameters = meta.get("parameters", {})
         if not isinstance(parameters, dict):
-            raise TrajectoryError(source, "metadata.parameters", parameters, "must be a JSON object")
+            raise TrajectoryError(
+                source, "metadata.parameters", _fragment(parameters), "must be a JSON object"
+            )
         params = param_type.from_mapping(parameters, source, "metadata.parameters.")
         t, q = _samples(source, t, q)
-        return cls(t, q, params, str(meta.get("scene", path.stem)), source, model_cls, urdf)
+        title = shortened(str(meta.get("scene", path.stem)), TITLE_WIDTH)
+        return cls(t, q, params, title, source, model_cls, urdf, tuple(notes))
+
+
+def _saved_model(meta: dict, source: str, analytic: str | Path | None) -> tuple[type | None, type, list[str]]:
+    """(model class or None for a built-in one, its parameter type, notes) of a saved run.
+
+    A Python model file named by ``metadata.model_file`` is not imported: ``analytic`` (the
+    user's ``--analytic FILE``) is loaded instead, and must define the model the run names.
+    """
+    model, model_file = meta.get("model"), meta.get("model_file")
+    if model_file is None:
+        if analytic is not None:
+            raise TrajectoryError(
+                source,
+                "metadata.model_file",
+                None,
+                f"the run is of the built-in model {_fragment(model)!r}; --analytic is for a run of a model "
+                "file",
+            )
+        if model not in PARAMETER_TYPES:
+            known = ", ".join(PARAMETER_TYPES)
+            raise TrajectoryError(
+                source, "metadata.model", _fragment(model), f"expected one of {known} or a model_file"
+            )
+        return None, PARAMETER_TYPES[model], []
+    if not isinstance(model_file, str) or not model_file or "\0" in model_file:
+        raise TrajectoryError(source, "metadata.model_file", _fragment(model_file), "must be a file name")
+    named = Path(model_file)
+    notes: list[str] = []
+    if analytic is None:
+        if named.suffix != ".toml":
+            raise TrajectoryError(
+                source,
+                "metadata.model_file",
+                _fragment(model_file),
+                "the run is of a Python model file, and a saved run never runs code: give that file "
+                "with --analytic FILE if you trust it",
+            )
+        model_cls = load_model_class(named)  # a text model is data: read, not run
+    else:
+        if Path(analytic).name != named.name:
+            notes.append(
+                f"the run names the model file {_fragment(model_file)}; drawn with --analytic {analytic}"
+            )
+        model_cls = load_model_class(analytic)
+    if model_cls.name != model:
+        raise TrajectoryError(
+            source,
+            "metadata.model",
+            _fragment(model),
+            f"the model file {analytic or model_file} defines the model {model_cls.name!r}, not the run's",
+        )
+    return model_cls, model_cls.params_type, notes
+
+
+def _fragment(value: object) -> object:
+    """A value of the metadata as a message quotes it: itself, or its text shortened."""
+    if isinstance(value, str):
+        return shortened(value, FRAGMENT_WIDTH)
+    text = repr(value)
+    return value if len(text) <= FRAGMENT_WIDTH else shortened(text, FRAGMENT_WIDTH)
 
 
 def _samples(source: str, t, q) -> tuple[np.ndarray, np.ndarray]:
@@ -148,6 +218,42 @@ def _samples(source: str, t, q) -> tuple[np.ndarray, np.ndarray]:
     if q.ndim != 2 or q.shape[0] != t.size or q.shape[1] == 0 or not np.all(np.isfinite(q)):
         raise TrajectoryError(source, "q", q.shape, f"must be {t.size} rows of finite coordinates, one per t")
     return t, q
+
+
+def max_frames() -> int:
+    """The limit on an animation's frames: ``PENDVERIFY_MAX_FRAMES``, else ``DEFAULT_MAX_FRAMES``."""
+    text = os.environ.get(MAX_FRAMES_VARIABLE)
+    if text is None or text.strip() == "":
+        return DEFAULT_MAX_FRAMES
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value >= 2 and value == int(value)):
+        raise InputError("<environment>", MAX_FRAMES_VARIABLE, text, "must be a whole number >= 2, e.g. 2e5")
+    return int(value)
+
+
+def check_frames(traj: Trajectory, fps: float = DEFAULT_FPS) -> None:
+    """Refuse a trajectory whose animation would have more frames than ``max_frames()``."""
+    shown = f"{traj.t[0]:g} … {traj.t[-1]:g} s"
+    check_frame_count(traj.source, "t", shown, float(traj.t[-1] - traj.t[0]), fps)
+
+
+def check_frame_count(
+    source: str, key: str, shown: object, duration: float, fps: float = DEFAULT_FPS
+) -> None:
+    """Refuse an animation of ``duration`` seconds at ``fps`` beyond ``max_frames()``, naming ``key``."""
+    limit = max_frames()
+    frames = duration * fps + 1  # a float: the count of a 1e300 s run overflows nothing
+    if frames > limit:
+        raise TrajectoryError(
+            source,
+            key,
+            shown,
+            f"{duration:g} s at {fps:g} frames per second ≈ {frames:.3g} frames exceed the limit of "
+            f"{limit:g}; raise the limit with {MAX_FRAMES_VARIABLE}",
+        )
 
 
 def resample(t: np.ndarray, q: np.ndarray, fps: float) -> tuple[np.ndarray, np.ndarray]:
@@ -231,6 +337,7 @@ def build_scene(traj: Trajectory, trace: bool = False, fps: float = DEFAULT_FPS)
     """Record the model, the camera and the animation of a trajectory (no server involved)."""
     if not FPS_RANGE[0] <= fps <= FPS_RANGE[1]:
         raise TrajectoryError(traj.source, "fps", fps, f"expected {FPS_RANGE[0]:g} to {FPS_RANGE[1]:g}")
+    check_frames(traj, fps)
     visual = _visual_system(traj)
     recorder = SceneRecorder()
     vis = recorder.visualizer()

@@ -2,7 +2,9 @@
 
 The scene is simulated (as ``pendverify simulate`` does), or, with
 ``--trajectory FILE.npz``, a saved run is loaded instead: its t, q and the
-metadata's model and parameters, from which the same URDF is written again.
+metadata's model and parameters, from which the same URDF is written again.  A run
+of a Python model file is drawn only with that file given as ``--analytic FILE``:
+the npz is data and never makes pendverify import what it names.
 The page plays from file:// with no server and no network (``pendverify.viz``).
 """
 
@@ -10,7 +12,7 @@ from __future__ import annotations
 
 import argparse
 
-from pendverify.commands import add_command
+from pendverify.commands import add_analytic_option, add_command
 
 
 def register(sub) -> None:
@@ -21,6 +23,7 @@ def register(sub) -> None:
         [
             "pendverify render double_pendulum/damped_double_pendulum.toml -o chaos.html --trace",
             "pendverify render --trajectory run.npz -o run.html",
+            "pendverify render --trajectory cart_pole.npz --analytic cart_pole/cart_pole.py -o run.html",
         ],
     )
     p.add_argument(
@@ -28,6 +31,9 @@ def register(sub) -> None:
     )
     p.add_argument("-o", "--output", required=True, help="the HTML file to write (required)")
     p.add_argument("--trajectory", help="render a saved run (npz of `pendverify simulate -o`) instead")
+    add_analytic_option(
+        p, "with --trajectory, the Python model file the saved run names (a saved run never imports it)"
+    )
     p.add_argument("--trace", action="store_true", help="draw the path of the tip as it moves")
     p.add_argument(
         "--engine",
@@ -48,10 +54,14 @@ def run(args: argparse.Namespace) -> int:
     from pendverify.commands.simulate import urdf_argument
     from pendverify.errors import InputError
     from pendverify.simulation.scene import load_scene
-    from pendverify.viz.animation import Trajectory, render_html
+    from pendverify.viz.animation import Trajectory, check_frame_count, render_html
 
     if args.scene is None and args.trajectory is None:
         raise InputError("<command line>", "scene", None, "give a scene file, or --trajectory FILE.npz")
+    if args.analytic is not None and not args.trajectory:
+        refuse_together(
+            "--analytic", "a scene file", "a scene names its model; --analytic is for --trajectory"
+        )
     if args.trajectory:
         for given, option in ((args.scene, "a scene file"), (args.engine, "--engine"), (args.urdf, "--urdf")):
             if given is not None:
@@ -59,11 +69,15 @@ def run(args: argparse.Namespace) -> int:
     check_output(args.output)
     status = 0
     if args.trajectory:
-        traj = Trajectory.from_npz(args.trajectory)
+        traj = Trajectory.from_npz(args.trajectory, args.analytic)
+        for note in traj.notes:
+            print(f"note: {note}")
     else:
         from pendverify.simulation.simulate import simulate
 
-        result = simulate(load_scene(args.scene), args.engine, urdf_argument(args.urdf))
+        scene = load_scene(args.scene)
+        check_frame_count(scene.source, "time.duration", scene.duration, scene.duration)  # before simulating
+        result = simulate(scene, args.engine, urdf_argument(args.urdf))
         traj = Trajectory.from_run(result)
         if not result.passed:
             print(f"note: {traj.title}: an invariant FAILS (see `pendverify simulate {args.scene}`)")

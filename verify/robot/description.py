@@ -27,12 +27,14 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+from pendverify.display import shortened
 from pendverify.errors import UrdfShapeError
 from pendverify.robot.mjcf import build_mjcf_model
 from pendverify.robot.sdf import build_sdf_model
 from pendverify.robot.strict import DescriptionFacts, parse_xml
 from pendverify.robot.urdfdom import build_pinocchio_model
 from pendverify.robot.xacro_expand import XACRO_SUFFIXES, expand_xacro, uses_xacro
+from pendverify.robot.xml_reading import MAX_XML_CHARACTERS, ignored_extensions
 
 #: format → the root element it has (xacro: the URDF's, after expansion)
 FORMATS = {"urdf": "robot", "xacro": "robot", "mjcf": "mujoco", "sdf": "sdf"}
@@ -94,12 +96,13 @@ def description_format(text: str, path: Path | None, source: str) -> str:
     root = parse_xml(text, source)
     if (path is not None and path.name.lower().endswith(XACRO_SUFFIXES)) or uses_xacro(root):
         return "xacro"
+    local = root.tag.rsplit("}", 1)[-1]  # a default namespace (Drake's URDFs) names no format
     for fmt, tag in FORMATS.items():
-        if root.tag == tag:
+        if local == tag:
             return fmt
     raise UrdfShapeError(
         source,
-        f"the root element is <{root.tag}>: pendverify reads URDF (<robot>), xacro (*.xacro), "
+        f"the root element is <{shortened(root.tag, 60)}>: pendverify reads URDF (<robot>), xacro (*.xacro), "
         "MJCF (<mujoco>) and SDFormat (<sdf>)",
     )
 
@@ -129,6 +132,12 @@ def load_description(description: str | Path, source: str | None = None) -> Load
         log = urdf_log
     elif fmt == "urdf":
         model, facts, log = build_pinocchio_model(text, source)
+        ignored = ignored_extensions(text, source)
+        if ignored:
+            listed = ", ".join(f"<{name}>" + (f" ×{n}" if n > 1 else "") for name, n in ignored.items())
+            notes.append(
+                f"extension elements urdfdom ignores, so the model leaves them out: {shortened(listed, 300)}"
+            )
     elif fmt == "mjcf":
         model, reading, log = build_mjcf_model(text, source)
         facts, notes, root_offset = reading.facts, reading.notes, reading.root_offset
@@ -175,9 +184,15 @@ def anchor_base(model: pin.Model) -> float:
 
 
 def read_text_file(path: Path, source: str) -> str:
-    """A user's text file as UTF-8 (a byte-order mark allowed); anything else is one clear error."""
+    """A user's text file as UTF-8 (a byte-order mark allowed), at most ``MAX_XML_CHARACTERS`` bytes
+    read (so at most that many characters); anything else is one clear error."""
     try:
-        return path.read_bytes().decode("utf-8-sig")
+        with path.open("rb") as handle:
+            data = handle.read(MAX_XML_CHARACTERS + 1)
+        if len(data) > MAX_XML_CHARACTERS:
+            limit = MAX_XML_CHARACTERS
+            raise UrdfShapeError(source, f"larger than the limit of {limit} bytes for a description")
+        return data.decode("utf-8-sig")
     except IsADirectoryError:
         raise UrdfShapeError(source, "is a directory, not a file") from None
     except UnicodeDecodeError as exc:

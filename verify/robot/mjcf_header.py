@@ -21,6 +21,7 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 
 from pendverify.robot.mjcf_rules import Numbers
+from pendverify.robot.urdf_numbers import quoted
 
 #: MuJoCo's default gravity [m/s²] (``<option gravity="0 0 -9.81">``)
 MUJOCO_G = 9.81
@@ -77,7 +78,7 @@ def read_compiler(root: ET.Element, numbers: Numbers) -> dict[str, str]:
     numbers.element(element, "<compiler>")
     for attr, (ok, rule) in COMPILER_RULES.items():
         if attr in element.attrib and not ok(element.attrib[attr]):
-            numbers.fail("<compiler>", f" {attr} = {element.attrib[attr]!r}: {rule}")
+            numbers.fail("<compiler>", f" {attr} = {quoted(element.attrib[attr])}: {rule}")
     return dict(element.attrib)
 
 
@@ -90,7 +91,9 @@ def read_gravity(root: ET.Element, numbers: Numbers) -> float:
     for attr in ("density", "viscosity"):
         if values.get(attr, (0.0,))[0] != 0:
             raw = option.attrib[attr]
-            numbers.fail("<option>", f" {attr} = {raw!r}: fluid forces are refused (Pinocchio has none)")
+            numbers.fail(
+                "<option>", f" {attr} = {quoted(raw)}: fluid forces are refused (Pinocchio has none)"
+            )
     for flag in option.findall("flag"):
         for attr in ("gravity", "passive", "damper", "spring"):
             if flag.get(attr) == "disable":
@@ -98,5 +101,5 @@ def read_gravity(root: ET.Element, numbers: Numbers) -> float:
     gx, gy, gz = values.get("gravity", (0.0, 0.0, -MUJOCO_G))
     if gx != 0 or gy != 0 or gz > 0:
         raw = option.attrib["gravity"]
-        numbers.fail("<option>", f" gravity = {raw!r}: must point along −z (0 0 −g, g ≥ 0)")
+        numbers.fail("<option>", f" gravity = {quoted(raw)}: must point along −z (0 0 −g, g ≥ 0)")
     return -gz + 0.0

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 from typing import NoReturn
 
 from pendverify.errors import UrdfShapeError
-from pendverify.robot.urdf_numbers import NOT_A_NUMBER, parse_number, parse_pieces, why_not
+from pendverify.robot.urdf_numbers import NOT_A_NUMBER, parse_number, parse_pieces, quoted, why_not
 
 ORIENTATIONS = ("quat", "axisangle", "euler", "xyaxes", "zaxis")
 _FRAME = {"pos": (3,), "quat": (4,), "axisangle": (4,), "euler": (3,), "xyaxes": (6,), "zaxis": (3,)}
@@ -106,11 +106,11 @@ class Numbers:
                 raw = element.attrib[attr]
                 number = parse_number(raw)
                 if number is None:
-                    self.fail(place, f" {attr} = {raw!r}: {NOT_A_NUMBER}{why_not(raw)}")
+                    self.fail(place, f" {attr} = {quoted(raw)}: {NOT_A_NUMBER}{why_not(raw)}")
                 values[attr] = (number,)
         for attr in NON_NEGATIVE.get(tag, ()):
             if attr in values and min(values[attr]) < 0:
-                self.fail(place, f" {attr} = {element.attrib[attr]!r}: must be ≥ 0")
+                self.fail(place, f" {attr} = {quoted(element.attrib[attr])}: must be ≥ 0")
         return values
 
     @staticmethod
@@ -119,7 +119,7 @@ class Numbers:
         pieces = raw.split()
         if len(pieces) not in counts:
             need = " or ".join(str(c) for c in counts)
-            fail(f"{raw!r}: needs exactly {need} numbers, found {len(pieces)}")
+            fail(f"{quoted(raw)}: needs exactly {need} numbers, found {len(pieces)}")
         return parse_pieces(raw, pieces, fail)
 
 
@@ -140,13 +140,15 @@ def read_defaults(root: ET.Element, numbers: Numbers) -> dict[str, DefaultClass]
     def visit(element: ET.Element, parent: str | None) -> None:
         name = element.get("class")
         if parent is None and name not in (None, "main"):
-            numbers.fail("<default>", f" class = {name!r}: the top-level default class is MuJoCo's 'main'")
+            numbers.fail(
+                "<default>", f" class = {quoted(name)}: the top-level default class is MuJoCo's 'main'"
+            )
         if parent is not None and name is None:
             numbers.fail(f"default class {parent!r}", ": a nested <default> needs a class name")
         name = name or "main"
         if name in classes:
-            numbers.fail(f"default class {name!r}", ": defined twice")
-        place = f"default class {name!r}"
+            numbers.fail(f"default class {quoted(name)}", ": defined twice")
+        place = f"default class {quoted(name)}"
         cls = classes[name] = DefaultClass(name, parent)
         for tag in ("joint", "geom", "site"):
             found = element.findall(tag)
@@ -159,7 +161,7 @@ def read_defaults(root: ET.Element, numbers: Numbers) -> dict[str, DefaultClass]
                 if attr in child.attrib:
                     numbers.fail(
                         f"{place} <joint>",
-                        f" {attr} = {child.attrib[attr]!r}: not in a default class ({why})",
+                        f" {attr} = {quoted(child.attrib[attr])}: not in a default class ({why})",
                     )
             cls.joint = dict(child.attrib)
         for child in element.findall("default"):
@@ -185,7 +187,7 @@ def resolve_joint(
     own = joint.get("class")
     for name in (own, childclass):
         if name is not None and name not in classes:
-            numbers.fail(place, f": class {name!r} is not defined by any <default>")
+            numbers.fail(place, f": class {quoted(name)} is not defined by any <default>")
     effective = own or childclass or ("main" if "main" in classes else None)
     mujoco = {**chain(classes, effective), **joint.attrib}
     pinocchio = {
@@ -198,8 +200,8 @@ def resolve_joint(
         if mujoco.get(attr) != pinocchio.get(attr):
             numbers.fail(
                 place,
-                f": {attr} resolves to {mujoco.get(attr)!r} for MuJoCo (class {effective!r}) but to "
-                f"{pinocchio.get(attr)!r} for Pinocchio's reader (which also applies childclass "
+                f": {attr} resolves to {quoted(mujoco.get(attr))} for MuJoCo (class {effective!r}) but to "
+                f"{quoted(pinocchio.get(attr))} for Pinocchio's reader (which also applies childclass "
                 f"{childclass!r}); give the joint its {attr} explicitly",
             )
     return mujoco, effective

@@ -16,7 +16,8 @@ rest with one line naming the file, the element, the attribute, the value and th
 * exactly one ``<body>`` in ``<worldbody>``; every body named, with at most one joint
   (``hinge`` or ``slide``; its name, if absent, Pinocchio's ``<body>Joint_0``), an
   ``<inertial>`` unless it has no geom, no ``frame``, ``freejoint``, ``mocap`` or
-  ``gravcomp``; a fixed root body not rotated (its position does not matter: the base is
+  ``gravcomp``; a fixed root body not rotated (the identity, e.g. ``quat="1 0 0 0"``, to a few
+  ulps: ``pendverify.robot.mjcf_identity``; its position does not matter: the base is
   anchored at the origin anyway); at most one orientation per element, a unit
   ``axisangle`` axis;
 * an inertial has ``pos``, ``mass`` and one of ``diaginertia``/``fullinertia`` (MuJoCo's order
@@ -35,8 +36,10 @@ from dataclasses import dataclass, field
 from pendverify.errors import UrdfShapeError
 from pendverify.robot.inertia_rounding import check_inertia_tensor
 from pendverify.robot.mjcf_header import check_sections, read_compiler, read_gravity
+from pendverify.robot.mjcf_identity import is_identity
 from pendverify.robot.mjcf_rules import ORIENTATIONS, Numbers, read_defaults, resolve_joint
 from pendverify.robot.strict import DescriptionFacts, JointDynamics, parse_xml
+from pendverify.robot.urdf_numbers import quoted
 
 IGNORED_IN_BODY = {"geom", "site", "camera", "light"}
 AXIS_UNIT_TOL = 1e-12
@@ -114,7 +117,7 @@ class _Reader:
         attr = given[0]
         values = self.numbers.element(element, place)[attr]
         self.uses_angles |= attr in ("euler", "axisangle")
-        head = f" {attr} = {element.attrib[attr]!r}: "
+        head = f" {attr} = {quoted(element.attrib[attr])}: "
         if attr == "quat" and not any(values):
             self.fail(place, head + "the zero quaternion is no rotation")
         if attr == "axisangle" and abs(math.hypot(*values[:3]) - 1) > AXIS_UNIT_TOL:
@@ -130,7 +133,7 @@ class _Reader:
         name = body.get("name")
         if name is None:
             self.fail("a <body>", " has no name: Pinocchio's MJCF reader needs every body named")
-        place = f"body {name!r}"
+        place = f"body {quoted(name)}"
         if name in self.bodies:
             self.fail(place, ": defined twice")
         self.bodies.add(name)
@@ -139,7 +142,7 @@ class _Reader:
         if body.get("mocap") == "true":
             self.fail(place, " mocap = 'true': refused (a mocap body is driven, not simulated)")
         if values.get("gravcomp", (0.0,))[0] != 0:
-            self.fail(place, f" gravcomp = {body.get('gravcomp')!r}: gravity compensation is refused")
+            self.fail(place, f" gravcomp = {quoted(body.get('gravcomp'))}: gravity compensation is refused")
         childclass = body.get("childclass", childclass)
         if childclass is not None and childclass not in self.classes:
             self.fail(place, f": childclass {childclass!r} is not defined by any <default>")
@@ -154,8 +157,14 @@ class _Reader:
                 place, f": has {len(joints)} joints; Pinocchio's reader merges them into one, not compared"
             )
         if root and not joints:
-            if any(a in body.attrib for a in ORIENTATIONS):
-                self.fail(place, ": a fixed root body may not be rotated (Pinocchio's reader drops its pose)")
+            degrees = self.compiler.get("angle", "degree") == "degree"
+            for attr in (a for a in ORIENTATIONS if a in body.attrib):
+                if not is_identity(attr, values[attr], degrees):
+                    self.fail(
+                        place,
+                        f" {attr} = {quoted(body.attrib[attr])}: a fixed root body may not be rotated "
+                        "(Pinocchio's reader drops its pose; only the identity is read)",
+                    )
             self.reading.root_offset = math.hypot(*values.get("pos", (0.0, 0.0, 0.0)))
         self._inertia(body, place, "geom" in tags)
         for joint in joints:
@@ -200,11 +209,11 @@ class _Reader:
         for attr, below in (("boundmass", values["mass"][0]), ("boundinertia", min(values[kind][:3]))):
             if float(self.compiler.get(attr, "0")) > below:
                 bound = self.compiler[attr]
-                self.fail(place, f": compiler {attr} = {bound!r} would replace {below:g}; refused")
+                self.fail(place, f": compiler {attr} = {quoted(bound)} would replace {below:g}; refused")
 
     def _joint(self, joint: ET.Element, body: str, childclass: str | None) -> None:
         name = joint.get("name", f"{body}Joint_0")  # Pinocchio's name for an unnamed joint
-        place = f"joint {name!r}"
+        place = f"joint {quoted(name)}"
         self.numbers.element(joint, place)
         if any(a in joint.attrib for a in ORIENTATIONS):
             self.fail(place, ": a joint has a pos and an axis, no orientation")
@@ -213,14 +222,16 @@ class _Reader:
         kind = attrs.get("type", "hinge")
         if kind not in ("hinge", "slide"):
             self.fail(
-                place, f" type = {kind!r}: hinge and slide joints only (Pinocchio drops a ball's damping)"
+                place,
+                f" type = {quoted(kind)}: hinge and slide joints only (Pinocchio drops a ball's damping)",
             )
         if not any(resolved.get("axis", (0.0, 0.0, 1.0))):
-            self.fail(place, f" axis = {attrs['axis']!r}: a joint axis must not be the zero vector")
+            self.fail(place, f" axis = {quoted(attrs['axis'])}: a joint axis must not be the zero vector")
         for attr in ("stiffness", "springdamper"):
             if any(resolved.get(attr, (0.0,))):
                 self.fail(
-                    place, f" {attr} = {attrs[attr]!r}: a joint spring is refused (Pinocchio ignores it)"
+                    place,
+                    f" {attr} = {quoted(attrs[attr])}: a joint spring is refused (Pinocchio ignores it)",
                 )
         self.uses_angles |= kind == "hinge" and bool({"range", "ref"} & attrs.keys())
         if name in self.reading.facts.joint_types:
@@ -234,7 +245,9 @@ class _Reader:
         self.reading.joints.append(name)
         self.reading.dynamics[name] = (damping or 0.0, armature or 0.0, friction or 0.0)
         if armature:
-            self.reading.notes.append(f"joint {name!r} has armature {armature:g}: Pinocchio adds it to M")
+            self.reading.notes.append(
+                f"joint {quoted(name)} has armature {armature:g}: Pinocchio adds it to M"
+            )
 
 
 def _cross(a, b):

@@ -31,7 +31,8 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 
 from pendverify.analytic import ParameterSet
-from pendverify.errors import PendverifyError, RebindError
+from pendverify.errors import RebindError
+from pendverify.robot.strict import parse_xml
 
 MATCH_RTOL = 1e-12
 _INERTIA = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
@@ -65,10 +66,7 @@ class Binding:
 
     @classmethod
     def of(cls, urdf_text: str, params: ParameterSet, source: str = "<URDF>") -> Binding:
-        try:
-            root = ET.fromstring(urdf_text)
-        except ET.ParseError as exc:
-            raise PendverifyError(f"{source}: not XML: {exc}") from None
+        root = parse_xml(urdf_text, source)  # the strict readers' XML: no DTD, bounded
         binding = cls(root, params)
         candidates = {}
         for f in dataclasses.fields(params):

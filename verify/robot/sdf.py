@@ -23,7 +23,7 @@ import pinocchio as pin
 from pendverify.errors import UrdfShapeError
 from pendverify.robot.inertia_rounding import check_inertia_tensor
 from pendverify.robot.strict import DescriptionFacts, JointDynamics, parse_xml
-from pendverify.robot.urdf_numbers import NOT_A_NUMBER, parse_number, why_not
+from pendverify.robot.urdf_numbers import NOT_A_NUMBER, parse_number, quoted, why_not
 from pendverify.robot.urdfdom import build_from_file
 
 #: element tag → how many numbers its text holds
@@ -80,7 +80,7 @@ def read_sdf_strictly(text: str, source: str) -> DescriptionFacts:
     for joint in root.iter("joint"):
         name = joint.get("name", "")
         if name in types:
-            raise UrdfShapeError(source, f"joint {name!r} is defined twice")
+            raise UrdfShapeError(source, f"joint {quoted(name)} is defined twice")
         types[name] = joint.get("type", "")
         found = joint.find("axis/dynamics")
         if found is not None:
@@ -97,7 +97,7 @@ def _walk(element: ET.Element, owner: str):
             continue
         name = child.get("name")
         here = (
-            f"{child.tag} {name!r}"
+            f"{child.tag} {quoted(name)}"
             if child.tag in ("model", "link", "joint") and name
             else f"{owner} <{child.tag}>"
         )
@@ -117,16 +117,18 @@ def _check(element: ET.Element, place: str, source: str) -> None:
     pieces = raw.split()
     if len(pieces) not in NUMBERS[tag]:
         need = " or ".join(str(c) for c in NUMBERS[tag])
-        raise UrdfShapeError(source, f"{place} = {raw!r}: needs exactly {need} numbers, found {len(pieces)}")
+        found = len(pieces)
+        raise UrdfShapeError(source, f"{place} = {quoted(raw)}: needs exactly {need} numbers, found {found}")
     values = []
     for piece in pieces:
         value = parse_number(piece)
         if value is None:
-            raise UrdfShapeError(source, f"{place} = {raw!r}: {piece!r} is {NOT_A_NUMBER}{why_not(piece)}")
+            rule = f"{quoted(piece)} is {NOT_A_NUMBER}{why_not(piece)}"
+            raise UrdfShapeError(source, f"{place} = {quoted(raw)}: {rule}")
         values.append(value)
     if tag in NON_NEGATIVE and min(values) < 0:
-        raise UrdfShapeError(source, f"{place} = {raw!r}: must be ≥ 0")
+        raise UrdfShapeError(source, f"{place} = {quoted(raw)}: must be ≥ 0")
     if tag == "spring_stiffness" and values[0] != 0:
         raise UrdfShapeError(
-            source, f"{place} = {raw!r}: a joint spring is refused (Pinocchio's model has none)"
+            source, f"{place} = {quoted(raw)}: a joint spring is refused (Pinocchio's model has none)"
         )

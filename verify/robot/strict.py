@@ -10,9 +10,11 @@ URDF model" while the reason went to stderr.  This module closes both gaps.
 
 ``read_urdf_strictly`` checks, wherever the element occurs in the file:
 
-* XML: parsed with ``defusedxml`` and ``forbid_dtd=True`` (a DOCTYPE or entity is
-  refused, so nothing the file declares can change what a number says); the root must
-  be ``<robot>``.
+* XML: no DOCTYPE or entities, bounded in size and depth (``pendverify.robot.xml_reading``),
+  and read as urdfdom reads it: names as written, so ``<robot xmlns="http://drake.mit.edu">``
+  is a ``<robot>``, and prefixed extension elements and attributes (Drake's ``<drake:joint>``,
+  ``drake:declare_convex``), which urdfdom never looks at, are ignored.  The root must be
+  ``<robot>``.
 * Syntax of one number: the whole attribute is a plain decimal literal, finite as a
   double, without surrounding whitespace (``pendverify.robot.urdf_numbers``).
 * Vectors (``origin@xyz``, ``origin@rpy``, ``axis@xyz``, ``mesh@scale``, ``box@size``: 3
@@ -30,6 +32,8 @@ URDF model" while the reason went to stderr.  This module closes both gaps.
   ``<inertia>``.  Children urdfdom reads only once (a link's ``<inertial>``; an
   inertial's ``origin``/``mass``/``inertia``; a joint's ``origin``/``axis``/``limit``/
   ``dynamics``) must not be repeated: urdfdom silently keeps the first.
+* Axes: a joint's ``<axis>`` is not the zero vector, except on a ``fixed`` or ``floating``
+  joint, whose axis urdfdom does not read (exported URDFs give fixed joints ``0 0 0``).
 * Signs: mass, damping, friction, ``limit`` effort and velocity, and every radius,
   length and box size are ≥ 0.
 * Each inertia tensor I is positive semi-definite and its principal moments
@@ -44,20 +48,19 @@ Pinocchio is then run on the text by ``pendverify.robot.urdfdom.build_pinocchio_
 
 from __future__ import annotations
 
-import re
 import xml.etree.ElementTree as ET
 from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import NoReturn
 
-import defusedxml
-import defusedxml.ElementTree as DET
-
+from pendverify.display import shortened
 from pendverify.errors import UrdfShapeError
 from pendverify.robot.inertia_rounding import check_inertia_tensor
-from pendverify.robot.urdf_numbers import NOT_A_NUMBER, RAW_WHITESPACE, parse_number, parse_vector, why_not
+from pendverify.robot.urdf_numbers import NOT_A_NUMBER, parse_number, parse_vector, quoted, why_not
+from pendverify.robot.xml_reading import parse_xml, parse_xml_as_urdfdom_reads
 
 __all__ = ["DescriptionFacts", "JointDynamics", "UrdfFacts", "parse_xml", "read_urdf_strictly"]
+# parse_xml's home is pendverify.robot.xml_reading; the readers of every format import it from here
 
 #: tag → (attribute → how many numbers it holds), following the URDF format.
 VECTORS: dict[str, dict[str, int]] = {
@@ -108,6 +111,10 @@ SINGLE_CHILDREN: dict[str, tuple[str, ...]] = {
     "inertial": ("origin", "mass", "inertia"),
     "joint": ("origin", "axis", "limit", "dynamics"),
 }
+#: joint types whose <axis> urdfdom does not read (a fixed joint's axis means nothing)
+AXIS_IGNORED = ("fixed", "floating")
+#: characters of an element's name or an attribute's value quoted in a message
+TAG_WIDTH = 60
 #: Elements that name what a message is about (the nearest one above a number).
 OWNERS = ("link", "joint", "material", "transmission")
 
@@ -162,57 +169,17 @@ def read_urdf_strictly(text: str, source: str) -> UrdfFacts:
     ``UrdfShapeError(source, problem)`` whose one-line problem names the link or joint,
     the element path, the attribute, the offending value and the rule.
     """
-    root = parse_xml(text, source)
+    root = parse_xml_as_urdfdom_reads(text, source)
     if root.tag != "robot":
-        raise UrdfShapeError(source, f"the root element is <{root.tag}>, a URDF's must be <robot>")
+        tag = shortened(root.tag, TAG_WIDTH)
+        raise UrdfShapeError(source, f"the root element is <{tag}>, a URDF's must be <robot>")
     for element, parent, place in _walk(root):
         _check_element(element, parent, place, source)
     return _facts(root, source)
 
 
-# --------------------------------------------------------------------------- XML
-
-
-def parse_xml(text: str, source: str) -> ET.Element:
-    """The XML of a description, DTDs and entities refused, tabs/line breaks in attributes kept."""
-    try:
-        root = DET.fromstring(text, forbid_dtd=True)
-    except defusedxml.DefusedXmlException as exc:
-        raise UrdfShapeError(source, f"XML with a DOCTYPE or entities is refused ({exc})") from None
-    except ET.ParseError as exc:
-        line, column = exc.position
-        reason = re.sub(r":\s*line \d+, column \d+$", "", str(exc))
-        raise UrdfShapeError(source, f"malformed XML at line {line}, column {column + 1}: {reason}") from None
-    exposed = _expose_attribute_whitespace(text)
-    if exposed != text:
-        # Same document, but literal tabs and line breaks inside attribute values are now
-        # character references, which XML keeps instead of normalising them to spaces.
-        try:
-            root = DET.fromstring(exposed, forbid_dtd=True)
-        except ET.ParseError:  # cannot happen for a well-formed file; keep the plain reading
-            pass
-    return root
-
-
-_ATTRIBUTE = re.compile(r"""(?P<head>[\s][^\s=<>"'/]+\s*=\s*)(?P<quote>["'])(?P<value>[^<]*?)(?P=quote)""")
-
-
-def _expose_attribute_whitespace(text: str) -> str:
-    """Write literal tabs/CR/LF inside quoted attribute values as character references."""
-
-    def escape(match: re.Match[str]) -> str:
-        value = match["value"]
-        if not any(c in value for c in RAW_WHITESPACE):
-            return match[0]
-        for char, ref in RAW_WHITESPACE.items():
-            value = value.replace(char, ref)
-        return f"{match['head']}{match['quote']}{value}{match['quote']}"
-
-    return _ATTRIBUTE.sub(escape, text)
-
-
-def _walk(root: ET.Element) -> Iterator[tuple[ET.Element, str, _Place]]:
-    """Every element below the root with its parent's tag and its place (owner, path from the owner down)."""
+def _walk(root: ET.Element) -> Iterator[tuple[ET.Element, ET.Element, _Place]]:
+    """Every element below the root with its parent and its place (owner, path from the owner down)."""
     robot_name = root.get("name")
     robot_owner = f"robot {robot_name!r}" if robot_name is not None else "robot"
 
@@ -222,11 +189,11 @@ def _walk(root: ET.Element) -> Iterator[tuple[ET.Element, str, _Place]]:
                 continue  # comments and processing instructions
             if child.tag in OWNERS:
                 name = child.get("name")
-                child_owner = f"{child.tag} {name!r}" if name is not None else f"{child.tag} (unnamed)"
+                child_owner = f"{child.tag} {quoted(name)}" if name is not None else f"{child.tag} (unnamed)"
                 child_path = ""
             else:
                 child_owner, child_path = owner, f"{path}<{child.tag}>"
-            yield child, element.tag, _Place(child_owner, child_path)
+            yield child, element, _Place(child_owner, child_path)
             yield from visit(child, child_owner, child_path)
 
     yield from visit(root, robot_owner, "")
@@ -235,8 +202,8 @@ def _walk(root: ET.Element) -> Iterator[tuple[ET.Element, str, _Place]]:
 # --------------------------------------------------------------------------- rules
 
 
-def _check_element(element: ET.Element, parent: str, place: _Place, source: str) -> None:
-    tag = element.tag
+def _check_element(element: ET.Element, parent_element: ET.Element, place: _Place, source: str) -> None:
+    tag, parent = element.tag, parent_element.tag
 
     def fail(problem: str) -> NoReturn:
         raise UrdfShapeError(source, f"{place}{problem}")
@@ -259,14 +226,15 @@ def _check_element(element: ET.Element, parent: str, place: _Place, source: str)
             raw = element.attrib[attr]
             number = parse_number(raw)
             if number is None:
-                fail(f" {attr} = {raw!r}: {NOT_A_NUMBER}{why_not(raw)}")
+                fail(f" {attr} = {quoted(raw)}: {NOT_A_NUMBER}{why_not(raw)}")
             values[attr] = (number,)
 
     for attr in NON_NEGATIVE.get(tag, ()):
         if attr in values and min(values[attr]) < 0:
-            fail(f" {attr} = {element.attrib[attr]!r}: must be ≥ 0")
-    if tag == "axis" and parent == "joint" and "xyz" in values and not any(values["xyz"]):
-        fail(f" xyz = {element.attrib['xyz']!r}: a joint axis must not be the zero vector")
+            fail(f" {attr} = {quoted(element.attrib[attr])}: must be ≥ 0")
+    moves = parent_element.get("type") not in AXIS_IGNORED
+    if tag == "axis" and parent == "joint" and moves and "xyz" in values and not any(values["xyz"]):
+        fail(f" xyz = {quoted(element.attrib['xyz'])}: a joint axis must not be the zero vector")
     if tag == "dynamics" and parent == "joint" and not {"damping", "friction"} & element.attrib.keys():
         fail(": has neither 'damping' nor 'friction' (urdfdom refuses an empty <dynamics>)")
     if tag == "inertial":
@@ -288,7 +256,7 @@ def _facts(root: ET.Element, source: str) -> UrdfFacts:
         if name is None:
             raise UrdfShapeError(source, "a <joint> has no name attribute")
         if name in types:
-            raise UrdfShapeError(source, f"joint {name!r} is defined twice")
+            raise UrdfShapeError(source, f"joint {quoted(name)} is defined twice")
         types[name] = joint.get("type", "")
         element = joint.find("dynamics")
         if element is not None:

@@ -21,11 +21,20 @@ import re
 from collections.abc import Callable
 from typing import NoReturn
 
+from pendverify.display import shortened
+
 #: A plain decimal literal; it must match the whole attribute (no surrounding whitespace).
 DECIMAL = re.compile(r"[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?")
 NOT_A_NUMBER = "not a finite decimal number"
+#: characters of a value quoted in a message (a longer one is shortened around "…")
+QUOTE_WIDTH = 60
 #: Whitespace an XML parser would normalise to a space inside an attribute, with its character reference.
 RAW_WHITESPACE = {"\t": "&#9;", "\n": "&#10;", "\r": "&#13;"}
+
+
+def quoted(value: object) -> str:
+    """A value from the file as a message quotes it: its repr, the text shortened to ``QUOTE_WIDTH``."""
+    return repr(shortened(value, QUOTE_WIDTH)) if isinstance(value, str) else repr(value)
 
 
 def parse_number(raw: str) -> float | None:
@@ -48,10 +57,13 @@ def why_not(raw: str) -> str:
 def parse_vector(raw: str, count: int, fail: Callable[[str], NoReturn]) -> tuple[float, ...]:
     """``count`` numbers separated by spaces (leading/trailing/repeated spaces allowed, as in urdfdom)."""
     if any(c in raw for c in RAW_WHITESPACE):
-        fail(f"{raw!r}: separate the numbers with spaces only; urdfdom does not split on tabs or line breaks")
+        fail(
+            f"{quoted(raw)}: separate the numbers with spaces only; urdfdom does not split on tabs or "
+            "line breaks"
+        )
     pieces = [p for p in raw.split(" ") if p]
     if len(pieces) != count:
-        fail(f"{raw!r}: needs exactly {count} numbers separated by spaces, found {len(pieces)}")
+        fail(f"{quoted(raw)}: needs exactly {count} numbers separated by spaces, found {len(pieces)}")
     return parse_pieces(raw, pieces, fail)
 
 
@@ -61,6 +73,6 @@ def parse_pieces(raw: str, pieces: list[str], fail: Callable[[str], NoReturn]) -
     for i, piece in enumerate(pieces, 1):
         number = parse_number(piece)
         if number is None:
-            fail(f"{raw!r}: number {i}, {piece!r}, is {NOT_A_NUMBER}{why_not(piece)}")
+            fail(f"{quoted(raw)}: number {i}, {quoted(piece)}, is {NOT_A_NUMBER}{why_not(piece)}")
         numbers.append(number)
     return tuple(numbers)

@@ -24,6 +24,7 @@ import threading
 import xml.dom.minidom
 from pathlib import Path
 
+from pendverify.display import shortened
 from pendverify.errors import UrdfShapeError
 from pendverify.robot.strict import parse_xml
 
@@ -33,6 +34,8 @@ XACRO_NAMESPACES = ("http://www.ros.org/wiki/xacro", "http://ros.org/wiki/xacro"
 XACRO_SUFFIXES = (".xacro",)
 
 _LOCK = threading.Lock()
+#: characters of xacro's message quoted (it may hold a whole ${...} expression)
+REASON_WIDTH = 200
 
 
 def uses_xacro(root) -> bool:
@@ -94,4 +97,4 @@ def _reason(exc: Exception) -> str:
             "it uses $(find PKG), which needs ROS's package index (ament_index_python), not installed here: "
             "expand it in a ROS environment (xacro FILE > FILE.urdf) and give the URDF"
         )
-    return message
+    return shortened(message, REASON_WIDTH)
