@@ -33,18 +33,23 @@ DEFAULT_MAX_STEPS = 100_000
 _BYTES_PER_VALUE = 8 * 4
 
 
-def max_samples() -> int:
-    """The limit on samples and on fixed steps: ``PENDVERIFY_MAX_SAMPLES``, else the default."""
-    text = os.environ.get(MAX_SAMPLES_VARIABLE)
+def environment_limit(variable: str, default: int) -> int:
+    """A work limit from the environment variable ``variable`` (a whole number >= 1), else ``default``."""
+    text = os.environ.get(variable)
     if text is None or text.strip() == "":
-        return DEFAULT_MAX_SAMPLES
+        return default
     try:
         value = float(text)
     except ValueError:
         value = math.nan
     if not (math.isfinite(value) and value >= 1 and value == int(value)):
-        raise InputError("<environment>", MAX_SAMPLES_VARIABLE, text, "must be a whole number >= 1, e.g. 5e6")
+        raise InputError("<environment>", variable, text, "must be a whole number >= 1, e.g. 5e6")
     return int(value)
+
+
+def max_samples() -> int:
+    """The limit on samples and on fixed steps: ``PENDVERIFY_MAX_SAMPLES``, else the default."""
+    return environment_limit(MAX_SAMPLES_VARIABLE, DEFAULT_MAX_SAMPLES)
 
 
 def check_scene_work(source: str, duration: float, sample_rate: float, step: float | None, nx: int) -> None:
