@@ -13,6 +13,8 @@ built, before the next operation:
   x**1025 overflows a double for every |x| ≥ 2 and underflows for every
   |x| ≤ 1/2, so a larger exponent means nothing in double precision, while
   expanding a sum to it would take without bound.  ``x**2`` is untouched.
+* A constant (``exp(1000)``, ``sqrt(2)**2000``) must be within a double's range
+  once evaluated, as a literal float must.
 * A number written as a literal is at most 309 digits (10**309 > 2**1024), and a
   float literal must be finite as a double (``1e300`` is read, ``1e400`` is not).
 * ``MAX_NESTING`` = 100: brackets (and calls, and powers of powers) nest at most
@@ -56,6 +58,18 @@ def checked(value):
         )
     if isinstance(value, sp.Float) and not math.isfinite(float(value)):
         raise ExpressionTooLarge(f"a number beyond a double's range (≈ 1.8e308): {sp.sstr(value)[:30]}")
+    if (
+        isinstance(value, sp.Expr)
+        and not isinstance(value, sp.Number)
+        and value.is_number
+        and not value.has(sp.zoo, sp.oo, sp.nan)  # refused as "not finite" by the readers
+    ):
+        number = complex(value.evalf(15))  # exp(1000): its arguments are already within range
+        if not (math.isfinite(number.real) and math.isfinite(number.imag)):
+            raise ExpressionTooLarge(
+                f"a constant beyond a double's range (≈ 1.8e308): {sp.sstr(value)[:40]} ≈ "
+                f"{sp.sstr(value.evalf(6))[:30]}"
+            )
     return value
 
 

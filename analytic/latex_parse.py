@@ -159,13 +159,13 @@ class _ToSympy(Transformer):
     def func(self, name, a):
         if isinstance(a, sp.MatrixBase):
             raise ValueError(f"{name} of a matrix")
-        return FUNCTIONS[str(name)[1:]](a)
+        return limits.checked(FUNCTIONS[str(name)[1:]](a))
 
     def funcpow(self, name, power, a):
         return limits.power(self.func(name, a), power)
 
     def sqrt(self, a):
-        return sp.sqrt(a)
+        return limits.checked(sp.sqrt(a))
 
     def rows(self, *rows):
         return [r for r in rows if not (hasattr(r, "type") and r.type == "ROWSEP")]

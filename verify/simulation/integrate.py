@@ -171,7 +171,16 @@ def integrate(rhs, x0, duration, integrator, sample_times, breakpoints=(), label
             ts, xs = sol.t, sol.y.T
             nfev += sol.nfev
             if inside.size:
-                samples_x.append(sol.sol(inside).T)
+                with _overflow_reported_as_failure():
+                    dense = sol.sol(inside).T
+                if not np.all(np.isfinite(dense)):
+                    raise IntegrationError(
+                        label,
+                        f"{integrator.method}'s solution left double's range between t = {a:.6g} s and "
+                        f"{b:.6g} s; the scene's values (gravity, damping, initial state, rtol/atol) are "
+                        "beyond double precision",
+                    )
+                samples_x.append(dense)
         else:
             with _overflow_reported_as_failure():
                 ts, xs, fs, n = _rk4_segment(_finite(rhs, label), a, b, x, integrator.step)
