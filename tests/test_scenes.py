@@ -379,8 +379,9 @@ def test_the_default_step_limit_is_stated_and_a_raised_one_is_used():
         ({"method": "RK45", "max_steps": 0}, "key 'integrator.max_steps' = 0: expected a number >= 1"),
         ({"method": "RK45", "max_steps": 2.5}, "key 'integrator.max_steps' = 2.5: expected a whole number"),
         ({"method": "rk4", "step": 0.01, "max_steps": 10}, "rk4 has a fixed step: give step, not max_steps"),
+        ({"method": "RK45", "rtol": 1e-300}, "key 'integrator.rtol' = 1e-300: expected rtol >= 2.22e-14"),
     ],
 )
-def test_a_bad_step_limit_is_refused(integrator, message):
+def test_a_bad_step_limit_or_tolerance_is_refused(integrator, message):
     with pytest.raises(SceneError, match=re.escape(message)):
         parse_scene(dp_scene() | {"integrator": integrator}, "x.toml")

@@ -57,6 +57,9 @@ from pendverify.simulation.laws import Law
 from pendverify.simulation.limits import DEFAULT_MAX_STEPS, check_scene_work
 from pendverify.simulation.scene_reader import TableReader
 
+#: the smallest rtol scipy's solve_ivp honours (it raises a smaller one to this, with a warning)
+MIN_RTOL = 100 * 2.220446049250313e-16
+
 ADAPTIVE_METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 FIXED_STEP_METHODS = ("rk4",)
 ENGINES = ("aba", "closed_form", "both")
@@ -240,6 +243,9 @@ def parse_scene(data: dict, source: str, base: Path | None = None) -> Scene:
         if integ.has("step"):
             integ.fail("step", integ.get("step"), f"{method} is adaptive: give rtol and atol, not step")
         rtol = integ.number("rtol", default=1e-9, positive=True)
+        if rtol < MIN_RTOL:
+            integ.fail("rtol", integ.get("rtol"), f"expected rtol >= {MIN_RTOL:.3g} (100 × double's epsilon: "
+                       "scipy's adaptive methods go no lower)")  # fmt: skip
         atol = integ.number("atol", default=rtol, positive=True)
         max_steps = integ.number("max_steps", default=DEFAULT_MAX_STEPS, minimum=1)
         if max_steps != int(max_steps):
