@@ -76,7 +76,7 @@ class Reader:
         self.path = path
 
     def fail(self, key: str, problem: str):
-        raise PendverifyError(f"{self.path}: key '{key}': {problem}")
+        raise PendverifyError(f"{self.path}: key '{shortened(key, 80)}': {problem}")
 
     def names(self, data: dict, key: str) -> tuple[str, ...]:
         value = data.get(key, [])
@@ -88,7 +88,10 @@ class Reader:
 
     def identifier(self, key: str, name: str) -> None:
         if not name.isidentifier() or keyword.iskeyword(name) or name in FUNCTIONS or name in CONSTANTS:
-            self.fail(key, f"{name!r} is not a usable name (a Python identifier, not sin/cos/…/pi)")
+            self.fail(
+                key,
+                f"{shortened(repr(name), 60)} is not a usable name (a Python identifier, not sin/cos/…/pi)",
+            )
 
     def numbers(self, key: str, value, shape: tuple[int, ...]):
         """A list (or list of rows) of finite numbers of the given shape, as tuples."""

@@ -169,3 +169,11 @@ def test_what_is_not_an_expression_is_still_refused(tmp_path, expr, words):
     result = run("show", str(text_model(tmp_path, expr)))
     assert_refused(result, "key 'V'", *words)
     assert not (tmp_path / "MARKER").exists() and not Path("MARKER").exists()
+
+
+def test_a_4000_character_name_is_quoted_shortened(tmp_path):
+    long_name = "q" * 4000
+    source = TEXT.read_text().replace('theta2 = "angle"', f'theta2 = "angle"\n{long_name}x = "sideways"', 1)
+    path = tmp_path / "model.toml"
+    path.write_text(source)
+    assert_refused(run("show", str(path)), "coordinates.", "must be")
