@@ -36,9 +36,10 @@ import re
 from dataclasses import dataclass
 
 import sympy as sp
-from lark import Lark, Transformer, v_args
+from lark import Lark, Token, Transformer, v_args
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken, VisitError
 
+from pendverify.analytic import expression_limits as limits
 from pendverify.analytic.latex_text import Stop, Text, canonical_symbol, normalise
 from pendverify.errors import PendverifyError
 
@@ -53,15 +54,8 @@ class LatexError(PendverifyError):
 
 _GRAMMAR = r"""
 ?start: sum
-?sum: term
-    | "-" term            -> neg
-    | "+" term
-    | sum "+" term        -> add
-    | sum "-" term        -> sub
-?term: power
-    | term "*" power      -> mul
-    | term "/" power      -> div
-    | term power          -> mul
+?sum: SIGN? term (SIGN term)*
+?term: power (MULOP? power)*
 ?power: primary
     | primary "^" "{" sum "}"  -> pow
 ?primary: NUMBER          -> number
@@ -80,6 +74,8 @@ FUNC: /\\(sin|cos|tan|exp)(?![A-Za-z])/
 BEGIN: /\\begin\{[A-Za-z]+\}/
 END: /\\end\{[A-Za-z]+\}/
 ROWSEP: /\\\\/
+SIGN: "+" | "-"
+MULOP: "*" | "/"
 NUMBER: /\d+(\.\d*)?|\.\d+/
 %ignore " "
 """
@@ -109,43 +105,67 @@ class _ToSympy(Transformer):
         self.table = table
 
     def number(self, tok):
-        return sp.Integer(tok) if tok.isdigit() else sp.Float(str(tok))
+        return limits.literal(str(tok))
 
     def symbol(self, tok):
         return self.table.entries[str(tok).replace(" ", "")]
 
-    def neg(self, a):
-        return -a
+    def sum(self, *items):
+        """Terms with their signs (a leading sign optional), added in one flat ``Add``."""
+        terms, sign = [], 1
+        for item in items:
+            if isinstance(item, Token) and item.type == "SIGN":
+                sign = -1 if item == "-" else 1
+            else:
+                terms.append(item if sign == 1 else -item)
+                sign = 1
+        if any(isinstance(t, sp.MatrixBase) for t in terms):
+            total = terms[0]
+            for t in terms[1:]:
+                total = total + t
+            return total
+        return limits.checked(sp.Add(*terms))
 
-    def add(self, a, b):
-        return a + b
-
-    def sub(self, a, b):
-        return a - b
-
-    def mul(self, a, b):
-        return a * b
+    def term(self, *items):
+        """Factors, implicit or with ``*`` and ``/``, multiplied left to right (one flat ``Mul``)."""
+        factors, divide = [], False
+        for item in items:
+            if isinstance(item, Token) and item.type == "MULOP":
+                divide = item == "/"
+                continue
+            if divide:
+                if isinstance(item, sp.MatrixBase):
+                    raise ValueError("division by a matrix")
+                item = limits.power(item, sp.Integer(-1))
+            factors.append(item)
+            divide = False
+        if any(isinstance(f, sp.MatrixBase) for f in factors):
+            product = factors[0]
+            for f in factors[1:]:
+                product = product * f
+            return product
+        return limits.checked(sp.Mul(*factors))
 
     def div(self, a, b):
         if isinstance(b, sp.MatrixBase):
             raise ValueError("division by a matrix")
-        return a / b
+        return limits.checked(a * limits.power(b, sp.Integer(-1)))
 
     def pow(self, a, b):
         if isinstance(a, sp.MatrixBase):
             raise ValueError("a power of a matrix (write the product, or give M_inv as its own key)")
-        return a**b
+        return limits.power(a, b)
 
     def func(self, name, a):
         if isinstance(a, sp.MatrixBase):
             raise ValueError(f"{name} of a matrix")
-        return FUNCTIONS[str(name)[1:]](a)
+        return limits.checked(FUNCTIONS[str(name)[1:]](a))
 
     def funcpow(self, name, power, a):
-        return self.func(name, a) ** power
+        return limits.power(self.func(name, a), power)
 
     def sqrt(self, a):
-        return sp.sqrt(a)
+        return limits.checked(sp.sqrt(a))
 
     def rows(self, *rows):
         return [r for r in rows if not (hasattr(r, "type") and r.type == "ROWSEP")]
@@ -203,6 +223,10 @@ class LatexReader:
         except Stop as stop:
             raise LatexError(_show(text, stop.at, stop.why)) from None
         t.sub(r"[\s,.;]+$", "")  # a sentence's punctuation after a display
+        try:
+            limits.check_nesting(t.text, "({", ")}")
+        except limits.ExpressionTooLarge as exc:
+            raise LatexError(f"{exc} in {_excerpt(text)}") from None
         sides = _split_chain(t)
         label = ""
         if len(sides) > 1 and not t.text[slice(*sides[0])].strip():

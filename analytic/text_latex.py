@@ -14,6 +14,7 @@ from __future__ import annotations
 import sympy as sp
 
 from pendverify.analytic.latex_parse import LatexError, LatexReader, SymbolTable, canonical_symbol
+from pendverify.display import shortened
 
 
 def read_symbol_table(reader, table, allowed: dict, parse_entry) -> LatexReader:
@@ -44,7 +45,7 @@ def parse_latex_equation(reader, latex: LatexReader, key: str, value, rows: int,
 
     def read(k: str, text):
         if not isinstance(text, str):
-            reader.fail(k, f"must be LaTeX, as a string, got {text!r}")
+            reader.fail(k, f"must be LaTeX, as a string, got {shortened(repr(text), 60)}")
         try:
             return latex.read(text)[0]
         except LatexError as exc:

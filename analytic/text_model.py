@@ -33,6 +33,7 @@ from pendverify.analytic.module_names import module_name
 from pendverify.analytic.params import ParameterSet
 from pendverify.analytic.source_file import TEXT_FILE
 from pendverify.analytic.text_parse import Reader, TextModelSpec, read_text_model
+from pendverify.display import shortened
 
 #: equation key → (method, its arguments)
 METHODS = {
@@ -75,7 +76,11 @@ def complete_equations(reader: Reader, spec: TextModelSpec) -> None:
     for i in range(M.rows):
         for j in range(i + 1, M.cols):
             if not _is_zero(M[i, j] - M[j, i]):
-                reader.fail("M", f"not symmetric: M[{i},{j}] = {M[i, j]} but M[{j},{i}] = {M[j, i]}")
+                reader.fail(
+                    "M",
+                    f"not symmetric: M[{i},{j}] = {shortened(str(M[i, j]), 60)} "
+                    f"but M[{j},{i}] = {shortened(str(M[j, i]), 60)}",
+                )
     q = spec.symbols["q"]
     if "H" not in eq and "V" not in eq:
         reader.fail("H", "missing: give H (the gravity vector) or V (the potential energy), or both")
@@ -115,7 +120,9 @@ def _split_f(reader: Reader, spec: TextModelSpec) -> None:
             J = f.jacobian(list(sym[group]))
             if J.free_symbols & set(sym["q"] + sym["v"] + sym["u"] + sym["w"]):
                 reader.fail(
-                    "f", f"is not f0(q, q̇) + {key}·{group} with a constant {key}: ∂f/∂{group} = {J.tolist()}"
+                    "f",
+                    f"is not f0(q, q̇) + {key}·{group} with a constant {key}: "
+                    f"∂f/∂{group} = {shortened(str(J.tolist()), 80)}",
                 )
             eq[key] = J
     driven = f.xreplace(rest)
@@ -131,7 +138,9 @@ def _split_f(reader: Reader, spec: TextModelSpec) -> None:
     D = -velocity.jacobian(list(v)).xreplace(zero)
     if D.free_symbols & set(sym["q"]):
         reader.fail(
-            "f", f"its part linear in q̇ (the damping −D·q̇) depends on the coordinates: D = {D.tolist()}"
+            "f",
+            "its part linear in q̇ (the damping −D·q̇) depends on the coordinates: "
+            f"D = {shortened(str(D.tolist()), 80)}",
         )
     Cqdot = -(velocity + D * v)  # kept as written: the homogeneity test below expands a copy
     lam = sp.Dummy("lam")

@@ -13,32 +13,31 @@ rates named ``d<coordinate>``; and ``[urdf]`` (``joints``, ``transform``,
 ``offset``).  With ``notation = "latex"`` the equations are LaTeX and a
 ``[symbols]`` table maps the document's symbols (``pendverify.analytic.text_latex``).
 
-Parsing is safe: no Python is run.  Each string is first read by ``ast`` and may
-hold only numbers, the declared names, + − * / ** and calls of sin, cos, tan,
-sqrt, exp (and pi); SymPy's ``parse_expr`` then builds it from an explicit symbol
-table, with no builtins and no automatic symbols.  Every problem is one line
-naming the file, the key and what is wrong.
+Parsing is safe: no Python is run.  Each string may hold only numbers, the
+declared names, + − * / ** and calls of sin, cos, tan, sqrt, exp (and pi); it is
+read by ``pendverify.analytic.text_expression``, which builds the SymPy expression
+itself, with bounded exact numbers and nesting
+(``pendverify.analytic.expression_limits``).  Every problem is one line naming the
+file, the key, what is wrong and where, quoting at most a short fragment.
 """
 
 from __future__ import annotations
 
-import ast
 import difflib
 import keyword
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import sympy as sp
-from sympy.parsing.sympy_parser import auto_number, parse_expr
 
 from pendverify.analytic.params import _RULES, read_toml
+from pendverify.analytic.text_expression import FUNCTIONS, ExpressionError, fragment, read_expression
 from pendverify.analytic.text_latex import parse_latex_equation, read_symbol_table
+from pendverify.display import shortened
 from pendverify.errors import PendverifyError
 
-FUNCTIONS = {"sin": sp.sin, "cos": sp.cos, "tan": sp.tan, "sqrt": sp.sqrt, "exp": sp.exp}
 CONSTANTS = {"pi": sp.pi}
-_GLOBALS = {"__builtins__": {}, "Integer": sp.Integer, "Float": sp.Float, "Rational": sp.Rational}
-_OPERATORS = (ast.Add, ast.Sub, ast.Mult, ast.Div, ast.Pow, ast.USub, ast.UAdd)
 TOP_KEYS = (
     "name", "notation", "coordinates", "inputs", "disturbances", "parameters", "symbols", "urdf",
     "M", "C", "C_plus_D", "Cqdot", "H", "V", "D", "B", "W", "f", "det_M", "M_inv", "qddot",
@@ -77,7 +76,7 @@ class Reader:
         self.path = path
 
     def fail(self, key: str, problem: str):
-        raise PendverifyError(f"{self.path}: key '{key}': {problem}")
+        raise PendverifyError(f"{self.path}: key '{shortened(key, 80)}': {problem}")
 
     def names(self, data: dict, key: str) -> tuple[str, ...]:
         value = data.get(key, [])
@@ -89,7 +88,10 @@ class Reader:
 
     def identifier(self, key: str, name: str) -> None:
         if not name.isidentifier() or keyword.iskeyword(name) or name in FUNCTIONS or name in CONSTANTS:
-            self.fail(key, f"{name!r} is not a usable name (a Python identifier, not sin/cos/…/pi)")
+            self.fail(
+                key,
+                f"{shortened(repr(name), 60)} is not a usable name (a Python identifier, not sin/cos/…/pi)",
+            )
 
     def numbers(self, key: str, value, shape: tuple[int, ...]):
         """A list (or list of rows) of finite numbers of the given shape, as tuples."""
@@ -105,42 +107,19 @@ class Reader:
         return tuple(map(float, value)) if len(shape) == 1 else tuple(tuple(map(float, row)) for row in value)
 
 
-def _check_ast(reader: Reader, key: str, text: str, allowed: dict) -> None:
-    try:
-        tree = ast.parse(text.strip(), mode="eval")
-    except SyntaxError as exc:
-        reader.fail(key, f"{text!r} is not an expression ({exc.msg})")
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Name):
-            if node.id not in allowed:
-                close = difflib.get_close_matches(node.id, list(allowed), n=3)
-                hint = f"; did you mean {', '.join(close)}?" if close else ""
-                reader.fail(key, f"unknown name {node.id!r} in {text!r}{hint}")
-        elif isinstance(node, ast.Call):
-            if not (isinstance(node.func, ast.Name) and node.func.id in FUNCTIONS) or node.keywords:
-                reader.fail(key, f"only {', '.join(FUNCTIONS)} may be called, in {text!r}")
-        elif isinstance(node, ast.Constant):
-            if isinstance(node.value, bool) or not isinstance(node.value, int | float):
-                reader.fail(key, f"{node.value!r} is not a number, in {text!r}")
-        elif isinstance(node, ast.BitXor):
-            reader.fail(key, f"'^' in {text!r}: write powers as **")
-        elif not isinstance(node, (ast.Expression, ast.BinOp, ast.UnaryOp, ast.Load, *_OPERATORS)):
-            reader.fail(key, f"{type(node).__name__} is not allowed in {text!r} (numbers, names, + - * / **)")
-
-
 def parse_entry(reader: Reader, key: str, value, allowed: dict):
-    """One expression: a string in SymPy syntax (or a plain number)."""
+    """One expression: a string in SymPy syntax (or a plain number), read by ``text_expression``."""
     if isinstance(value, bool) or not isinstance(value, str | int | float):
-        reader.fail(key, f"each entry must be an expression string, got {value!r}")
-    text = str(value)
-    _check_ast(reader, key, text, allowed)
+        reader.fail(key, f"each entry must be an expression string, got {shortened(repr(value), 60)}")
+    if isinstance(value, float) and not math.isfinite(value):
+        reader.fail(key, f"{value!r} is not finite")
+    text = repr(value) if isinstance(value, float) else str(value)
     try:
-        expr = parse_expr(text.strip(), local_dict=dict(allowed), global_dict=dict(_GLOBALS),
-                          transformations=(auto_number,))  # fmt: skip
-    except (SyntaxError, TypeError, ValueError, NameError, ZeroDivisionError) as exc:
-        reader.fail(key, f"{text!r} cannot be read ({type(exc).__name__}: {exc})")
+        expr = read_expression(text, allowed)
+    except ExpressionError as exc:
+        reader.fail(key, f"{exc.why}, at character {exc.at + 1} of {fragment(text, exc.at)}")
     if expr.has(sp.zoo, sp.oo, sp.nan):
-        reader.fail(key, f"{text!r} is not finite")
+        reader.fail(key, f"{fragment(text, 0)} is not finite")
     return expr
 
 

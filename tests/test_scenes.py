@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import copy
 import json
+import re
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -11,7 +14,7 @@ import pytest
 
 from pendverify.analytic import CartDoublePendulum, DoublePendulum
 from pendverify.cli import main
-from pendverify.errors import SceneError
+from pendverify.errors import IntegrationError, SceneError
 from pendverify.simulation.dynamics import build_dynamics
 from pendverify.simulation.scene import load_scene, parse_scene
 from pendverify.simulation.simulate import simulate
@@ -317,3 +320,68 @@ def test_bad_scene_is_exit_2_with_one_line(tmp_path, capsys):
         capsys.readouterr().err
         == f"pendverify: error: {path}: key 'time.duration' = 0: expected a number > 0\n"
     )
+
+
+# --- bounded work: an adaptive run stops at integrator.max_steps ---------------------------------
+FAST_GRAVITY = GOOD + "[effects]\ngravity = 1_000_000_000\n"
+
+
+def _run_cli(*args: str, timeout: float = 120) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "pendverify", *args], capture_output=True, text=True, timeout=timeout
+    )
+
+
+def test_an_adaptive_run_that_needs_too_many_steps_stops_naming_the_key_and_limit(tmp_path):
+    path = _write(tmp_path, FAST_GRAVITY.replace('method = "RK45"', 'method = "RK45"\nmax_steps = 2000'))
+    result = _run_cli("simulate", path, "-o", str(tmp_path / "run.npz"))
+    err = result.stderr.strip()
+    assert result.returncode == 2, err
+    assert len(err.splitlines()) == 1 and "Traceback" not in err
+    assert path in err and "key 'integrator.max_steps'" in err and "more than 2000 steps" in err
+    assert not (tmp_path / "run.npz").exists()
+
+
+def test_report_stops_at_the_step_limit_too(tmp_path):
+    scenes = tmp_path / "scenes"
+    scenes.mkdir()
+    (scenes / "fast.toml").write_text(
+        FAST_GRAVITY.replace('method = "RK45"', 'method = "RK45"\nmax_steps = 500')
+    )
+    result = _run_cli(
+        "report", "-o", str(tmp_path / "out"), "--scenes", str(scenes), "--no-erd", "--samples", "5"
+    )
+    err = result.stderr.strip()
+    assert result.returncode == 2, err[-2000:]
+    assert "key 'integrator.max_steps'" in err and "Traceback" not in err
+
+
+def test_the_default_step_limit_is_stated_and_a_raised_one_is_used():
+    from pendverify.simulation.limits import DEFAULT_MAX_STEPS
+
+    assert (
+        load_scene(REPO / "scenes" / "damped_double_pendulum.toml").integrator.max_steps == DEFAULT_MAX_STEPS
+    )
+    scene = parse_scene(
+        dp_scene(gravity=True) | {"integrator": {"method": "DOP853", "max_steps": 5}}, "x.toml"
+    )
+    with pytest.raises(IntegrationError, match=r"key 'integrator.max_steps'.*more than 5 steps"):
+        simulate(scene)
+    enough = parse_scene(
+        dp_scene(gravity=True) | {"integrator": {"method": "DOP853", "max_steps": 5000}}, "x.toml"
+    )
+    assert all(r.passed for r in simulate(enough).invariants)
+
+
+@pytest.mark.parametrize(
+    ("integrator", "message"),
+    [
+        ({"method": "RK45", "max_steps": 0}, "key 'integrator.max_steps' = 0: expected a number >= 1"),
+        ({"method": "RK45", "max_steps": 2.5}, "key 'integrator.max_steps' = 2.5: expected a whole number"),
+        ({"method": "rk4", "step": 0.01, "max_steps": 10}, "rk4 has a fixed step: give step, not max_steps"),
+        ({"method": "RK45", "rtol": 1e-300}, "key 'integrator.rtol' = 1e-300: expected rtol >= 2.22e-14"),
+    ],
+)
+def test_a_bad_step_limit_or_tolerance_is_refused(integrator, message):
+    with pytest.raises(SceneError, match=re.escape(message)):
+        parse_scene(dp_scene() | {"integrator": integrator}, "x.toml")

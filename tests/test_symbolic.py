@@ -8,6 +8,10 @@ energies written from the stated conventions does.
 from __future__ import annotations
 
 import math
+import os
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,6 +19,7 @@ import sympy as sp
 
 from pendverify.analytic import MODELS, CartDoublePendulum, DoublePendulum
 from pendverify.analytic.forms import Energies
+from pendverify.analytic.plugin import load_model_class
 from pendverify.checks.catalogue import run_checks
 from pendverify.checks.sampling import sample_states
 from pendverify.checks.verdict import CHRISTOFFEL_CONSISTENT, NON_CHRISTOFFEL
@@ -25,6 +30,7 @@ from pendverify.robot.writer import urdf_for
 from pendverify.symbolic.compare import DIFFERS, EQUAL, SKIPPED, WARNING, compare
 from pendverify.symbolic.lagrange import derive
 from pendverify.symbolic.model import SymbolicModel, is_zero
+from pendverify.symbolic.work import DEFAULT_MAX_SYMBOLIC, MAX_SYMBOLIC_VARIABLE, symbolic_work
 
 from .conftest import SEED, default_params
 
@@ -183,3 +189,59 @@ def test_sympy_command(capsys):
     out = capsys.readouterr().out
     assert "58 entries" in out and "every closed form equals its derivation" in out
     assert main(["sympy", "--model", "triple"]) == 2
+
+
+# --- bounded work: the derivation's size is estimated before it starts ------------------------------
+def _dense_text_model(path: Path, n: int) -> Path:
+    """A text model whose n × n mass matrix is dense: every pair of coordinates is coupled."""
+
+    def entry(i: int, j: int) -> str:
+        a, b = min(i, j), max(i, j)
+        return f'"{n + 1}*m1 + m1*cos(q{i})**2"' if i == j else f'"m1*cos(q{a} - q{b})/{n}"'
+
+    rows = ",\n".join("[" + ", ".join(entry(i, j) for j in range(n)) + "]" for i in range(n))
+    lines = [
+        'name = "dense"',
+        f"M = [\n{rows}\n]",
+        'V = "' + " + ".join(f"g*m1*sin(q{i})" for i in range(n)) + '"',
+        "Cqdot = [" + ", ".join('"0"' for _ in range(n)) + "]",
+        "[coordinates]",
+        *(f'q{i} = "angle"' for i in range(n)),
+        "[parameters]",
+        'm1 = { kind = "mass", unit = "kg" }',
+        'g = { kind = "gravity", unit = "m/s²" }',
+    ]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def _sympy_cli(*args: str, env: dict | None = None) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "pendverify", "sympy", *args],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env={**os.environ, **(env or {})},
+    )
+
+
+def test_a_dense_50_dof_model_is_refused_before_the_derivation_naming_the_limit(tmp_path):
+    model = _dense_text_model(tmp_path / "dense.toml", 50)
+    result = _sympy_cli("--analytic", str(model))
+    err = result.stderr.strip()
+    assert result.returncode == 2, err
+    assert len(err.splitlines()) == 1 and "Traceback" not in err
+    assert str(model) in err and f"limit of {DEFAULT_MAX_SYMBOLIC}" in err and MAX_SYMBOLIC_VARIABLE in err
+
+
+def test_the_symbolic_limit_is_overridden_from_the_environment(tmp_path):
+    lowered = _sympy_cli("--model", "double_pendulum", env={MAX_SYMBOLIC_VARIABLE: "100"})
+    assert lowered.returncode == 2 and "limit of 100" in lowered.stderr, lowered.stderr
+    model = _dense_text_model(tmp_path / "dense.toml", 4)
+    n, ops = symbolic_work(SymbolicModel.of(load_model_class(model)))
+    refused = _sympy_cli("--analytic", str(model), env={MAX_SYMBOLIC_VARIABLE: str(n * ops - 1)})
+    assert refused.returncode == 2 and f"limit of {n * ops - 1}" in refused.stderr
+    allowed = _sympy_cli("--analytic", str(model), "--quiet", env={MAX_SYMBOLIC_VARIABLE: str(n * ops)})
+    assert allowed.returncode == 1, allowed.stderr  # read and compared: its Cqdot = 0 differs
+    bad = _sympy_cli("--model", "double_pendulum", env={MAX_SYMBOLIC_VARIABLE: "lots"})
+    assert bad.returncode == 2 and f"key '{MAX_SYMBOLIC_VARIABLE}'" in bad.stderr, bad.stderr

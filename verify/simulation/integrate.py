@@ -93,8 +93,49 @@ def _hermite(ts, xs, fs, t):
     return h00 * xs[i] + h10 * h * fs[i] + h01 * xs[i + 1] + h11 * h * fs[i + 1]
 
 
+class _StepLimit(Exception):
+    """Raised by ``_StepCounter`` out of ``solve_ivp`` at time ``t``."""
+
+    def __init__(self, t: float):
+        super().__init__(t)
+        self.t = t
+
+
+class _StepCounter:
+    """A ``solve_ivp`` event that counts the run's steps and stops it beyond ``limit``.
+
+    ``solve_ivp`` evaluates its events once at the start of a segment and once after every
+    accepted step; the event never changes sign, and past the limit it raises ``_StepLimit``."""
+
+    terminal = False
+    direction = 0
+
+    def __init__(self, limit: int):
+        self.limit, self.steps = limit, 0
+
+    def __call__(self, t, x) -> float:
+        self.steps += 1
+        if self.steps > self.limit:
+            raise _StepLimit(float(t))
+        return 1.0
+
+    def segment_started(self) -> None:
+        self.steps -= 1  # the call at the segment's start is no step
+
+
+def _too_many_steps(label: str, integrator, t: float, duration: float) -> IntegrationError:
+    return IntegrationError(
+        label,
+        f"key 'integrator.max_steps': {integrator.method} took more than {integrator.max_steps:g} steps and "
+        f"reached only t = {t:.6g} s of {duration:g} s; the scene's values (gravity, damping, initial "
+        "state, rtol/atol) ask for very small steps. Raise the limit with integrator.max_steps in the "
+        "scene, or change those values",
+    )
+
+
 def integrate(rhs, x0, duration, integrator, sample_times, breakpoints=(), label="simulate") -> Integration:
     bounds = _segments(duration, list(breakpoints))
+    counter = _StepCounter(integrator.max_steps + 1) if integrator.adaptive else None  # + the first call
     steps_t, steps_x, samples_t, samples_x = [np.array([0.0])], [x0[None, :]], [], []
     nfev = 0
     x = np.asarray(x0, dtype=float)
@@ -103,16 +144,23 @@ def integrate(rhs, x0, duration, integrator, sample_times, breakpoints=(), label
         last = b == bounds[-1]
         inside = sample_times[(sample_times >= a) & ((sample_times < b) | (last & (sample_times <= b)))]
         if integrator.adaptive:
-            with _overflow_reported_as_failure():
-                sol = solve_ivp(
-                    rhs,
-                    (a, b),
-                    x,
-                    method=integrator.method,
-                    rtol=integrator.rtol,
-                    atol=integrator.atol,
-                    dense_output=True,
-                )
+            try:
+                with _overflow_reported_as_failure():
+                    sol = solve_ivp(
+                        rhs,
+                        (a, b),
+                        x,
+                        method=integrator.method,
+                        rtol=integrator.rtol,
+                        atol=integrator.atol,
+                        dense_output=True,
+                        events=counter,
+                    )
+            except _StepLimit as stop:
+                if bar is not None:
+                    bar.close()
+                raise _too_many_steps(label, integrator, stop.t, duration) from None
+            counter.segment_started()
             if sol.status != 0:
                 raise IntegrationError(
                     label,
@@ -123,7 +171,16 @@ def integrate(rhs, x0, duration, integrator, sample_times, breakpoints=(), label
             ts, xs = sol.t, sol.y.T
             nfev += sol.nfev
             if inside.size:
-                samples_x.append(sol.sol(inside).T)
+                with _overflow_reported_as_failure():
+                    dense = sol.sol(inside).T
+                if not np.all(np.isfinite(dense)):
+                    raise IntegrationError(
+                        label,
+                        f"{integrator.method}'s solution left double's range between t = {a:.6g} s and "
+                        f"{b:.6g} s; the scene's values (gravity, damping, initial state, rtol/atol) are "
+                        "beyond double precision",
+                    )
+                samples_x.append(dense)
         else:
             with _overflow_reported_as_failure():
                 ts, xs, fs, n = _rk4_segment(_finite(rhs, label), a, b, x, integrator.step)

@@ -23,6 +23,7 @@ A scene is a TOML file::
     method = "DOP853"           # RK45 | RK23 | DOP853 | Radau | BDF | LSODA (adaptive) | rk4 (fixed step)
     rtol = 1e-10                # adaptive methods
     atol = 1e-10
+    # max_steps = 100000        # adaptive methods: the most steps the run may take (the default)
     # step = 1e-3               # rk4 only, s
 
     [effects]                   # every effect is off unless turned on here
@@ -53,8 +54,11 @@ from pendverify.analytic.plugin import check_model_outputs, load_model_class, pl
 from pendverify.errors import InputError, PendverifyError, SceneError
 from pendverify.simulation.effects import parse_actuation, parse_disturbance
 from pendverify.simulation.laws import Law
-from pendverify.simulation.limits import check_scene_work
+from pendverify.simulation.limits import DEFAULT_MAX_STEPS, check_scene_work
 from pendverify.simulation.scene_reader import TableReader
+
+#: the smallest rtol scipy's solve_ivp honours (it raises a smaller one to this, with a warning)
+MIN_RTOL = 100 * 2.220446049250313e-16
 
 ADAPTIVE_METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 FIXED_STEP_METHODS = ("rk4",)
@@ -79,6 +83,7 @@ class Integrator:
     rtol: float = 1e-9
     atol: float = 1e-9
     step: float | None = None
+    max_steps: int = DEFAULT_MAX_STEPS  # adaptive methods: their accepted steps over the whole run
 
     @property
     def adaptive(self) -> bool:
@@ -232,16 +237,22 @@ def parse_scene(data: dict, source: str, base: Path | None = None) -> Scene:
     sample_rate = time.number("sample_rate", default=100.0, positive=True)
 
     integ = top.sub("integrator")
-    integ.only(("method", "rtol", "atol", "step"))
+    integ.only(("method", "rtol", "atol", "step", "max_steps"))
     method = integ.string("method", ADAPTIVE_METHODS + FIXED_STEP_METHODS)
     if method in ADAPTIVE_METHODS:
         if integ.has("step"):
             integ.fail("step", integ.get("step"), f"{method} is adaptive: give rtol and atol, not step")
         rtol = integ.number("rtol", default=1e-9, positive=True)
+        if rtol < MIN_RTOL:
+            integ.fail("rtol", integ.get("rtol"), f"expected rtol >= {MIN_RTOL:.3g} (100 × double's epsilon: "
+                       "scipy's adaptive methods go no lower)")  # fmt: skip
         atol = integ.number("atol", default=rtol, positive=True)
-        integrator = Integrator(method, rtol, atol)
+        max_steps = integ.number("max_steps", default=DEFAULT_MAX_STEPS, minimum=1)
+        if max_steps != int(max_steps):
+            integ.fail("max_steps", integ.get("max_steps"), "expected a whole number of steps >= 1")
+        integrator = Integrator(method, rtol, atol, max_steps=int(max_steps))
     else:
-        for key in ("rtol", "atol"):
+        for key in ("rtol", "atol", "max_steps"):
             if integ.has(key):
                 integ.fail(key, integ.get(key), f"{method} has a fixed step: give step, not {key}")
         step = integ.number("step", positive=True)

@@ -43,6 +43,7 @@ from pendverify.checks.verdict import CHRISTOFFEL_CONSISTENT, NON_CHRISTOFFEL
 from pendverify.errors import PendverifyError
 from pendverify.symbolic.lagrange import Lagrangian, derive, mass_matrix_rate
 from pendverify.symbolic.model import SymbolicModel, entries, is_zero, show, to_sympy
+from pendverify.symbolic.work import check_symbolic_work
 
 EQUAL, DIFFERS, WARNING, SKIPPED = "equal", "DIFFERS", "warning", "skipped"
 
@@ -177,6 +178,7 @@ def compare(model_cls: type[ClosedFormModel], label: str | None = None) -> Symbo
     """Every closed form of ``model_cls`` against the derivation from its energies."""
     started = time.perf_counter()
     sm = SymbolicModel.of(model_cls)
+    check_symbolic_work(sm)
     lag = derive(sm)
     angles, n = sm.angles, len(sm.symbols["q"])
     q = sm.symbols["q"]
