@@ -205,6 +205,8 @@ def _model_and_base(path: Path, data: dict):
     source = str(path)
     ref = data.get("model")
     base_ref = data.get("base", "default")
+    if not isinstance(base_ref, str) or not base_ref:
+        raise SweepError(source, "base", base_ref, 'expected "default" or a parameter file (a string)')
     if isinstance(ref, str) and ref.endswith((".py", ".toml")):
         model_file = path.parent / ref
         try:
@@ -212,7 +214,7 @@ def _model_and_base(path: Path, data: dict):
         except PendverifyError as exc:
             raise SweepError(source, "model", ref, f"not a usable model file: {exc}") from None
         cls = model.load()
-        if base_ref == "default" or not isinstance(base_ref, str):
+        if base_ref == "default":
             raise SweepError(
                 source, "base", base_ref, "a model file has no default set: give a parameter file"
             )
@@ -223,7 +225,7 @@ def _model_and_base(path: Path, data: dict):
         if not isinstance(urdf_ref, str) or not (path.parent / urdf_ref).is_file():
             raise SweepError(source, "urdf", urdf_ref, "a model file needs the URDF of its base set (a file)")
         return model, base, urdf_text(path.parent / urdf_ref, "a sweep")
-    if ref not in MODELS:
+    if not isinstance(ref, str) or ref not in MODELS:
         raise SweepError(source, "model", ref, f"expected a model file (.py) or one of {', '.join(MODELS)}")
     if "urdf" in data:
         raise SweepError(

@@ -33,6 +33,7 @@ from dataclasses import dataclass
 from pendverify.certify.sweep import Sweep
 from pendverify.certify.sweep_summary import SweepSummary
 from pendverify.certify.sweep_task import certify_chunk
+from pendverify.display import shortened
 from pendverify.errors import InputError, PendverifyError
 from pendverify.progress import bar
 
@@ -40,6 +41,7 @@ INTERRUPTED = 130  # 128 + SIGINT
 POLL_S = 0.2  # how often the run looks for an interruption
 MAX_CHUNK = 8  # sets per task at most: a chunk's results arrive together
 CHUNKS_PER_WORKER = 4  # smaller chunks below this many per worker, so the workers finish together
+SCHEDULER_SCHEMES = ("tcp", "tls", "ws", "wss")  # Dask's comms that need no extra package
 
 
 @dataclass
@@ -82,14 +84,20 @@ class Workers:
             raise PendverifyError("--scheduler needs Dask: pip install 'pendverify[dask]'") from None
         scheme, _, rest = scheduler.partition("://")
         host, _, port = rest.rpartition(":")
-        if not (scheme and host and port.isdigit()):
+        if not (scheme in SCHEDULER_SCHEMES and host and port.isdigit()):
+            schemes = ", ".join(f"{s}://" for s in SCHEDULER_SCHEMES)
             raise InputError(
-                "<command line>", "--scheduler", scheduler, "a Dask scheduler address, e.g. tcp://HOST:PORT"
+                "<command line>",
+                "--scheduler",
+                shortened(scheduler, 80),
+                f"a Dask scheduler address HOST:PORT after {schemes} (e.g. tcp://HOST:PORT)",
             )
         try:
             self.client = Client(scheduler, timeout="10s")
-        except (OSError, ValueError) as exc:  # unreachable, refused, or an address Dask cannot parse
-            raise PendverifyError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
+        except Exception as exc:  # Dask's connect: unreachable, refused, TLS unset, ...
+            raise PendverifyError(
+                f"cannot reach the Dask scheduler at {shortened(scheduler, 80)}: {type(exc).__name__}: {exc}"
+            ) from None
         self.executor = self.client.get_executor()
         self.count = max(1, sum(self.client.nthreads().values()))  # tasks the cluster runs at once
 
