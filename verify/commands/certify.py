@@ -163,7 +163,12 @@ def _run_sweep(args) -> int:
     sweep = load_sweep(args.sweep, args.max_sets)
     check_sweep_names(sweep, args.sweep)
     key = _key(args)  # a bad key fails before any work
-    state = prepare_output(sweep, args.output, args.force, args.resume)
+    state = prepare_output(sweep, args.output, args.force, args.resume, key)
+    if state.resigned and not args.quiet:
+        print(
+            f"{len(state.resigned)} set(s) certified in {args.output} but not signed by --key "
+            "(unsigned, or signed by another key): recomputed and signed"
+        )
 
     def write(result: dict, replace: bool) -> int:
         return write_sweep_certificates(sweep, [result], args.output, args.force or replace, key)
