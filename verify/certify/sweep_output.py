@@ -29,7 +29,7 @@ from pathlib import Path
 from pendverify.certify.certificate import verify_digest
 from pendverify.certify.names import envelope_name
 from pendverify.certify.signing import fingerprint, open_envelope, sha256_bytes
-from pendverify.errors import CertificateError, InputError, SigningError
+from pendverify.errors import CertificateError, FileAccessError, InputError, SigningError
 
 BUNDLE_SUFFIXES = (".cert.json", ".urdf", ".mjcf.xml", ".sdf", ".params.toml", ".model.py", ".model.toml")
 TEMPORARY = re.compile(r"^\.(?P<file>.+)\.[a-z0-9_]+\.tmp$")  # pendverify.atomic's temporaries
@@ -99,6 +99,48 @@ def prepare_output(sweep, output, force: bool, resume: bool, key=None) -> Output
         elif any(name + suffix in files for suffix in BUNDLE_SUFFIXES):
             state.partial.add(name)
     return state
+
+
+class SameFolder:
+    """The output folder a sweep writes to, which must stay the one it started writing to.
+
+    ``check()`` before each bundle raises FileAccessError once the folder was removed or
+    replaced (the atomic writer would make a new, empty one: the sweep would then count
+    certificates that are no longer anywhere); ``wrote()`` after it records the folder
+    the first bundle created."""
+
+    def __init__(self, output):
+        self.path = Path(output)
+        self.identity = self._now()
+
+    def _now(self):
+        try:
+            st = os.stat(self.path)
+        except OSError:
+            return None
+        return st.st_dev, st.st_ino
+
+    def check(self) -> None:
+        if self.identity is not None and self._now() != self.identity:
+            raise FileAccessError(
+                str(self.path),
+                "write",
+                "the folder was removed or replaced during the sweep; the sweep stopped "
+                "(what is left there is kept: continue with --resume)",
+            )
+
+    def wrote(self) -> None:
+        if self.identity is None:
+            self.identity = self._now()
+
+
+def certificates_in(sweep, output) -> int:
+    """How many of the sweep's sets have a certificate in ``output`` now."""
+    try:
+        files = set(os.listdir(output))
+    except OSError:
+        return 0
+    return sum(f"{name}.cert.json" in files for name, _ in sweep.sets)
 
 
 def _remove_temporaries(out: Path, files: set[str], names: set[str]) -> None:

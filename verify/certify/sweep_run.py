@@ -11,18 +11,22 @@ their results, nor their futures: its memory does not grow with the number of se
 (``SweepSummary`` keeps counters, the worst figure per battery item and the first
 failures).  A sweep stopped part way keeps the certificates of the sets it finished.
 
-On SIGINT (Ctrl-C) the run stops: queued tasks are cancelled, local workers are
-terminated (they ignore SIGINT themselves, so a terminal's Ctrl-C reaches only
-the main process), a Dask client cancels its futures and closes, and the run
-returns marked ``interrupted``.  A bundle being written is finished first; a
-second SIGINT ends the process at once with status 130 (workers killed).  The
-sweep's progress bar is the only one: tasks draw none.
+On SIGINT (Ctrl-C) or SIGTERM the run stops: queued tasks are cancelled, local
+workers are killed (they ignore SIGINT and SIGTERM themselves, so a terminal's Ctrl-C
+or a ``kill`` of the process group reaches only the main process), a Dask client
+cancels its futures and closes, and the run returns marked ``interrupted`` with the
+signal's status (130 for SIGINT, 143 for SIGTERM).  A bundle being written is
+finished first; a second signal ends the process at once with that status (workers
+killed).  Local workers die with the main process however it ends, ``kill -9``
+included (``pendverify.signals.die_with_parent``), so none outlives it holding the
+caller's standard output.  The sweep's progress bar is the only one: tasks draw none.
 """
 
 from __future__ import annotations
 
 import itertools
 import math
+import multiprocessing
 import os
 import signal
 import sys
@@ -36,8 +40,10 @@ from pendverify.certify.sweep_task import certify_chunk
 from pendverify.display import shortened
 from pendverify.errors import InputError, PendverifyError
 from pendverify.progress import bar
+from pendverify.signals import TERMINATED, die_with_parent
 
 INTERRUPTED = 130  # 128 + SIGINT
+STATUS = {signal.SIGINT: INTERRUPTED, signal.SIGTERM: TERMINATED}  # a stopping signal's exit status
 POLL_S = 0.2  # how often the run looks for an interruption
 MAX_CHUNK = 8  # sets per task at most: a chunk's results arrive together
 CHUNKS_PER_WORKER = 4  # smaller chunks below this many per worker, so the workers finish together
@@ -51,6 +57,7 @@ class SweepRun:
     skipped: int  # sets whose valid bundle was already there (--resume)
     total: int
     interrupted: bool = False
+    status: int = INTERRUPTED  # when interrupted: the exit status of the signal that stopped it
     chunk: int = 1  # sets per task
     in_flight: int = 0  # tasks submitted and not finished, at most (the bound)
     peak_in_flight: int = 0  # the most there were at once
@@ -63,9 +70,12 @@ def chunk_size(sets: int, workers: int) -> int:
     return max(1, min(MAX_CHUNK, math.ceil(sets / (CHUNKS_PER_WORKER * max(1, workers)))))
 
 
-def _ignore_interrupts() -> None:
-    """A local worker's initializer: Ctrl-C is the main process's to handle."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+def _start_worker(parent: int | None) -> None:
+    """A local worker's initializer: Ctrl-C and SIGTERM are the main process's to handle, and
+    the worker dies with ``parent`` (the main process, or None: the fork server that forked it)."""
+    for signum in STATUS:
+        signal.signal(signum, signal.SIG_IGN)
+    die_with_parent(parent)
 
 
 class Workers:
@@ -76,7 +86,12 @@ class Workers:
         self.client = None
         if scheduler is None:
             self.count = workers or os.cpu_count() or 1
-            self.executor = ProcessPoolExecutor(max_workers=self.count, initializer=_ignore_interrupts)
+            forked_by_main = multiprocessing.get_start_method() != "forkserver"
+            self.executor = ProcessPoolExecutor(
+                max_workers=self.count,
+                initializer=_start_worker,
+                initargs=(os.getpid() if forked_by_main else None,),
+            )
             return
         try:
             from distributed import Client
@@ -120,39 +135,41 @@ class Workers:
             return
         processes = self._processes()
         self.executor.shutdown(wait=not cancel, cancel_futures=cancel)
-        if cancel:
+        if cancel:  # the workers ignore SIGTERM: SIGKILL (a task is a pure function: nothing to save)
             for process in processes:
-                process.terminate()
+                process.kill()
             for process in processes:
                 process.join(timeout=2)
-                if process.is_alive():
-                    process.kill()
 
 
 class Interrupts:
-    """SIGINT during a run: the first one asks the run to stop; a second ends the process (130)."""
+    """SIGINT or SIGTERM during a run: the first one asks the run to stop; a second ends the
+    process (130 or 143: ``status``, the first signal's)."""
 
     def __init__(self, workers: Workers):
         self.workers = workers
         self.requested = False
+        self.status = INTERRUPTED
         self._writing = False
         self._exit_pending = False
-        self._previous = None
+        self._previous = {}
 
     def __enter__(self) -> Interrupts:
         try:
-            self._previous = signal.signal(signal.SIGINT, self._handle)
+            for signum in STATUS:
+                self._previous[signum] = signal.signal(signum, self._handle)
         except ValueError:  # not the main thread: Ctrl-C stays a KeyboardInterrupt
-            self._previous = None
+            self._previous = {}
         return self
 
     def __exit__(self, *exc) -> None:
-        if self._previous is not None:
-            signal.signal(signal.SIGINT, self._previous)
+        for signum, previous in self._previous.items():
+            signal.signal(signum, previous)
 
     def _handle(self, signum, frame) -> None:
         if not self.requested:
             self.requested = True
+            self.status = STATUS[signum]
         elif self._writing:
             self._exit_pending = True
         else:
@@ -162,7 +179,7 @@ class Interrupts:
         self.workers.kill()
         sys.stdout.flush()
         print("pendverify: interrupted again: stopped at once", file=sys.stderr, flush=True)
-        os._exit(INTERRUPTED)
+        os._exit(self.status)
 
     @contextmanager
     def writing(self):
@@ -225,4 +242,5 @@ def run_sweep(
         finally:
             workers.close(cancel=bool(pending) or interrupts.requested)
     run.interrupted = interrupts.requested and run.summary.sets < total - skipped
+    run.status = interrupts.status
     return run

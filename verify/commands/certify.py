@@ -157,8 +157,9 @@ def _run_sweep(args) -> int:
 
     from pendverify.certify.issue import check_sweep_names, write_sweep_certificates
     from pendverify.certify.sweep import load_sweep
-    from pendverify.certify.sweep_output import prepare_output
-    from pendverify.certify.sweep_run import INTERRUPTED, Workers, run_sweep
+    from pendverify.certify.sweep_output import SameFolder, certificates_in, prepare_output
+    from pendverify.certify.sweep_run import Workers, run_sweep
+    from pendverify.signals import TERMINATED
 
     sweep = load_sweep(args.sweep, args.max_sets)
     check_sweep_names(sweep, args.sweep)
@@ -170,18 +171,32 @@ def _run_sweep(args) -> int:
             "(unsigned, or signed by another key): recomputed and signed"
         )
 
+    folder = SameFolder(args.output)
+
     def write(result: dict, replace: bool) -> int:
-        return write_sweep_certificates(sweep, [result], args.output, args.force or replace, key)
+        folder.check()
+        written = write_sweep_certificates(sweep, [result], args.output, args.force or replace, key)
+        folder.wrote()
+        return written
 
     run = run_sweep(sweep, Workers(args.scheduler, args.workers), write, state.done, state.partial)
     certified = run.written + run.skipped
     if run.interrupted:
+        how = "terminated" if run.status == TERMINATED else "interrupted"
         print(
-            f"pendverify: interrupted: {certified} of {run.total} set(s) certified in {args.output}; "
+            f"pendverify: {how}: {certified} of {run.total} set(s) certified in {args.output}; "
             "continue with --resume",
             file=sys.stderr,
         )
-        return INTERRUPTED
+        return run.status
+    there = certificates_in(sweep, args.output)  # what is there, not only what was written
+    if there < certified:
+        print(
+            f"pendverify: error: {certified} certificate(s) written or kept, but only {there} of the "
+            f"sweep's are in {args.output}: files were removed during the sweep; continue with --resume",
+            file=sys.stderr,
+        )
+        return 1
     if not args.quiet:
         print(run.summary.table())
         if args.resume:  # how many it skipped, zero included
