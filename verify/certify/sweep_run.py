@@ -17,7 +17,13 @@ or a ``kill`` of the process group reaches only the main process), a Dask client
 cancels its futures and closes, and the run returns marked ``interrupted`` with the
 signal's status (130 for SIGINT, 143 for SIGTERM).  A bundle being written is
 finished first; a second signal ends the process at once with that status (workers
-killed).  Local workers die with the main process however it ends, ``kill -9``
+killed).
+
+A sweep whose workers cannot go on stops with one line instead of waiting: a Dask
+client that lost its scheduler, a Dask cluster with no worker for ``worker_timeout``
+seconds (``--worker-timeout``, default ``WORKER_TIMEOUT_S``), or a local worker process
+that died (killed, out of memory).  The run returns marked ``lost`` (the reason); the
+certificates written so far stay.  Local workers die with the main process however it ends, ``kill -9``
 included (``pendverify.signals.die_with_parent``), so none outlives it holding the
 caller's standard output.  The sweep's progress bar is the only one: tasks draw none.
 """
@@ -25,12 +31,15 @@ caller's standard output.  The sweep's progress bar is the only one: tasks draw 
 from __future__ import annotations
 
 import itertools
+import logging
 import math
 import multiprocessing
 import os
 import signal
 import sys
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+import time
+from concurrent.futures import FIRST_COMPLETED, CancelledError, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
 from contextlib import contextmanager
 from dataclasses import dataclass
 
@@ -48,6 +57,8 @@ POLL_S = 0.2  # how often the run looks for an interruption
 MAX_CHUNK = 8  # sets per task at most: a chunk's results arrive together
 CHUNKS_PER_WORKER = 4  # smaller chunks below this many per worker, so the workers finish together
 SCHEDULER_SCHEMES = ("tcp", "tls", "ws", "wss")  # Dask's comms that need no extra package
+WORKER_TIMEOUT_S = 60.0  # a Dask cluster without a worker this long stops the sweep (--worker-timeout)
+WORKER_CHECK_S = 1.0  # how often the run asks the Dask scheduler how many workers it has
 
 
 @dataclass
@@ -57,6 +68,7 @@ class SweepRun:
     skipped: int  # sets whose valid bundle was already there (--resume)
     total: int
     interrupted: bool = False
+    lost: str | None = None  # why the workers could not go on (the sweep stopped), or None
     status: int = INTERRUPTED  # when interrupted: the exit status of the signal that stopped it
     chunk: int = 1  # sets per task
     in_flight: int = 0  # tasks submitted and not finished, at most (the bound)
@@ -82,8 +94,17 @@ class Workers:
     """Local worker processes, or a Dask cluster through a Client (``close`` stops either);
     ``count``: how many tasks they run at once."""
 
-    def __init__(self, scheduler: str | None = None, workers: int | None = None):
+    def __init__(
+        self,
+        scheduler: str | None = None,
+        workers: int | None = None,
+        worker_timeout: float = WORKER_TIMEOUT_S,
+    ):
         self.client = None
+        self.scheduler = scheduler
+        self.worker_timeout = worker_timeout
+        self._checked = -math.inf  # when the Dask scheduler was last asked for its workers
+        self._no_worker_since = None  # since when it has had none (time.monotonic), or None
         if scheduler is None:
             self.count = workers or os.cpu_count() or 1
             forked_by_main = multiprocessing.get_start_method() != "forkserver"
@@ -119,6 +140,28 @@ class Workers:
     def submit(self, *args):
         return self.executor.submit(*args)
 
+    def lost(self) -> str | None:
+        """Why a Dask cluster can no longer run the sweep's tasks, or None (local workers: None)."""
+        if self.client is None:
+            return None
+        if self.client.status != "running":
+            return f"lost the Dask scheduler at {shortened(self.scheduler, 80)} (client {self.client.status})"
+        now = time.monotonic()
+        if now - self._checked < WORKER_CHECK_S:
+            return None
+        self._checked = now
+        if self.client.scheduler_info().get("workers"):
+            self._no_worker_since = None
+            return None
+        if self._no_worker_since is None:
+            self._no_worker_since = now
+        if now - self._no_worker_since < self.worker_timeout:
+            return None
+        return (
+            f"the Dask cluster at {shortened(self.scheduler, 80)} has had no worker for "
+            f"{self.worker_timeout:g} s (--worker-timeout)"
+        )
+
     def _processes(self) -> list:
         return list((getattr(self.executor, "_processes", None) or {}).values())
 
@@ -130,8 +173,13 @@ class Workers:
     def close(self, cancel: bool = False) -> None:
         """Shut down; with ``cancel``, drop queued tasks and end the running ones."""
         if self.client is not None:
+            if self.client.status != "running":  # the scheduler is gone: the sweep says so in one line
+                _silence_dask_logs()
             self.executor.shutdown(wait=not cancel)  # wait=False cancels the futures
-            self.client.close(timeout=5)
+            try:
+                self.client.close(timeout=5)
+            except (OSError, TimeoutError):  # the scheduler is gone: nothing left to tell it
+                pass
             return
         processes = self._processes()
         self.executor.shutdown(wait=not cancel, cancel_futures=cancel)
@@ -140,6 +188,13 @@ class Workers:
                 process.kill()
             for process in processes:
                 process.join(timeout=2)
+
+
+def _silence_dask_logs() -> None:
+    """No more of Dask's own log lines (their tracebacks of a lost connection) in this process."""
+    for name in ["distributed", *logging.Logger.manager.loggerDict]:
+        if name == "distributed" or name.startswith("distributed."):
+            logging.getLogger(name).disabled = True
 
 
 class Interrupts:
@@ -193,6 +248,12 @@ class Interrupts:
                 self.exit_now()
 
 
+def _died(exc: BaseException) -> str:
+    if isinstance(exc, BrokenProcessPool):
+        return "a local worker process died (killed, or out of memory)"
+    return "the cluster cancelled a task of the sweep"
+
+
 def run_sweep(
     sweep: Sweep,
     workers: Workers,
@@ -232,15 +293,25 @@ def run_sweep(
                 if not pending:
                     break
                 finished, _ = wait(list(pending), timeout=POLL_S, return_when=FIRST_COMPLETED)
+                run.lost = None if finished else workers.lost()
+                if run.lost:
+                    break
                 for future in finished:
                     del pending[future]
-                    for result in future.result():
+                    try:
+                        results = future.result()
+                    except (BrokenProcessPool, CancelledError) as exc:  # not the task's own error
+                        run.lost = workers.lost() or _died(exc)
+                        break
+                    for result in results:
                         run.summary.add(result)
                         with interrupts.writing():
                             run.written += write(result, result["name"] in replace)
                         progress.update(1)
+                if run.lost:
+                    break
         finally:
-            workers.close(cancel=bool(pending) or interrupts.requested)
-    run.interrupted = interrupts.requested and run.summary.sets < total - skipped
+            workers.close(cancel=bool(pending) or interrupts.requested or run.lost is not None)
+    run.interrupted = interrupts.requested and run.summary.sets < total - skipped and not run.lost
     run.status = interrupts.status
     return run

@@ -9,12 +9,14 @@ from pendverify.commands import (
     add_analytic_option,
     add_command,
     non_negative_int,
+    positive_float,
     positive_int,
     refuse_together,
     write_json_report,
 )
 
 DEFAULT_MAX_SETS = 100_000  # pendverify.certify.sweep.DEFAULT_MAX_SETS, without importing NumPy here
+WORKER_TIMEOUT_S = 60.0  # pendverify.certify.sweep_run.WORKER_TIMEOUT_S, without importing it here
 
 
 def register(sub) -> None:
@@ -44,6 +46,14 @@ def register(sub) -> None:
     )
     p.add_argument(
         "--workers", type=positive_int, help="with --sweep: local worker processes (default: one per core)"
+    )
+    p.add_argument(
+        "--worker-timeout",
+        type=positive_float,
+        default=WORKER_TIMEOUT_S,
+        metavar="SECONDS",
+        help="with --scheduler: stop the sweep when the cluster has had no worker this long "
+        f"(default: {WORKER_TIMEOUT_S:g})",
     )
     p.add_argument(
         "--resume",
@@ -159,6 +169,7 @@ def _run_sweep(args) -> int:
     from pendverify.certify.sweep import load_sweep
     from pendverify.certify.sweep_output import SameFolder, certificates_in, prepare_output
     from pendverify.certify.sweep_run import Workers, run_sweep
+    from pendverify.exitcodes import BAD_INPUT
     from pendverify.signals import TERMINATED
 
     sweep = load_sweep(args.sweep, args.max_sets)
@@ -179,8 +190,16 @@ def _run_sweep(args) -> int:
         folder.wrote()
         return written
 
-    run = run_sweep(sweep, Workers(args.scheduler, args.workers), write, state.done, state.partial)
+    workers = Workers(args.scheduler, args.workers, args.worker_timeout)
+    run = run_sweep(sweep, workers, write, state.done, state.partial)
     certified = run.written + run.skipped
+    if run.lost:
+        print(
+            f"pendverify: error: {run.lost}: the sweep stopped; {certified} of {run.total} set(s) "
+            f"certified in {args.output}; continue with --resume",
+            file=sys.stderr,
+        )
+        return BAD_INPUT
     if run.interrupted:
         how = "terminated" if run.status == TERMINATED else "interrupted"
         print(
