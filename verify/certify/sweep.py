@@ -19,8 +19,9 @@ values rewritten where the base set's values sit (``pendverify.robot.rebind``); 
 range over a parameter the URDF does not show is refused, naming it.  Tasks carry
 the model file's source text, not the class, and load it once per worker.
 
-A sweep of more than ``max_sets`` sets (a count, or the product of a grid's
-points) is refused before any set is made.  ``pendverify.certify.sweep_run``
+A sweep's ``samples`` above ``PENDVERIFY_MAX_SAMPLES`` (``pendverify.simulation.limits``)
+is refused, as its simulations' samples are.  A sweep of more than ``max_sets`` sets (a
+count, or the product of a grid's points) is refused before any set is made.  ``pendverify.certify.sweep_run``
 runs the tasks (``pendverify.certify.sweep_task``), on local processes or a Dask
 cluster; the task is the same pure function either way, so both produce the same
 certificates.
@@ -44,6 +45,7 @@ from pendverify.certify.model_source import ModelSource
 from pendverify.errors import PendverifyError, SweepError
 from pendverify.robot.description import urdf_text
 from pendverify.robot.rebind import Binding
+from pendverify.simulation.limits import MAX_SAMPLES_VARIABLE, max_samples
 
 
 @dataclass(frozen=True)
@@ -122,6 +124,14 @@ def load_sweep(path: str | Path, max_sets: int = DEFAULT_MAX_SETS) -> Sweep:
         if isinstance(value, bool) or not isinstance(value, int) or value < (0 if key == "seed" else 1):
             raise SweepError(source, key, value, f"expected an integer >= {0 if key == 'seed' else 1}")
         ints[key] = value
+    limit = max_samples()
+    if ints["samples"] > limit:
+        raise SweepError(
+            source,
+            "samples",
+            ints["samples"],
+            f"more battery states per set than the limit of {limit:,}; raise it with {MAX_SAMPLES_VARIABLE}",
+        )
     duration = data.get("duration", 1.0)
     if (
         isinstance(duration, bool)
