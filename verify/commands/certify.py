@@ -169,6 +169,7 @@ def _run_sweep(args) -> int:
     from pendverify.certify.sweep import load_sweep
     from pendverify.certify.sweep_output import SameFolder, certificates_in, prepare_output
     from pendverify.certify.sweep_run import Workers, run_sweep
+    from pendverify.errors import PendverifyError
     from pendverify.exitcodes import BAD_INPUT
     from pendverify.signals import TERMINATED
 
@@ -186,7 +187,11 @@ def _run_sweep(args) -> int:
 
     def write(result: dict, replace: bool) -> int:
         folder.check()
-        written = write_sweep_certificates(sweep, [result], args.output, args.force or replace, key)
+        try:
+            written = write_sweep_certificates(sweep, [result], args.output, args.force or replace, key)
+        except PendverifyError:  # a write that failed because the folder went away says so
+            folder.check()
+            raise
         folder.wrote()
         return written
 
