@@ -1,6 +1,6 @@
 """A sweep whose workers go away stops with one line and keeps what finished, planted: the only
 Dask worker killed (no worker for ``--worker-timeout`` seconds), the Dask scheduler killed, and a
-local worker process killed."""
+local worker process killed; and a Dask scheduler frozen (SIGSTOP: connected, silent)."""
 
 from __future__ import annotations
 
@@ -58,6 +58,7 @@ def _stopped_with_one_line(proc: subprocess.Popen, out: Path, words: str) -> Non
 def _stop(*procs: subprocess.Popen) -> None:
     for proc in procs:
         if proc.poll() is None:
+            proc.send_signal(signal.SIGCONT)  # a stopped process too
             proc.kill()
         proc.wait(timeout=TIMEOUT_S)
 
@@ -79,7 +80,15 @@ def test_a_dask_cluster_whose_only_worker_died(tmp_path):
             _stop(proc, worker)
 
 
-def test_a_dask_scheduler_that_died(tmp_path):
+@pytest.mark.parametrize(
+    ("how", "words"),
+    [
+        (signal.SIGKILL, "lost the Dask scheduler at"),
+        (signal.SIGSTOP, "has not answered for 2 s (--worker-timeout)"),  # frozen: connected, silent
+    ],
+    ids=["killed", "frozen"],
+)
+def test_a_dask_scheduler_that_died(tmp_path, how, words):
     pytest.importorskip("distributed", reason="the dask extra is part of the test extras")
     file = tmp_path / "scheduler.json"
     listen = ("--host", "127.0.0.1", "--port", "0", "--scheduler-file", str(file))
@@ -95,10 +104,10 @@ def test_a_dask_scheduler_that_died(tmp_path):
         worker = _worker(address)
         out = tmp_path / "out"
         sweep = ("--sweep", str(_sweep(tmp_path)), "-o", str(out), "--scheduler", address)
-        proc = pendverify_process("certify", *sweep)
+        proc = pendverify_process("certify", *sweep, "--worker-timeout", "2")
         _until_first_certificate(proc, out)
-        scheduler.kill()
-        _stopped_with_one_line(proc, out, "lost the Dask scheduler at")
+        scheduler.send_signal(how)
+        _stopped_with_one_line(proc, out, words)
     finally:
         _stop(*(p for p in (proc, worker, scheduler) if p is not None))
 

@@ -150,15 +150,21 @@ class Workers:
         if now - self._checked < WORKER_CHECK_S:
             return None
         self._checked = now
-        if self.client.scheduler_info().get("workers"):
+        try:  # an RPC with a bound: a scheduler that does not answer counts as one without workers
+            identity = self.client.sync(self.client.scheduler.identity, callback_timeout=WORKER_CHECK_S * 5)
+            answered = True
+        except (OSError, TimeoutError):
+            identity, answered = {}, False
+        if identity.get("workers"):
             self._no_worker_since = None
             return None
         if self._no_worker_since is None:
             self._no_worker_since = now
         if now - self._no_worker_since < self.worker_timeout:
             return None
+        how = "had no worker" if answered else "not answered"
         return (
-            f"the Dask cluster at {shortened(self.scheduler, 80)} has had no worker for "
+            f"the Dask cluster at {shortened(self.scheduler, 80)} has {how} for "
             f"{self.worker_timeout:g} s (--worker-timeout)"
         )
 
