@@ -427,3 +427,40 @@ def test_a_closed_pipe_is_quiet_not_an_internal_error():
     finally:
         os.close(write_end)
     assert proc.returncode == 141 and proc.stderr.decode() == "", proc.stderr.decode()
+
+
+@pytest.mark.parametrize("address", ["ucx://127.0.0.1:8786", "inproc://x:1", "tcp://:8786"])
+def test_a_scheduler_address_dask_cannot_use_is_one_line(tmp_path, capsys, address):
+    sweep = tmp_path / "sweep.toml"
+    sweep.write_text('model = "double_pendulum"\ncount = 2\n[ranges]\nm1 = [0.5, 2.0]\n')
+    argv = ["certify", "--sweep", str(sweep), "-o", str(tmp_path / "out"), "--scheduler", address]
+    assert main(argv) == 2
+    line = error_line(capsys)
+    assert f"key '--scheduler' = '{address}'" in line and "tcp://" in line
+
+
+@pytest.mark.parametrize("base", ["0", "[1]", '""', "{ a = 1 }"])
+def test_a_sweep_base_that_is_not_a_file_name(tmp_path, capsys, base):
+    sweep = tmp_path / "sweep.toml"
+    sweep.write_text(f'model = "double_pendulum"\nbase = {base}\ncount = 2\n[ranges]\nm1 = [0.5, 2.0]\n')
+    assert main(["certify", "--sweep", str(sweep), "-o", str(tmp_path / "out")]) == 2
+    assert "key 'base'" in error_line(capsys)
+
+
+def test_a_sweep_model_that_is_not_a_name(tmp_path, capsys):
+    sweep = tmp_path / "sweep.toml"
+    sweep.write_text('model = ["double_pendulum"]\ncount = 2\n[ranges]\nm1 = [0.5, 2.0]\n')
+    assert main(["certify", "--sweep", str(sweep), "-o", str(tmp_path / "out")]) == 2
+    assert "key 'model'" in error_line(capsys)
+
+
+def test_sweep_samples_beyond_the_sample_limit_are_refused_up_front(tmp_path, capsys, monkeypatch):
+    sweep = tmp_path / "sweep.toml"
+    sweep.write_text('model = "double_pendulum"\nsamples = 100_000_000\n[ranges]\nm1 = [0.5, 2.0]\n')
+    assert main(["certify", "--sweep", str(sweep), "-o", str(tmp_path / "out")]) == 2
+    line = error_line(capsys)
+    assert "key 'samples' = 100000000" in line and "1,000,000" in line and "PENDVERIFY_MAX_SAMPLES" in line
+    monkeypatch.setenv("PENDVERIFY_MAX_SAMPLES", "1e9")  # raised: read (run is not asserted here)
+    from pendverify.certify.sweep import load_sweep
+
+    assert load_sweep(sweep).settings.samples == 100_000_000

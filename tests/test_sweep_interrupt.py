@@ -47,7 +47,7 @@ def _sweep(folder: Path, count: int = SETS) -> Path:
     return path
 
 
-def _pendverify(*args: str, **kw) -> subprocess.Popen:
+def pendverify_process(*args: str, **kw) -> subprocess.Popen:
     cmd = [sys.executable, "-c", "import sys; from pendverify.cli import main; sys.exit(main())", *args]
     return subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True, **kw)
 
@@ -60,7 +60,7 @@ def _items(folder: Path) -> dict[str, list]:
     }
 
 
-def _session_processes(sid: int) -> list[int]:
+def session_processes(sid: int) -> list[int]:
     """Processes still alive in session ``sid`` (the sweep and its workers)."""
     alive = []
     for stat in Path("/proc").glob("[0-9]*/stat"):
@@ -74,7 +74,7 @@ def _session_processes(sid: int) -> list[int]:
 
 
 def _interrupt_after_first_bundle(sweep: Path, out: Path, signals: int = 1, where=("--workers", "2")):
-    proc = _pendverify("certify", "--sweep", str(sweep), "-o", str(out), *where)
+    proc = pendverify_process("certify", "--sweep", str(sweep), "-o", str(out), *where)
     deadline = time.monotonic() + 120
     while not list(out.glob("*.cert.json")):
         assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
@@ -99,7 +99,7 @@ def test_ctrl_c_keeps_finished_sets_and_resume_completes_the_sweep(tmp_path, uni
     proc, elapsed, err = _interrupt_after_first_bundle(sweep, out)
     assert proc.returncode == 130, (proc.returncode, elapsed, err)
     assert "Traceback" not in err and "interrupted" in err and "--resume" in err, err
-    assert not _session_processes(proc.pid), "workers outlived the sweep"
+    assert not session_processes(proc.pid), "workers outlived the sweep"
     finished = sorted(out.glob("*.cert.json"))
     assert 1 <= len(finished) < SETS
     assert not [p for p in out.iterdir() if p.name.startswith(".")], "stray temporary files"
@@ -124,7 +124,7 @@ def test_a_second_ctrl_c_exits_at_once(tmp_path):
     assert len(list(out.glob("*.cert.json"))) < SETS, "the sweep computed every set"
     assert "Traceback" not in err, err
     time.sleep(0.5)
-    assert not _session_processes(proc.pid), "workers outlived the sweep"
+    assert not session_processes(proc.pid), "workers outlived the sweep"
 
 
 def test_ctrl_c_on_a_dask_sweep_cancels_its_tasks(tmp_path):
@@ -286,7 +286,7 @@ def test_an_error_mid_report_leaves_no_folder(tmp_path, monkeypatch):
     scenes = tmp_path / "scenes"
     scenes.mkdir()
     for stem in ("a", "b"):
-        _short_scene(scenes / f"{stem}.toml")
+        short_scene(scenes / f"{stem}.toml")
     calls = []
 
     def failing_review(*args):
@@ -314,7 +314,7 @@ def test_an_error_mid_report_leaves_no_folder(tmp_path, monkeypatch):
     assert [p.name for p in site.iterdir()] == ["review"]
 
 
-def _short_scene(path: Path) -> None:
+def short_scene(path: Path) -> None:
     path.write_text(
         'name = "short"\nmodel = "double_pendulum"\n[initial]\nq = [0.4, 0.9]\n'
         "[time]\nduration = 0.5\nsample_rate = 20.0\n"

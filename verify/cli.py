@@ -3,7 +3,8 @@
 ``main`` returns the exit status of the contract in ``pendverify.exitcodes``: 0 all
 good, 1 a verification failed, 2 bad input or usage (one line naming the file, key,
 value and rule), 3 an internal error (a bug: one line, the traceback with
-``--debug``), 130 interrupted.  Text goes out as UTF-8 whatever the locale.
+``--debug``), 130 interrupted, 143 terminated (SIGTERM, handled as Ctrl-C is:
+``pendverify.signals``).  Text goes out as UTF-8 whatever the locale.
 
 The global options ``--debug``, ``--quiet`` and ``--json PATH`` may come before or after
 the command's name; a command refuses those it does not take (status 2).  With
@@ -27,6 +28,7 @@ import traceback
 from pendverify import __version__, commands
 from pendverify.atomic import STDOUT
 from pendverify.commands import HelpFormatter, add_global_options
+from pendverify.signals import terminate_as_interrupt
 
 EXAMPLES = (
     "pendverify check",
@@ -38,7 +40,7 @@ EXAMPLES = (
 )
 EXIT_STATUS = (
     "exit status: 0 passed, 1 a verification failed, 2 bad input or usage, "
-    "3 internal error (a bug), 130 interrupted"
+    "3 internal error (a bug), 130 interrupted, 143 terminated (SIGTERM)"
 )
 
 
@@ -124,6 +126,11 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
 
 
 def main(argv: list[str] | None = None) -> int:
+    with terminate_as_interrupt():  # SIGTERM stops a command as Ctrl-C does (status 143)
+        return _main(argv)
+
+
+def _main(argv: list[str] | None) -> int:
     started = time.perf_counter()
     utf8_streams()
     try:

@@ -7,7 +7,9 @@ code meaning
 1    a verification failed (a check, an invariant, a certificate)
 2    bad input or usage: a file, a key, an option, an output path
 3    internal error: a bug in pendverify (one line; the traceback with ``--debug``)
-130  interrupted (Ctrl-C)
+130  interrupted (Ctrl-C, SIGINT)
+143  terminated (SIGTERM): handled as Ctrl-C is (finished work kept, temporaries removed),
+     as a shell reports a command ended by SIGTERM (128 + 15)
 141  the reader of standard output went away (``pendverify show X | head``): nothing printed,
      as a shell reports a command ended by SIGPIPE (128 + 13)
 ==== =====================================================================
@@ -22,6 +24,7 @@ import traceback
 
 from pendverify.analytic.plugin import user_code_error
 from pendverify.errors import PendverifyError
+from pendverify.signals import TERMINATED, Terminated
 
 PASSED = 0
 FAILED = 1
@@ -38,6 +41,8 @@ REPORT_BUGS = (
 
 def classify(exc: BaseException) -> tuple[int, str]:
     """(exit status, the one line to print on stderr) for an exception a command raised."""
+    if isinstance(exc, Terminated):
+        return TERMINATED, "terminated (SIGTERM)"
     if isinstance(exc, KeyboardInterrupt):
         return INTERRUPTED, "interrupted"
     if isinstance(exc, BrokenPipeError):

@@ -19,8 +19,9 @@ values rewritten where the base set's values sit (``pendverify.robot.rebind``); 
 range over a parameter the URDF does not show is refused, naming it.  Tasks carry
 the model file's source text, not the class, and load it once per worker.
 
-A sweep of more than ``max_sets`` sets (a count, or the product of a grid's
-points) is refused before any set is made.  ``pendverify.certify.sweep_run``
+A sweep's ``samples`` above ``PENDVERIFY_MAX_SAMPLES`` (``pendverify.simulation.limits``)
+is refused, as its simulations' samples are.  A sweep of more than ``max_sets`` sets (a
+count, or the product of a grid's points) is refused before any set is made.  ``pendverify.certify.sweep_run``
 runs the tasks (``pendverify.certify.sweep_task``), on local processes or a Dask
 cluster; the task is the same pure function either way, so both produce the same
 certificates.
@@ -44,6 +45,7 @@ from pendverify.certify.model_source import ModelSource
 from pendverify.errors import PendverifyError, SweepError
 from pendverify.robot.description import urdf_text
 from pendverify.robot.rebind import Binding
+from pendverify.simulation.limits import MAX_SAMPLES_VARIABLE, max_samples
 
 
 @dataclass(frozen=True)
@@ -122,6 +124,14 @@ def load_sweep(path: str | Path, max_sets: int = DEFAULT_MAX_SETS) -> Sweep:
         if isinstance(value, bool) or not isinstance(value, int) or value < (0 if key == "seed" else 1):
             raise SweepError(source, key, value, f"expected an integer >= {0 if key == 'seed' else 1}")
         ints[key] = value
+    limit = max_samples()
+    if ints["samples"] > limit:
+        raise SweepError(
+            source,
+            "samples",
+            ints["samples"],
+            f"more battery states per set than the limit of {limit:,}; raise it with {MAX_SAMPLES_VARIABLE}",
+        )
     duration = data.get("duration", 1.0)
     if (
         isinstance(duration, bool)
@@ -205,6 +215,8 @@ def _model_and_base(path: Path, data: dict):
     source = str(path)
     ref = data.get("model")
     base_ref = data.get("base", "default")
+    if not isinstance(base_ref, str) or not base_ref:
+        raise SweepError(source, "base", base_ref, 'expected "default" or a parameter file (a string)')
     if isinstance(ref, str) and ref.endswith((".py", ".toml")):
         model_file = path.parent / ref
         try:
@@ -212,7 +224,7 @@ def _model_and_base(path: Path, data: dict):
         except PendverifyError as exc:
             raise SweepError(source, "model", ref, f"not a usable model file: {exc}") from None
         cls = model.load()
-        if base_ref == "default" or not isinstance(base_ref, str):
+        if base_ref == "default":
             raise SweepError(
                 source, "base", base_ref, "a model file has no default set: give a parameter file"
             )
@@ -223,7 +235,7 @@ def _model_and_base(path: Path, data: dict):
         if not isinstance(urdf_ref, str) or not (path.parent / urdf_ref).is_file():
             raise SweepError(source, "urdf", urdf_ref, "a model file needs the URDF of its base set (a file)")
         return model, base, urdf_text(path.parent / urdf_ref, "a sweep")
-    if ref not in MODELS:
+    if not isinstance(ref, str) or ref not in MODELS:
         raise SweepError(source, "model", ref, f"expected a model file (.py) or one of {', '.join(MODELS)}")
     if "urdf" in data:
         raise SweepError(

@@ -9,6 +9,12 @@ found to be this sweep's (anything else is refused, or recomputed with
 ``--force``); a set with only part of its bundle (no certificate: it is written
 last) is recomputed and its files replaced; temporaries that a killed writer
 left beside the sweep's bundles are removed.
+
+With ``--resume --key KEY`` a certificate is kept only if it is signed by that key
+(its ``signature.keyid`` is the key's fingerprint, its envelope verifies with the key
+and records the certificate file's SHA-256); an unsigned certificate, or one signed by
+another key, is recomputed and signed, and ``OutputState.resigned`` names those sets so
+that the command says how many.
 """
 
 from __future__ import annotations
@@ -21,7 +27,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from pendverify.certify.certificate import verify_digest
-from pendverify.errors import CertificateError, InputError
+from pendverify.certify.names import envelope_name
+from pendverify.certify.signing import fingerprint, open_envelope, sha256_bytes
+from pendverify.errors import CertificateError, FileAccessError, InputError, SigningError
 
 BUNDLE_SUFFIXES = (".cert.json", ".urdf", ".mjcf.xml", ".sdf", ".params.toml", ".model.py", ".model.toml")
 TEMPORARY = re.compile(r"^\.(?P<file>.+)\.[a-z0-9_]+\.tmp$")  # pendverify.atomic's temporaries
@@ -31,6 +39,7 @@ TEMPORARY = re.compile(r"^\.(?P<file>.+)\.[a-z0-9_]+\.tmp$")  # pendverify.atomi
 class OutputState:
     done: set[str] = field(default_factory=set)  # sets whose valid certificate is there: skipped
     partial: set[str] = field(default_factory=set)  # sets with part of a bundle: recomputed, replaced
+    resigned: set[str] = field(default_factory=set)  # of partial: certified, but not signed by --key
 
 
 def check_output_folder(output) -> Path:
@@ -53,8 +62,9 @@ def check_output_folder(output) -> Path:
     return out
 
 
-def prepare_output(sweep, output, force: bool, resume: bool) -> OutputState:
-    """Check the folder and the bundles already in it (module docstring)."""
+def prepare_output(sweep, output, force: bool, resume: bool, key=None) -> OutputState:
+    """Check the folder and the bundles already in it (module docstring); ``key``: the
+    private key the sweep signs with, or None."""
     out = check_output_folder(output)
     files = set(os.listdir(out)) if out.is_dir() else set()
     state = OutputState()
@@ -73,17 +83,64 @@ def prepare_output(sweep, output, force: bool, resume: bool) -> OutputState:
     params_type = sweep.model.load().params_type
     for name, values in sweep.sets:
         if name + ".cert.json" in files:
+            path = out / f"{name}.cert.json"
             try:
-                _validate(out / f"{name}.cert.json", sweep, name, params_type.from_mapping(values).as_dict())
+                cert = _validate(path, sweep, name, params_type.from_mapping(values).as_dict())
             except CertificateError:
                 if not force:
                     raise
                 state.partial.add(name)
                 continue
+            if key is not None and not signed_by(path, cert, key):
+                state.partial.add(name)
+                state.resigned.add(name)
+                continue
             state.done.add(name)
         elif any(name + suffix in files for suffix in BUNDLE_SUFFIXES):
             state.partial.add(name)
     return state
+
+
+class SameFolder:
+    """The output folder a sweep writes to, which must stay the one it started writing to.
+
+    ``check()`` before each bundle raises FileAccessError once the folder was removed or
+    replaced (the atomic writer would make a new, empty one: the sweep would then count
+    certificates that are no longer anywhere); ``wrote()`` after it records the folder
+    the first bundle created."""
+
+    def __init__(self, output):
+        self.path = Path(output)
+        self.identity = self._now()
+
+    def _now(self):
+        try:
+            st = os.stat(self.path)
+        except OSError:
+            return None
+        return st.st_dev, st.st_ino
+
+    def check(self) -> None:
+        if self.identity is not None and self._now() != self.identity:
+            raise FileAccessError(
+                str(self.path),
+                "write",
+                "the folder was removed or replaced during the sweep; the sweep stopped "
+                "(what is left there is kept: continue with --resume)",
+            )
+
+    def wrote(self) -> None:
+        if self.identity is None:
+            self.identity = self._now()
+
+
+def certificates_in(sweep, output) -> int:
+    """How many of the sweep's sets have a certificate in ``output`` now."""
+    try:
+        files = set(os.listdir(output))
+    except OSError:
+        return 0
+    return sum(f"{name}.cert.json" in files for name, _ in sweep.sets)
 
 
 def _remove_temporaries(out: Path, files: set[str], names: set[str]) -> None:
@@ -94,8 +151,31 @@ def _remove_temporaries(out: Path, files: set[str], names: set[str]) -> None:
             (out / file).unlink(missing_ok=True)
 
 
-def _validate(path: Path, sweep, name: str, parameters: dict) -> None:
-    """Raise CertificateError unless ``path`` is an intact certificate of this sweep's set ``name``."""
+def signed_by(path: Path, cert: dict, key) -> bool:
+    """Whether the certificate ``cert`` (read from ``path``) is signed by ``key`` (a private key):
+    it names the key, its envelope verifies with the key and records this file's SHA-256."""
+    public = key.public_key()
+    signature = cert.get("signature")
+    if not isinstance(signature, dict) or signature.get("keyid") != fingerprint(public):
+        return False
+    envelope = path.parent / envelope_name(cert["name"])
+    try:
+        stmt = open_envelope(envelope.read_text(encoding="utf-8").strip(), public, str(envelope), "--key")
+    except (OSError, UnicodeDecodeError, SigningError):
+        return False
+    subjects = stmt.get("subject")
+    own = f"{cert['name']}.cert.json"
+    recorded = [
+        s.get("digest", {}).get("sha256")
+        for s in (subjects if isinstance(subjects, list) else [])
+        if isinstance(s, dict) and s.get("name") == own and isinstance(s.get("digest"), dict)
+    ]
+    return recorded == [sha256_bytes(path.read_bytes())]
+
+
+def _validate(path: Path, sweep, name: str, parameters: dict) -> dict:
+    """``path``'s certificate; CertificateError unless it is an intact certificate of this
+    sweep's set ``name``."""
     hint = "; remove it, or pass --force to recompute that set"
     try:
         cert = json.loads(path.read_text(encoding="utf-8"))
@@ -116,3 +196,4 @@ def _validate(path: Path, sweep, name: str, parameters: dict) -> None:
     for key, value in expected.items():
         if cert.get(key) != value:
             raise CertificateError(f"{path}: its {key} {cert.get(key)!r} is not this sweep's {value!r}{hint}")
+    return cert

@@ -9,12 +9,14 @@ from pendverify.commands import (
     add_analytic_option,
     add_command,
     non_negative_int,
+    positive_float,
     positive_int,
     refuse_together,
     write_json_report,
 )
 
 DEFAULT_MAX_SETS = 100_000  # pendverify.certify.sweep.DEFAULT_MAX_SETS, without importing NumPy here
+WORKER_TIMEOUT_S = 60.0  # pendverify.certify.sweep_run.WORKER_TIMEOUT_S, without importing it here
 
 
 def register(sub) -> None:
@@ -44,6 +46,14 @@ def register(sub) -> None:
     )
     p.add_argument(
         "--workers", type=positive_int, help="with --sweep: local worker processes (default: one per core)"
+    )
+    p.add_argument(
+        "--worker-timeout",
+        type=positive_float,
+        default=WORKER_TIMEOUT_S,
+        metavar="SECONDS",
+        help="with --scheduler: stop the sweep when the cluster has had no worker this long "
+        f"(default: {WORKER_TIMEOUT_S:g})",
     )
     p.add_argument(
         "--resume",
@@ -157,26 +167,60 @@ def _run_sweep(args) -> int:
 
     from pendverify.certify.issue import check_sweep_names, write_sweep_certificates
     from pendverify.certify.sweep import load_sweep
-    from pendverify.certify.sweep_output import prepare_output
-    from pendverify.certify.sweep_run import INTERRUPTED, Workers, run_sweep
+    from pendverify.certify.sweep_output import SameFolder, certificates_in, prepare_output
+    from pendverify.certify.sweep_run import Workers, run_sweep
+    from pendverify.errors import PendverifyError
+    from pendverify.exitcodes import BAD_INPUT
+    from pendverify.signals import TERMINATED
 
     sweep = load_sweep(args.sweep, args.max_sets)
     check_sweep_names(sweep, args.sweep)
     key = _key(args)  # a bad key fails before any work
-    state = prepare_output(sweep, args.output, args.force, args.resume)
+    state = prepare_output(sweep, args.output, args.force, args.resume, key)
+    if state.resigned and not args.quiet:
+        print(
+            f"{len(state.resigned)} set(s) certified in {args.output} but not signed by --key "
+            "(unsigned, or signed by another key): recomputed and signed"
+        )
+
+    folder = SameFolder(args.output)
 
     def write(result: dict, replace: bool) -> int:
-        return write_sweep_certificates(sweep, [result], args.output, args.force or replace, key)
+        folder.check()
+        try:
+            written = write_sweep_certificates(sweep, [result], args.output, args.force or replace, key)
+        except PendverifyError:  # a write that failed because the folder went away says so
+            folder.check()
+            raise
+        folder.wrote()
+        return written
 
-    run = run_sweep(sweep, Workers(args.scheduler, args.workers), write, state.done, state.partial)
+    workers = Workers(args.scheduler, args.workers, args.worker_timeout)
+    run = run_sweep(sweep, workers, write, state.done, state.partial)
     certified = run.written + run.skipped
-    if run.interrupted:
+    if run.lost:
         print(
-            f"pendverify: interrupted: {certified} of {run.total} set(s) certified in {args.output}; "
+            f"pendverify: error: {run.lost}: the sweep stopped; {certified} of {run.total} set(s) "
+            f"certified in {args.output}; continue with --resume",
+            file=sys.stderr,
+        )
+        return BAD_INPUT
+    if run.interrupted:
+        how = "terminated" if run.status == TERMINATED else "interrupted"
+        print(
+            f"pendverify: {how}: {certified} of {run.total} set(s) certified in {args.output}; "
             "continue with --resume",
             file=sys.stderr,
         )
-        return INTERRUPTED
+        return run.status
+    there = certificates_in(sweep, args.output)  # what is there, not only what was written
+    if there < certified:
+        print(
+            f"pendverify: error: {certified} certificate(s) written or kept, but only {there} of the "
+            f"sweep's are in {args.output}: files were removed during the sweep; continue with --resume",
+            file=sys.stderr,
+        )
+        return 1
     if not args.quiet:
         print(run.summary.table())
         if args.resume:  # how many it skipped, zero included
