@@ -222,3 +222,15 @@ def test_a_scene_too_long_to_animate_is_refused_before_it_is_simulated(tmp_path,
     line = error_line(capsys)
     assert "key 'time.duration'" in line and "limit of 50" in line
     assert "trajectory" not in capsys.readouterr().out
+
+
+def test_simulate_html_checks_the_frame_limit_before_simulating(tmp_path, monkeypatch, capsys):
+    """`simulate --html` is bounded as `render` is: refused from the scene's duration, no run made."""
+    scene = REPO / "scenes" / "damped_double_pendulum.toml"
+    monkeypatch.setenv(MAX_FRAMES_VARIABLE, "10")
+    npz = tmp_path / "run.npz"
+    code = main(["simulate", str(scene), "-o", str(npz), "--html", str(tmp_path / "x.html")])
+    assert code == 2
+    line = error_line(capsys)
+    assert "time.duration" in line and "limit of 10" in line
+    assert not npz.exists() and not (tmp_path / "x.html").exists()

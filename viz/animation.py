@@ -36,7 +36,6 @@ metadata names (``Trajectory.from_npz``).
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -48,7 +47,8 @@ from meshcat.animation import Animation
 from pendverify.analytic import MODELS, PARAMETER_TYPES, ParameterSet
 from pendverify.analytic.plugin import load_model_class
 from pendverify.display import shortened
-from pendverify.errors import InputError, TrajectoryError
+from pendverify.errors import TrajectoryError
+from pendverify.simulation.limits import environment_limit
 from pendverify.viz.geometry import ROOT, UP, VisualSystem
 from pendverify.viz.recorder import SceneRecorder
 from pendverify.viz.saved_run import read_saved_arrays
@@ -222,16 +222,7 @@ def _samples(source: str, t, q) -> tuple[np.ndarray, np.ndarray]:
 
 def max_frames() -> int:
     """The limit on an animation's frames: ``PENDVERIFY_MAX_FRAMES``, else ``DEFAULT_MAX_FRAMES``."""
-    text = os.environ.get(MAX_FRAMES_VARIABLE)
-    if text is None or text.strip() == "":
-        return DEFAULT_MAX_FRAMES
-    try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not (math.isfinite(value) and value >= 2 and value == int(value)):
-        raise InputError("<environment>", MAX_FRAMES_VARIABLE, text, "must be a whole number >= 2, e.g. 2e5")
-    return int(value)
+    return environment_limit(MAX_FRAMES_VARIABLE, DEFAULT_MAX_FRAMES, minimum=2)
 
 
 def check_frames(traj: Trajectory, fps: float = DEFAULT_FPS) -> None:

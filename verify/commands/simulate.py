@@ -89,6 +89,10 @@ def run(args: argparse.Namespace) -> int:
         check_output(path)
     check_report_output(args.json)
     scene = load_scene(args.scene)
+    if args.html:
+        from pendverify.viz.animation import check_frame_count
+
+        check_frame_count(scene.source, "time.duration", scene.duration, scene.duration)  # before simulating
     result = simulate(scene, args.engine, urdf_argument(args.urdf))
     text = summary(result)
     print(text.splitlines()[-1] if args.quiet else text)  # its last line is the verdict

@@ -33,8 +33,9 @@ DEFAULT_MAX_STEPS = 100_000
 _BYTES_PER_VALUE = 8 * 4
 
 
-def environment_limit(variable: str, default: int) -> int:
-    """A work limit from the environment variable ``variable`` (a whole number >= 1), else ``default``."""
+def environment_limit(variable: str, default: int, minimum: int = 1) -> int:
+    """A work limit from the environment variable ``variable`` (a whole number >= ``minimum``), else
+    ``default``."""
     text = os.environ.get(variable)
     if text is None or text.strip() == "":
         return default
@@ -42,8 +43,8 @@ def environment_limit(variable: str, default: int) -> int:
         value = float(text)
     except ValueError:
         value = math.nan
-    if not (math.isfinite(value) and value >= 1 and value == int(value)):
-        raise InputError("<environment>", variable, text, "must be a whole number >= 1, e.g. 5e6")
+    if not (math.isfinite(value) and value >= minimum and value == int(value)):
+        raise InputError("<environment>", variable, text, f"must be a whole number >= {minimum}, e.g. 5e6")
     return int(value)
 
 
