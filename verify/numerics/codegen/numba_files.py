@@ -72,14 +72,19 @@ def prune(module_path: Path, recorded: dict) -> dict[str, str]:
 
 
 def dispatchers(module: types.ModuleType) -> list:
-    from numba.core.dispatcher import Dispatcher
+    """The module's numba functions (found once per module)."""
+    found = module.__dict__.get("__pendverify_dispatchers__")
+    if found is None:
+        from numba.core.dispatcher import Dispatcher
 
-    return [obj for obj in vars(module).values() if isinstance(obj, Dispatcher)]
+        found = [obj for obj in vars(module).values() if isinstance(obj, Dispatcher)]
+        module.__pendverify_dispatchers__ = found
+    return found
 
 
 def compilations(module: types.ModuleType) -> int:
     """How many compilations this process ran for the module's functions (numba's cache misses)."""
-    return sum(sum(d.stats.cache_misses.values()) for d in dispatchers(module))
+    return sum(len(d.stats.cache_misses) for d in dispatchers(module))
 
 
 _WARNED: set[str] = set()
