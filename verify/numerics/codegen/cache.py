@@ -1,16 +1,24 @@
-"""The on-disk cache of generated modules.
+"""The on-disk cache of generated modules, trusted only where this user's pendverify wrote it.
 
 A generated module is written to ``$PENDVERIFY_CACHE/generated`` (or
-``~/.cache/pendverify/generated``) as ``rhs_<model>_<digest>.py``, the digest the
-SHA-256 of its source: it depends on the model's expressions (and on the copied
-templates), never on parameter values.  It is imported with importlib; its numba
-functions are ``@njit(cache=True)``, so their machine code lands in ``__pycache__``
-beside it.  An index file maps a *model key* — the SHA-256 of the source files that
-define the model class, its bases and its parameter set (and of the modules they
-use from outside the standard library and site-packages), of the generator package,
-of the symbolic reader and of the template modules — to that digest, so that a
-second process neither reads the model with SymPy nor compiles again.  A model
-whose formulas depend on code the key does not see may pass ``fresh=True``.
+``~/.cache/pendverify/generated``; a private temporary folder when that one is not
+private or cannot be written: ``codegen.folder``) as ``rhs_<model>_<digest>.py``, the
+digest the SHA-256 of its source: it depends on the model's expressions (and on the
+copied templates), never on parameter values.  Its numba functions are
+``@njit(cache=True)``, so their machine code lands in ``__pycache__`` beside it.  A signed
+index (``codegen.signed``) maps a *model key* — the SHA-256 of the source files that
+define the model class, its bases and its parameter set (and of the modules they use
+from outside the standard library and site-packages), of the generator package, of the
+symbolic reader and of the template modules, and of pendverify's and SymPy's versions —
+to that digest, so that a second process neither reads the model with SymPy nor
+compiles again.  A model whose formulas depend on code the key does not see may pass
+``fresh=True``.
+
+Before anything is imported: the index's signature, key and version hold, the module's
+bytes have the digest, and every numba file of the module that its signed record does
+not list with its SHA-256 is deleted (``codegen.numba_files``); the module is executed
+from the bytes that were hashed.  An entry that does not verify is regenerated, never
+imported (``docs/code-cache.md``).
 """
 
 from __future__ import annotations
