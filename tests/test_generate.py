@@ -395,7 +395,7 @@ def test_a_fresh_process_neither_generates_nor_compiles(fresh_cache):
         return json.loads(done.stdout.strip().splitlines()[-1])
 
     first, second = child(), child()
-    assert first["sympy"] and not second["sympy"]  # the second process does not even import SymPy
+    assert first["sympy"] and not second["sympy"], (first, second)  # the second does not import SymPy
     for name in ("double_pendulum", "cart_pole"):
         assert first[name]["origin"] == "generated", first
         assert second[name]["origin"] == "disk", second
