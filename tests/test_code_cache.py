@@ -327,3 +327,50 @@ def test_a_reference_that_cannot_be_cached_is_returned_with_a_note(small_problem
     assert not ref.cached and np.all(np.isfinite(ref.hi))
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "No space left on device" in err[0], err
+
+
+_LIMITED = """
+import resource, signal, sys
+signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write beyond the limit fails (EFBIG), as on a full disk
+resource.setrlimit(resource.RLIMIT_FSIZE, (int(sys.argv[1]), int(sys.argv[1])))
+from pendverify.cli import main
+sys.exit(main(sys.argv[2:]))
+"""
+
+
+def _limited(base: Path, limit: int, *argv: str) -> subprocess.CompletedProcess:
+    """``pendverify ARGV`` with files limited to ``limit`` bytes, on the cache ``base``."""
+    env = dict(os.environ, PENDVERIFY_CACHE=str(base))
+    command = [sys.executable, "-c", _LIMITED, str(limit), *argv]
+    return subprocess.run(command, env=env, capture_output=True, text=True, timeout=TIMEOUT)
+
+
+def test_certify_on_a_disk_too_full_for_any_code_is_one_line_exit_2(tmp_path):
+    params = str(REPO / "analytic" / "params" / "double_pendulum.toml")
+    out = str(tmp_path / "out")
+    done = _limited(tmp_path / "cache", 4096, "certify", params, "-o", out, "--samples", "40")
+    assert done.returncode == 2, done.stderr
+    assert "Traceback" not in done.stderr and "internal error" not in done.stderr
+    error = [line for line in done.stderr.splitlines() if line.startswith("pendverify: error:")]
+    assert len(error) == 1 and "pendverify-code-" in error[0] and "File too large" in error[0], done.stderr
+    assert str(tmp_path / "cache" / "generated") in done.stderr  # the note names the cache folder
+
+
+def test_numba_that_cannot_write_its_cache_runs_uncached_with_a_note(warm, tmp_path):
+    """Files limited to a size the module fits in and numba's machine code of ``_rhs`` does not
+    (≈ 21 and 26 kB): it runs, uncached."""
+    module_size = Path(warm[1]["path"]).stat().st_size
+    code_size = _numba_file(Path(warm[1]["path"]).parent, "_rhs", ".nbc").stat().st_size
+    assert module_size < code_size
+    size = (module_size + code_size) // 2
+    limit = "import resource, signal; signal.signal(signal.SIGXFSZ, signal.SIG_IGN); "
+    limit += f"resource.setrlimit(resource.RLIMIT_FSIZE, ({size}, {size}))\n"
+    env = dict(os.environ, PENDVERIFY_CACHE=str(tmp_path / "cache"))
+    done = subprocess.run(
+        [sys.executable, "-c", limit + _CHILD], env=env, capture_output=True, text=True, timeout=TIMEOUT
+    )
+    assert done.returncode == 0 and "Traceback" not in done.stderr, done.stderr
+    result = json.loads(done.stdout.strip().splitlines()[-1])
+    assert result["out"] == warm[1]["out"] and result["misses"] == 1
+    notes = [line for line in done.stderr.splitlines() if "numba cannot write its cache" in line]
+    assert len(notes) == 1 and "File too large" in notes[0], done.stderr

@@ -289,8 +289,12 @@ def _write(name: str, source: str, digest: str, key: str | None) -> Path:
                 signed.write(where / f"index_{key[:24]}.json", record)
             return path
         except (FileAccessError, OSError, UnicodeDecodeError) as exc:
-            reason = str(exc) if isinstance(exc, FileAccessError) else f"{path}: {exc}"
-            where = folder.give_up(where, reason)
+            failure = exc
+            if not isinstance(exc, FileAccessError):
+                failure = FileAccessError(str(path), "write", str(exc))
+            where = folder.give_up(where, str(failure))
+            if where is None:  # the temporary folder failed too: one line naming the file and why
+                raise failure from None
 
 
 def kernel(model_cls, fresh: bool = False) -> GeneratedKernel:

@@ -78,11 +78,11 @@ def used(folder: Path) -> Path:
     return _USED[asked]
 
 
-def give_up(folder: Path, why: str) -> Path:
-    """A write into ``folder`` failed (``why``): a temporary folder from now on, or, when ``folder``
-    is already the temporary one, a ``FileAccessError`` naming it (one line, exit status 2)."""
+def give_up(folder: Path, why: str) -> Path | None:
+    """A write into ``folder`` failed (``why``): the temporary folder to use from now on, or None
+    when ``folder`` is already this process's temporary folder (the caller reports the failure)."""
     if folder in _TEMPORARY:
-        raise FileAccessError(str(folder), "write", why)
+        return None
     for asked, path in list(_USED.items()):
         if path == folder:
             _USED[asked] = _temporary(folder, why)
