@@ -7,7 +7,9 @@ Engines, recorded in each invariant item's ``engine``:
   with the model's generated energy (``pendverify.numerics.energies``).  Every battery
   scene compiles: gravity, damping, the sine input and the seeded noise
   (``pendverify.numerics.forcing``).  It is the engine of every item the battery issues,
-  unless the fast path cannot take the model (its closed forms unreadable by SymPy);
+  unless the fast path cannot take the model (its closed forms unreadable by SymPy) —
+  never because of the code cache: one that cannot be used is replaced by a temporary
+  folder, and when no folder can be written the battery stops with that one line;
 * ``aba`` — scipy's DOP853 on Pinocchio's ABA on the URDF being certified, with
   Pinocchio's energy (``pendverify.simulation.simulate``): the engine of every invariant
   item issued before the fast path, so an item that records no engine ran on it.
@@ -41,7 +43,7 @@ from dataclasses import replace
 import numpy as np
 
 from pendverify.certify.scenes import effect_scenes
-from pendverify.errors import FastPathError, PendverifyError
+from pendverify.errors import FastPathError, FileAccessError, PendverifyError
 
 COMPILED, ABA = "compiled", "aba"
 ENGINES = {
@@ -98,6 +100,10 @@ def _run(scene, urdf: str, engine: str | None):
     if engine in (None, COMPILED):
         try:
             compiled = fast_scene.compile_scene(scene)
+        except FileAccessError:
+            # the code cache cannot be written, not even a temporary folder (``codegen.folder``):
+            # the item's engine must not change because of where code is cached; stop with the line
+            raise
         except (FastPathError, PendverifyError) as exc:
             if engine == COMPILED:
                 return COMPILED, None, 0, str(exc)

@@ -59,7 +59,7 @@ import numpy as np
 
 from pendverify.errors import FastPathError
 from pendverify.numerics.dop853 import OK, STEP_TOO_SMALL
-from pendverify.numerics.generate import GeneratedSystem
+from pendverify.numerics.generate import GeneratedSystem, record_compiled
 
 __all__ = ["FastPathError", "FastResult", "integrate", "integrate_ensemble", "warm_up"]
 
@@ -96,6 +96,7 @@ def integrate(system: GeneratedSystem, x0, t_end, rtol, atol, t_out=None, record
         if rows <= cap or not record:
             break
         cap = rows  # the run is deterministic: the second pass fits exactly
+    record_compiled()  # numba's files of a first call go into the cache's signed record
     if status != OK:
         why = "step size fell below 10 ulp" if status == STEP_TOO_SMALL else "non-finite error estimate"
         raise RuntimeError(f"fast-path DOP853 failed: {why} (rtol {rtol:g}, atol {atol:g})")
@@ -131,6 +132,7 @@ def integrate_ensemble(system: GeneratedSystem, X0, t_end, rtol, atol, threads: 
     else:
         with ThreadPoolExecutor(threads) as pool:
             list(pool.map(work, range(threads)))
+    record_compiled()
     if np.any(status != OK):
         raise RuntimeError(f"fast-path ensemble: {int(np.sum(status != OK))} trajectories failed")
     return X, nfev

@@ -42,7 +42,7 @@ import numpy as np
 from pendverify.errors import PendverifyError
 from pendverify.numerics.codegen.templates import placeholder, template
 from pendverify.numerics.fastpath import distinct_modules
-from pendverify.numerics.generate import GeneratedSystem
+from pendverify.numerics.generate import GeneratedSystem, record_compiled
 
 METHODS = {"euler": 1, "symplectic_euler": 1, "implicit_midpoint": 2, "rk4": 4}
 MAX_ITERATIONS = 200
@@ -170,6 +170,7 @@ def integrate_fixed(method: str, system: GeneratedSystem, x0, duration: float, s
     x0 = np.ascontiguousarray(x0, dtype=float)
     run = system.kernel.module._run
     out, nfev, status = run(_IDS[method], system.packed(), x0, duration / steps, steps, every)
+    record_compiled()  # numba's files of a first call go into the cache's signed record
     return out, int(nfev), status == OK
 
 

@@ -22,9 +22,10 @@ writes one Python module per model:
   (float, numpy, mpmath, Decimal, Taylor series) for the high-precision references
   (``codegen.generic``).
 
-The module is cached on disk by the digest of its source, and an index maps the
-model's source files to it, so a second process neither runs SymPy nor compiles
-(``codegen.cache``).
+The module is cached on disk by the digest of its source, and a signed index maps the
+model's source files (and pendverify's version) to it, so a second process neither runs
+SymPy nor compiles (``codegen.cache``; what is verified before anything is imported:
+``docs/code-cache.md``).
 
 Packed layout (``GeneratedSystem.packed``), for n coordinates, n_p parameters and
 nu inputs of the force law::
@@ -55,7 +56,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from pendverify.errors import FastPathError, PendverifyError
-from pendverify.numerics.codegen.cache import GeneratedKernel, cache_dir, forget, kernel, model_key
+from pendverify.numerics.codegen.cache import (
+    GeneratedKernel,
+    cache_dir,
+    forget,
+    kernel,
+    model_key,
+    record_compiled,
+)
 from pendverify.numerics.codegen.expressions import Expressions, expressions
 from pendverify.numerics.codegen.module import GENERATOR, render
 from pendverify.numerics.forcing import NO_FORCING, Forcing, forcing_of
@@ -71,6 +79,7 @@ __all__ = [
     "forget",
     "kernel",
     "model_key",
+    "record_compiled",
     "render",
 ]
 

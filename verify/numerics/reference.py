@@ -21,7 +21,10 @@ Cache.  Results go to ``$PENDVERIFY_CACHE`` or ``~/.cache/pendverify``, one
 digest of the model's generated generic code ``FIELD_DIGEST`` — the equations the
 reference integrates —, the packed parameters and force law and the initial
 state as exact float hex, horizon, dense grid, precisions, method version), so a
-cached reference is reused only for the identical problem.
+cached reference is reused only for the identical problem.  The files are arrays read
+without pickles; one that is truncated or not a reference of its key is computed again
+and rewritten, and a reference that cannot be written (a read-only or full cache) is
+returned uncached with one line on stderr.
 """
 
 from __future__ import annotations
@@ -30,7 +33,9 @@ import hashlib
 import io
 import json
 import os
+import sys
 import time
+import zipfile
 from dataclasses import dataclass
 from decimal import Decimal, localcontext
 from pathlib import Path
@@ -39,6 +44,8 @@ import mpmath
 import numpy as np
 
 from pendverify.atomic import write_atomic
+from pendverify.errors import FileAccessError
+from pendverify.numerics.codegen.folder import create_private
 from pendverify.numerics.taylor import (
     GUARD_DIGITS,
     TaylorRun,
@@ -113,15 +120,40 @@ def _cache_path(key: str) -> Path:
     return cache_dir() / f"reference-{key[:24]}.npz"
 
 
+#: what reading a cached reference that is not one ``_assemble`` wrote raises (truncated, garbage)
+UNREADABLE = (OSError, EOFError, ValueError, KeyError, TypeError, zipfile.BadZipFile)
+
+
 def _load(key: str) -> Reference | None:
+    """The cached reference of ``key``, or None when there is none or the file is not a complete
+    one for that key (it is then computed again and rewritten).  Arrays only: no pickles."""
     path = _cache_path(key)
     if not path.is_file():
         return None
-    with np.load(path) as data:
-        meta = json.loads(str(data["meta"]))
-        if meta.get("key") != key:
-            return None
-        return Reference(data["t"], data["hi"], data["lo"], **meta, cached=True)
+    try:
+        with open(path, "rb") as fh, np.load(fh, allow_pickle=False) as data:  # closed if np.load raises
+            meta = json.loads(str(data["meta"]))
+            if not isinstance(meta, dict) or meta.get("key") != key or set(meta) != set(_META):
+                return None
+            t, hi, lo = (np.asarray(data[name], float) for name in ("t", "hi", "lo"))
+    except UNREADABLE:
+        return None
+    if hi.shape != lo.shape or hi.shape[:1] != t.shape:
+        return None
+    return Reference(t, hi, lo, **meta, cached=True)
+
+
+_META = ("error_bound", "digits", "check_digits", "steps", "order", "seconds", "key")
+
+
+def _store(key: str, data: bytes) -> None:
+    """Write a reference to the cache; one that cannot be written is only noted (it was computed)."""
+    path = _cache_path(key)
+    try:
+        create_private(path.parent)
+        write_atomic(path, data)
+    except (FileAccessError, OSError) as exc:
+        print(f"pendverify: note: the reference is not cached ({exc})", file=sys.stderr, flush=True)
 
 
 def _assemble(run: TaylorRun, check: TaylorRun, grid, key, seconds, digits, check_digits, cache) -> Reference:
@@ -151,7 +183,7 @@ def _assemble(run: TaylorRun, check: TaylorRun, grid, key, seconds, digits, chec
     if cache:
         buf = io.BytesIO()
         np.savez(buf, t=grid, hi=hi, lo=lo, meta=np.array(json.dumps(meta)))
-        write_atomic(_cache_path(key), buf.getvalue())
+        _store(key, buf.getvalue())
     return Reference(np.asarray(grid, float), hi, lo, **meta)
 
 

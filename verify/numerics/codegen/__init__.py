@@ -10,5 +10,8 @@ generated and the packed layout).  The pieces:
   each generated module, so that they inline that model's right-hand side;
 * ``compiled``: the numba functions ``_rhs``, ``_hamilton``, ``_to_momentum``;
 * ``generic``: the plain-Python ``field``, ``energy`` and ``potential`` (Taylor, mpmath);
-* ``cache``: the on-disk cache of generated modules, keyed by the model's source.
+* ``cache``: the on-disk cache of generated modules, keyed by the model's source;
+* ``folder``: the cache's folder, private to its user (else a temporary one);
+* ``signed``: the cache's index and module records, signed with the user's cache key;
+* ``numba_files``: numba's cache files of a module, recorded by digest and pruned before import.
 """

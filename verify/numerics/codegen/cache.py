@@ -1,20 +1,29 @@
-"""The on-disk cache of generated modules.
+"""The on-disk cache of generated modules, trusted only where this user's pendverify wrote it.
 
 A generated module is written to ``$PENDVERIFY_CACHE/generated`` (or
-``~/.cache/pendverify/generated``) as ``rhs_<model>_<digest>.py``, the digest the
-SHA-256 of its source: it depends on the model's expressions (and on the copied
-templates), never on parameter values.  It is imported with importlib; its numba
-functions are ``@njit(cache=True)``, so their machine code lands in ``__pycache__``
-beside it.  An index file maps a *model key* — the SHA-256 of the source files that
-define the model class, its bases and its parameter set (and of the modules they
-use from outside the standard library and site-packages), of the generator package,
-of the symbolic reader and of the template modules — to that digest, so that a
-second process neither reads the model with SymPy nor compiles again.  A model
-whose formulas depend on code the key does not see may pass ``fresh=True``.
+``~/.cache/pendverify/generated``; a private temporary folder when that one is not
+private or cannot be written: ``codegen.folder``) as ``rhs_<model>_<digest>.py``, the
+digest the SHA-256 of its source: it depends on the model's expressions (and on the
+copied templates), never on parameter values.  Its numba functions are
+``@njit(cache=True)``, so their machine code lands in ``__pycache__`` beside it.  A signed
+index (``codegen.signed``) maps a *model key* — the SHA-256 of the source files that
+define the model class, its bases and its parameter set (and of the modules they use
+from outside the standard library and site-packages), of the generator package, of the
+symbolic reader and of the template modules, and of pendverify's and SymPy's versions —
+to that digest, so that a second process neither reads the model with SymPy nor
+compiles again.  A model whose formulas depend on code the key does not see may pass
+``fresh=True``.
+
+Before anything is imported: the index's signature, key and version hold, the module's
+bytes have the digest, and every numba file of the module that its signed record does
+not list with its SHA-256 is deleted (``codegen.numba_files``); the module is executed
+from the bytes that were hashed.  An entry that does not verify is regenerated, never
+imported (``docs/code-cache.md``).
 """
 
 from __future__ import annotations
 
+import atexit
 import functools
 import hashlib
 import importlib.metadata
@@ -30,7 +39,9 @@ from pathlib import Path
 
 from pendverify.analytic.source_file import defining_file
 from pendverify.atomic import write_atomic
+from pendverify.errors import FileAccessError, PendverifyError
 from pendverify.numerics.codegen import expressions as _expressions
+from pendverify.numerics.codegen import folder, numba_files, signed
 from pendverify.numerics.codegen import module as _module
 
 #: the modules the generated source depends on besides the model's own
@@ -38,10 +49,16 @@ SOURCES = ("pendverify.symbolic.model", "pendverify.numerics.dop853", "pendverif
 
 
 def cache_dir() -> Path:
-    """Where generated modules (and numba's cache of them) live."""
+    """Where generated modules (and numba's cache of them) live: ``generated`` in the cache folder
+    if that is private and writable, else a temporary folder (``codegen.folder``)."""
     from pendverify.numerics.reference import cache_dir as base
 
-    return base() / "generated"
+    return folder.used(base() / "generated")
+
+
+@functools.cache
+def _version() -> str:
+    return importlib.metadata.version("pendverify")
 
 
 #: {path: SHA-256} of model files imported from a text and deleted since (a certificate's
@@ -125,8 +142,8 @@ def _model_key(model_cls) -> str | None:
     except (TypeError, OSError):
         return None
     # not the module's name: a plug-in's is salted per process (pendverify.analytic.plugin)
-    version = importlib.metadata.version("sympy")
-    h = hashlib.sha256(f"{_module.GENERATOR}|{version}|{model_cls.__qualname__}".encode())
+    versions = f"{_version()}|{importlib.metadata.version('sympy')}"
+    h = hashlib.sha256(f"{_module.GENERATOR}|{versions}|{model_cls.__qualname__}".encode())
     try:  # names and contents, in an order that does not depend on where the files are
         entries = sorted(f"|{Path(path).name}:{_file_digest(path)}" for path in files)
     except OSError:  # a class loaded from a file that is gone and whose text was not remembered
@@ -166,36 +183,118 @@ _MEMORY: dict[str, types.ModuleType] = {}  # digest → module
 _KEYS: dict[str, str] = {}  # model key → digest
 _MODEL_KEYS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # model class → its model key
 _KEYLESS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # class without a key → digest
+_COMPILED: dict[str, int] = {}  # digest → numba compilations of its module already recorded
 
 
 def forget() -> None:
-    """Forget the modules and model keys this process holds: the next ``kernel`` call reads the
-    disk (tests)."""
+    """Record what this process compiled, then forget the modules, model keys and folder choices
+    it holds: the next ``kernel`` call reads the disk, as a new process would (tests)."""
+    record_compiled()
     _MEMORY.clear()
     _KEYS.clear()
     _MODEL_KEYS.clear()
     _KEYLESS.clear()
+    _COMPILED.clear()
+    folder.forget()
+    signed.forget()
+
+
+def _record_path(path: Path) -> Path:
+    return path.with_suffix(".json")
 
 
 def _import(path: Path, digest: str) -> types.ModuleType:
+    """The module at ``path`` executed from bytes whose SHA-256 is ``digest`` (a PendverifyError if
+    they are not), after deleting every numba file of it its signed record does not list."""
     if digest in _MEMORY:
         return _MEMORY[digest]
+    data = path.read_bytes()
+    if hashlib.sha256(data).hexdigest() != digest:
+        raise PendverifyError(f"{path}: the generated module changed on disk while it was used")
+    record = signed.read(_record_path(path)) or {}
+    numba = record.get("numba") if record.get("sha256") == digest else None
+    numba_files.prune(path, numba if isinstance(numba, dict) else {})
     name = f"pendverify_generated_{digest[:16]}"
     spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
     sys.modules[name] = module
-    spec.loader.exec_module(module)
+    # the verified bytes, not the file again (nor a .pyc beside it, which a loader would prefer)
+    exec(compile(data, str(path), "exec"), module.__dict__)
+    numba_files.guard(module)
     _MEMORY[digest] = module
+    _COMPILED[digest] = 0
     return module
+
+
+def record_compiled() -> None:
+    """Record, in each module's signed record, the numba files of the modules this process compiled
+    since it last recorded (numba writes them as it compiles; one comparison per module otherwise)."""
+    for digest, module in list(_MEMORY.items()):
+        done = numba_files.compilations(module)
+        if done <= _COMPILED.get(digest, 0):
+            continue
+        _COMPILED[digest] = done
+        path = Path(module.__file__)
+        record = {"sha256": digest, "pendverify": _version(), "numba": numba_files.digests(path)}
+        try:
+            signed.write(_record_path(path), record)
+        except (PendverifyError, OSError):  # a full disk: the files are compiled again next time
+            continue
+
+
+atexit.register(record_compiled)
 
 
 def _restore(path: Path, digest: str, origin: str, seconds: float) -> GeneratedKernel:
     return GeneratedKernel(_import(path, digest), digest, path, origin, seconds)
 
 
-def _module_path(name: str, digest: str) -> Path:
+def _module_path(name: str, digest: str, where: Path | None = None) -> Path:
     safe = "".join(c if c.isalnum() else "_" for c in name)[:40]
-    return cache_dir() / f"rhs_{safe}_{digest[:24]}.py"
+    return (where or cache_dir()) / f"rhs_{safe}_{digest[:24]}.py"
+
+
+def _index_path(key: str) -> Path:
+    return cache_dir() / f"index_{key[:24]}.json"
+
+
+def _from_index(key: str, name: str) -> tuple[str, Path] | None:
+    """(digest, path) of the module the signed index of ``key`` names, if it verifies."""
+    record = signed.read(_index_path(key))
+    if not record or record.get("key") != key or record.get("pendverify") != _version():
+        return None
+    digest = record.get("sha256")
+    if not isinstance(digest, str) or len(digest) != 64:
+        return None
+    path = _module_path(name, digest)
+    try:
+        if hashlib.sha256(path.read_bytes()).hexdigest() != digest:
+            return None
+    except OSError:
+        return None
+    return digest, path
+
+
+def _write(name: str, source: str, digest: str, key: str | None) -> Path:
+    """Write the module (unless it is there already) and the index of ``key``; in a temporary folder
+    when the cache folder refuses the write (``codegen.folder``)."""
+    where = cache_dir()
+    while True:
+        path = _module_path(name, digest, where)
+        try:
+            if not (path.is_file() and path.read_text(encoding="utf-8") == source):
+                write_atomic(path, source)  # never rewritten otherwise: numba's cache keys on the file
+            if key:
+                record = {"key": key, "sha256": digest, "pendverify": _version()}
+                signed.write(where / f"index_{key[:24]}.json", record)
+            return path
+        except (FileAccessError, OSError, UnicodeDecodeError) as exc:
+            failure = exc
+            if not isinstance(exc, FileAccessError):
+                failure = FileAccessError(str(path), "write", str(exc))
+            where = folder.give_up(where, str(failure))
+            if where is None:  # the temporary folder failed too: one line naming the file and why
+                raise failure from None
 
 
 def kernel(model_cls, fresh: bool = False) -> GeneratedKernel:
@@ -205,7 +304,6 @@ def kernel(model_cls, fresh: bool = False) -> GeneratedKernel:
     the module itself is still reused when its digest is unchanged."""
     start = time.perf_counter()
     key = None if fresh else model_key(model_cls)
-    index = cache_dir() / f"index_{key[:24]}.txt" if key else None
     if fresh:
         digest = None
     else:
@@ -213,21 +311,17 @@ def kernel(model_cls, fresh: bool = False) -> GeneratedKernel:
     if digest is not None:
         module = _MEMORY[digest]
         return GeneratedKernel(module, digest, Path(module.__file__), "memory", time.perf_counter() - start)
-    if index is not None and index.is_file():
-        digest = index.read_text(encoding="utf-8").strip()
-        path = _module_path(model_cls.name, digest)
-        if path.is_file() and hashlib.sha256(path.read_bytes()).hexdigest() == digest:
-            module = _import(path, digest)
-            _KEYS[key] = digest
-            return GeneratedKernel(module, digest, path, "disk", time.perf_counter() - start)
+    found = _from_index(key, model_cls.name) if key else None
+    if found is not None:
+        digest, path = found
+        module = _import(path, digest)
+        _KEYS[key] = digest
+        return GeneratedKernel(module, digest, path, "disk", time.perf_counter() - start)
     source = _module.render(_expressions.expressions(model_cls))
     digest = hashlib.sha256(source.encode()).hexdigest()
-    path = _module_path(model_cls.name, digest)
-    if not (path.is_file() and path.read_text(encoding="utf-8") == source):
-        write_atomic(path, source)  # never rewritten otherwise: numba's cache keys on the file's mtime
+    path = _write(model_cls.name, source, digest, key)
     module = _import(path, digest)
     if key:
-        write_atomic(index, digest + "\n")
         _KEYS[key] = digest
     elif not fresh:  # a class loaded from a file that is gone (a certificate's model source)
         _KEYLESS[model_cls] = digest
