@@ -33,16 +33,24 @@ def read_limited(path: str | Path, limit: int, what: str, error=CertificateError
         raise error(f"{path}: is a directory; give the {what} file") from None
     except OSError as exc:
         raise error(f"{path}: cannot read the {what}: {exc.strerror or exc}") from None
-    with os.fdopen(fd, "rb") as fh:
-        mode = os.fstat(fh.fileno()).st_mode
+    try:
+        mode = os.fstat(fd).st_mode
         if stat.S_ISDIR(mode):
             raise error(f"{path}: is a directory; give the {what} file")
         if not stat.S_ISREG(mode):
             raise error(f"{path}: not a regular file; the {what} must be one")
-        try:
-            data = fh.read(limit + 1)
-        except OSError as exc:
-            raise error(f"{path}: cannot read the {what}: {exc.strerror or exc}") from None
+        chunks, size = [], 0
+        while size <= limit:  # a read may return less than asked
+            chunk = os.read(fd, limit + 1 - size)
+            if not chunk:
+                break
+            chunks.append(chunk)
+            size += len(chunk)
+        data = b"".join(chunks)
+    except OSError as exc:
+        raise error(f"{path}: cannot read the {what}: {exc.strerror or exc}") from None
+    finally:
+        os.close(fd)
     if len(data) > limit:
         raise error(f"{path}: larger than the limit of {limit:,} bytes for a {what}")
     return data
