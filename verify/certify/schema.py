@@ -23,15 +23,26 @@ from pendverify.errors import CertificateError, PendverifyError
 NONFINITE = ("inf", "-inf", "nan")  # how pendverify.jsonio writes non-finite numbers
 
 
+def _as_float(v) -> float | None:
+    """A JSON number as a float (an integer beyond float's range is none); None for anything else."""
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        return None
+    try:
+        return float(v)
+    except OverflowError:
+        return None
+
+
 def _number(v) -> bool:
     if isinstance(v, str):
         return v in NONFINITE
-    return isinstance(v, (int, float)) and not isinstance(v, bool)
+    return _as_float(v) is not None
 
 
 def _finite(v) -> bool:
     """A number that is not infinite or NaN (written as itself, never as a string)."""
-    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+    number = _as_float(v)
+    return number is not None and math.isfinite(number)
 
 
 def _model_file(v) -> bool:
@@ -139,7 +150,7 @@ def check_schema(cert, source: str) -> None:
     if not isinstance(cert, dict):
         raise CertificateError(f"{source}: not a certificate: expected a JSON object")
     schema = cert.get("schema")
-    if schema in OLD_SCHEMAS:
+    if isinstance(schema, str) and schema in OLD_SCHEMAS:
         raise CertificateError(f"{source}: schema {schema!r} is no longer rechecked: {OLD_SCHEMAS[schema]}")
     if schema != SCHEMA:
         raise _bad(source, "schema", schema, f"expected {SCHEMA!r}")

@@ -26,8 +26,12 @@ def _whole(value) -> bool:
 
 
 def _positive_finite(value) -> bool:
-    number = isinstance(value, (int, float)) and not isinstance(value, bool)
-    return number and math.isfinite(value) and value > 0
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return False
+    try:
+        return math.isfinite(float(value)) and value > 0
+    except OverflowError:  # an integer beyond float's range
+        return False
 
 
 def settings_problem(key: str, value) -> str:
