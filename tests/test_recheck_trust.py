@@ -290,3 +290,12 @@ def test_an_endless_key_file_is_read_only_up_to_its_limit(tmp_path):
     assert "/dev/zero: larger than the limit of 65,536 bytes for a private key" in done.stderr
     done = _cli("recheck", str(write_bundle(tmp_path, make_certificate())), "--trust", "/dev/zero")
     assert done.returncode == 2 and "larger than the limit" in done.stderr
+
+
+def test_a_deeply_nested_envelope_is_refused(tmp_path, keys):
+    mine = keys["mine"][0]
+    path = write_bundle(tmp_path, make_certificate(key=mine), mine)
+    (tmp_path / "double_pendulum.intoto.jsonl").write_text("[" * 100_000 + "]" * 100_000 + "\n")
+    done = _cli("recheck", str(path), "--trust", str(keys["mine"][2]))
+    assert done.returncode == 2 and "Traceback" not in done.stderr, done.stderr
+    assert "not a DSSE envelope" in done.stderr

@@ -177,7 +177,7 @@ def open_envelope(text: str, trusted: Ed25519PublicKey, source: str, trusted_nam
         payload = base64.b64decode(envelope["payload"], validate=True)
         signatures = [(s["keyid"], base64.b64decode(s["sig"], validate=True)) for s in envelope["signatures"]]
         payload_type = envelope["payloadType"]
-    except (ValueError, KeyError, TypeError) as exc:  # binascii.Error is a ValueError
+    except (ValueError, KeyError, TypeError, RecursionError) as exc:  # binascii.Error is a ValueError
         raise SigningError(
             f"{source}: not a DSSE envelope (payloadType, payload, signatures): {exc}"
         ) from exc
@@ -203,7 +203,7 @@ def open_envelope(text: str, trusted: Ed25519PublicKey, source: str, trusted_nam
         )
     try:
         stmt = json.loads(payload)
-    except ValueError as exc:
+    except (ValueError, RecursionError) as exc:
         raise SigningError(f"{source}: the signed payload is not JSON: {exc}") from None
     if not isinstance(stmt, dict) or stmt.get("_type") != STATEMENT_TYPE:
         raise SigningError(f"{source}: the signed payload is not an in-toto Statement v1")
@@ -265,5 +265,5 @@ def signer_keyids(text: str) -> list[str]:
     """The keyids an envelope names (unverified), for messages; [] if it cannot be read."""
     try:
         return [s["keyid"] for s in json.loads(text)["signatures"]]
-    except (ValueError, KeyError, TypeError):
+    except (ValueError, KeyError, TypeError, RecursionError):
         return []
