@@ -299,3 +299,16 @@ def test_a_deeply_nested_envelope_is_refused(tmp_path, keys):
     done = _cli("recheck", str(path), "--trust", str(keys["mine"][2]))
     assert done.returncode == 2 and "Traceback" not in done.stderr, done.stderr
     assert "not a DSSE envelope" in done.stderr
+
+
+def test_a_bundle_file_beside_that_is_not_the_embedded_text_is_refused(tmp_path, capsys):
+    cert = make_certificate()
+    path = write_bundle(tmp_path, cert)
+    (tmp_path / "double_pendulum.urdf").write_text(cert["urdf"]["text"])  # the real one: fine
+    (tmp_path / "double_pendulum.model.py").write_text("raise SystemExit('not this bundle's file')\n")
+    from pendverify.certify.bundle import check_files_beside
+
+    check_files_beside(path, cert)  # a built-in model's bundle has no model file to compare
+    (tmp_path / "double_pendulum.urdf").write_text(cert["urdf"]["text"].replace("double_pendulum", "other"))
+    assert main(["recheck", str(path)]) == 2
+    assert "double_pendulum.urdf: not the text double_pendulum.cert.json embeds" in _one_line_error(capsys)

@@ -30,7 +30,7 @@ from pendverify.certify.signing import (
     statement_subjects,
 )
 from pendverify.display import shortened
-from pendverify.errors import CertificateError, SigningError
+from pendverify.errors import CertificateError, PendverifyError, SigningError
 from pendverify.robot.description import FILE_SUFFIXES, text_suffix
 
 
@@ -104,6 +104,34 @@ def bundle_file_names(name: str) -> set[str]:
     descriptions = {f"{name}{suffix}" for suffix in FILE_SUFFIXES.values()}
     models = {model_path(".", name, f"model{suffix}").name for suffix in MODEL_SUFFIXES}
     return {*descriptions, *models, *(p.name for p in bundle_paths(".", name))}
+
+
+def check_files_beside(cert_path: str | Path, cert: dict) -> None:
+    """Refuse a bundle whose description or model file beside ``NAME.cert.json`` is not the text the
+    certificate embeds (a file not copied along is fine).  A certificate file under another name
+    than its set's is not in a bundle: nothing beside it is compared."""
+    cert_path = Path(cert_path)
+    name = cert["name"]
+    if cert_path.name != bundle_paths(".", name)[2].name:
+        return
+    try:
+        suffix = text_suffix(cert["urdf"]["text"])
+    except PendverifyError:
+        suffix = None  # not a description at all: the battery's re-run says so
+    embedded = {f"{name}{suffix}": cert["urdf"]["text"]} if suffix else {}
+    record = cert.get("model_source")
+    if record is not None:
+        embedded[model_path(".", name, record["file"]).name] = record["text"]
+    for file_name, text in embedded.items():
+        path = cert_path.parent / file_name
+        if not path.is_file():
+            continue
+        data = read_limited(path, MAX_CERTIFICATE_BYTES, "bundle file", CertificateError)
+        if sha256_bytes(data) != sha256_bytes(text.encode()):
+            raise CertificateError(
+                f"{path}: not the text {cert_path.name} embeds (sha256 {sha256_bytes(data)}, embedded "
+                f"{sha256_bytes(text.encode())}): the bundle's file was replaced or edited"
+            )
 
 
 def verify_signature(cert_path: str | Path, cert: dict, trust: str | Path, data: bytes) -> str:

@@ -24,7 +24,7 @@ from pendverify.analytic import ParameterSet
 from pendverify.analytic.params import load_parameter_file
 from pendverify.analytic.plugin import plugin_parameters
 from pendverify.certify.battery import BatteryItem, BatterySettings, run_battery
-from pendverify.certify.bundle import refuse_existing, verify_signature, write_bundle
+from pendverify.certify.bundle import check_files_beside, refuse_existing, verify_signature, write_bundle
 from pendverify.certify.certificate import build_certificate, compare_items, derived_constants, verify_digest
 from pendverify.certify.model_source import ModelSource
 from pendverify.certify.names import check_name
@@ -214,6 +214,7 @@ def recheck(path: str, trust: str | None = None, run_embedded_code: bool = False
     check_schema(cert, path)
     verify_digest(cert, path)
     source = ModelSource.from_certificate(cert, path)
+    check_files_beside(path, cert)
     if trust is not None:
         signature = verify_signature(path, cert, trust, data)
     elif "signature" in cert:
