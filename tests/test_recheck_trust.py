@@ -312,3 +312,9 @@ def test_a_bundle_file_beside_that_is_not_the_embedded_text_is_refused(tmp_path,
     (tmp_path / "double_pendulum.urdf").write_text(cert["urdf"]["text"].replace("double_pendulum", "other"))
     assert main(["recheck", str(path)]) == 2
     assert "double_pendulum.urdf: not the text double_pendulum.cert.json embeds" in _one_line_error(capsys)
+
+
+def test_a_folder_given_as_the_trusted_key(tmp_path, capsys):
+    path = write_bundle(tmp_path / "b", make_certificate())
+    assert main(["recheck", str(path), "--trust", str(tmp_path)]) == 2
+    assert "is a directory; give the public key file (PEM)" in _one_line_error(capsys)
