@@ -12,6 +12,8 @@ model              the model's name: double_pendulum | cart_double_pendulum, or 
 model_source       plug-ins only: {"file": the model file's name, "text": its source
                    verbatim, "sha256": of that text (UTF-8)}; ``recheck`` runs
                    the battery on this text, never on the file at that path now
+                   (Python text only when a trusted key signed it, or when told
+                   to run embedded code: ``pendverify.certify.issue.recheck``)
 parameters         the physical parameters, SI units (as the parameter file)
 derived            the model's ``derived_constants()``: α, β, δ (double pendulum);
                    m + m1 + m2, l1 (m1 + m2), m2 l2 and det M at upright (cart);

@@ -19,7 +19,8 @@ certificate, and makes any edit detectable by anyone holding the public key.
   battery's items).  DSSE signs the payload bytes, so nothing depends on how JSON is
   canonicalised.
 * ``recheck CERT --trust PUB.pem`` accepts only a certificate whose envelope verifies
-  with that key and whose statement records the certificate file's SHA-256.
+  with that key and whose statement (its shape checked: ``statement_subjects``) names
+  files of the certificate's own bundle and records the certificate file's SHA-256.
 
 PAE(type, body) = "DSSEv1" SP LEN(type) SP type SP LEN(body) SP body, lengths in ASCII
 decimal (the DSSE v1 protocol).
