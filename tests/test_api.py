@@ -504,7 +504,7 @@ def test_certify_set_takes_a_model_file_and_a_missing_urdf_is_named_in_api_words
         samples=40,
     )
     assert issued.certified and issued.certificate["model_source"]["text"].startswith('"""')
-    assert recheck(str(issued.path)).passed
+    assert recheck(str(issued.path), run_embedded_code=True).passed
     with pytest.raises(
         pendverify.PendverifyError, match=r"give the URDF to certify cart_pole against \(--urdf, urdf=\)"
     ):

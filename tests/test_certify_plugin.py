@@ -115,7 +115,7 @@ def test_example_is_certified_and_rechecked(name, tmp_path, capsys):
     names = {c["name"] for c in cert["checks"]}
     assert {"check:crba", "stress:large-angles", "invariant:gravity:energy"} <= names
     capsys.readouterr()
-    assert main(["recheck", str(cert_path)]) == 0
+    assert main(["recheck", str(cert_path), "--run-embedded-code"]) == 0
     assert "recheck passed" in capsys.readouterr().out
 
 
@@ -138,7 +138,7 @@ def test_a_model_written_in_the_test_is_certified(tmp_path, capsys):
     assert {"invariant:damping:dissipation", "invariant:actuation:work–energy"} <= names
     assert not any(n.startswith("invariant:disturbance") for n in names)
     (tmp_path / "single.py").write_text("# replaced after certification\n")  # recheck must not read it
-    assert main(["recheck", str(cert_path)]) == 0
+    assert main(["recheck", str(cert_path), "--run-embedded-code"]) == 0
 
 
 def test_a_planted_error_is_not_certified(tmp_path, capsys):
@@ -202,7 +202,7 @@ def test_sweep_over_a_model_file_locally_and_on_dask(tmp_path, capsys):
     for name, cert in certs.items():
         assert cert["model_source"]["file"] == "hanging.py"
         assert f'<mass value="{cert["parameters"]["m1"]!r}"' in cert["urdf"]["text"]
-        assert main(["recheck", str(local / name)]) == 0
+        assert main(["recheck", str(local / name), "--run-embedded-code"]) == 0
     with distributed.LocalCluster(
         n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None, processes=True
     ) as cluster:

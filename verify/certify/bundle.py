@@ -16,16 +16,21 @@ from pathlib import Path
 from pendverify.analytic import ParameterSet
 from pendverify.atomic import write_atomic
 from pendverify.certify.certificate import certificate_text
+from pendverify.certify.model_source import MODEL_SUFFIXES
 from pendverify.certify.names import envelope_name, target_inside
+from pendverify.certify.reading import MAX_CERTIFICATE_BYTES, read_limited
 from pendverify.certify.signing import (
+    MAX_ENVELOPE_BYTES,
     envelope_line,
     fingerprint,
     load_public_key,
     open_envelope,
     sha256_bytes,
     statement,
+    statement_subjects,
 )
-from pendverify.errors import CertificateError, SigningError
+from pendverify.display import shortened
+from pendverify.errors import CertificateError, PendverifyError, SigningError
 from pendverify.robot.description import FILE_SUFFIXES, text_suffix
 
 
@@ -33,9 +38,6 @@ def bundle_paths(directory, name: str, description_suffix: str = ".urdf") -> tup
     """NAME.urdf (or NAME.mjcf.xml, ...: ``description_suffix``), NAME.params.toml, NAME.cert.json."""
     d = Path(directory)
     return d / f"{name}{description_suffix}", d / f"{name}.params.toml", d / f"{name}.cert.json"
-
-
-MODEL_SUFFIXES = (".py", ".toml")  # a Python model file, or a text one
 
 
 def model_path(directory, name: str, file: str = "model.py") -> Path:
@@ -96,12 +98,51 @@ def write_bundle(
     return cert_path
 
 
-def verify_signature(cert_path: str | Path, cert: dict, trust: str | Path) -> str:
+def bundle_file_names(name: str) -> set[str]:
+    """Every file name set ``name``'s bundle may hold besides its envelope (what a signed statement
+    may name as subjects)."""
+    descriptions = {f"{name}{suffix}" for suffix in FILE_SUFFIXES.values()}
+    models = {model_path(".", name, f"model{suffix}").name for suffix in MODEL_SUFFIXES}
+    return {*descriptions, *models, *(p.name for p in bundle_paths(".", name))}
+
+
+def check_files_beside(cert_path: str | Path, cert: dict) -> None:
+    """Refuse a bundle whose description or model file beside ``NAME.cert.json`` is not the text the
+    certificate embeds (a file not copied along is fine).  A certificate file under another name
+    than its set's is not in a bundle: nothing beside it is compared."""
+    cert_path = Path(cert_path)
+    name = cert["name"]
+    if cert_path.name != bundle_paths(".", name)[2].name:
+        return
+    try:
+        suffix = text_suffix(cert["urdf"]["text"])
+    except PendverifyError:
+        suffix = None  # not a description at all: the battery's re-run says so
+    embedded = {f"{name}{suffix}": cert["urdf"]["text"]} if suffix else {}
+    record = cert.get("model_source")
+    if record is not None:
+        embedded[model_path(".", name, record["file"]).name] = record["text"]
+    for file_name, text in embedded.items():
+        path = cert_path.parent / file_name
+        if not path.is_file():
+            continue
+        data = read_limited(path, MAX_CERTIFICATE_BYTES, "bundle file", CertificateError)
+        if sha256_bytes(data) != sha256_bytes(text.encode()):
+            raise CertificateError(
+                f"{path}: not the text {cert_path.name} embeds (sha256 {sha256_bytes(data)}, embedded "
+                f"{sha256_bytes(text.encode())}): the bundle's file was replaced or edited"
+            )
+
+
+def verify_signature(cert_path: str | Path, cert: dict, trust: str | Path, data: bytes) -> str:
     """Check a certificate against the key in ``trust`` (a public-key PEM); return a line saying so.
 
-    The certificate must name its envelope; the envelope must be signed by the trusted
-    key and its statement must record this certificate file's SHA-256 (and of every
-    other subject present beside it).  Anything else raises SigningError, saying why.
+    ``data`` is the certificate file's bytes as read (and parsed into ``cert``).  The file
+    must be its set's ``NAME.cert.json`` and name its envelope ``NAME.intoto.jsonl``; the
+    envelope must be signed by the trusted key; its statement (shape checked:
+    ``signing.statement_subjects``) must name only files of set NAME's bundle and record
+    ``data``'s SHA-256 for NAME.cert.json and the SHA-256 of every other subject present
+    beside it.  Anything else raises SigningError, saying why.
     """
     cert_path = Path(cert_path)
     trusted = load_public_key(trust)
@@ -111,29 +152,44 @@ def verify_signature(cert_path: str | Path, cert: dict, trust: str | Path) -> st
             f"{cert_path}: unsigned: it names no envelope (it was issued without --key), and --trust "
             f"accepts only a certificate signed by the trusted key {fingerprint(trusted)}; rejected"
         )
-    envelope = cert_path.parent / signature["envelope"]
-    try:
-        text = envelope.read_text(encoding="utf-8")
-    except OSError as exc:
+    name = cert["name"]
+    own = bundle_paths(".", name)[2].name  # NAME.cert.json
+    if cert_path.name != own:
         raise SigningError(
-            f"{cert_path}: its envelope {envelope} cannot be read ({exc.strerror or exc}); rejected"
-        ) from None
-    lines = [line for line in text.splitlines() if line.strip()]
+            f"{cert_path}: holds the certificate of set {name!r} (its file is {own}), not of the set "
+            f"this file names; a bundle's NAME.cert.json must hold set NAME's certificate; rejected"
+        )
+    if signature["envelope"] != envelope_name(name):
+        raise SigningError(
+            f"{cert_path}: key 'signature.envelope' = {shortened(signature['envelope'], 80)!r}: "
+            f"set {name!r}'s envelope is {envelope_name(name)}; rejected"
+        )
+    envelope = cert_path.parent / signature["envelope"]
+    text = read_limited(envelope, MAX_ENVELOPE_BYTES, "envelope (NAME.intoto.jsonl)", SigningError)
+    lines = [line for line in text.decode("utf-8", "replace").splitlines() if line.strip()]
     if len(lines) != 1:
         raise SigningError(f"{envelope}: expected one DSSE envelope (one line), found {len(lines)}")
     stmt = open_envelope(lines[0], trusted, str(envelope), str(trust))
-    subjects = {s.get("name"): s.get("digest", {}).get("sha256") for s in stmt.get("subject", [])}
-    own = f"{cert['name']}.cert.json"  # the certificate's subject, whatever the file is called now
+    subjects = statement_subjects(stmt, str(envelope))
     if own not in subjects:
         raise SigningError(f"{envelope}: the signed statement does not name {own}; rejected")
-    for name, recorded in subjects.items():
-        path = cert_path if name == own else cert_path.parent / name
-        if not path.is_file():
+    foreign = sorted(set(subjects) - bundle_file_names(name))
+    if foreign:
+        raise SigningError(
+            f"{envelope}: the signed statement names {shortened(foreign[0], 80)!r}, not a file of set "
+            f"{name!r}'s bundle; rejected"
+        )
+    for subject, recorded in sorted(subjects.items()):
+        path = cert_path.parent / subject
+        if subject == own:
+            computed = sha256_bytes(data)
+        elif path.is_file():
+            computed = sha256_bytes(read_limited(path, MAX_CERTIFICATE_BYTES, "bundle file", SigningError))
+        else:
             continue  # a bundle file not copied along: the certificate embeds what recheck needs
-        computed = sha256_bytes(path.read_bytes())
         if computed != recorded:
             raise SigningError(
-                f"{path}: sha256 {computed}, but the signed statement records {recorded} for {name}: "
+                f"{path}: sha256 {computed}, but the signed statement records {recorded} for {subject}: "
                 "the file was edited after it was signed; rejected"
             )
     return f"signature ok: signed by the trusted key {fingerprint(trusted)} ({envelope.name})"

@@ -12,6 +12,8 @@ model              the model's name: double_pendulum | cart_double_pendulum, or 
 model_source       plug-ins only: {"file": the model file's name, "text": its source
                    verbatim, "sha256": of that text (UTF-8)}; ``recheck`` runs
                    the battery on this text, never on the file at that path now
+                   (Python text only when a trusted key signed it, or when told
+                   to run embedded code: ``pendverify.certify.issue.recheck``)
 parameters         the physical parameters, SI units (as the parameter file)
 derived            the model's ``derived_constants()``: α, β, δ (double pendulum);
                    m + m1 + m2, l1 (m1 + m2), m2 l2 and det M at upright (cart);
@@ -53,6 +55,7 @@ figures cannot be compared with /2's; certify the set again.
 from __future__ import annotations
 
 import hashlib
+import math
 from datetime import datetime, timezone
 
 from pendverify.analytic import ParameterSet
@@ -171,6 +174,17 @@ def verify_digest(cert: dict, source: str) -> None:
 FIGURE_RTOL = 1e-6  # rounding-level errors may shift in their last digits across library builds
 
 
+def figures_agree(a: float, b: float, rtol: float) -> bool:
+    """Whether two figures agree to ``rtol``: a finite figure agrees only with a finite one, an
+    infinite one only with the same infinity, NaN only with NaN."""
+    a, b = float(a), float(b)
+    if math.isnan(a) or math.isnan(b):
+        return math.isnan(a) and math.isnan(b)
+    if math.isinf(a) or math.isinf(b):
+        return a == b
+    return abs(a - b) <= rtol * max(abs(a), abs(b))
+
+
 def compare_items(recorded: list[dict], fresh: list[BatteryItem]) -> list[str]:
     """Names of the fields whose values differ between a certificate and a re-run."""
     differences = []
@@ -192,8 +206,8 @@ def compare_items(recorded: list[dict], fresh: list[BatteryItem]) -> list[str]:
                 if (a is None) != (b is None):
                     differences.append(f"{old['name']}.{key}: recorded {a!r}, now {b!r}")
                 continue
-            a, b = float(a), float(b)
-            if abs(a - b) > FIGURE_RTOL * max(abs(a), abs(b)):
+            if not figures_agree(a, b, FIGURE_RTOL):
+                a, b = float(a), float(b)
                 differences.append(f"{old['name']}.{key}: recorded {a:.6g}, now {b:.6g}")
     differences += [f"{name}: new in the re-run, not in the certificate" for name in by_name]
     return differences

@@ -6,8 +6,9 @@ parameters are read off the URDF; a model file (``--analytic``) with its URDF an
 parameter file — into (bundle name, model, parameters, URDF text).  ``issue``
 refuses an existing bundle before any work, runs the battery on that URDF, and
 writes the bundle only if every item passes (signed when given a key).  ``recheck``
-checks a certificate's schema, digest and derived fields, with ``trust`` its
-signature, and re-runs its battery, each invariant item on the engine it records.
+checks a certificate's schema, digest and, with ``trust``, its signature before it
+loads the model (embedded Python only when trusted), then its derived fields, and
+re-runs its battery, each invariant item on the engine it records.
 
 Every name that becomes a file name is checked where it is read
 (``pendverify.certify.names``): a parameter file's ``name``, a URDF's stem, a sweep's
@@ -16,7 +17,6 @@ set names.
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -24,10 +24,11 @@ from pendverify.analytic import ParameterSet
 from pendverify.analytic.params import load_parameter_file
 from pendverify.analytic.plugin import plugin_parameters
 from pendverify.certify.battery import BatteryItem, BatterySettings, run_battery
-from pendverify.certify.bundle import refuse_existing, verify_signature, write_bundle
+from pendverify.certify.bundle import check_files_beside, refuse_existing, verify_signature, write_bundle
 from pendverify.certify.certificate import build_certificate, compare_items, derived_constants, verify_digest
 from pendverify.certify.model_source import ModelSource
 from pendverify.certify.names import check_name
+from pendverify.certify.reading import read_certificate
 from pendverify.certify.schema import check_derived, check_schema
 from pendverify.certify.signing import fingerprint
 from pendverify.certify.simulations import recorded_engines
@@ -196,31 +197,39 @@ class Rechecked:
         return not self.differences and all(i.passed for i in self.items)
 
 
-def recheck(path: str, trust: str | None = None) -> Rechecked:
+RUN_EMBEDDED_CODE = "--run-embedded-code"
+
+
+def recheck(path: str, trust: str | None = None, run_embedded_code: bool = False) -> Rechecked:
     """Check a certificate, then re-run its battery.
 
-    Schema, digest, derived fields and (with ``trust``, a public-key PEM) the signature
-    are checked first: any failure raises a PendverifyError naming the field or the key.
+    In this order, each failure a PendverifyError naming the field or the key: the file
+    (bounded: ``pendverify.certify.reading``), the schema (the settings within
+    certify's bounds), the digests, with ``trust`` (a public-key PEM) the signature
+    and the bundle's files beside it — and only then the model.  A built-in or text
+    model is data; an embedded Python model runs only when the trusted key signed the
+    certificate, or when ``run_embedded_code`` says the caller trusts it anyway.
     """
-    try:
-        with open(path, encoding="utf-8") as fh:
-            cert = json.load(fh)
-    except FileNotFoundError:
-        raise CertificateError(f"{path}: file not found") from None
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise CertificateError(f"{path}: not JSON: {exc}") from None
+    data, cert = read_certificate(path)
     check_schema(cert, path)
     verify_digest(cert, path)
-    source = ModelSource.from_certificate(cert, path)  # a plug-in: from the embedded source
-    cls = source.load()
-    params = cls.params_type.from_mapping(cert["parameters"], path, "parameters.")
-    check_derived(cert, derived_constants(source, params), path)
+    source = ModelSource.from_certificate(cert, path)
+    check_files_beside(path, cert)
     if trust is not None:
-        signature = verify_signature(path, cert, trust)
+        signature = verify_signature(path, cert, trust, data)
     elif "signature" in cert:
         signature = f"signed by key {cert['signature']['keyid']}: not verified (give --trust PUBLIC.pem)"
     else:
         signature = "unsigned: only the digest was checked (it detects accidental corruption, not edits)"
+    if source.runs_code and trust is None and not run_embedded_code:
+        raise CertificateError(
+            f"{path}: refused: its model is embedded Python source ({shortened(source.file, 60)}), which "
+            "recheck would run, and no trusted key vouches for it; give --trust PUBLIC.pem (the key "
+            f"that signed it), or {RUN_EMBEDDED_CODE} if you trust the code itself"
+        )
+    cls = source.load()
+    params = cls.params_type.from_mapping(cert["parameters"], path, "parameters.")
+    check_derived(cert, derived_constants(source, params), path)
     settings = BatterySettings(**cert["settings"])
     engines = recorded_engines(cert["checks"])  # each invariant item on the engine it ran on
     items = run_battery(cls, params, cert["urdf"]["text"], settings, engines)

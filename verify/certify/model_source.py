@@ -18,8 +18,16 @@ from pathlib import Path
 
 from pendverify.analytic import MODELS, ClosedFormModel
 from pendverify.analytic.plugin import load_model_class
+from pendverify.display import shortened
 from pendverify.errors import PendverifyError
 from pendverify.numerics.codegen.cache import remember_text
+
+MODEL_SUFFIXES = (".py", ".toml")  # Python source (runs when imported), or a text model (parsed)
+MAX_FILE_NAME_BYTES = 255  # what a file system takes as one name
+MODEL_FILE_RULE = (
+    "a plain file name ending in .py or .toml: no folder, separator or control character, "
+    f"at most {MAX_FILE_NAME_BYTES} bytes"
+)
 
 _LOADED: dict[tuple[str, str], type[ClosedFormModel]] = {}  # (file name, sha256) -> class, per process
 
@@ -39,6 +47,11 @@ class ModelSource:
     @property
     def builtin(self) -> bool:
         return not self.text
+
+    @property
+    def runs_code(self) -> bool:
+        """Whether loading it imports Python source (a text model is parsed, never executed)."""
+        return not self.builtin and not self.file.endswith(".toml")
 
     @classmethod
     def of_builtin(cls, name: str) -> ModelSource:
@@ -95,12 +108,28 @@ class ModelSource:
         return cls(name, record["file"], record["text"])
 
 
+def model_file_problem(name: str) -> str:
+    """Why ``name`` cannot be an embedded model's file name (``MODEL_FILE_RULE``), or ""."""
+    if (
+        name in (".", "..")
+        or any(c in "/\\" or ord(c) < 32 or ord(c) == 127 for c in name)
+        or len(name.encode("utf-8", "surrogatepass")) > MAX_FILE_NAME_BYTES
+        or not name.endswith(MODEL_SUFFIXES)
+        or name in MODEL_SUFFIXES
+    ):
+        return MODEL_FILE_RULE
+    return ""
+
+
 def source_problem(record) -> str:
     """Why an embedded ``model_source`` record does not hold, or ""."""
     if not isinstance(record, dict) or not all(
         isinstance(record.get(k), str) for k in ("file", "text", "sha256")
     ):
         return "key 'model_source': expected a table of strings file, text and sha256"
+    if model_file_problem(record["file"]):
+        shown = shortened(record["file"], 60)
+        return f"key 'model_source.file' = {shown!r}: expected {MODEL_FILE_RULE}"
     computed = sha256_text(record["text"])
     if computed != record["sha256"]:
         return (

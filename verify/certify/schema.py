@@ -9,19 +9,44 @@ or holds a value of the wrong type, naming the field (``checks[3].error``).
 
 from __future__ import annotations
 
+import math
 import re
 from datetime import datetime
 
-from pendverify.certify.certificate import OLD_SCHEMAS, SCHEMA, summary_of
+from pendverify.certify.certificate import OLD_SCHEMAS, SCHEMA, figures_agree, summary_of
+from pendverify.certify.model_source import MODEL_FILE_RULE, model_file_problem
 from pendverify.certify.names import check_name
+from pendverify.certify.settings_rules import settings_problem
 from pendverify.certify.simulations import ENGINES
 from pendverify.errors import CertificateError, PendverifyError
 
 NONFINITE = ("inf", "-inf", "nan")  # how pendverify.jsonio writes non-finite numbers
 
 
+def _as_float(v) -> float | None:
+    """A JSON number as a float (an integer beyond float's range is none); None for anything else."""
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        return None
+    try:
+        return float(v)
+    except OverflowError:
+        return None
+
+
 def _number(v) -> bool:
-    return (isinstance(v, (int, float)) and not isinstance(v, bool)) or v in NONFINITE
+    if isinstance(v, str):
+        return v in NONFINITE
+    return _as_float(v) is not None
+
+
+def _finite(v) -> bool:
+    """A number that is not infinite or NaN (written as itself, never as a string)."""
+    number = _as_float(v)
+    return number is not None and math.isfinite(number)
+
+
+def _model_file(v) -> bool:
+    return isinstance(v, str) and not model_file_problem(v)
 
 
 def _integer(v) -> bool:
@@ -53,7 +78,7 @@ TOP = {
     "name": (True, _string, "a string"),
     "model": (True, _string, "a string"),
     "model_source": (False, lambda v: isinstance(v, dict), "a table"),
-    "parameters": (True, _table_of(_number), "a table of numbers"),
+    "parameters": (True, _table_of(_finite), "a table of finite numbers"),
     "derived": (True, _table_of(_number), "a table of numbers"),
     "urdf": (True, lambda v: isinstance(v, dict), "a table"),
     "settings": (True, lambda v: isinstance(v, dict), "a table"),
@@ -67,6 +92,11 @@ TOP = {
 }
 NESTED = {
     "urdf": {"text": (True, _string, "a string"), "sha256": (True, _hex64, "64 hex digits")},
+    "model_source": {
+        "file": (True, _model_file, f"a model file's name ({MODEL_FILE_RULE})"),
+        "text": (True, _string, "a string"),
+        "sha256": (True, _hex64, "64 hex digits"),
+    },
     "settings": {
         "samples": (True, _integer, "an integer"),
         "seed": (True, _integer, "an integer"),
@@ -80,6 +110,7 @@ NESTED = {
         "format": (True, _string, "a string"),
     },
 }
+FIGURES = ("error", "tolerance", "max_error")  # an item's figures
 ITEM = {
     "name": (True, _string, "a string"),
     "kind": (True, lambda v: v in ("check", "stress", "invariant"), "check, stress or invariant"),
@@ -119,7 +150,7 @@ def check_schema(cert, source: str) -> None:
     if not isinstance(cert, dict):
         raise CertificateError(f"{source}: not a certificate: expected a JSON object")
     schema = cert.get("schema")
-    if schema in OLD_SCHEMAS:
+    if isinstance(schema, str) and schema in OLD_SCHEMAS:
         raise CertificateError(f"{source}: schema {schema!r} is no longer rechecked: {OLD_SCHEMAS[schema]}")
     if schema != SCHEMA:
         raise _bad(source, "schema", schema, f"expected {SCHEMA!r}")
@@ -127,10 +158,19 @@ def check_schema(cert, source: str) -> None:
     for key, spec in NESTED.items():
         if key in cert:
             _check_table(cert[key], spec, source, f"{key}.")
+    for key, value in cert["settings"].items():
+        problem = settings_problem(key, value)
+        if problem:
+            raise _bad(source, f"settings.{key}", value, problem + " (as certify's options)")
     for i, item in enumerate(cert["checks"]):
         if not isinstance(item, dict):
             raise _bad(source, f"checks[{i}]", item, "expected a table")
         _check_table(item, ITEM, source, f"checks[{i}].")
+        if item["passed"]:
+            for key in FIGURES:
+                if item[key] is not None and not _finite(item[key]):
+                    rule = "a passed item's figures are finite numbers"
+                    raise _bad(source, f"checks[{i}].{key}", item[key], rule)
     try:
         check_name(cert["name"], source, "name")
         if "signature" in cert:
@@ -153,7 +193,7 @@ def check_derived(cert: dict, derived: dict[str, float], source: str) -> None:
             )
     for key in sorted(set(derived) | set(cert["derived"])):
         recorded, computed = cert["derived"].get(key), derived.get(key)
-        if recorded is None or computed is None or abs(float(recorded) - computed) > 1e-12 * abs(computed):
+        if recorded is None or computed is None or not figures_agree(recorded, computed, 1e-12):
             raise CertificateError(
                 f"{source}: key 'derived.{key}': recorded {recorded!r}, computed from the parameters "
                 f"{computed!r}: the certificate was edited after it was issued"

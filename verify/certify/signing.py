@@ -19,7 +19,8 @@ certificate, and makes any edit detectable by anyone holding the public key.
   battery's items).  DSSE signs the payload bytes, so nothing depends on how JSON is
   canonicalised.
 * ``recheck CERT --trust PUB.pem`` accepts only a certificate whose envelope verifies
-  with that key and whose statement records the certificate file's SHA-256.
+  with that key and whose statement (its shape checked: ``statement_subjects``) names
+  files of the certificate's own bundle and records the certificate file's SHA-256.
 
 PAE(type, body) = "DSSEv1" SP LEN(type) SP type SP LEN(body) SP body, lengths in ASCII
 decimal (the DSSE v1 protocol).
@@ -38,7 +39,8 @@ from cryptography.exceptions import InvalidSignature
 from cryptography.hazmat.primitives import serialization
 from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey, Ed25519PublicKey
 
-from pendverify.errors import SigningError
+from pendverify.certify.names import NAME_RULE, check_name
+from pendverify.errors import PendverifyError, SigningError
 
 PAYLOAD_TYPE = "application/vnd.in-toto+json"
 STATEMENT_TYPE = "https://in-toto.io/Statement/v1"
@@ -80,6 +82,8 @@ def generate_keys(directory: str | Path, force: bool = False) -> tuple[Path, Pat
     folder = Path(directory)
     private, public = folder / PRIVATE_NAME, folder / PUBLIC_NAME
     for path in (private, public):
+        if path.is_dir() or (path.exists() and not path.is_file()):
+            raise SigningError(f"{path}: is a folder (or not a file); --force replaces only a key file")
         if path.exists() and not force:
             raise SigningError(f"{path} exists; pass --force to replace the key pair")
     folder.mkdir(parents=True, exist_ok=True)
@@ -97,11 +101,22 @@ def generate_keys(directory: str | Path, force: bool = False) -> tuple[Path, Pat
     return private, public, fingerprint(key.public_key())
 
 
+MAX_KEY_BYTES = 64 * 1024  # a PEM key is a few hundred bytes
+MAX_ENVELOPE_BYTES = 16 * 1024 * 1024
+
+
 def _read(path: str | Path, what: str) -> bytes:
+    """At most ``MAX_KEY_BYTES`` of a key file (a pipe is fine: ``--key <(...)``)."""
+    if Path(path).is_dir():
+        raise SigningError(f"{path}: is a directory; give the {what} file (PEM)")
     try:
-        return Path(path).read_bytes()
+        with open(path, "rb") as fh:
+            data = fh.read(MAX_KEY_BYTES + 1)
     except OSError as exc:
         raise SigningError(f"{path}: cannot read the {what}: {exc.strerror or exc}") from None
+    if len(data) > MAX_KEY_BYTES:
+        raise SigningError(f"{path}: larger than the limit of {MAX_KEY_BYTES:,} bytes for a {what} (PEM)")
+    return data
 
 
 def load_private_key(path: str | Path) -> Ed25519PrivateKey:
@@ -163,7 +178,7 @@ def open_envelope(text: str, trusted: Ed25519PublicKey, source: str, trusted_nam
         payload = base64.b64decode(envelope["payload"], validate=True)
         signatures = [(s["keyid"], base64.b64decode(s["sig"], validate=True)) for s in envelope["signatures"]]
         payload_type = envelope["payloadType"]
-    except (ValueError, KeyError, TypeError) as exc:  # binascii.Error is a ValueError
+    except (ValueError, KeyError, TypeError, RecursionError) as exc:  # binascii.Error is a ValueError
         raise SigningError(
             f"{source}: not a DSSE envelope (payloadType, payload, signatures): {exc}"
         ) from exc
@@ -189,7 +204,7 @@ def open_envelope(text: str, trusted: Ed25519PublicKey, source: str, trusted_nam
         )
     try:
         stmt = json.loads(payload)
-    except ValueError as exc:
+    except (ValueError, RecursionError) as exc:
         raise SigningError(f"{source}: the signed payload is not JSON: {exc}") from None
     if not isinstance(stmt, dict) or stmt.get("_type") != STATEMENT_TYPE:
         raise SigningError(f"{source}: the signed payload is not an in-toto Statement v1")
@@ -199,9 +214,57 @@ def open_envelope(text: str, trusted: Ed25519PublicKey, source: str, trusted_nam
     return stmt
 
 
+def _hex64(value) -> bool:
+    return isinstance(value, str) and len(value) == 64 and all(c in "0123456789abcdef" for c in value)
+
+
+def statement_subjects(stmt: dict, source: str) -> dict[str, str]:
+    """A signed statement's subjects, name → SHA-256, once its shape is checked: ``subject`` a
+    non-empty list of {"name": a bundle file's name, "digest": {"sha256": 64 hex digits}}, each
+    name once; ``predicate`` a test result (``result`` PASSED or FAILED, lists of test names).
+
+    A subject's name is a file beside the certificate (``pendverify.certify.names``): no
+    folder, no ``..``, not absolute.  Anything else raises SigningError naming the key."""
+
+    def bad(key: str, value, rule: str) -> SigningError:
+        shown = repr(value) if len(repr(value)) <= 80 else repr(value)[:77] + "..."
+        return SigningError(f"{source}: the signed statement's key '{key}' = {shown}: {rule}; rejected")
+
+    subjects = stmt.get("subject")
+    if not isinstance(subjects, list) or not subjects:
+        raise bad("subject", subjects, "expected a non-empty list of {name, digest}")
+    found: dict[str, str] = {}
+    for i, subject in enumerate(subjects):
+        if not isinstance(subject, dict) or set(subject) != {"name", "digest"}:
+            raise bad(f"subject[{i}]", subject, "expected a table of name and digest")
+        name, digest = subject["name"], subject["digest"]
+        try:
+            check_name(name, source, f"subject[{i}].name")
+        except PendverifyError:
+            rule = f"expected a file name beside the certificate ({NAME_RULE})"
+            raise bad(f"subject[{i}].name", name, rule) from None
+        if not isinstance(digest, dict) or set(digest) != {"sha256"} or not _hex64(digest["sha256"]):
+            raise bad(f"subject[{i}].digest", digest, 'expected {"sha256": 64 hex digits}')
+        if name in found:
+            raise bad(f"subject[{i}].name", name, "named twice: each file is a subject once")
+        found[name] = digest["sha256"]
+    predicate = stmt.get("predicate")
+    if not isinstance(predicate, dict):
+        raise bad("predicate", predicate, "expected a table (a test result)")
+    if predicate.get("result") not in ("PASSED", "FAILED"):
+        raise bad("predicate.result", predicate.get("result"), "expected PASSED or FAILED")
+    for key in ("passedTests", "failedTests"):
+        tests = predicate.get(key)
+        if not isinstance(tests, list) or not all(isinstance(t, str) for t in tests):
+            raise bad(f"predicate.{key}", tests, "expected a list of test names")
+    if not isinstance(predicate.get("configuration"), list):
+        raise bad("predicate.configuration", predicate.get("configuration"), "expected a list")
+    return found
+
+
 def signer_keyids(text: str) -> list[str]:
     """The keyids an envelope names (unverified), for messages; [] if it cannot be read."""
     try:
         return [s["keyid"] for s in json.loads(text)["signatures"]]
-    except (ValueError, KeyError, TypeError):
+    except (ValueError, KeyError, TypeError, RecursionError):
         return []

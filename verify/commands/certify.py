@@ -5,10 +5,10 @@ from __future__ import annotations
 import argparse
 
 from pendverify.atomic import check_output, check_report_output
+from pendverify.certify.settings_rules import samples_option, seed_option
 from pendverify.commands import (
     add_analytic_option,
     add_command,
-    non_negative_int,
     positive_float,
     positive_int,
     refuse_together,
@@ -69,8 +69,12 @@ def register(sub) -> None:
     p.add_argument(
         "-o", "--output", required=True, help="directory for the certificate, URDF and parameters (required)"
     )
-    p.add_argument("--samples", type=positive_int, help="random states for the core checks (default: 2000)")
-    p.add_argument("--seed", type=non_negative_int, help="seed of the state sampler (default: 20260301)")
+    p.add_argument(
+        "--samples",
+        type=samples_option,
+        help="random states for the core checks, at most PENDVERIFY_MAX_SAMPLES (default: 2000)",
+    )
+    p.add_argument("--seed", type=seed_option, help="seed of the state sampler (default: 20260301)")
     p.add_argument("--force", action="store_true", help="replace existing files")
     p.add_argument(
         "--key",
@@ -93,6 +97,12 @@ def register(sub) -> None:
     r.add_argument(
         "--trust",
         help="accept only a certificate signed by this public key (PEM) (default: any signature or none)",
+    )
+    r.add_argument(
+        "--run-embedded-code",
+        action="store_true",
+        help="run a certificate's embedded Python model although no --trust key vouches for it "
+        "(default: refused; built-in and text models are data and always rechecked)",
     )
     r.set_defaults(func=run_recheck)
 
@@ -256,7 +266,7 @@ def run_recheck(args: argparse.Namespace) -> int:
     from pendverify.certify.issue import recheck
 
     check_report_output(args.json)
-    result = recheck(args.certificate, args.trust)
+    result = recheck(args.certificate, args.trust, args.run_embedded_code)
     if not args.quiet:
         print(f"digest ok: {result.certificate['digest']['value']}")
         print(result.signature)
