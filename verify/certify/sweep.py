@@ -19,8 +19,9 @@ values rewritten where the base set's values sit (``pendverify.robot.rebind``); 
 range over a parameter the URDF does not show is refused, naming it.  Tasks carry
 the model file's source text, not the class, and load it once per worker.
 
-A sweep's ``samples`` above ``PENDVERIFY_MAX_SAMPLES`` (``pendverify.simulation.limits``)
-is refused, as its simulations' samples are.  A sweep of more than ``max_sets`` sets (a
+A sweep's ``seed``, ``samples`` and ``duration`` obey the rule of certify's options and
+of a certificate's settings (``pendverify.certify.settings_rules``: ``samples`` at most
+``PENDVERIFY_MAX_SAMPLES``).  A sweep of more than ``max_sets`` sets (a
 count, or the product of a grid's points) is refused before any set is made.  ``pendverify.certify.sweep_run``
 runs the tasks (``pendverify.certify.sweep_task``), on local processes or a Dask
 cluster; the task is the same pure function either way, so both produce the same
@@ -42,10 +43,10 @@ from pendverify.analytic.params import default_parameter_file, load_parameter_fi
 from pendverify.analytic.plugin import plugin_parameters
 from pendverify.certify.battery import BatterySettings
 from pendverify.certify.model_source import ModelSource
+from pendverify.certify.settings_rules import settings_problem
 from pendverify.errors import PendverifyError, SweepError
 from pendverify.robot.description import urdf_text
 from pendverify.robot.rebind import Binding
-from pendverify.simulation.limits import MAX_SAMPLES_VARIABLE, max_samples
 
 
 @dataclass(frozen=True)
@@ -118,27 +119,20 @@ def load_sweep(path: str | Path, max_sets: int = DEFAULT_MAX_SETS) -> Sweep:
     mode = data.get("mode", "random")
     if mode not in ("random", "grid"):
         raise SweepError(source, "mode", mode, "expected random or grid")
-    ints = {}
-    for key, default in (("count", 100), ("seed", 0), ("samples", 200)):
-        value = data.get(key, default)
-        if isinstance(value, bool) or not isinstance(value, int) or value < (0 if key == "seed" else 1):
-            raise SweepError(source, key, value, f"expected an integer >= {0 if key == 'seed' else 1}")
-        ints[key] = value
-    limit = max_samples()
-    if ints["samples"] > limit:
-        raise SweepError(
-            source,
-            "samples",
-            ints["samples"],
-            f"more battery states per set than the limit of {limit:,}; raise it with {MAX_SAMPLES_VARIABLE}",
-        )
-    duration = data.get("duration", 1.0)
-    if (
-        isinstance(duration, bool)
-        or not isinstance(duration, (int, float))
-        or not 0 < duration < float("inf")
-    ):
-        raise SweepError(source, "duration", duration, "expected a number > 0 (s, per simulated effect)")
+    count = data.get("count", 100)
+    if isinstance(count, bool) or not isinstance(count, int) or count < 1:
+        raise SweepError(source, "count", count, "expected an integer >= 1")
+    values = {
+        "seed": data.get("seed", 0),
+        "samples": data.get("samples", 200),
+        "duration": data.get("duration", 1.0),
+    }
+    for key, value in values.items():  # the battery's settings: the rule certify's options and recheck apply
+        problem = settings_problem("sim_duration" if key == "duration" else key, value)
+        if problem:
+            raise SweepError(
+                source, key, value, problem + (" (s, per simulated effect)" if key == "duration" else "")
+            )
     ranges = data.get("ranges")
     if not isinstance(ranges, dict) or not ranges:
         raise SweepError(source, "ranges", ranges, "expected a table of at least one parameter range")
@@ -154,9 +148,11 @@ def load_sweep(path: str | Path, max_sets: int = DEFAULT_MAX_SETS) -> Sweep:
             raise SweepError(source, f"ranges.{key}", value, f"cannot be varied: {binding.reasons[key]}")
         specs[key] = _range(source, key, value)
 
-    count = _count(source, mode, ints["count"], specs, max_sets)
-    sets = SweepSets(model.name, base.as_dict(), specs, mode, count, ints["seed"])
-    settings = BatterySettings(samples=ints["samples"], seed=ints["seed"], sim_duration=float(duration))
+    count = _count(source, mode, count, specs, max_sets)
+    sets = SweepSets(model.name, base.as_dict(), specs, mode, count, values["seed"])
+    settings = BatterySettings(
+        samples=values["samples"], seed=values["seed"], sim_duration=float(values["duration"])
+    )
     return Sweep(model, sets, settings, urdf, None if urdf is None else base.as_dict())
 
 
