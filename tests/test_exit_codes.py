@@ -464,3 +464,25 @@ def test_sweep_samples_beyond_the_sample_limit_are_refused_up_front(tmp_path, ca
     from pendverify.certify.sweep import load_sweep
 
     assert load_sweep(sweep).settings.samples == 100_000_000
+
+
+@pytest.mark.parametrize("command", ["check", "mutate", "report"])
+def test_more_random_states_than_the_sample_limit_are_a_usage_error(command, capsys, monkeypatch):
+    """`--samples` is bounded by PENDVERIFY_MAX_SAMPLES before any state is drawn (10**8 states
+    would exhaust memory); 0 is still allowed (the named hard cases only) and the limit can be raised."""
+    with pytest.raises(SystemExit) as stopped:
+        main([command, "--samples", str(10**8)])
+    assert stopped.value.code == 2
+    err = capsys.readouterr().err
+    assert "100,000,000 states exceed the limit of 1,000,000" in err and "PENDVERIFY_MAX_SAMPLES" in err
+    assert "Traceback" not in err
+    monkeypatch.setenv("PENDVERIFY_MAX_SAMPLES", "5")
+    with pytest.raises(SystemExit):
+        main([command, "--samples", "6"])
+    assert "6 states exceed the limit of 5" in capsys.readouterr().err
+
+
+def test_the_raised_sample_limit_admits_more_states(capsys, monkeypatch):
+    monkeypatch.setenv("PENDVERIFY_MAX_SAMPLES", "5")
+    assert main(["check", "--model", "double_pendulum", "--no-erd", "--samples", "5"]) == 0
+    assert main(["check", "--model", "double_pendulum", "--no-erd", "--samples", "0"]) == 0

@@ -146,6 +146,19 @@ def non_negative_int(text: str) -> int:
     return _int_at_least(0, text)
 
 
+def state_count(text: str) -> int:
+    """A number of random states from 0 to the sample limit (``PENDVERIFY_MAX_SAMPLES``)."""
+    from pendverify.simulation.limits import MAX_SAMPLES_VARIABLE, max_samples
+
+    value = non_negative_int(text)
+    limit = max_samples()
+    if value > limit:
+        raise argparse.ArgumentTypeError(
+            f"{value:,} states exceed the limit of {limit:,} (raise it with {MAX_SAMPLES_VARIABLE})"
+        )
+    return value
+
+
 def positive_float(text: str) -> float:
     """A finite number > 0, for options such as a tolerance."""
     try:
@@ -163,7 +176,7 @@ def add_sampling_options(parser: argparse.ArgumentParser, samples_default: int |
     if samples_default is not None:
         parser.add_argument(
             "--samples",
-            type=non_negative_int,
+            type=state_count,
             default=None,
             help=f"random states per model (default: {samples_default})",
         )
