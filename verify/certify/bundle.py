@@ -135,7 +135,14 @@ def check_files_beside(cert_path: str | Path, cert: dict) -> None:
 
 
 def verify_signature(cert_path: str | Path, cert: dict, trust: str | Path, data: bytes) -> str:
-    """Check a certificate against the key in ``trust`` (a public-key PEM); return a line saying so.
+    """Check a certificate against the key in ``trust`` (a public-key PEM); return a line saying so
+    (``verify_signed_by``)."""
+    return verify_signed_by(cert_path, cert, load_public_key(trust), data, str(trust))
+
+
+def verify_signed_by(cert_path: str | Path, cert: dict, trusted, data: bytes, key_name: str) -> str:
+    """Check a certificate against the public key ``trusted`` (named ``key_name`` in messages);
+    return a line saying so.
 
     ``data`` is the certificate file's bytes as read (and parsed into ``cert``).  The file
     must be its set's ``NAME.cert.json`` and name its envelope ``NAME.intoto.jsonl``; the
@@ -145,7 +152,6 @@ def verify_signature(cert_path: str | Path, cert: dict, trust: str | Path, data:
     beside it.  Anything else raises SigningError, saying why.
     """
     cert_path = Path(cert_path)
-    trusted = load_public_key(trust)
     signature = cert.get("signature")
     if signature is None:
         raise SigningError(
@@ -169,7 +175,7 @@ def verify_signature(cert_path: str | Path, cert: dict, trust: str | Path, data:
     lines = [line for line in text.decode("utf-8", "replace").splitlines() if line.strip()]
     if len(lines) != 1:
         raise SigningError(f"{envelope}: expected one DSSE envelope (one line), found {len(lines)}")
-    stmt = open_envelope(lines[0], trusted, str(envelope), str(trust))
+    stmt = open_envelope(lines[0], trusted, str(envelope), key_name)
     subjects = statement_subjects(stmt, str(envelope))
     if own not in subjects:
         raise SigningError(f"{envelope}: the signed statement does not name {own}; rejected")

@@ -19,16 +19,15 @@ that the command says how many.
 
 from __future__ import annotations
 
-import json
 import os
 import re
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from pendverify.certify.bundle import verify_signed_by
 from pendverify.certify.certificate import verify_digest
-from pendverify.certify.names import envelope_name
-from pendverify.certify.signing import fingerprint, open_envelope, sha256_bytes
+from pendverify.certify.reading import read_certificate
 from pendverify.errors import CertificateError, FileAccessError, InputError, SigningError
 
 BUNDLE_SUFFIXES = (".cert.json", ".urdf", ".mjcf.xml", ".sdf", ".params.toml", ".model.py", ".model.toml")
@@ -85,13 +84,13 @@ def prepare_output(sweep, output, force: bool, resume: bool, key=None) -> Output
         if name + ".cert.json" in files:
             path = out / f"{name}.cert.json"
             try:
-                cert = _validate(path, sweep, name, params_type.from_mapping(values).as_dict())
+                data, cert = _validate(path, sweep, name, params_type.from_mapping(values).as_dict())
             except CertificateError:
                 if not force:
                     raise
                 state.partial.add(name)
                 continue
-            if key is not None and not signed_by(path, cert, key):
+            if key is not None and not signed_by(path, data, cert, key):
                 state.partial.add(name)
                 state.resigned.add(name)
                 continue
@@ -151,36 +150,24 @@ def _remove_temporaries(out: Path, files: set[str], names: set[str]) -> None:
             (out / file).unlink(missing_ok=True)
 
 
-def signed_by(path: Path, cert: dict, key) -> bool:
-    """Whether the certificate ``cert`` (read from ``path``) is signed by ``key`` (a private key):
-    it names the key, its envelope verifies with the key and records this file's SHA-256."""
-    public = key.public_key()
-    signature = cert.get("signature")
-    if not isinstance(signature, dict) or signature.get("keyid") != fingerprint(public):
-        return False
-    envelope = path.parent / envelope_name(cert["name"])
+def signed_by(path: Path, data: bytes, cert: dict, key) -> bool:
+    """Whether the certificate ``cert`` (``data``, read from ``path``) is signed by ``key`` (a
+    private key), by the rule ``recheck --trust`` applies (``bundle.verify_signed_by``)."""
     try:
-        stmt = open_envelope(envelope.read_text(encoding="utf-8").strip(), public, str(envelope), "--key")
-    except (OSError, UnicodeDecodeError, SigningError):
+        verify_signed_by(path, cert, key.public_key(), data, "--key")
+    except (SigningError, CertificateError):
         return False
-    subjects = stmt.get("subject")
-    own = f"{cert['name']}.cert.json"
-    recorded = [
-        s.get("digest", {}).get("sha256")
-        for s in (subjects if isinstance(subjects, list) else [])
-        if isinstance(s, dict) and s.get("name") == own and isinstance(s.get("digest"), dict)
-    ]
-    return recorded == [sha256_bytes(path.read_bytes())]
+    return True
 
 
-def _validate(path: Path, sweep, name: str, parameters: dict) -> dict:
-    """``path``'s certificate; CertificateError unless it is an intact certificate of this
-    sweep's set ``name``."""
+def _validate(path: Path, sweep, name: str, parameters: dict) -> tuple[bytes, dict]:
+    """``path``'s bytes and certificate (read bounded: ``reading.read_certificate``);
+    CertificateError unless it is an intact certificate of this sweep's set ``name``."""
     hint = "; remove it, or pass --force to recompute that set"
     try:
-        cert = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise CertificateError(f"{path}: not a readable certificate: {exc}{hint}") from None
+        data, cert = read_certificate(path)
+    except CertificateError as exc:
+        raise CertificateError(f"{exc}{hint}") from None
     if not isinstance(cert, dict):
         raise CertificateError(f"{path}: not a certificate{hint}")
     try:
@@ -196,4 +183,4 @@ def _validate(path: Path, sweep, name: str, parameters: dict) -> dict:
     for key, value in expected.items():
         if cert.get(key) != value:
             raise CertificateError(f"{path}: its {key} {cert.get(key)!r} is not this sweep's {value!r}{hint}")
-    return cert
+    return data, cert
