@@ -45,6 +45,18 @@ def _generated_code_cache(tmp_path_factory):
         yield folder
 
 
+@pytest.fixture
+def fresh_cache(tmp_path, monkeypatch):
+    """An empty generated-code cache of this test's own (its ``generated`` folder), forgotten in
+    this process before and after."""
+    from pendverify.numerics import generate
+
+    monkeypatch.setenv("PENDVERIFY_CACHE", str(tmp_path / "cache"))
+    generate.forget()
+    yield tmp_path / "cache" / "generated"
+    generate.forget()
+
+
 def default_params(name: str):
     return load_parameter_file(default_parameter_file(name))[2]
 

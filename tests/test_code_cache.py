@@ -194,30 +194,25 @@ def test_damaged_numba_files_are_compiled_again(warm, cache, damage):
 
 
 # --- a cache that cannot be written ------------------------------------------------------------------
-@pytest.fixture
-def empty_cache(tmp_path, monkeypatch):
-    monkeypatch.setenv("PENDVERIFY_CACHE", str(tmp_path / "cache"))
-    generate.forget()
-    yield tmp_path / "cache" / "generated"
-    generate.forget()
+# (fixture fresh_cache: conftest.py)
 
 
-def test_a_full_disk_generates_into_a_temporary_folder(empty_cache, monkeypatch, capsys):
+def test_a_full_disk_generates_into_a_temporary_folder(fresh_cache, monkeypatch, capsys):
     real = code_cache.write_atomic
 
     def full(path, data):
-        if Path(path).is_relative_to(empty_cache):
+        if Path(path).is_relative_to(fresh_cache):
             raise FileAccessError(str(path), "write", "No space left on device")
         return real(path, data)
 
     monkeypatch.setattr(code_cache, "write_atomic", full)
     k = generate.kernel(MODELS["double_pendulum"])
-    assert k.origin == "generated" and not k.path.is_relative_to(empty_cache) and k.path.is_file()
+    assert k.origin == "generated" and not k.path.is_relative_to(fresh_cache) and k.path.is_file()
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and str(empty_cache) in err[0] and "No space left on device" in err[0], err
+    assert len(err) == 1 and str(fresh_cache) in err[0] and "No space left on device" in err[0], err
 
 
-def test_a_full_disk_everywhere_is_one_line_naming_the_folder(empty_cache, monkeypatch):
+def test_a_full_disk_everywhere_is_one_line_naming_the_folder(fresh_cache, monkeypatch):
     def full(path, data):
         raise FileAccessError(str(path), "write", "No space left on device")
 

@@ -320,13 +320,7 @@ def test_asymmetric_mass_matrix_is_refused():
         generate.kernel(Skewed)
 
 
-# --- the cache -------------------------------------------------------------------------------------
-@pytest.fixture
-def fresh_cache(tmp_path, monkeypatch):
-    monkeypatch.setenv("PENDVERIFY_CACHE", str(tmp_path / "cache"))
-    generate.forget()
-    yield tmp_path / "cache" / "generated"
-    generate.forget()
+# --- the cache (fixture fresh_cache: conftest.py) ----------------------------------------------------
 
 
 def _listing(folder: Path) -> dict[str, int]:
