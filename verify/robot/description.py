@@ -31,10 +31,10 @@ from pendverify.display import shortened
 from pendverify.errors import UrdfShapeError
 from pendverify.robot.mjcf import build_mjcf_model
 from pendverify.robot.sdf import build_sdf_model
-from pendverify.robot.strict import DescriptionFacts, parse_xml
+from pendverify.robot.strict import DescriptionFacts
 from pendverify.robot.urdfdom import build_pinocchio_model
 from pendverify.robot.xacro_expand import XACRO_SUFFIXES, expand_xacro, uses_xacro
-from pendverify.robot.xml_reading import MAX_XML_CHARACTERS, ignored_extensions
+from pendverify.robot.xml_reading import MAX_XML_CHARACTERS, ignored_extensions, parse_xml
 
 #: format → the root element it has (xacro: the URDF's, after expansion)
 FORMATS = {"urdf": "robot", "xacro": "robot", "mjcf": "mujoco", "sdf": "sdf"}

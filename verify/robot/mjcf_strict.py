@@ -38,8 +38,9 @@ from pendverify.robot.inertia_rounding import check_inertia_tensor
 from pendverify.robot.mjcf_header import check_sections, read_compiler, read_gravity
 from pendverify.robot.mjcf_identity import is_identity
 from pendverify.robot.mjcf_rules import ORIENTATIONS, Numbers, read_defaults, resolve_joint
-from pendverify.robot.strict import DescriptionFacts, JointDynamics, parse_xml
+from pendverify.robot.strict import DescriptionFacts, JointDynamics
 from pendverify.robot.urdf_numbers import quoted
+from pendverify.robot.xml_reading import parse_xml
 
 IGNORED_IN_BODY = {"geom", "site", "camera", "light"}
 AXIS_UNIT_TOL = 1e-12

@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 
 from pendverify.analytic import ParameterSet
 from pendverify.errors import RebindError
-from pendverify.robot.strict import parse_xml
+from pendverify.robot.xml_reading import parse_xml
 
 MATCH_RTOL = 1e-12
 _INERTIA = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")

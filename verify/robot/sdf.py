@@ -22,9 +22,10 @@ import pinocchio as pin
 
 from pendverify.errors import UrdfShapeError
 from pendverify.robot.inertia_rounding import check_inertia_tensor
-from pendverify.robot.strict import DescriptionFacts, JointDynamics, parse_xml
+from pendverify.robot.strict import DescriptionFacts, JointDynamics
 from pendverify.robot.urdf_numbers import NOT_A_NUMBER, parse_number, quoted, why_not
 from pendverify.robot.urdfdom import build_from_file
+from pendverify.robot.xml_reading import parse_xml
 
 #: element tag → how many numbers its text holds
 NUMBERS: dict[str, tuple[int, ...]] = {

@@ -57,10 +57,9 @@ from pendverify.display import shortened
 from pendverify.errors import UrdfShapeError
 from pendverify.robot.inertia_rounding import check_inertia_tensor
 from pendverify.robot.urdf_numbers import NOT_A_NUMBER, parse_number, parse_vector, quoted, why_not
-from pendverify.robot.xml_reading import parse_xml, parse_xml_as_urdfdom_reads
+from pendverify.robot.xml_reading import parse_xml_as_urdfdom_reads
 
-__all__ = ["DescriptionFacts", "JointDynamics", "UrdfFacts", "parse_xml", "read_urdf_strictly"]
-# parse_xml's home is pendverify.robot.xml_reading; the readers of every format import it from here
+__all__ = ["DescriptionFacts", "JointDynamics", "UrdfFacts", "read_urdf_strictly"]
 
 #: tag → (attribute → how many numbers it holds), following the URDF format.
 VECTORS: dict[str, dict[str, int]] = {

@@ -2,7 +2,7 @@
 
 Conventions:
 
-* The file is first read as XML with the strict reader's rules (``pendverify.robot.strict.parse_xml``:
+* The file is first read as XML with the strict reader's rules (``pendverify.robot.xml_reading.parse_xml``:
   no DOCTYPE, no entities); xacro then processes that document as ``xacro FILE`` would, with
   no ``name:=value`` mappings: every ``xacro:arg`` takes the default the file gives it (an
   argument without a default is xacro's own error).  Includes are resolved relative to the
@@ -26,7 +26,7 @@ from pathlib import Path
 
 from pendverify.display import shortened
 from pendverify.errors import UrdfShapeError
-from pendverify.robot.strict import parse_xml
+from pendverify.robot.xml_reading import parse_xml
 
 #: namespace URIs that mark an element or attribute as xacro's (ElementTree spells them {uri}tag)
 XACRO_NAMESPACES = ("http://www.ros.org/wiki/xacro", "http://ros.org/wiki/xacro", "http://wiki.ros.org/xacro")
