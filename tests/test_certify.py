@@ -172,7 +172,7 @@ def test_sweep_runs_locally_and_on_dask_alike(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "3 passed, 0 failed, 3 sets" in out and "worst error/tolerance" in out
     with distributed.LocalCluster(
-        n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None, processes=True
+        n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=":0", processes=True
     ) as cluster:
         assert cluster.scheduler_address.startswith("tcp://127.0.0.1:")
         remote = tmp_path / "dask"

@@ -204,7 +204,7 @@ def test_sweep_over_a_model_file_locally_and_on_dask(tmp_path, capsys):
         assert f'<mass value="{cert["parameters"]["m1"]!r}"' in cert["urdf"]["text"]
         assert main(["recheck", str(local / name), "--run-embedded-code"]) == 0
     with distributed.LocalCluster(
-        n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None, processes=True
+        n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=":0", processes=True
     ) as cluster:
         remote = tmp_path / "dask"
         args = ["certify", "--sweep", str(sweep), "-o", str(remote), "--scheduler", cluster.scheduler_address]

@@ -60,17 +60,26 @@ def _items(folder: Path) -> dict[str, list]:
     }
 
 
-def session_processes(sid: int) -> list[int]:
-    """Processes still alive in session ``sid`` (the sweep and its workers)."""
+#: fields of /proc/PID/stat after the command's name: 0 state, 1 parent's pid, 3 session id
+PARENT_FIELD, SESSION_FIELD = 1, 3
+
+
+def live_processes(field: int, value: int) -> list[int]:
+    """Processes alive (not zombies) whose /proc stat field ``field`` is ``value``."""
     alive = []
     for stat in Path("/proc").glob("[0-9]*/stat"):
         try:
             fields = stat.read_text().rsplit(")", 1)[1].split()
         except OSError:
             continue
-        if int(fields[3]) == sid and fields[0] != "Z":
+        if int(fields[field]) == value and fields[0] != "Z":
             alive.append(int(stat.parent.name))
     return alive
+
+
+def session_processes(sid: int) -> list[int]:
+    """Processes still alive in session ``sid`` (the sweep and its workers)."""
+    return live_processes(SESSION_FIELD, sid)
 
 
 def _interrupt_after_first_bundle(sweep: Path, out: Path, signals: int = 1, where=("--workers", "2")):
@@ -130,7 +139,7 @@ def test_a_second_ctrl_c_exits_at_once(tmp_path):
 def test_ctrl_c_on_a_dask_sweep_cancels_its_tasks(tmp_path):
     distributed = pytest.importorskip("distributed", reason="the dask extra is part of the test extras")
     with distributed.LocalCluster(
-        n_workers=2, threads_per_worker=1, host="127.0.0.1", dashboard_address=None, processes=True
+        n_workers=2, threads_per_worker=1, host="127.0.0.1", dashboard_address=":0", processes=True
     ) as cluster:
         where = ("--scheduler", cluster.scheduler_address)
         out = tmp_path / "out"

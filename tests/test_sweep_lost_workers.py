@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 
 from pendverify.certify.certificate import verify_digest
-from tests.test_sweep_interrupt import SWEEP, pendverify_process
+from tests.test_sweep_interrupt import PARENT_FIELD, SWEEP, live_processes, pendverify_process
 
 SETS = 24
 TIMEOUT_S = 120  # a hard bound on every wait: a hang fails the test
@@ -66,7 +66,7 @@ def _stop(*procs: subprocess.Popen) -> None:
 def test_a_dask_cluster_whose_only_worker_died(tmp_path):
     distributed = pytest.importorskip("distributed", reason="the dask extra is part of the test extras")
     with distributed.LocalCluster(
-        n_workers=0, processes=False, protocol="tcp", host="127.0.0.1", dashboard_address=None
+        n_workers=0, processes=False, protocol="tcp", host="127.0.0.1", dashboard_address=":0"
     ) as cluster:
         worker = _worker(cluster.scheduler_address)
         out = tmp_path / "out"
@@ -113,15 +113,7 @@ def test_a_dask_scheduler_that_died(tmp_path, how, words):
 
 
 def _children(pid: int) -> list[int]:
-    found = []
-    for stat in Path("/proc").glob("[0-9]*/stat"):
-        try:
-            fields = stat.read_text().rsplit(")", 1)[1].split()
-        except OSError:
-            continue
-        if int(fields[1]) == pid and fields[0] != "Z":
-            found.append(int(stat.parent.name))
-    return found
+    return live_processes(PARENT_FIELD, pid)
 
 
 @pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="finds the workers in /proc")
