@@ -293,10 +293,14 @@ def run_sweep(
                         exhausted = True
                         break
                     task = (sweep.model, sets, settings, sweep.urdf, sweep.base)
-                    pending[workers.submit(certify_chunk, *task)] = len(sets)
+                    try:
+                        pending[workers.submit(certify_chunk, *task)] = len(sets)
+                    except BrokenProcessPool as exc:  # a worker died since the last results came
+                        run.lost = _died(exc)
+                        break
                     run.submitted += 1
                     run.peak_in_flight = max(run.peak_in_flight, len(pending))
-                if not pending:
+                if run.lost or not pending:
                     break
                 finished, _ = wait(list(pending), timeout=POLL_S, return_when=FIRST_COMPLETED)
                 run.lost = None if finished else workers.lost()
