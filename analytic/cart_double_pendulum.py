@@ -195,9 +195,9 @@ class CartDoublePendulum(ClosedFormModel):
         return adj / self.det_mass_matrix(y)
 
     def state_derivative(self, x, u, w):
-        """F(x, u, w) = (ẏ, M⁻¹ f) with x = (y, ẏ)."""
+        """F(x, u, w) = (ẏ, M⁻¹(y) f(y, ẏ, u, w)) with x = (y, ẏ), M⁻¹ the closed form above."""
         y, yd = x[:3], x[3:]
-        return np.concatenate([yd, np.linalg.solve(self.mass_matrix(y), self.f(y, yd, u, w))])
+        return np.concatenate([yd, self.inverse_mass_matrix(y) @ self.f(y, yd, u, w)])
 
     def acceleration(self, q, v, u, w):
         return self.state_derivative(np.concatenate([q, v]), u, w)[3:]

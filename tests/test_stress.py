@@ -14,6 +14,8 @@ import pytest
 
 from pendverify.analytic import MODELS, CartDoublePendulum, DoublePendulum
 from pendverify.checks import trust as near_singular
+from pendverify.checks import verification
+from pendverify.checks.batch import world_lever
 from pendverify.checks.trust import Conditioning, IllConditionedError, check_conditioning
 from pendverify.cli import main
 from pendverify.errors import InputError
@@ -199,7 +201,7 @@ def test_planted_large_angle_passes_at_small_angles(ctx):
 def test_without_the_guard_the_singular_cases_fail(monkeypatch, ctx):
     """Refusal is what keeps a 1e12-conditioned case from passing garbage: disable it, and it fails."""
     monkeypatch.setattr(
-        framework, "check_conditioning", lambda *a, **k: Conditioning(1.0, 1.0, 0.0, "ok", 1.0)
+        verification, "check_conditioning", lambda *a, **k: Conditioning(1.0, 1.0, 0.0, "ok", 1.0)
     )
     for name in ("double pendulum l1 1e3 m, l2 1e-3 m", "cart rods 1e-3 m / 1e3 m"):
         result = stress.run_case(_case(name), ctx)
@@ -256,9 +258,7 @@ def test_conditioning_levels_and_scaling():
 def test_term_amplification_grows_with_the_square_of_the_lever_arm():
     params = default_params("cart_double_pendulum").replace(l1=1e-3, l2=1e-3)
     model, system = CartDoublePendulum(params), framework.system_for(params)
-    near, one, eight = (
-        near_singular.term_amplification(model, system, np.array([x, 0.7, 0.7])) for x in (0.0, 1.0, 8.0)
-    )
+    near, one, eight = (world_lever(model, system, np.array([x, 0.7, 0.7])) for x in (0.0, 1.0, 8.0))
     assert 1 <= near < 20  # a 1 mm pendulum at the origin: terms as large as the result
     assert 60 < eight / one < 68  # 1 mm rods 1 m and 8 m from the origin: (8/1)²
 

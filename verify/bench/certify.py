@@ -9,13 +9,11 @@ whole measurement instead of putting them all into one spell):
 * the battery (``certify.battery.run_battery``) and its parts: ``checks`` (the trust
   guard and every check on the sampled states), ``stress`` (the four generic cases) and
   ``invariants`` (one simulation per effect);
-* the per-state reference path of the checks and stress parts (``run_check_per_state``
-  and ``trust.assess`` state by state, as before the batch; ``reference_repeats`` runs);
 * their floor: the bare Pinocchio calls and closed-form evaluations the parts contain,
   timed alone on the same states — each Pinocchio function called once per state in a
   plain loop with the configurations already mapped, and the closed forms evaluated as
-  the batch evaluates them (``checks.forms_batch``: once over all states where the
-  model's code allows it, state by state where it does not).
+  the checks evaluate them (``pendverify.checks.closed_forms``: the generated NumPy
+  functions over all states, the model's own Python where SymPy cannot read a method).
 
 The battery's floor counts the invariants at their own cost (their simulations are not
 split further here).  Nothing here is asserted on time: ``tests/test_bench_certify.py``
@@ -24,7 +22,6 @@ runs ``--quick`` and checks the table's shape and that the ratios are finite.
 
 from __future__ import annotations
 
-import contextlib
 import gc
 import time
 from dataclasses import dataclass, field, replace
@@ -41,8 +38,8 @@ from pendverify.certify.battery import (
     stress_items,
 )
 from pendverify.certify.issue import certification_input
-from pendverify.checks import batch as batch_module
-from pendverify.checks.forms_batch import ClosedFormBatch
+from pendverify.checks.batch import recording_batches
+from pendverify.checks.closed_forms import ClosedForms
 from pendverify.robot.batch import configurations
 from pendverify.robot.system import PinocchioSystem
 
@@ -51,12 +48,11 @@ PARTS = ("checks", "stress", "invariants")
 
 @dataclass
 class SetCost:
-    """One parameter set's seconds: the battery and its parts, batch, per state and floor."""
+    """One parameter set's seconds: the battery, its parts and their floor."""
 
     name: str
     battery: float
     batch: dict[str, float]
-    per_state: dict[str, float]
     floor: dict[str, float]
     states: int
     contexts: dict[str, int] = field(default_factory=dict)
@@ -84,51 +80,21 @@ def cpu_seconds(fn, repeats: int) -> float:
     return min(cpu_once(fn) for _ in range(max(1, repeats)))
 
 
-def least_in_rounds(figures: dict, repeats: int, between=None) -> dict:
+def least_in_rounds(figures: dict, repeats: int) -> dict:
     """{key: the least process time of ``figures[key]()``}, each timed once per round, ``repeats`` rounds.
 
     On a shared machine a slow spell lasts seconds: ``repeats`` calls in a row can all
     fall into one, while rounds over every figure spread each figure's calls across the
-    whole run.  ``between()`` (the slow per-state path) runs after half of the rounds.
+    whole run.
     """
     for fn in figures.values():
         fn()  # untimed: caches, generated code
     best = dict.fromkeys(figures, float("inf"))
     rounds = max(1, repeats)
-    for r in range(rounds):
-        if between is not None and r == rounds // 2:
-            between()
+    for _ in range(rounds):
         for key, fn in figures.items():
             best[key] = min(best[key], cpu_once(fn))
     return best
-
-
-@contextlib.contextmanager
-def per_state_only():
-    """Every check and trust verdict takes the per-state reference path (``BatchContext.of`` → None)."""
-    real = batch_module.BatchContext.__dict__["of"]
-    batch_module.BatchContext.of = classmethod(lambda cls, *args: None)
-    try:
-        yield
-    finally:
-        batch_module.BatchContext.of = real
-
-
-@contextlib.contextmanager
-def recorded_batches(into: list):
-    """Every ``BatchContext`` made meanwhile is appended to ``into``."""
-    cls = batch_module.BatchContext
-    real = cls.__init__
-
-    def record(self, *args, **kwargs):
-        real(self, *args, **kwargs)
-        into.append(self)
-
-    cls.__init__ = record
-    try:
-        yield
-    finally:
-        cls.__init__ = real
 
 
 def _pinocchio_floor(ctx) -> list:
@@ -140,7 +106,7 @@ def _pinocchio_floor(ctx) -> list:
     pb = ctx.pin
     system, n = pb.system, pb.system.model.nv
     zero, unit = np.zeros(n), np.eye(n)
-    m0, d0 = system._no_gravity, system._no_gravity_data
+    m0, d0 = system.model_without_gravity, system.data_without_gravity
     done, loops = pb.computed, []
     table = {
         "crba": (pin.crba, pb.q),
@@ -157,11 +123,10 @@ def _pinocchio_floor(ctx) -> list:
     if pb.aba_torques is not None:
         loops.append((pin.aba, pb.q, pb.v, pb.aba_torques))
     if "lever" in ctx.__dict__:  # the term amplification: forward kinematics (and CRBA at θ if reduced)
-        if ctx.source[1] is None:
-            loops.append((pin.forwardKinematics, pb.q))
-        else:
-            configs = configurations(system.cmap, ctx.Q)
-            loops += [(pin.forwardKinematics, configs), (pin.crba, configs)]
+        configs = configurations(system.cmap, ctx.Q)
+        loops.append((pin.forwardKinematics, configs))
+        if ctx.pinocchio_angles is not None:
+            loops.append((pin.crba, configs))
     return loops
 
 
@@ -181,7 +146,7 @@ def floor_work(contexts):
         for item in work:
             if item[0] == "forms":
                 _, ctx, names = item
-                forms = ClosedFormBatch(ctx.model, ctx.states, ctx.Q, ctx.V, ctx.U, ctx.W)
+                forms = ClosedForms(ctx.model, ctx.Q, ctx.V, ctx.U, ctx.W, ctx.python_only)
                 for name in names:
                     forms.value(name)
                 continue
@@ -214,21 +179,17 @@ def _prepare(params_file: str, settings: BatterySettings) -> _SetRun:
     }
     floors, contexts = {}, {}
     for part in ("checks", "stress"):
-        recorded: list = []
-        with recorded_batches(recorded):
+        with recording_batches() as recorded:
             parts[part]()
         floors[part], contexts[part] = floor_work(recorded), len(recorded)
     return _SetRun(source.name, parts, lambda: run_battery(cls, params, urdf, settings), floors, contexts)
 
 
-def measure(
-    params_files=None, settings: BatterySettings | None = None, repeats: int = 7, reference_repeats=1
-):
+def measure(params_files=None, settings: BatterySettings | None = None, repeats: int = 7):
     """``SetCost`` for each parameter file (default: every built-in model's own set).
 
-    Each batch, battery and floor figure is the least of ``repeats`` rounds over every
-    set and figure (``least_in_rounds``); the per-state path runs once between the
-    rounds, the least of ``reference_repeats`` calls in a row kept.
+    Each battery, part and floor figure is the least of ``repeats`` rounds over every
+    set and figure (``least_in_rounds``).
     """
     files = params_files or [str(default_parameter_file(name)) for name in MODELS]
     settings = settings or BatterySettings()
@@ -238,21 +199,12 @@ def measure(
         figures.update({(i, "batch", part): fn for part, fn in run.parts.items()})
         figures[(i, "battery")] = run.battery
         figures.update({(i, "floor", part): fn for part, fn in run.floors.items()})
-    per_state: dict = {}
-
-    def reference():
-        with per_state_only():
-            for i, run in enumerate(runs):
-                for part in ("checks", "stress"):
-                    per_state[(i, part)] = cpu_seconds(run.parts[part], reference_repeats)
-
-    best = least_in_rounds(figures, repeats, reference)
+    best = least_in_rounds(figures, repeats)
     return [
         SetCost(
             run.name,
             best[(i, "battery")],
             {part: best[(i, "batch", part)] for part in PARTS},
-            {part: per_state[(i, part)] for part in ("checks", "stress")},
             {part: best[(i, "floor", part)] for part in ("checks", "stress")},
             settings.samples,
             run.contexts,

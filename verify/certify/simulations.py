@@ -147,7 +147,7 @@ def cross_check(run, system):
     from pendverify.checks.catalogue import CHECKS
     from pendverify.checks.quantities import aba
     from pendverify.checks.sampling import State
-    from pendverify.checks.scaling import world_lever
+    from pendverify.checks.batch import world_lever
     from pendverify.checks.trust import EPS, REFUSE_REL
     from pendverify.simulation.invariants import figures_of
 

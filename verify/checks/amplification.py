@@ -1,4 +1,4 @@
-"""The term amplification A ≥ 1 of the trust rule, at one state or at a batch of states.
+"""The term amplification A ≥ 1 of the trust rule, at each state of a batch.
 
 Pinocchio's recursions work with spatial inertias expressed in the world frame, whose
 entries grow like m·|c|² (c a centre of mass seen from the world origin); their rounding
@@ -6,27 +6,17 @@ is ε times *those* terms.  With W_j = Σ_{k in subtree(j)} m_k|c_k|² + tr I_k 
 revolute joint (M_q,jj for a prismatic one, never less than M_q,jj) and T the coordinate
 map, A = max_i (Σ_k |T|_ki √W_k)² / S_i (the argument is in ``pendverify.checks.trust``).
 
-``amplification`` is the one arithmetic: elementwise numpy over optional leading batch
-axes, every sum written out in a fixed order, so that one state (``term_amplification``,
-cached on the system) and a batch (``term_amplification_batch``, the batched checks)
-give the same bits.
+``amplification`` is the arithmetic, elementwise over leading batch axes;
+``term_amplification_batch`` feeds it the placements of a batch of configurations.
 """
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-AMPLIFICATION_CACHE = 4096  # states whose term amplification a system remembers
 
-
-def joint_levers(system) -> tuple:
-    """((v, ((body, mass, lever, tr I), …)), …) for each non-prismatic joint; kept on the system."""
-    pm = system.model
-    cached = system.__dict__.get("_joint_levers")
-    if cached is not None and cached[0] is pm:
-        return cached[1]
+def joint_levers(pm) -> tuple:
+    """((v, ((body, mass, lever, tr I), …)), …) for each non-prismatic joint of Pinocchio model ``pm``."""
     table = []
     for j in range(1, pm.njoints):
         name = pm.joints[j].shortname()
@@ -42,7 +32,6 @@ def joint_levers(system) -> tuple:
             for k in pm.subtrees[j]
         )
         table.append((pm.joints[j].idx_v, bodies))
-    system.__dict__["_joint_levers"] = (pm, tuple(table))
     return tuple(table)
 
 
@@ -77,43 +66,12 @@ def amplification(diag_M, frames: dict, levers, abs_T: np.ndarray, S):
         return np.where(np.isfinite(A), np.where(1.0 > A, 1.0, A), np.inf)
 
 
-def term_amplification(model, system, q) -> float:
-    """A ≥ 1: how much larger than the result (in the model's scaled coordinates) Pinocchio's terms are.
-
-    The trust guard and two checks ask for it at every state: answers are kept on the
-    system, keyed by the state, with the model and Pinocchio data they came from (held,
-    so that their ids cannot be reused while the entry lives).
-    """
-    key = np.asarray(q, dtype=float).tobytes()
-    cache = system.__dict__.setdefault("_amplification_cache", {})
-    entry = cache.get(key)
-    if entry is None or entry[0] is not model or entry[1] is not system.data:
-        if len(cache) >= AMPLIFICATION_CACHE:
-            cache.clear()
-        entry = cache[key] = (model, system.data, _term_amplification(model, system, q))
-    return entry[2]
-
-
-def _term_amplification(model, system, q) -> float:
-    import pinocchio as pin
-
-    pm, data = system.model, system.data
-    config = system.cmap.configuration(q)
-    levers = joint_levers(system)
-    pin.forwardKinematics(pm, data, config)
-    frames = {k: data.oMi[k].homogeneous for k in _bodies(levers)}
-    upper = pin.crba(pm, data, config)
-    S = model.diagonal_scale(np.asarray(q, dtype=float))
-    A = float(amplification(np.diag(upper), frames, levers, np.abs(system.cmap.T), S))
-    return A if math.isfinite(A) else math.inf
-
-
-def term_amplification_batch(model, system, configs: np.ndarray, diag_M: np.ndarray, S: np.ndarray):
+def term_amplification_batch(system, configs: np.ndarray, diag_M: np.ndarray, S: np.ndarray):
     """A at each of a batch of Pinocchio configurations (N, nq), given diag M_q (N, n) and S (N, n)."""
     import pinocchio as pin
 
     pm, data = system.model, system.data
-    levers = joint_levers(system)
+    levers = joint_levers(pm)
     bodies = _bodies(levers)
     frames = {k: np.empty((len(configs), 4, 4)) for k in bodies}
     oMi = data.oMi

@@ -29,22 +29,18 @@ tolerance (K·ε·((1 + |θ|max)·c_T + (A − 1)) + a/s) at the worst state, th
 with the largest e / tolerance.  A state whose rounding term alone exceeds the
 trust limit (``pendverify.checks.trust.REFUSE_REL``) is refused, not judged.
 
-Two ways, one set of numbers: ``run_check`` and ``run_checks`` evaluate a check over all
-states at once (``pendverify.checks.batch``: the tolerance above as arrays), and
-``run_check_per_state`` one state at a time, the reference the batch falls back to
-wherever it cannot follow it exactly; both hand their evidence to
-``pendverify.checks.judge.conclude``.  ``tests/test_batch_checks.py`` holds them equal,
-state by state, bit for bit.
+``run_check`` and ``run_checks`` evaluate a check over all states at once: one
+``pendverify.checks.batch.CheckBatch`` holds the states and every quantity the checks
+share, ``pendverify.checks.judge.collect`` forms the tolerance above as arrays and
+``pendverify.checks.judge.conclude`` draws the verdict.  One state is the batch of one.
 """
 
 from __future__ import annotations
 
-import numpy as np
-
 from pendverify.checks import quantities
 from pendverify.checks.applicability import hand_written, needs_matrix_c, needs_urdf_damping
-from pendverify.checks.batch import BatchContext, collect_batch
-from pendverify.checks.judge import OUT_OF_RANGE, collect_per_state, conclude
+from pendverify.checks.batch import CheckBatch
+from pendverify.checks.judge import collect, conclude
 from pendverify.checks.result import Check, CheckResult
 from pendverify.checks.trust import EPS
 
@@ -52,37 +48,35 @@ __all__ = [
     "CHECKS",
     "CHECK_NAMES",
     "EPS",
-    "OUT_OF_RANGE",
     "Check",
     "CheckResult",
     "applicable_checks",
     "not_applicable",
     "run_check",
-    "run_check_per_state",
     "run_checks",
     "skipped_notes",
 ]
 
 
 CHECKS: tuple[Check, ...] = (
-    Check("crba", "crba (symmetrised)", "M(q)", 8, quantities.crba),
-    Check("rnea", "rnea(q, q̇, 0)", "C(q,q̇)·q̇ + H(q), friction removed", 16, quantities.rnea),
-    Check("gravity", "computeGeneralizedGravity", "H(q)", 16, quantities.gravity),
+    Check("crba", "crba (symmetrised)", "M(q)", 8, quantities.measure_crba),
+    Check("rnea", "rnea(q, q̇, 0)", "C(q,q̇)·q̇ + H(q), friction removed", 16, quantities.measure_rnea),
+    Check("gravity", "computeGeneralizedGravity", "H(q)", 16, quantities.measure_gravity),
     Check(
         "coriolis",
         "computeCoriolisMatrix",
         "C(q,q̇) without friction",
         16,
-        quantities.coriolis,
+        quantities.measure_coriolis,
         needs_matrix_c,
     ),
-    Check("skew", "Ṁ (RNEA derivatives) − 2C", "skew-symmetric", 16, quantities.skew, needs_matrix_c),
+    Check("skew", "Ṁ (RNEA derivatives) − 2C", "skew-symmetric", 16, quantities.measure_skew, needs_matrix_c),
     Check(
         "det",
         "det(crba) by LU",
         "closed-form det M(q) > 0",
         16,
-        quantities.det,
+        quantities.measure_det,
         hand_written("det_mass_matrix"),
     ),
     Check(
@@ -90,52 +84,38 @@ CHECKS: tuple[Check, ...] = (
         "computeMinverse",
         "M(q)⁻¹ (closed form)",
         16,
-        quantities.minverse,
+        quantities.measure_minverse,
         hand_written("inverse_mass_matrix"),
     ),
-    Check("aba", "aba(q, q̇, Bu + Ww − Dq̇)", "closed-form q̈ (f + g·u, M⁻¹f)", 16, quantities.aba),
-    Check("energy", "kinetic + potential energy", "½q̇ᵀMq̇, V(q) − V(0)", 16, quantities.energy),
+    Check("aba", "aba(q, q̇, Bu + Ww − Dq̇)", "closed-form q̈ (f + g·u, M⁻¹f)", 16, quantities.measure_aba),
+    Check("energy", "kinetic + potential energy", "½q̇ᵀMq̇, V(q) − V(0)", 16, quantities.measure_energy),
     # Tᵀ·diag(b)·T: each entry a sum of at most n products of exact decimals' roundings
     Check(
-        "damping", "<dynamics damping> (Tᵀ·diag(b)·T)", "D", 8, quantities.damping, needs_urdf_damping, False
+        "damping",
+        "<dynamics damping> (Tᵀ·diag(b)·T)",
+        "D",
+        8,
+        quantities.measure_damping,
+        needs_urdf_damping,
+        False,
     ),
 )
 CHECK_NAMES = tuple(c.name for c in CHECKS)
 
 
-def run_check_per_state(check: Check, label: str, model, system, states, seed: int) -> CheckResult:
-    """Evaluate one check on every state, one state at a time, and keep the evidence of the worst one.
-
-    The reference path.  A state whose own rounding tolerance K·ε·((1 + |θ|)·c_T + (A − 1))
-    exceeds the trust limit (``trust.REFUSE_REL``) is not judged: a tolerance that wide
-    would pass a 1 ppm modelling error.  The check is then ``refused`` (unless another
-    state fails), whatever the guard before it let through.  Failing states are judged
-    again with the hand-written closed forms evaluated in high precision
-    (``pendverify.checks.precision``): if all then pass, the check is a warning.
-    """
-    return conclude(
-        check, label, model, system, states, seed, collect_per_state(check, model, system, states)
-    )
-
-
 def run_check(check: Check, label: str, model, system, states, seed: int, batch=None) -> CheckResult:
-    """One check on every state, evaluated over all states at once (``pendverify.checks.batch``).
+    """One check on every state, evaluated over all states at once.
 
-    The same verdict, errors, tolerances, states and notes as ``run_check_per_state``,
-    which it falls back to wherever the batch cannot follow it exactly.  ``batch``: a
-    ``BatchContext`` of these states to share with other checks (``run_checks``).
+    A state whose own rounding tolerance K·ε·((1 + |θ|)·c_T + (A − 1)) exceeds the trust
+    limit (``trust.REFUSE_REL``) is not judged: a tolerance that wide would pass a 1 ppm
+    modelling error.  The check is then ``refused`` (unless another state fails).  Failing
+    states are judged again with the hand-written closed forms evaluated in high precision
+    (``pendverify.checks.precision``): if all then pass, the check is a warning.
+    ``batch``: a ``CheckBatch`` of these states to share with other checks (``run_checks``).
     """
     if batch is None:
-        batch = BatchContext.of(model, system, states)
-    if batch is not None:
-        try:
-            with np.errstate(all="ignore"):
-                evidence = collect_batch(check, batch)
-        except Exception as exc:  # anything unusual: the reference path decides, as it always has
-            batch.fallbacks.append((check.name, f"{type(exc).__name__}: {exc}"))
-        else:
-            return conclude(check, label, model, system, states, seed, evidence)
-    return run_check_per_state(check, label, model, system, states, seed)
+        batch = CheckBatch(model, system, states)
+    return conclude(check, label, batch, seed, collect(check, batch))
 
 
 def not_applicable(model, system=None) -> dict[str, str]:
@@ -165,5 +145,5 @@ def run_checks(label, model, system, states, seed, names=CHECK_NAMES, batch=None
     """
     names = set(names) & set(applicable_checks(model, system))
     if batch is None:
-        batch = BatchContext.of(model, system, states)
+        batch = CheckBatch(model, system, states)
     return [run_check(c, label, model, system, states, seed, batch) for c in CHECKS if c.name in names]

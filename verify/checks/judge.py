@@ -1,11 +1,13 @@
-"""Judging a check's states and drawing its verdict: one ``conclude`` for both ways of evaluating.
+"""Judging a check at every state of a batch and drawing its verdict.
 
-A check's states are evaluated either one at a time (``collect_per_state``, the reference)
-or all at once (``pendverify.checks.batch``); both hand the same ``Evidence`` — which
-states were judged, their rounding tolerance, relative error, relative tolerance and
-absolute error, which were refused and the notes so far — to ``conclude``, which
-re-judges failing states in high precision, picks the worst and the largest state and
-writes the ``CheckResult``.  The tolerance argument is in ``pendverify.checks.catalogue``.
+``collect`` runs a check's measure (``pendverify.checks.quantities``) on a batch
+(``pendverify.checks.batch.CheckBatch``) and forms, per state, the rounding tolerance
+K·ε·((1 + |θ|max)·c_T + (A − 1)), the relative error e/s and the relative tolerance
+rounding + a/s (the argument for them is in ``pendverify.checks.catalogue``): the
+``Evidence``.  A state whose rounding tolerance exceeds the trust limit is refused, not
+judged.  ``conclude`` re-judges failing states with the closed forms in high precision
+(``pendverify.checks.precision``), picks the worst and the largest state and writes the
+``CheckResult``.
 """
 
 from __future__ import annotations
@@ -15,14 +17,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pendverify.checks.batch import CheckBatch
 from pendverify.checks.result import Check, CheckResult
 from pendverify.checks.sampling import State
-from pendverify.checks.scaling import world_lever
 from pendverify.checks.trust import EPS, REFUSE_REL
 from pendverify.checks.verdict import REFUSED, WARN
-
-#: what evaluating a state raises when its numbers leave double's range (parameters of 1e200)
-OUT_OF_RANGE = (OverflowError, FloatingPointError, np.linalg.LinAlgError)
 
 
 @dataclass(frozen=True)
@@ -58,76 +57,68 @@ class Evidence:
     notes: list[str]
 
 
-def rounding_tolerance(check: Check, angle: float, c_T: float, lever: float) -> float:
-    """K·ε·((1 + |θ|max)·c_T + (A − 1)): the state's own rounding (on arrays too, elementwise)."""
+def rounding_tolerance(check: Check, angle, c_T: float, lever):
+    """K·ε·((1 + |θ|max)·c_T + (A − 1)): each state's own rounding (elementwise on arrays)."""
     return check.K * EPS * ((1.0 + angle) * c_T + (lever - 1.0))
 
 
-def judge_state(check: Check, model, system, state: State, rounding: float) -> Judged:
-    """One state: the check's error and scale (``quantities``) as relative error and tolerance."""
-    sample = check.evaluate(model, system, state)
-    if sample.scale > 0:
-        rel_tol = rounding + sample.allowance / sample.scale
-        rel_err = sample.error / sample.scale
-    else:  # nothing acts (at rest with g = 0): any error at all is a failure
-        rel_tol = rounding
-        rel_err = 0.0 if sample.error == 0 else np.inf
-    note = sample.note or ("NaN" if np.isnan(rel_err) else "")
-    return Judged(np.inf if np.isnan(rel_err) else float(rel_err), float(rel_tol), float(sample.error), note)
+def collect(check: Check, batch) -> Evidence:
+    """The check at every state of ``batch`` (``pendverify.checks.batch.CheckBatch``): its evidence."""
+    n = len(batch)
+    with np.errstate(all="ignore"):
+        lever = batch.lever if check.world_frame else 1.0
+        rounding = np.broadcast_to(rounding_tolerance(check, batch.angle, batch.c_T, lever), (n,))
+        m = check.measure(batch.terms)
+        error, scale, allowance = (
+            np.broadcast_to(np.asarray(x, dtype=float), (n,)) for x in (m.error, m.scale, m.allowance)
+        )
+    # the size of the terms left double's range (parameters of 1e200): nothing can be verified there
+    overflow = ~np.isfinite(scale)
+    trusted = (rounding <= REFUSE_REL) & ~overflow
+    judged = np.flatnonzero(trusted)
+    refused = [(int(i), np.inf if overflow[i] else float(rounding[i])) for i in np.flatnonzero(~trusted)]
+    notes = [
+        f"{batch.states[i].label}: refused: its terms overflow double (their size is {scale[i]:g})"
+        for i in np.flatnonzero(overflow)[:3]
+    ]
+    error, scale, allowance, r = error[judged], scale[judged], allowance[judged], rounding[judged]
+    with np.errstate(all="ignore"):
+        positive = scale > 0
+        rel_tol = np.where(positive, r + allowance / scale, r)
+        # nothing acts (at rest with g = 0): any error at all is a failure
+        rel_err = np.where(positive, error / scale, np.where(error == 0, 0.0, np.inf))
+    noted = np.broadcast_to(np.asarray(m.noted, dtype=bool), (n,))[judged]
+    nan = np.isnan(rel_err)
+    for k in np.flatnonzero(noted | nan)[: max(0, 3 - len(notes))]:
+        i = int(judged[k])
+        note = m.describe(i) if noted[k] else "NaN"
+        notes.append(f"{batch.states[i].label}: {note}")
+    return Evidence(judged, r.copy(), np.where(nan, np.inf, rel_err), rel_tol, error.copy(), refused, notes)
 
 
-def collect_per_state(check: Check, model, system, states) -> Evidence:
-    """Evaluate the check at each state in turn: the reference way (``catalogue.run_check_per_state``)."""
-    c_T = system.cmap.amplification
-    notes: list[str] = []
-    refused: list[tuple[int, float]] = []
-    judged: list[tuple[int, float, Judged]] = []
-    for i, state in enumerate(states):
-        angle = float(np.max(np.abs(state.q[np.array(model.angular)]), initial=0.0))
-        lever = world_lever(model, system, state.q) if check.world_frame else 1.0
-        rounding = rounding_tolerance(check, angle, c_T, lever)
-        if not rounding <= REFUSE_REL:
-            refused.append((i, rounding))
-            continue
-        try:
-            j = judge_state(check, model, system, state, rounding)
-        except OUT_OF_RANGE as exc:  # terms beyond double's range: nothing can be verified there
-            refused.append((i, np.inf))
-            notes.append(f"{state.label}: refused: its terms overflow double ({type(exc).__name__}: {exc})")
-            continue
-        if j.note and len(notes) < 3:
-            notes.append(f"{state.label}: {j.note}")
-        judged.append((i, rounding, j))
-    return Evidence(
-        np.array([i for i, _, _ in judged], dtype=int),
-        np.array([r for _, r, _ in judged], dtype=float),
-        np.array([j.rel_err for *_, j in judged], dtype=float),
-        np.array([j.rel_tol for *_, j in judged], dtype=float),
-        np.array([j.abs_err for *_, j in judged], dtype=float),
-        refused,
-        notes,
-    )
-
-
-def rejudge_precisely(check: Check, model, system, failing) -> tuple[dict[int, Judged], str]:
+def rejudge_precisely(check: Check, batch, failing: list[int], ev: Evidence) -> tuple[dict[int, Judged], str]:
     """Failing states judged again with the closed forms in high precision (``checks.precision``).
 
-    ``failing``: (index, state, rounding, judged) in the order of the states.  Worst
-    first; stops at the first state that still fails.  Returns {index: judged} for the
-    states that pass so (all of them, or the check still fails) and why not.
+    ``failing``: positions in ``ev`` of the failing states.  Worst first; stops at the
+    first state that still fails.  Returns {state index: judged} for the states that pass
+    so (all of them, or the check still fails) and why not.
     """
     from pendverify.checks import precision  # mpmath, loaded only when a state fails
 
     try:
-        precise = precision.precise_model(model)
+        precise = precision.precise_model(batch.model)
     except precision.PrecisionUnavailable as exc:
         return {}, str(exc)
+    ratios = _ratios(ev.rel_err, ev.rel_tol)
     passed = {}
-    for i, state, rounding, _ in sorted(failing, key=lambda f: -f[3].ratio):
+    for k in sorted(failing, key=lambda k: -ratios[k]):
+        i = int(ev.judged[k])
+        one = CheckBatch(precise, batch.system, [batch.states[i]], batch.pinocchio_angles, python_only=True)
         try:
-            judged = judge_state(check, precise, system, state, rounding)
+            again = collect(check, one)
         except precision.PrecisionUnavailable as exc:
             return passed, str(exc)
+        judged = Judged(float(again.rel_err[0]), float(again.rel_tol[0]), float(again.abs_err[0]))
         if not judged.ratio <= 1.0:
             return passed, ""
         passed[i] = judged
@@ -149,13 +140,14 @@ def _python_max(values: np.ndarray) -> float:
     return float(np.nanmax(values))
 
 
-def conclude(check: Check, label: str, model, system, states, seed: int, ev: Evidence) -> CheckResult:
-    """The verdict on one check from its evidence (both paths of ``run_check`` end here).
+def conclude(check: Check, label: str, batch, seed: int, ev: Evidence) -> CheckResult:
+    """The verdict on one check from its evidence at the states of ``batch``.
 
     Failing states are judged again in high precision: if all then pass, the check is a
     warning.  Reported: the state with the worst error/tolerance ratio (the first of
     equals), the one with the largest relative error, the largest absolute error.
     """
+    states = batch.states
     notes = ev.notes
     rel_err, rel_tol = ev.rel_err.copy(), ev.rel_tol.copy()
     ratio = _ratios(rel_err, rel_tol)
@@ -163,19 +155,12 @@ def conclude(check: Check, label: str, model, system, states, seed: int, ev: Evi
     status = ""
     failing = [int(k) for k in np.flatnonzero(~(ratio <= 1.0))]
     if failing:
-        items = [
-            (
-                int(ev.judged[k]),
-                states[ev.judged[k]],
-                float(ev.rounding[k]),
-                Judged(float(rel_err[k]), float(rel_tol[k]), float(ev.abs_err[k])),
-            )
-            for k in failing
-        ]
-        precise, why = rejudge_precisely(check, model, system, items)
+        precise, why = rejudge_precisely(check, batch, failing, ev)
         if len(precise) == len(failing):
-            i, state, _, double = max(items, key=lambda f: f[3].ratio)
-            notes.insert(0, unstable_note(check, state, double, precise[i], len(failing), len(ev.judged)))
+            k = max(failing, key=lambda k: ratio[k])  # the first of equals
+            i = int(ev.judged[k])
+            double = Judged(float(rel_err[k]), float(rel_tol[k]), float(ev.abs_err[k]))
+            notes.insert(0, unstable_note(check, states[i], double, precise[i], len(failing), len(ev.judged)))
             position = {int(i): k for k, i in enumerate(ev.judged)}
             for i, j in precise.items():
                 rel_err[position[i]], rel_tol[position[i]] = j.rel_err, j.rel_tol
@@ -192,7 +177,7 @@ def conclude(check: Check, label: str, model, system, states, seed: int, ev: Evi
     if ev.refused:
         i, rounding = ev.refused[0]
         state = states[i]
-        lever = world_lever(model, system, state.q)
+        lever = batch.lever[i]
         notes.insert(
             0,
             f"{len(ev.refused)} of {len(states)} states refused: at {state.label} the rounding tolerance "

@@ -9,14 +9,15 @@ relative 2e-11 where Pinocchio's M⁻¹ is good to 1e-13.  Judged as it is, the 
 fails; yet the formula is right, and a user told "your M⁻¹ is wrong" would lose a day.
 
 The remedy is to remove the closed form's own rounding and judge again.  Where a
-check fails at a state, ``run_check`` calls ``judge_precisely``: the model's
-hand-written methods (``hand_written()``: M, C, H, det M, M⁻¹, q̈, …; not the
+check fails at a state, ``pendverify.checks.judge.rejudge_precisely`` judges it again: the
+model's hand-written methods (``hand_written()``: M, C, H, det M, M⁻¹, q̈, …; not the
 tolerance scales) are evaluated at that state in ``DIGITS`` significant digits —
 the same code, on a second instance of the model class whose parameters are mpmath
 numbers and whose ``self.math`` is mpmath's functions, with object arrays of mpmath
 numbers as arguments (the parameters and the state convert exactly) — and rounded
-to double; derived quantities are formed from those roundings as usual.  The state
-is then judged by the same check, tolerance and scale.
+to double; derived quantities are formed from those roundings as usual (a batch of
+that one state whose closed forms are the model's own code, ``CheckBatch(...,
+python_only=True)``).  The state is then judged by the same check, tolerance and scale.
 
 * If every failing state passes so judged, the formulas agree with Pinocchio
   within the check's tolerance and the check is a *warning* (``pendverify.checks.verdict``): its
@@ -24,7 +25,7 @@ is then judged by the same check, tolerance and scale.
   knowing (a controller evaluates it in double) but is not a derivation error.
   ``--strict`` makes it a failure.
 * A wrong formula is wrong in any precision: the state still fails, and so does
-  the check (a planted error in the same M⁻¹ is caught, ``tests/test_precision.py``).
+  the check (a planted error in the same M⁻¹ is caught, ``tests/test_stress_plugin.py``).
 * A closed form that cannot run on mpmath numbers (it calls ``np.cos`` or
   ``np.linalg`` rather than ``self.math`` and plain arithmetic) is judged in double
   only; the note says why.

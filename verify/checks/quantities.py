@@ -1,17 +1,12 @@
-"""What each check measures: its error at one state and the scale that error is judged against.
+"""What each check measures: its error at every state of a batch and the scale it is judged against.
 
 Each check's measure (``MEASURES``) reads the closed forms' and Pinocchio's quantities
-from ``Terms`` and returns the error e in scaled coordinates (``pendverify.checks.scaling``),
-the scale s (the size of the terms that produced the quantity, including cancellation)
-and the known model-form allowance a.  One state's terms (``StateTerms``, the model's and
-the system's methods called at that state) give numbers; a batch's terms
-(``pendverify.checks.batch``) give arrays with the batch axis first, and the measure
-runs once for all states.  The measures use only operations that give each state the
-same bits either way (elementwise arithmetic, reductions over the last axes, one
-BLAS/LAPACK call per state).  The per-state functions (``crba``, ``rnea``, …: model,
-Pinocchio system, state → ``Sample``) are what ``Check.evaluate`` calls.
-``pendverify.checks.catalogue`` names them, gives each its constant K and passes a
-state when e ≤ K·ε·((1 + |θ|max)·c_T + (A − 1))·s + a.
+from ``Terms`` — arrays with the batch axis first, each computed once for all states and
+all checks (``pendverify.checks.batch``) — and returns the error e in scaled coordinates
+(``pendverify.checks.scaling``), the scale s (the size of the terms that produced the
+quantity, including cancellation) and the known model-form allowance a, one of each per
+state.  ``pendverify.checks.catalogue`` names the checks, gives each its constant K and
+passes a state when e ≤ K·ε·((1 + |θ|max)·c_T + (A − 1))·s + a.
 
 The scales:
 
@@ -50,30 +45,148 @@ from pendverify.checks.scaling import (
 
 
 @dataclass(frozen=True)
-class Sample:
-    error: float
-    scale: float
-    allowance: float = 0.0
-    note: str = ""
-
-
-@dataclass(frozen=True)
 class Measure:
-    """A measure at one state (numbers) or at each state of a batch (arrays, batch axis first).
+    """A check's measure at each state of a batch (arrays, batch axis first, or scalars for all).
 
-    ``noted``: where a note is due; ``describe(index)`` writes it (index () for one state).
+    ``noted``: where a note is due; ``describe(i)`` writes it for state i.
     """
 
     error: object
     scale: object
     allowance: object = 0.0
     noted: object = False
-    describe: Callable[[tuple], str] | None = None
+    describe: Callable[[int], str] | None = None
 
 
 class Terms:
-    """What the measures read; subclasses give the quantities, the derived scales are formed here."""
+    """What the measures read at every state of ``batch``: the quantities, each computed when first read.
 
+    ``*_hand`` are the closed forms (``batch.forms``, ``pendverify.checks.closed_forms``),
+    ``*_pin`` Pinocchio's (``batch.pin``, ``pendverify.robot.batch``); D, B, W, the gravity
+    scale and the model-form allowance are the same at every state.
+    """
+
+    def __init__(self, batch):
+        self.batch = batch
+        self.q, self.v, self.u, self.w_in = batch.Q, batch.V, batch.U, batch.W
+        self.angular, self.coordinates = batch.model.angular, batch.model.coordinates
+
+    # --- the model's scales and constant matrices --------------------------------------
+    @cached_property
+    def S(self):
+        return self.batch.forms.value("diagonal_scale")
+
+    @cached_property
+    def g_scale(self):
+        return self.batch.forms.constant("gravity_scale")
+
+    @cached_property
+    def D(self):
+        return self.batch.forms.constant("damping_matrix")
+
+    @cached_property
+    def B(self):
+        return self.batch.forms.constant("input_matrix")
+
+    @cached_property
+    def W(self):
+        return self.batch.forms.constant("disturbance_matrix")
+
+    @cached_property
+    def allowance(self):
+        return self.batch.system.allowance
+
+    @cached_property
+    def D_urdf(self):
+        system = self.batch.system
+        return system.cmap.matrix_to_model(np.diag(system.urdf_damping()))
+
+    # --- each quantity, closed form and Pinocchio ----------------------------------------
+    @cached_property
+    def M_pin(self):
+        return self.batch.pin.mass_matrix()
+
+    @cached_property
+    def M_hand(self):
+        return self.batch.forms.value("mass_matrix")
+
+    @cached_property
+    def bias_pin(self):
+        return self.batch.pin.bias()
+
+    @cached_property
+    def bias_hand(self):
+        return self.batch.forms.value("bias")
+
+    @cached_property
+    def H_pin(self):
+        return self.batch.pin.gravity()
+
+    @cached_property
+    def H_hand(self):
+        return self.batch.forms.value("gravity")
+
+    @cached_property
+    def C_pin(self):
+        return self.batch.pin.coriolis_matrix()
+
+    @cached_property
+    def C_hand(self):
+        return self.batch.forms.value("coriolis_matrix")
+
+    @cached_property
+    def Mdot_pin(self):
+        return self.batch.pin.mass_matrix_derivative()
+
+    @cached_property
+    def det_hand(self):
+        return self.batch.forms.value("det_mass_matrix")
+
+    @cached_property
+    def det_pin(self):
+        return self.batch.pin.det_mass_matrix()
+
+    @cached_property
+    def Minv_pin(self):
+        return self.batch.pin.inverse_mass_matrix()
+
+    @cached_property
+    def Minv_hand(self):
+        return self.batch.forms.value("inverse_mass_matrix")
+
+    @cached_property
+    def a_hand(self):
+        return self.batch.forms.value("acceleration")
+
+    def acceleration_pin(self, tau):
+        return self.batch.pin.acceleration(tau)
+
+    @cached_property
+    def KE_pin(self):
+        return self.batch.pin.kinetic_energy()
+
+    @cached_property
+    def KE_hand(self):
+        return self.batch.forms.value("kinetic_energy")
+
+    @cached_property
+    def V_pin(self):
+        return self.batch.pin.potential_energy()
+
+    @cached_property
+    def V_pin0(self):
+        """Pinocchio's V at θ = 0 (potential energies agree up to a constant)."""
+        return self.batch.system.potential_energy(np.zeros(self.batch.model.nv))
+
+    @cached_property
+    def V_hand(self):
+        return self.batch.forms.value("potential_energy")
+
+    @cached_property
+    def V_hand0(self):
+        return self.batch.forms.constant("potential_energy", np.zeros(self.batch.model.nv))
+
+    # --- derived scales ---------------------------------------------------------------
     @cached_property
     def w(self):
         return weights_of(self.S)
@@ -94,60 +207,6 @@ class Terms:
         if key not in memo:
             memo[key] = norms2(A)
         return memo[key]
-
-
-class StateTerms(Terms):
-    """One state's terms: the model's and the system's methods at that state, called when first read."""
-
-    def __init__(self, model, system, s):
-        self.model, self.system = model, system
-        self.q, self.v, self.u, self.w_in = s.q, s.v, s.u, s.w
-        self.angular, self.coordinates = model.angular, model.coordinates
-
-    def __getattr__(self, name):  # the quantities, each computed once
-        if name.startswith("__") or name not in _STATE_QUANTITIES:
-            raise AttributeError(name)
-        value = _STATE_QUANTITIES[name](self.model, self.system, self)
-        self.__dict__[name] = value
-        return value
-
-    def acceleration_pin(self, tau):
-        return self.system.acceleration(self.q, self.v, tau)
-
-
-def _zero(model):
-    return np.zeros(model.nv)
-
-
-_STATE_QUANTITIES = {
-    "S": lambda m, sy, t: m.diagonal_scale(t.q),
-    "g_scale": lambda m, sy, t: m.gravity_scale(),
-    "D": lambda m, sy, t: m.damping_matrix(),
-    "B": lambda m, sy, t: m.input_matrix(),
-    "W": lambda m, sy, t: m.disturbance_matrix(),
-    "allowance": lambda m, sy, t: sy.allowance,
-    "D_urdf": lambda m, sy, t: sy.cmap.matrix_to_model(np.diag(sy.urdf_damping())),
-    "M_pin": lambda m, sy, t: sy.mass_matrix(t.q),
-    "M_hand": lambda m, sy, t: m.mass_matrix(t.q),
-    "bias_pin": lambda m, sy, t: sy.bias(t.q, t.v),
-    "bias_hand": lambda m, sy, t: m.bias(t.q, t.v),
-    "H_pin": lambda m, sy, t: sy.gravity(t.q),
-    "H_hand": lambda m, sy, t: m.gravity(t.q),
-    "C_pin": lambda m, sy, t: sy.coriolis_matrix(t.q, t.v),
-    "C_hand": lambda m, sy, t: m.coriolis_matrix(t.q, t.v),
-    "Mdot_pin": lambda m, sy, t: sy.mass_matrix_derivative(t.q, t.v),
-    "det_hand": lambda m, sy, t: m.det_mass_matrix(t.q),
-    "det_pin": lambda m, sy, t: sy.det_mass_matrix(t.q),
-    "Minv_pin": lambda m, sy, t: sy.inverse_mass_matrix(t.q),
-    "Minv_hand": lambda m, sy, t: m.inverse_mass_matrix(t.q),
-    "a_hand": lambda m, sy, t: m.acceleration(t.q, t.v, t.u, t.w_in),
-    "KE_pin": lambda m, sy, t: sy.kinetic_energy(t.q, t.v),
-    "KE_hand": lambda m, sy, t: m.kinetic_energy(t.q, t.v),
-    "V_pin": lambda m, sy, t: sy.potential_energy(t.q),
-    "V_pin0": lambda m, sy, t: sy.potential_energy(_zero(m)),
-    "V_hand": lambda m, sy, t: m.potential_energy(t.q),
-    "V_hand0": lambda m, sy, t: m.potential_energy(_zero(m)),
-}
 
 
 def _max2(A):
@@ -273,19 +332,3 @@ MEASURES: dict[str, Callable] = {
     "energy": measure_energy,
     "damping": measure_damping,
 }
-
-
-def _at_one_state(measure):
-    def evaluate(model, system, s) -> Sample:
-        m = measure(StateTerms(model, system, s))
-        note = m.describe(()) if m.describe is not None and bool(m.noted) else ""
-        return Sample(float(m.error), float(m.scale), float(m.allowance), note)
-
-    evaluate.__name__ = evaluate.__qualname__ = measure.__name__.removeprefix("measure_")
-    evaluate.__doc__ = measure.__doc__
-    return evaluate
-
-
-crba, rnea, gravity, coriolis, skew, det, minverse, aba, energy, damping = (
-    _at_one_state(MEASURES[name]) for name in MEASURES
-)

@@ -14,8 +14,7 @@ from pendverify.checks.verdict import FAIL, PASS
 
 if TYPE_CHECKING:
     from pendverify.analytic import ClosedFormModel
-    from pendverify.checks.quantities import Sample
-    from pendverify.checks.sampling import State
+    from pendverify.checks.quantities import Measure, Terms
     from pendverify.robot.system import PinocchioSystem
 
 
@@ -25,7 +24,8 @@ class Check:
     pinocchio: str
     closed_form: str
     K: float
-    evaluate: Callable[[ClosedFormModel, PinocchioSystem, State], Sample]
+    #: the check's measure at every state of a batch (``pendverify.checks.quantities``)
+    measure: Callable[[Terms], Measure]
     #: "" when the check applies to this model and system, else why it is not run
     requires: Callable[[ClosedFormModel, PinocchioSystem | None], str] = lambda model, system: ""
     #: whether the Pinocchio side is computed by its world-frame recursions (then A counts)

@@ -8,14 +8,12 @@ M̃ = S^{-½} M S^{-½} has entries of order one (``scaled_matrix(M, weights)``,
 weights w_i = 1/√S_i), forces scale by S^{-½} (w·f) and accelerations by S^{½} (a/w).
 
 Rates are measured in 1/s (``rate_scale``): angular rates as they are, linear rates
-over a radius of gyration.  A ≥ 1 (``world_lever``) is the factor by which
-Pinocchio's world-frame terms exceed the result.  The checks
-(``pendverify.checks.quantities``) build each state's *scale* from these.
+over a radius of gyration.  The checks (``pendverify.checks.quantities``) build each
+state's *scale* from these.
 
 The functions ending in ``_of`` (and ``scaled_matrix``, ``mv``, ``total``, ``norms2``)
-take one state's arrays or a batch's (leading batch axes): elementwise arithmetic,
-reductions over the last axes and one BLAS/LAPACK call per state, so that a state
-judged alone and judged in a batch (``pendverify.checks.batch``) give the same bits.
+take a batch's arrays (leading batch axes): elementwise arithmetic, reductions over the
+last axes and one BLAS/LAPACK call per state, so no state's figure depends on the others.
 """
 
 from __future__ import annotations
@@ -23,7 +21,6 @@ from __future__ import annotations
 import numpy as np
 
 from pendverify.checks.spectral import norms2
-from pendverify.checks.trust import term_amplification
 
 
 def weights_of(S):
@@ -72,19 +69,6 @@ def rate_scale(model, q, v) -> float:
 def norm2(A) -> float:
     """‖A‖₂ of one matrix (``checks.spectral``)."""
     return float(norms2(A))
-
-
-def world_lever(model, system, q) -> float:
-    """A ≥ 1: how much larger Pinocchio's world-frame terms are than M's diagonal (scaled).
-
-    Pinocchio expresses spatial inertias about the world origin, so a joint whose
-    subtree sits far from it (a cart 10 m along the rail, a small link 2 at the
-    end of a long link 1) carries second moments m·|c|² ≫ M_ii into its
-    recursions, which cancel in the result: its rounding is ε·A times the
-    result's scale, added to the angles' (``pendverify.checks.catalogue.run_check``).
-    (``pendverify.checks.trust.term_amplification``.)
-    """
-    return term_amplification(model, system, q)
 
 
 def force_scale_of(rate, v, w, g_scale, B, W, D, u, w_in):

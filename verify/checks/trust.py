@@ -76,12 +76,11 @@ lives in ``pendverify.stress.trust_study``.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from pendverify.checks.amplification import term_amplification
+from pendverify.checks.batch import CheckBatch, state_at
 from pendverify.checks.spectral import conds2
 from pendverify.errors import IllConditionedError
 
@@ -113,11 +112,35 @@ class Conditioning:
         )
 
 
-def _cond(A: np.ndarray) -> float:
-    if not np.all(np.isfinite(A)):
-        return math.inf
-    kappa = conds2(A)
-    return kappa if math.isfinite(kappa) else math.inf
+def _cond(M: np.ndarray) -> np.ndarray:
+    """κ₂ of each matrix of a stack (``checks.spectral``); inf for one not finite or singular."""
+    finite = np.all(np.isfinite(M), axis=(-2, -1))
+    kappa = conds2(np.where(finite[:, None, None], M, np.eye(M.shape[-1])))
+    return np.where(finite & np.isfinite(kappa), kappa, np.inf)
+
+
+def _level(bound: float) -> str:
+    return "ok" if bound <= WARN_REL else "warn" if bound <= REFUSE_REL else "refuse"
+
+
+def conditionings(M, S, angle, amplification) -> tuple[np.ndarray, ...]:
+    """The rule's numbers for each mass matrix of a stack (N, n, n) with scales S (N, n).
+
+    Returns (κ raw, κ̃, bound, spread, whether the spread decides the bound), each (N,);
+    ``angle`` is |θ|max and ``amplification`` A per state.  A scale that is not positive
+    and finite makes κ̃ and the spread infinite.
+    """
+    M, S = np.asarray(M, dtype=float), np.asarray(S, dtype=float)
+    usable = np.all(S > 0, axis=-1) & np.all(np.isfinite(S), axis=-1)
+    with np.errstate(all="ignore"):
+        root = np.sqrt(np.where(usable[:, None], S, 1.0))
+        kappa_scaled = np.where(usable, _cond(M / (root[:, :, None] * root[:, None, :])), np.inf)
+        spread = np.where(usable, np.sqrt(np.max(S, axis=-1) / np.min(S, axis=-1)), np.inf)
+        growth = 1.0 + np.abs(angle)
+        rounding = kappa_scaled * (growth + (amplification - 1.0))
+        visibility = growth * spread
+        bound = KAPPA_K * EPS * np.where(visibility > rounding, visibility, rounding)
+    return _cond(M), kappa_scaled, bound, spread, visibility > rounding
 
 
 def conditioning(
@@ -126,29 +149,80 @@ def conditioning(
     """Judge one mass matrix; ``scale`` is S (default |diag M|), ``angle`` the largest |θ|."""
     M = np.asarray(M, dtype=float)
     S = np.abs(np.diag(M)) if scale is None else np.asarray(scale, dtype=float)
-    if np.all(S > 0) and np.all(np.isfinite(S)):
-        root = np.sqrt(S)
-        kappa_scaled = _cond(M / np.outer(root, root))
-        spread = math.sqrt(float(np.max(S) / np.min(S)))
-    else:
-        kappa_scaled = spread = math.inf
-    growth = 1.0 + abs(angle)
-    rounding, visibility = kappa_scaled * (growth + (amplification - 1.0)), growth * spread
-    bound = KAPPA_K * EPS * max(rounding, visibility)
-    level = "ok" if bound <= WARN_REL else "warn" if bound <= REFUSE_REL else "refuse"
-    return Conditioning(_cond(M), kappa_scaled, bound, level, amplification, spread, visibility > rounding)
+    kappa_raw, kappa_scaled, bound, spread, by_spread = (
+        x[0] for x in conditionings(M[None], S[None], np.array([angle]), np.array([amplification]))
+    )
+    return Conditioning(
+        float(kappa_raw),
+        float(kappa_scaled),
+        float(bound),
+        _level(float(bound)),
+        float(amplification),
+        float(spread),
+        bool(by_spread),
+    )
+
+
+class Verdicts:
+    """The trust rule's verdict at each state of a batch (``pendverify.checks.batch.CheckBatch``).
+
+    Three mass matrices are judged at each state — the closed form's M with the model's
+    scale S, the same with Pinocchio's term amplification A, and Pinocchio's M with its own
+    diagonal — and the verdict is the worst: the largest bound, then the largest κ raw, the
+    first of equals.  Without a system only the first is judged.  ``verdicts[i]`` is state
+    i's ``Conditioning``.
+    """
+
+    def __init__(self, batch, with_system: bool = True):
+        forms = batch.forms
+        M_hand, S = forms.value("mass_matrix"), forms.value("diagonal_scale")
+        n, angle = len(batch), batch.angle
+        one = np.ones(n)
+        candidates = [(*conditionings(M_hand, S, angle, one), one)]
+        if with_system:
+            M_pin, A = batch.pin.mass_matrix(), batch.lever
+            diag_pin = np.abs(np.diagonal(M_pin, axis1=-2, axis2=-1))
+            candidates.append((*conditionings(M_hand, S, angle, A), A))
+            candidates.append((*conditionings(M_pin, diag_pin, angle, A), A))
+        # (κ raw, κ̃, bound, spread, by spread, A), each stacked over the candidates
+        self.fields = [np.stack([c[k] for c in candidates]) for k in range(6)]
+        kappa, bound = self.fields[0], self.fields[2]
+        best = np.zeros(n, dtype=int)
+        for j in range(1, len(candidates)):
+            b0, k0 = np.choose(best, bound), np.choose(best, kappa)
+            with np.errstate(invalid="ignore"):
+                later = np.where(bound[j] == b0, kappa[j] > k0, bound[j] > b0)
+            best = np.where(later | (np.isnan(bound[j]) & ~np.isnan(b0)), j, best)
+        self.best = best
+        self.bound = np.choose(best, bound)
+
+    def __len__(self) -> int:
+        return len(self.best)
+
+    def refuses(self, i: int) -> bool:
+        """Whether state i's verdict is ``refuse`` (a bound above the limit, or not a number)."""
+        return not self.bound[i] <= REFUSE_REL
+
+    def __getitem__(self, i: int) -> Conditioning:
+        kappa_raw, kappa_scaled, bound, spread, by_spread, amplification = (
+            x[self.best[i], i] for x in self.fields
+        )
+        return Conditioning(
+            float(kappa_raw),
+            float(kappa_scaled),
+            float(bound),
+            _level(float(bound)),
+            float(amplification),
+            float(spread),
+            bool(by_spread),
+        )
 
 
 def assess(model, q, system=None) -> Conditioning:
-    """The verdict on M(q) from the closed form and, if given, Pinocchio's CRBA and terms; never raises."""
-    q = np.asarray(q, dtype=float)
-    angle = float(np.max(np.abs(q[np.array(model.angular)]), initial=0.0))
-    verdicts = [conditioning(model.mass_matrix(q), model.diagonal_scale(q), angle)]
-    if system is not None:
-        A = term_amplification(model, system, q)
-        verdicts.append(conditioning(model.mass_matrix(q), model.diagonal_scale(q), angle, A))
-        verdicts.append(conditioning(system.mass_matrix(q), None, angle, A))
-    return max(verdicts, key=lambda c: (c.bound, c.kappa_raw))
+    """The verdict on M(q) from the closed form and, if given, Pinocchio's CRBA and terms."""
+    batch = CheckBatch(model, system, [state_at(model, q)])
+    with np.errstate(all="ignore"):
+        return Verdicts(batch, with_system=system is not None)[0]
 
 
 def check_conditioning(
@@ -157,7 +231,7 @@ def check_conditioning(
     """``assess``, raising ``IllConditionedError`` when the verdict is ``refuse``.
 
     Returns the verdict when it is ``ok`` or ``warn`` (see ``Conditioning.note``).
-    ``verdict``: ``assess(model, q, system)`` when already made (``trust_batch.assess_batch``).
+    ``verdict``: ``assess(model, q, system)`` when already made (``Verdicts``).
     """
     verdict = assess(model, q, system) if verdict is None else verdict
     if verdict.level == "refuse":

@@ -20,51 +20,33 @@ from __future__ import annotations
 import numpy as np
 
 from pendverify.checks.applicability import derived_notes
-from pendverify.checks.batch import BatchContext
+from pendverify.checks.batch import CheckBatch
 from pendverify.checks.catalogue import CheckResult, applicable_checks, run_checks, skipped_notes
 from pendverify.checks.diagnose import diagnose
 from pendverify.checks.report import Report
 from pendverify.checks.sampling import sample_states
-from pendverify.checks.trust import check_conditioning
-from pendverify.checks.trust_batch import assess_batch
+from pendverify.checks.trust import Conditioning, Verdicts, check_conditioning
 from pendverify.checks.verdict import FAIL, REFUSED, WARN, apply_strict, non_christoffel_c
 from pendverify.errors import IllConditionedError
 from pendverify.progress import bar
 from pendverify.robot.geometry import MODEL_FORM_RTOL
 
 
-def batch_verdicts(model, system, states, batch=None):
-    """``trust.assess`` at every state, for all states at once (``trust_batch``); None if no batch."""
-    batch = batch if batch is not None else BatchContext.of(model, system, states)
-    if batch is None:
-        return None
-    try:
-        with np.errstate(all="ignore"):
-            return assess_batch(batch)
-    except Exception:  # the states are judged one by one, which raises what it raises
-        return None
-
-
-def trusted_states(label: str, model, system, states, batch=None) -> tuple[list, list[str]]:
-    """(states within the trust limit, one sentence per refused state).
-
-    ``batch``: a ``BatchContext`` of ``states`` whose quantities the verdicts may share.
-    """
-    kept, refused = [], []
-    verdicts = batch_verdicts(model, system, states, batch)
+def trusted(label: str, batch: CheckBatch) -> tuple[list[int], list[str], list[Conditioning]]:
+    """The trust rule at every state of ``batch``: (indices of the states it accepts, one sentence
+    per refused state, the accepted states' verdicts (ok or warn))."""
     with np.errstate(all="ignore"):
-        for i, state in enumerate(states):
-            if verdicts is not None and not verdicts.refuses(i):
-                kept.append(state)  # ok or warn: check_conditioning would return the verdict
-                continue
-            try:
-                verdict = None if verdicts is None else verdicts[i]
-                check_conditioning(model, state.q, system, what=label, verdict=verdict)
-            except IllConditionedError as exc:
-                refused.append(f"{state.label}: {exc}")
-            else:
-                kept.append(state)
-    return kept, refused
+        verdicts = Verdicts(batch)
+    kept, refused, accepted = [], [], []
+    for i, state in enumerate(batch.states):
+        try:
+            verdict = check_conditioning(batch.model, state.q, batch.system, what=label, verdict=verdicts[i])
+        except IllConditionedError as exc:
+            refused.append(f"{state.label}: {exc}")
+        else:
+            kept.append(i)
+            accepted.append(verdict)
+    return kept, refused, accepted
 
 
 def model_form_result(target, seed: int) -> CheckResult | None:
@@ -118,14 +100,12 @@ def guarded_checks(label: str, model, system, states, seed: int) -> tuple[list[C
     The one way every caller (``check``, the certification battery) runs the checks on
     sampled states: (results, one sentence per refused state).
     """
-    batch = BatchContext.of(model, system, states)
-    kept, refused = trusted_states(label, model, system, states, batch)
+    batch = CheckBatch(model, system, states)
+    kept, refused, _ = trusted(label, batch)
     names = applicable_checks(model, system)
-    checked = kept or states
-    if batch is not None and len(checked) < len(states):
-        batch = BatchContext.of(model, system, checked)
-    with np.errstate(all="ignore"):
-        results = run_checks(label, model, system, checked, seed, names, batch)
+    if refused and kept:
+        batch = batch.subset(kept)
+    results = run_checks(label, model, system, batch.states, seed, names, batch)
     if refused:
         _refuse(results, refused, len(states))
     return results, refused

@@ -56,7 +56,7 @@ def register(sub) -> None:
     c = add_command(
         what,
         "certify",
-        "the certification battery's cost per parameter set on one core: batch, per-state path, floor",
+        "the certification battery's cost per parameter set on one core: its parts and their floor",
         [
             "pendverify bench certify --quick",
             "pendverify bench certify --params double_pendulum/double_pendulum.toml --json bench.json",
@@ -69,12 +69,6 @@ def register(sub) -> None:
         type=positive_int,
         default=None,
         help="runs per figure, least kept (default: 7; 1 with --quick)",
-    )
-    c.add_argument(
-        "--reference-repeats",
-        type=positive_int,
-        default=1,
-        help="runs of the slow per-state path, least kept",
     )
     c.add_argument(
         "--params",
@@ -142,7 +136,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def run_certify(args: argparse.Namespace) -> int:
-    """``bench certify``: the battery per set, its per-state path and its floor, in one run."""
+    """``bench certify``: the battery per set, its parts and their floor, in one run."""
     check_report_output(args.json)
     guard, blas = limit_blas()
     with guard:
@@ -160,8 +154,8 @@ def run_certify(args: argparse.Namespace) -> int:
 
         settings = quick_settings() if args.quick else BatterySettings()
         repeats = args.repeats or (1 if args.quick else 7)
-        costs = measure(args.params, settings, repeats, args.reference_repeats)
-    lines = table(costs, settings, repeats, args.reference_repeats, blas).splitlines()
+        costs = measure(args.params, settings, repeats)
+    lines = table(costs, settings, repeats, blas).splitlines()
     print("\n".join(line for line in lines if line.startswith("target ")) if args.quiet else "\n".join(lines))
     if args.json:
         machine = {
@@ -172,6 +166,6 @@ def run_certify(args: argparse.Namespace) -> int:
             "numpy": np.__version__,
             "pinocchio": pinocchio.__version__,
         }
-        text = json.dumps(to_json(costs, settings, repeats, args.reference_repeats, machine), indent=2)
+        text = json.dumps(to_json(costs, settings, repeats, machine), indent=2)
         write_json_report(args, text + "\n")
     return 0

@@ -1,17 +1,16 @@
-"""Pinocchio at every state of a batch, in a closed-form model's coordinates.
+"""Pinocchio at a batch of states, in a closed-form model's coordinates: the one evaluator.
 
-``PinocchioSystem``'s methods wrap each bare Pinocchio call (1–5 µs) in 15–35 µs of
-Python: validating the state, mapping it to joint coordinates, mapping the result
-back.  ``PinocchioBatch`` maps the whole batch at once with NumPy, calls each bare
-function in one tight loop over the states with the system's own model and data,
-and maps the stacked results back — the same NumPy calls on stacked arrays, which
-NumPy carries out state by state with the same BLAS/LAPACK calls, so every number is
-the bit-for-bit equal of the per-state method's.  Each quantity is computed once, when
-first asked for.
+``PinocchioBatch(system, θ, θ̇)`` maps the states (N, n) to Pinocchio's configurations
+and velocities at once (``CoordinateMap``: q = T (θ − θ0), v = T θ̇; continuous joints as
+(cos, sin)), calls each bare Pinocchio function in one tight loop over the states with the
+system's own model and data, and maps the stacked results back:
 
-A system that evaluates Pinocchio at other angles than it is given (the stress
-catalogue's ``ReducedAngleSystem``) says so by ``pinocchio_batch_source() -> (system,
-map of the angles)``; any other wrapper has no batch (``batch_source`` is None).
+    M_θ = Tᵀ M_q T,   C_θ = Tᵀ C_q T,   Ṁ_θ = Tᵀ Ṁ_q T,   τ_θ = Tᵀ τ_q,
+    θ̈ = T⁻¹ q̈,   M_θ⁻¹ = T⁻¹ M_q⁻¹ T⁻ᵀ,   det M_θ = det(T)² det M_q.
+
+Each quantity is computed once, when first asked for.  One state is the batch of one:
+``PinocchioSystem``'s methods (``mass_matrix(θ)``, ``acceleration(θ, θ̇, τ)``, …) call this.
+Pinocchio's C++ fills only the upper triangle of M and M⁻¹ (``symmetrised``).
 """
 
 from __future__ import annotations
@@ -19,47 +18,59 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from pendverify.robot.system import PinocchioSystem
+from pendverify.validate import finite_state
 
 
-def batch_source(system):
-    """(the PinocchioSystem evaluated, the map applied to the angles or None), or None."""
-    if type(system) is PinocchioSystem:
-        return system, None
-    hook = getattr(type(system), "pinocchio_batch_source", None)
-    if hook is None:
-        return None
-    base, angles = hook(system)
-    return (base, angles) if type(base) is PinocchioSystem else None
-
-
-_symmetric = PinocchioSystem._symmetric  # Pinocchio fills only the upper triangle of M and M⁻¹
+def symmetrised(upper: np.ndarray) -> np.ndarray:
+    """The symmetric matrix (or stack) whose upper triangle Pinocchio filled."""
+    return np.triu(upper) + np.swapaxes(np.triu(upper, 1), -1, -2)
 
 
 def _mv(A, x):
     return (A @ x[..., None])[..., 0]
 
 
-class PinocchioBatch:
-    """Pinocchio's quantities at states θ (N, n), θ̇ (N, n) of ``system``, in the model's coordinates."""
+def _finite_rows(key: str, X: np.ndarray, n: int, source: str) -> np.ndarray:
+    """``X`` as (N, n) floats; the first row that is not finite raises ``finite_state``'s error."""
+    X = np.asarray(X, dtype=float)
+    if X.ndim != 2 or X.shape[1] != n or not np.all(np.isfinite(X)):
+        rows = X.reshape(-1, X.shape[-1]) if X.ndim >= 1 and X.size else [X]
+        for row in rows:
+            finite_state(key, row, n, source)
+        raise ValueError(f"{key}: states of shape {X.shape}, expected (N, {n})")
+    return np.ascontiguousarray(X)
 
-    def __init__(self, system, theta: np.ndarray, theta_dot: np.ndarray):
-        source = batch_source(system)
-        if source is None:
-            raise TypeError(f"{type(system).__name__} has no batch evaluation")
-        self.system, angles = source
-        theta = np.asarray(theta, dtype=float)
-        if angles is not None:
-            theta = angles(theta)
-        n = self.system.model.nv
-        if theta.shape[-1:] != (n,) or theta_dot.shape != theta.shape:
-            raise ValueError("states of the wrong size")
-        if not (np.all(np.isfinite(theta)) and np.all(np.isfinite(theta_dot))):
-            raise ValueError("a state that is not finite")  # the per-state methods say which
-        cmap = self.system.cmap
-        self.q = configurations(cmap, theta)
-        self.v = np.ascontiguousarray(_mv(cmap.T, np.ascontiguousarray(theta_dot, dtype=float)))
+
+def configurations(cmap, theta: np.ndarray) -> np.ndarray:
+    """Pinocchio's configuration at each state θ (N, n) (``CoordinateMap.configuration``, row by row)."""
+    positions = _mv(cmap.T, np.asarray(theta, dtype=float) - cmap.theta0)
+    parts = []
+    for k, nq in enumerate(cmap.joint_nq):
+        angle = np.ascontiguousarray(positions[:, k])
+        parts += [angle] if nq == 1 else [np.cos(angle), np.sin(angle)]
+    return np.ascontiguousarray(np.stack(parts, axis=-1))
+
+
+class PinocchioBatch:
+    """Pinocchio's quantities at states θ (N, n), θ̇ (N, n) of ``system``, in the model's coordinates.
+
+    ``system`` is a ``PinocchioSystem`` (its Pinocchio model and data, the gravity-free copy
+    for Ṁ, the coordinate map and the source named in errors).
+    """
+
+    def __init__(self, system, theta: np.ndarray, theta_dot: np.ndarray | None = None):
+        self.system = system
+        n = system.model.nv
+        theta = _finite_rows("q", theta, n, system.source)
+        if theta_dot is None:
+            theta_dot = np.zeros_like(theta)
+        theta_dot = _finite_rows("v", theta_dot, n, system.source)
+        if theta_dot.shape != theta.shape:
+            raise ValueError(f"{theta.shape[0]} positions but {theta_dot.shape[0]} velocities")
+        cmap = system.cmap
         self.N = len(theta)
+        self.q = configurations(cmap, theta)
+        self.v = np.ascontiguousarray(_mv(cmap.T, theta_dot))
         self._cache: dict[str, object] = {}
         #: the joint torques of the last ``acceleration`` (what ``bench certify`` times ABA on)
         self.aba_torques: np.ndarray | None = None
@@ -89,28 +100,35 @@ class PinocchioBatch:
 
     # --- joint-space quantities, each once ----------------------------------------------
     def crba_upper(self) -> np.ndarray:
+        """CRBA's M in joint coordinates, upper triangle (N, n, n)."""
         n = self.system.model.nv
         return self._once("crba", lambda: self._loop(pin.crba, self.q, shape=(n, n)))
 
-    # --- in the model's coordinates (as PinocchioSystem's methods) -----------------------
+    # --- in the model's coordinates -------------------------------------------------------
     def mass_matrix(self) -> np.ndarray:
+        """M(θ) by CRBA, symmetrised."""
         T = self.system.cmap.T
-        return self._once("M", lambda: T.T @ _symmetric(self.crba_upper()) @ T)
+        return self._once("M", lambda: T.T @ symmetrised(self.crba_upper()) @ T)
 
     def det_mass_matrix(self) -> np.ndarray:
+        """det of the CRBA matrix by LU (numpy), times det(T)²."""
         return self._once(
-            "det", lambda: np.linalg.det(_symmetric(self.crba_upper())) * self.system.cmap.det_factor
+            "det", lambda: np.linalg.det(symmetrised(self.crba_upper())) * self.system.cmap.det_factor
         )
 
     def inverse_mass_matrix(self) -> np.ndarray:
+        """M(θ)⁻¹ by computeMinverse, symmetrised."""
+
         def compute():
             n = self.system.model.nv
             Ti = self.system.cmap._T_inv
-            return Ti @ _symmetric(self._loop(pin.computeMinverse, self.q, shape=(n, n))) @ Ti.T
+            return Ti @ symmetrised(self._loop(pin.computeMinverse, self.q, shape=(n, n))) @ Ti.T
 
         return self._once("Minv", compute)
 
     def bias(self) -> np.ndarray:
+        """C(θ, θ̇)·θ̇ + H(θ) by RNEA at zero acceleration."""
+
         def compute():
             zero = np.zeros(self.system.model.nv)
             tau = self._loop(lambda m, d, q, v: pin.rnea(m, d, q, v, zero), self.q, self.v)
@@ -119,11 +137,14 @@ class PinocchioBatch:
         return self._once("bias", compute)
 
     def gravity(self) -> np.ndarray:
+        """H(θ) by computeGeneralizedGravity."""
         return self._once(
             "H", lambda: _mv(self.system.cmap.T.T, self._loop(pin.computeGeneralizedGravity, self.q))
         )
 
     def coriolis_matrix(self) -> np.ndarray:
+        """Pinocchio's Coriolis matrix (computeCoriolisMatrix)."""
+
         def compute():
             n, T = self.system.model.nv, self.system.cmap.T
             return T.T @ self._loop(pin.computeCoriolisMatrix, self.q, self.v, shape=(n, n)) @ T
@@ -131,11 +152,14 @@ class PinocchioBatch:
         return self._once("C", compute)
 
     def mass_matrix_derivative(self) -> np.ndarray:
-        """Ṁ by Pinocchio's RNEA derivatives with gravity off (``PinocchioSystem.mass_matrix_derivative``)."""
+        """Ṁ by Pinocchio's analytic RNEA derivatives, independent of its Coriolis matrix.
+
+        With gravity off and q̇ = 0, τ(q, 0, a) = M(q) a, so ∂τ/∂q(q, 0, e_j)·q̇ = Ṁ e_j.
+        """
 
         def compute():
             system = self.system
-            m, d, n = system._no_gravity, system._no_gravity_data, system.model.nv
+            m, d, n = system.model_without_gravity, system.data_without_gravity, system.model.nv
             zero, unit = np.zeros(n), [np.eye(n)[j].copy() for j in range(n)]
             dtau = np.empty((n, self.N, n, n))
             derivatives = pin.computeRNEADerivatives
@@ -149,29 +173,17 @@ class PinocchioBatch:
         return self._once("Mdot", compute)
 
     def acceleration(self, tau_theta: np.ndarray) -> np.ndarray:
-        """q̈ by ABA for generalized forces given in the model's coordinates (N, n)."""
-        if not np.all(np.isfinite(tau_theta)):
-            raise ValueError("a generalized force that is not finite")
+        """θ̈ by ABA for generalized forces given in the model's coordinates (N, n)."""
         cmap = self.system.cmap
-        tau = _mv(cmap._T_inv.T, np.ascontiguousarray(tau_theta, dtype=float))
+        tau_theta = _finite_rows("tau", tau_theta, self.system.model.nv, self.system.source)
+        tau = np.ascontiguousarray(_mv(cmap._T_inv.T, tau_theta))
         self.aba_torques = tau
         return _mv(cmap._T_inv, self._loop(pin.aba, self.q, self.v, tau))
 
     def kinetic_energy(self) -> np.ndarray:
+        """T(θ, θ̇) by computeKineticEnergy."""
         return self._once("KE", lambda: self._loop(pin.computeKineticEnergy, self.q, self.v, shape=()))
 
     def potential_energy(self) -> np.ndarray:
+        """V(θ) by computePotentialEnergy (Pinocchio's zero)."""
         return self._once("V", lambda: self._loop(pin.computePotentialEnergy, self.q, shape=()))
-
-
-def configurations(cmap, theta: np.ndarray) -> np.ndarray:
-    """Pinocchio's configuration at each state θ (N, n), as ``CoordinateMap.configuration`` one at a time."""
-    positions = _mv(cmap.T, np.asarray(theta, dtype=float) - cmap.theta0)
-    parts = []
-    for k, nq in enumerate(cmap.joint_nq):
-        angle = np.ascontiguousarray(positions[:, k])
-        if nq == 1:
-            parts.append(angle)
-        else:  # np.cos of each number, as one state's map takes it (an array's SIMD loop may round otherwise)
-            parts += [np.array([np.cos(x) for x in angle]), np.array([np.sin(x) for x in angle])]
-    return np.ascontiguousarray(np.stack(parts, axis=-1))

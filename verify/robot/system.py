@@ -17,6 +17,7 @@ import pinocchio as pin
 from pendverify.analytic import MODELS
 from pendverify.display import listed, shortened
 from pendverify.robot import seed_geometry  # noqa: F401  (registers the reference systems' readers)
+from pendverify.robot.batch import PinocchioBatch
 from pendverify.robot.coordinates import CoordinateMap
 from pendverify.robot.geometry import MODEL_FORM_RTOL, UrdfGeometry, reader
 from pendverify.robot.joint_map import declared_geometry
@@ -60,9 +61,10 @@ class PinocchioSystem:
         self.urdf = urdf
         #: the model-form threshold (``MODEL_FORM_RTOL``; ``check --model-form-rtol``)
         self.model_form_rtol = model_form_rtol
-        self._no_gravity = model.copy()
-        self._no_gravity.gravity.linear = np.zeros(3)
-        self._no_gravity_data = self._no_gravity.createData()
+        #: a copy of the model with gravity off, and its data (Ṁ from RNEA's derivatives)
+        self.model_without_gravity = model.copy()
+        self.model_without_gravity.gravity.linear = np.zeros(3)
+        self.data_without_gravity = self.model_without_gravity.createData()
 
     def __repr__(self) -> str:
         joints = listed(self.model.names[1:], 80)
@@ -165,83 +167,54 @@ class PinocchioSystem:
             return {}
         return {name: d.friction for name, d in self.urdf.facts.joint_dynamics.items() if d.friction}
 
-    def _qv(self, theta, theta_dot=None):
-        # Pinocchio turns a NaN angle into NaN results without a word: refuse it here.
-        n = self.model.nv
-        q = self.cmap.configuration(finite_state("q", theta, n, self.source))
-        v = (
-            np.zeros(n)
-            if theta_dot is None
-            else self.cmap.velocity(finite_state("v", theta_dot, n, self.source))
-        )
-        return q, v
+    def at(self, theta, theta_dot=None) -> PinocchioBatch:
+        """Pinocchio at states θ (N, n) and θ̇ (N, n; default zero), in the model's coordinates."""
+        return PinocchioBatch(self, theta, theta_dot)
 
-    @staticmethod
-    def _symmetric(upper: np.ndarray) -> np.ndarray:
-        # Pinocchio's C++ fills only the upper triangle of M and M⁻¹ (one matrix, or a stack)
-        return np.triu(upper) + np.swapaxes(np.triu(upper, 1), -1, -2)
+    def _one(self, theta, theta_dot=None) -> PinocchioBatch:
+        """The batch of the one state (θ, θ̇); a state that is not finite is refused by name."""
+        n = self.model.nv
+        theta = finite_state("q", theta, n, self.source)
+        theta_dot = None if theta_dot is None else finite_state("v", theta_dot, n, self.source)
+        return PinocchioBatch(self, theta[None], None if theta_dot is None else theta_dot[None])
 
     def mass_matrix(self, theta) -> np.ndarray:
         """M(θ) by CRBA, in the model's coordinates."""
-        q, _ = self._qv(theta)
-        return self.cmap.matrix_to_model(self._symmetric(pin.crba(self.model, self.data, q)))
+        return self._one(theta).mass_matrix()[0]
 
     def det_mass_matrix(self, theta) -> float:
         """det of the CRBA matrix by LU (numpy), mapped to the model's coordinates."""
-        q, _ = self._qv(theta)
-        return (
-            float(np.linalg.det(self._symmetric(pin.crba(self.model, self.data, q)))) * self.cmap.det_factor
-        )
+        return float(self._one(theta).det_mass_matrix()[0])
 
     def inverse_mass_matrix(self, theta) -> np.ndarray:
         """M(θ)⁻¹ by Pinocchio's computeMinverse, in the model's coordinates."""
-        q, _ = self._qv(theta)
-        return self.cmap.inverse_to_model(self._symmetric(pin.computeMinverse(self.model, self.data, q)))
+        return self._one(theta).inverse_mass_matrix()[0]
 
     def bias(self, theta, theta_dot) -> np.ndarray:
         """C(θ, θ̇)·θ̇ + H(θ) by RNEA at zero acceleration, in the model's coordinates."""
-        q, v = self._qv(theta, theta_dot)
-        return self.cmap.force_to_model(pin.rnea(self.model, self.data, q, v, np.zeros(self.model.nv)))
+        return self._one(theta, theta_dot).bias()[0]
 
     def gravity(self, theta) -> np.ndarray:
         """H(θ) by computeGeneralizedGravity, in the model's coordinates."""
-        q, _ = self._qv(theta)
-        return self.cmap.force_to_model(pin.computeGeneralizedGravity(self.model, self.data, q))
+        return self._one(theta).gravity()[0]
 
     def coriolis_matrix(self, theta, theta_dot) -> np.ndarray:
         """Pinocchio's Coriolis matrix C(θ, θ̇) (computeCoriolisMatrix), in the model's coordinates."""
-        q, v = self._qv(theta, theta_dot)
-        return self.cmap.matrix_to_model(pin.computeCoriolisMatrix(self.model, self.data, q, v))
+        return self._one(theta, theta_dot).coriolis_matrix()[0]
 
     def mass_matrix_derivative(self, theta, theta_dot) -> np.ndarray:
-        """Ṁ by Pinocchio's analytic RNEA derivatives, independent of its Coriolis matrix.
-
-        With gravity off and v = 0, τ(q, 0, a) = M(q) a, so ∂τ/∂q(q, 0, e_j) · q̇ = Ṁ e_j.
-        """
-        q, v = self._qv(theta, theta_dot)
-        m, d = self._no_gravity, self._no_gravity_data
-        zero = np.zeros(m.nv)
-        columns = []
-        for j in range(m.nv):
-            e_j = np.zeros(m.nv)
-            e_j[j] = 1.0
-            dtau_dq, _, _ = pin.computeRNEADerivatives(m, d, q, zero, e_j)
-            columns.append(dtau_dq @ v)
-        return self.cmap.matrix_to_model(np.column_stack(columns))
+        """Ṁ by Pinocchio's analytic RNEA derivatives (``PinocchioBatch.mass_matrix_derivative``)."""
+        return self._one(theta, theta_dot).mass_matrix_derivative()[0]
 
     def acceleration(self, theta, theta_dot, tau_theta) -> np.ndarray:
         """q̈ by ABA for a generalized force given in the model's coordinates."""
-        q, v = self._qv(theta, theta_dot)
-        tau = self.cmap.force_to_joints(finite_state("tau", tau_theta, self.model.nv, self.source))
-        a = pin.aba(self.model, self.data, q, v, tau)
-        return self.cmap.acceleration_to_model(a)
+        tau = finite_state("tau", tau_theta, self.model.nv, self.source)
+        return self._one(theta, theta_dot).acceleration(tau[None])[0]
 
     def kinetic_energy(self, theta, theta_dot) -> float:
         """T(θ, θ̇) by computeKineticEnergy."""
-        q, v = self._qv(theta, theta_dot)
-        return float(pin.computeKineticEnergy(self.model, self.data, q, v))
+        return float(self._one(theta, theta_dot).kinetic_energy()[0])
 
     def potential_energy(self, theta) -> float:
         """V(θ) by computePotentialEnergy (Pinocchio's zero)."""
-        q, _ = self._qv(theta)
-        return float(pin.computePotentialEnergy(self.model, self.data, q))
+        return float(self._one(theta).potential_energy()[0])

@@ -19,13 +19,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from pendverify.analytic import MODELS
-from pendverify.checks.batch import BatchContext
+from pendverify.checks.batch import CheckBatch
 from pendverify.checks.catalogue import applicable_checks, run_checks
 from pendverify.checks.sampling import DEFAULT_SEED, State, sample_states
-from pendverify.checks.trust import check_conditioning
 from pendverify.checks.verdict import WARN
-from pendverify.checks.verification import batch_verdicts
-from pendverify.errors import IllConditionedError
+from pendverify.checks.verification import trusted
 from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.urdf import LoadedUrdf, load_urdf
 from pendverify.stress.trust_study import StudyResult, cart_study
@@ -173,30 +171,25 @@ class _Comparison:
     level: str
 
 
-def compare(name: str, model, system, states: list[State], seed: int) -> _Comparison:
-    """Guard every state (validity, conditioning), then run the nine checks on the accepted ones."""
-    kept, refused = [], []
-    kappa_raw = kappa_scaled = amplification = 0.0
-    level = "ok"
+def compare(name: str, model, system, states: list[State], seed: int, pinocchio_angles=None) -> _Comparison:
+    """Guard every state (validity, conditioning), then run the checks on the accepted ones.
+
+    ``pinocchio_angles``: the map of the states' angles to those Pinocchio is evaluated at
+    (``CheckBatch``), for the 2πk-invariance case.
+    """
     model_states(model, states, lambda s: f"<{name}: {s.label}>")
-    batch = BatchContext.of(model, system, states)
-    verdicts = batch_verdicts(model, system, states, batch)
-    for i, s in enumerate(states):
-        try:
-            verdict = None if verdicts is None else verdicts[i]
-            c = check_conditioning(model, s.q, system, what=name, verdict=verdict)
-        except IllConditionedError as exc:
-            refused.append(str(exc))
-            continue
-        kept.append(s)
-        kappa_raw, kappa_scaled = max(kappa_raw, c.kappa_raw), max(kappa_scaled, c.kappa_scaled)
-        amplification = max(amplification, c.amplification)
-        level = "warn" if c.level == "warn" else level
+    batch = CheckBatch(model, system, states, pinocchio_angles)
+    kept, refused, verdicts = trusted(name, batch)
+    kappa_raw = max((c.kappa_raw for c in verdicts), default=0.0)
+    kappa_scaled = max((c.kappa_scaled for c in verdicts), default=0.0)
+    amplification = max((c.amplification for c in verdicts), default=0.0)
+    level = "warn" if any(c.level == "warn" for c in verdicts) else "ok"
+    if not kept:
+        return _Comparison([], 0, refused, kappa_raw, kappa_scaled, amplification, level)
+    if refused:
+        batch = batch.subset(kept)
     names = applicable_checks(model, system)
-    if batch is not None and len(kept) < len(states):
-        batch = BatchContext.of(model, system, kept)
-    with np.errstate(all="ignore"):
-        results = run_checks(name, model, system, kept, seed, names, batch) if kept else []
+    results = run_checks(name, model, system, batch.states, seed, names, batch)
     return _Comparison(results, len(kept), refused, kappa_raw, kappa_scaled, amplification, level)
 
 

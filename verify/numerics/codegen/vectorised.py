@@ -1,0 +1,178 @@
+"""A model class's hand-written closed forms as NumPy functions over a batch of states.
+
+Each closed form the class writes itself (``own_methods``: M, C or C·q̇, H, V, D, B, W,
+det M, M⁻¹, q̈, the tolerance scales, the bias and T when written) is read as SymPy
+expressions by ``SymbolicModel`` — the model's own code called with symbols for q, q̇, u, w
+and the parameters — its common subexpressions are eliminated (``sympy.cse``) and it is
+printed as one function of the module this writes::
+
+    def mass_matrix(P, Q, V, U, W):      # P: the parameters in the field order of params_type
+        N = Q.shape[0]                   # Q, V, U, W: (N, ·), one row per state
+        q1 = Q[:, 1]
+        c0 = numpy.cos(q1)
+        out = numpy.empty((N, 2, 2))
+        out[:, 0, 0] = p4 + 2*p5*c0
+        ...
+        return out                       # (N, rows, columns); (N,) for a scalar
+
+Every operation is one of NumPy's elementwise ufuncs on arrays of the N states, so a call
+evaluates all states at once, and a state's value depends neither on the others nor on N.
+Numbers are written exactly: a float as its ``repr``, a rational p/q as the correctly
+rounded quotient.  The expressions are SymPy's arrangement of the model's formulas (terms
+collected and ordered), so a value may differ from the model's own Python in the last
+bits; the checks' tolerances are some ε wide, and a failing state is judged again with
+the model's own code in high precision (``pendverify.checks.precision``).
+
+A method SymPy cannot read (a branch on a value, a numerical solve, ``np.cos`` instead of
+``self.math.cos``), or whose expressions hold a function NumPy has no ufunc for, is not
+generated: ``MISSING`` in the module names it with the reason, and the checks evaluate it
+with the model's own Python, state by state (``pendverify.checks.closed_forms``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import types
+import weakref
+
+#: the methods that may be generated, each with its arguments from the state (q, q̇, u, w)
+METHODS = {
+    "mass_matrix": "q",
+    "coriolis_matrix": "qv",
+    "coriolis_force": "qv",
+    "gravity": "q",
+    "potential_energy": "q",
+    "damping_matrix": "",
+    "input_matrix": "",
+    "disturbance_matrix": "",
+    "det_mass_matrix": "q",
+    "inverse_mass_matrix": "q",
+    "acceleration": "qvuw",
+    "diagonal_scale": "q",
+    "gravity_scale": "",
+    "bias": "qv",
+    "kinetic_energy": "qv",
+}
+GENERATOR = "vectorised-1"  # bump when the generated code changes meaning
+
+
+def own_methods(model_cls) -> tuple[str, ...]:
+    """The methods of ``METHODS`` that ``model_cls`` (or a base that is a real model) writes itself."""
+    from pendverify.analytic.interface import BiasOnlyModel, ClosedFormModel
+
+    own = []
+    for name in METHODS:
+        owner = next((k for k in model_cls.__mro__ if name in vars(k)), None)
+        if owner is not None and owner not in (ClosedFormModel, BiasOnlyModel):
+            own.append(name)
+    return tuple(own)
+
+
+def _printer():
+    """NumPy's SymPy printer with exact numbers; it raises on a function NumPy does not have."""
+    from sympy.printing.numpy import NumPyPrinter
+
+    class Printer(NumPyPrinter):
+        def _print_Float(self, expr):
+            return repr(float(expr))
+
+        def _print_Rational(self, expr):
+            return repr(int(expr.p) / int(expr.q))  # correctly rounded p/q
+
+    return Printer({"strict": True})
+
+
+def _renamed(sm) -> dict:
+    """{the model's symbol: its name in the generated code}: p0…, q0…, v0…, u0…, w0…."""
+    import sympy as sp
+
+    names = {}
+    params = [sm.parameters[f.name] for f in dataclasses.fields(sm.cls.params_type)]
+    for i, s in enumerate(params):
+        names[s] = sp.Symbol(f"p{i}")
+    for kind in "qvuw":
+        for i, s in enumerate(sm.symbols[kind]):
+            names[s] = sp.Symbol(f"{kind}{i}")
+    return names
+
+
+def _function(method: str, value, names: dict, printer) -> list[str]:
+    """The lines of one generated function (a PrintMethodNotImplementedError if NumPy cannot)."""
+    import sympy as sp
+
+    matrix = isinstance(value, sp.MatrixBase)
+    entries = [e.xreplace(names) for e in (value if matrix else [value])]
+    replacements, reduced = sp.cse(entries, symbols=sp.numbered_symbols("c"), order="canonical")
+    used = set().union(*(e.free_symbols for e in [*reduced, *(r for _, r in replacements)]))
+    parameters = sorted((s for s in used if s.name[0] == "p"), key=lambda s: int(s.name[1:]))
+    body = [f"{p.name} = P[{p.name[1:]}]" for p in parameters]
+    arrays = {"q": "Q", "v": "V", "u": "U", "w": "W"}
+    for s in sorted((s for s in used if s.name[0] in arrays), key=lambda s: s.name):
+        body.append(f"{s.name} = {arrays[s.name[0]]}[:, {s.name[1:]}]")
+    for symbol, expr in replacements:
+        body.append(f"{symbol.name} = {printer.doprint(expr)}")
+    if matrix:
+        rows, cols = value.shape
+        body.append(f"out = numpy.empty((N, {rows}, {cols}))")
+        for k, expr in enumerate(reduced):
+            body.append(f"out[:, {k // cols}, {k % cols}] = {printer.doprint(expr)}")
+    else:
+        body.append("out = numpy.empty(N)")
+        body.append(f"out[:] = {printer.doprint(reduced[0])}")
+    body.append("return out")
+    return [f"def {method}(P, Q, V, U, W):", "    N = Q.shape[0]", *(f"    {line}" for line in body)]
+
+
+def render(model_cls) -> str:
+    """The module of ``model_cls``'s generated closed forms (see the module docstring)."""
+    from sympy.printing.codeprinter import PrintMethodNotImplementedError
+
+    from pendverify.errors import PendverifyError
+    from pendverify.symbolic.model import SymbolicModel
+
+    written = own_methods(model_cls)
+    functions: list[str] = []
+    generated: list[str] = []
+    missing: dict[str, str] = {}
+    try:
+        sm = SymbolicModel.of(model_cls)
+    except PendverifyError as exc:
+        sm, missing = None, dict.fromkeys(written, str(exc))
+    if sm is not None:
+        names, printer = _renamed(sm), _printer()
+        for method in written:
+            try:
+                lines = _function(method, sm.evaluate(method, METHODS[method]), names, printer)
+            except PendverifyError as exc:
+                missing[method] = str(exc)
+                continue
+            except PrintMethodNotImplementedError as exc:
+                missing[method] = f"its expressions use a function NumPy has no ufunc for ({exc})"
+                continue
+            functions += ["", "", *lines]
+            generated.append(method)
+    header = [
+        f'"""Generated by pendverify.numerics.codegen.vectorised ({GENERATOR}) from model '
+        f'{model_cls.name!r}; do not edit."""',
+        "",
+        "import numpy",
+        "",
+        f"PARAMETERS = {tuple(f.name for f in dataclasses.fields(model_cls.params_type))!r}",
+        f"MISSING = {missing!r}",
+    ]
+    registry = ["", "", "FUNCTIONS = {", *(f"    {m!r}: {m}," for m in generated), "}", ""]
+    return "\n".join(header + functions + registry)
+
+
+_MODULES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # model class → its module
+
+
+def generated(model_cls) -> types.ModuleType:
+    """The generated module of ``model_cls`` (``FUNCTIONS``, ``MISSING``), made once per class and process."""
+    module = _MODULES.get(model_cls)
+    if module is None:
+        source = render(model_cls)
+        module = types.ModuleType(f"pendverify_vectorised_{model_cls.name}")
+        exec(compile(source, f"<vectorised closed forms of {model_cls.name}>", "exec"), module.__dict__)
+        _MODULES[model_cls] = module
+    return module
