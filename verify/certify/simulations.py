@@ -144,10 +144,10 @@ def cross_check(run, system):
     quantity, scale, K, c_T, world-frame amplification A and model-form allowance), with
     the generated code in place of the hand-written q̈; a state beyond the trust limit fails.
     """
+    from pendverify.checks.batch import world_lever
     from pendverify.checks.catalogue import CHECKS
     from pendverify.checks.quantities import aba
     from pendverify.checks.sampling import State
-    from pendverify.checks.batch import world_lever
     from pendverify.checks.trust import EPS, REFUSE_REL
     from pendverify.simulation.invariants import figures_of
 

@@ -94,11 +94,14 @@ def _refuse(results: list[CheckResult], refused: list[str], total: int) -> None:
             r.notes.insert(0, f"{len(refused)} of {total} states refused, e.g. {refused[0]}")
 
 
-def guarded_checks(label: str, model, system, states, seed: int) -> tuple[list[CheckResult], list[str]]:
+def guarded_checks(
+    label: str, model, system, states, seed: int
+) -> tuple[list[CheckResult], list[str], dict[str, str]]:
     """The checks that apply, on the states the trust rule accepts; checks refused where it refuses.
 
     The one way every caller (``check``, the certification battery) runs the checks on
-    sampled states: (results, one sentence per refused state).
+    sampled states: (results, one sentence per refused state, {method: why it ran in the
+    model's own Python state by state} (``ClosedForms.per_state``)).
     """
     batch = CheckBatch(model, system, states)
     kept, refused, _ = trusted(label, batch)
@@ -108,7 +111,18 @@ def guarded_checks(label: str, model, system, states, seed: int) -> tuple[list[C
     results = run_checks(label, model, system, batch.states, seed, names, batch)
     if refused:
         _refuse(results, refused, len(states))
-    return results, refused
+    return results, refused, batch.forms.per_state
+
+
+def per_state_note(per_state: dict[str, str]) -> list[str]:
+    """The note naming the closed forms evaluated with the model's own Python, state by state."""
+    if not per_state:
+        return []
+    why = "; ".join(f"{name}: {reason}" for name, reason in per_state.items())
+    return [
+        f"evaluated with the model's own Python state by state, not as generated NumPy over all "
+        f"states (slower, same verdicts): {why}"
+    ]
 
 
 def verify_target(report: Report, target, samples: int, seed: int) -> None:
@@ -123,7 +137,8 @@ def verify_target(report: Report, target, samples: int, seed: int) -> None:
         + skipped_notes(target.model, target.system)
         + derived_notes(target.model)
     )
-    results, refused = guarded_checks(label, target.model, target.system, states, seed)
+    results, refused, per_state = guarded_checks(label, target.model, target.system, states, seed)
+    notes += per_state_note(per_state)
     kept = len(refused) < len(states)
     if refused:
         notes.append(

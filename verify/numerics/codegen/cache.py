@@ -34,6 +34,7 @@ import sysconfig
 import time
 import types
 import weakref
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -154,6 +155,24 @@ def _model_key(model_cls) -> str | None:
 
 
 @dataclass(frozen=True)
+class Family:
+    """A kind of generated module: its file prefix, how a model class's source is rendered, and
+    whether it holds numba functions (then numba's files beside it are verified and recorded)."""
+
+    prefix: str
+    render: Callable[[type], str]
+    numba: bool
+
+
+def _render_rhs(model_cls) -> str:
+    return _module.render(_expressions.expressions(model_cls))
+
+
+#: the compiled right-hand side, its steppers and the generic references (``pendverify.numerics.generate``)
+RHS = Family("rhs", _render_rhs, numba=True)
+
+
+@dataclass(frozen=True)
 class GeneratedKernel:
     """A generated module and where it came from."""
 
@@ -180,10 +199,10 @@ class GeneratedKernel:
 
 
 _MEMORY: dict[str, types.ModuleType] = {}  # digest → module
-_KEYS: dict[str, str] = {}  # model key → digest
+_KEYS: dict[tuple[str, str], str] = {}  # (family prefix, model key) → digest
 _MODEL_KEYS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # model class → its model key
-_KEYLESS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # class without a key → digest
-_COMPILED: dict[str, int] = {}  # digest → numba compilations of its module already recorded
+_KEYLESS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # class without a key → {prefix: digest}
+_COMPILED: dict[str, int] = {}  # digest of a numba module → its compilations already recorded
 
 
 def forget() -> None:
@@ -203,33 +222,37 @@ def _record_path(path: Path) -> Path:
     return path.with_suffix(".json")
 
 
-def _import(path: Path, digest: str) -> types.ModuleType:
+def _import(path: Path, digest: str, numba: bool = True) -> types.ModuleType:
     """The module at ``path`` executed from bytes whose SHA-256 is ``digest`` (a PendverifyError if
-    they are not), after deleting every numba file of it its signed record does not list."""
+    they are not); for a numba module, after deleting every numba file of it its signed record
+    does not list."""
     if digest in _MEMORY:
         return _MEMORY[digest]
     data = path.read_bytes()
     if hashlib.sha256(data).hexdigest() != digest:
         raise PendverifyError(f"{path}: the generated module changed on disk while it was used")
-    record = signed.read(_record_path(path)) or {}
-    numba = record.get("numba") if record.get("sha256") == digest else None
-    numba_files.prune(path, numba if isinstance(numba, dict) else {})
+    if numba:
+        record = signed.read(_record_path(path)) or {}
+        recorded = record.get("numba") if record.get("sha256") == digest else None
+        numba_files.prune(path, recorded if isinstance(recorded, dict) else {})
     name = f"pendverify_generated_{digest[:16]}"
     spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
     sys.modules[name] = module
     # the verified bytes, not the file again (nor a .pyc beside it, which a loader would prefer)
     exec(compile(data, str(path), "exec"), module.__dict__)
-    numba_files.guard(module)
     _MEMORY[digest] = module
-    _COMPILED[digest] = 0
+    if numba:
+        numba_files.guard(module)
+        _COMPILED[digest] = 0
     return module
 
 
 def record_compiled() -> None:
     """Record, in each module's signed record, the numba files of the modules this process compiled
     since it last recorded (numba writes them as it compiles; one comparison per module otherwise)."""
-    for digest, module in list(_MEMORY.items()):
+    for digest in list(_COMPILED):
+        module = _MEMORY[digest]
         done = numba_files.compilations(module)
         if done <= _COMPILED.get(digest, 0):
             continue
@@ -249,24 +272,24 @@ def _restore(path: Path, digest: str, origin: str, seconds: float) -> GeneratedK
     return GeneratedKernel(_import(path, digest), digest, path, origin, seconds)
 
 
-def _module_path(name: str, digest: str, where: Path | None = None) -> Path:
+def _module_path(family: Family, name: str, digest: str, where: Path | None = None) -> Path:
     safe = "".join(c if c.isalnum() else "_" for c in name)[:40]
-    return (where or cache_dir()) / f"rhs_{safe}_{digest[:24]}.py"
+    return (where or cache_dir()) / f"{family.prefix}_{safe}_{digest[:24]}.py"
 
 
-def _index_path(key: str) -> Path:
-    return cache_dir() / f"index_{key[:24]}.json"
+def _index_name(family: Family, key: str) -> str:
+    return f"index_{family.prefix}_{key[:24]}.json"
 
 
-def _from_index(key: str, name: str) -> tuple[str, Path] | None:
+def _from_index(family: Family, key: str, name: str) -> tuple[str, Path] | None:
     """(digest, path) of the module the signed index of ``key`` names, if it verifies."""
-    record = signed.read(_index_path(key))
+    record = signed.read(cache_dir() / _index_name(family, key))
     if not record or record.get("key") != key or record.get("pendverify") != _version():
         return None
     digest = record.get("sha256")
     if not isinstance(digest, str) or len(digest) != 64:
         return None
-    path = _module_path(name, digest)
+    path = _module_path(family, name, digest)
     try:
         if hashlib.sha256(path.read_bytes()).hexdigest() != digest:
             return None
@@ -275,18 +298,18 @@ def _from_index(key: str, name: str) -> tuple[str, Path] | None:
     return digest, path
 
 
-def _write(name: str, source: str, digest: str, key: str | None) -> Path:
+def _write(family: Family, name: str, source: str, digest: str, key: str | None) -> Path:
     """Write the module (unless it is there already) and the index of ``key``; in a temporary folder
     when the cache folder refuses the write (``codegen.folder``)."""
     where = cache_dir()
     while True:
-        path = _module_path(name, digest, where)
+        path = _module_path(family, name, digest, where)
         try:
             if not (path.is_file() and path.read_text(encoding="utf-8") == source):
                 write_atomic(path, source)  # never rewritten otherwise: numba's cache keys on the file
             if key:
                 record = {"key": key, "sha256": digest, "pendverify": _version()}
-                signed.write(where / f"index_{key[:24]}.json", record)
+                signed.write(where / _index_name(family, key), record)
             return path
         except (FileAccessError, OSError, UnicodeDecodeError) as exc:
             failure = exc
@@ -297,8 +320,9 @@ def _write(name: str, source: str, digest: str, key: str | None) -> Path:
                 raise failure from None
 
 
-def kernel(model_cls, fresh: bool = False) -> GeneratedKernel:
-    """The generated module of ``model_cls``: from memory, from the on-disk cache, or generated.
+def kernel(model_cls, fresh: bool = False, family: Family = RHS) -> GeneratedKernel:
+    """The generated module of ``family`` for ``model_cls``: from memory, from the on-disk cache, or
+    generated.
 
     ``fresh``: skip the model-key index (and memory) and read the model with SymPy again;
     the module itself is still reused when its digest is unchanged."""
@@ -306,23 +330,25 @@ def kernel(model_cls, fresh: bool = False) -> GeneratedKernel:
     key = None if fresh else model_key(model_cls)
     if fresh:
         digest = None
+    elif key:
+        digest = _KEYS.get((family.prefix, key))
     else:
-        digest = _KEYS.get(key) if key else _KEYLESS.get(model_cls)
+        digest = _KEYLESS.get(model_cls, {}).get(family.prefix)
     if digest is not None:
         module = _MEMORY[digest]
         return GeneratedKernel(module, digest, Path(module.__file__), "memory", time.perf_counter() - start)
-    found = _from_index(key, model_cls.name) if key else None
+    found = _from_index(family, key, model_cls.name) if key else None
     if found is not None:
         digest, path = found
-        module = _import(path, digest)
-        _KEYS[key] = digest
+        module = _import(path, digest, family.numba)
+        _KEYS[(family.prefix, key)] = digest
         return GeneratedKernel(module, digest, path, "disk", time.perf_counter() - start)
-    source = _module.render(_expressions.expressions(model_cls))
+    source = family.render(model_cls)
     digest = hashlib.sha256(source.encode()).hexdigest()
-    path = _write(model_cls.name, source, digest, key)
-    module = _import(path, digest)
+    path = _write(family, model_cls.name, source, digest, key)
+    module = _import(path, digest, family.numba)
     if key:
-        _KEYS[key] = digest
+        _KEYS[(family.prefix, key)] = digest
     elif not fresh:  # a class loaded from a file that is gone (a certificate's model source)
-        _KEYLESS[model_cls] = digest
+        _KEYLESS.setdefault(model_cls, {})[family.prefix] = digest
     return GeneratedKernel(module, digest, path, "generated", time.perf_counter() - start)

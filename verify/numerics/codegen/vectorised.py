@@ -27,13 +27,15 @@ A method SymPy cannot read (a branch on a value, a numerical solve, ``np.cos`` i
 ``self.math.cos``), or whose expressions hold a function NumPy has no ufunc for, is not
 generated: ``MISSING`` in the module names it with the reason, and the checks evaluate it
 with the model's own Python, state by state (``pendverify.checks.closed_forms``).
+
+The module is cached on disk and verified before it runs as the compiled fast path's is
+(``pendverify.numerics.codegen.cache``, ``docs/code-cache.md``).
 """
 
 from __future__ import annotations
 
 import dataclasses
 import types
-import weakref
 
 #: the methods that may be generated, each with its arguments from the state (q, q̇, u, w)
 METHODS = {
@@ -164,15 +166,10 @@ def render(model_cls) -> str:
     return "\n".join(header + functions + registry)
 
 
-_MODULES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # model class → its module
-
-
 def generated(model_cls) -> types.ModuleType:
-    """The generated module of ``model_cls`` (``FUNCTIONS``, ``MISSING``), made once per class and process."""
-    module = _MODULES.get(model_cls)
-    if module is None:
-        source = render(model_cls)
-        module = types.ModuleType(f"pendverify_vectorised_{model_cls.name}")
-        exec(compile(source, f"<vectorised closed forms of {model_cls.name}>", "exec"), module.__dict__)
-        _MODULES[model_cls] = module
-    return module
+    """The generated module of ``model_cls`` (``FUNCTIONS``, ``MISSING``): from memory, from the
+    signed on-disk cache (``codegen.cache``, where a second process finds it without SymPy),
+    or generated."""
+    from pendverify.numerics.codegen.cache import Family, kernel
+
+    return kernel(model_cls, family=Family("vectorised", render, numba=False)).module
