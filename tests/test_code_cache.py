@@ -101,15 +101,15 @@ def _plant_module_and_index(generated: Path, marker: Path, sign_with: bytes | No
     digest = hashlib.sha256(source.encode()).hexdigest()
     (generated / f"rhs_double_pendulum_{digest[:24]}.py").write_text(source)
     key = _key_of_double_pendulum()
-    for old in generated.glob(f"index_{key[:24]}.*"):
+    for old in generated.glob(f"index_rhs_{key[:24]}.*"):
         old.unlink()
     if sign_with is None:
-        (generated / f"index_{key[:24]}.txt").write_text(digest + "\n")
+        (generated / f"index_rhs_{key[:24]}.txt").write_text(digest + "\n")
         return generated
     record = {"key": key, "sha256": digest, "pendverify": importlib.metadata.version("pendverify")}
     text = json.dumps(record, sort_keys=True, separators=(",", ":"))
     mac = hmac.new(sign_with, text.encode(), hashlib.sha256).hexdigest()
-    (generated / f"index_{key[:24]}.json").write_text(f"{text}\n{mac}\n")
+    (generated / f"index_rhs_{key[:24]}.json").write_text(f"{text}\n{mac}\n")
     return generated
 
 

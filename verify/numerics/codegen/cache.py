@@ -112,8 +112,9 @@ def _generator_files() -> set[str]:
 def model_key(model_cls) -> str | None:
     """SHA-256 of everything the generated source depends on, without reading the model (docstring).
 
-    None when a class has no source file, or one that is gone and whose text was not given to
-    ``remember_text`` (the generator then runs once per process).  Computed
+    None when a class has no source file, is not defined at top level by its module (made at
+    run time), or comes from a file that is gone and whose text was not given to
+    ``remember_text`` (the generator then runs once per process and class).  Computed
     once per class and process (resolving and hashing the files costs ≈ 40 ms): a source file
     edited while a process runs is seen after ``forget()``."""
     if model_cls not in _MODEL_KEYS:
@@ -121,7 +122,16 @@ def model_key(model_cls) -> str | None:
     return _MODEL_KEYS[model_cls]
 
 
+def _defined_by_its_file(cls) -> bool:
+    """Whether ``cls`` is the class its module defines at top level under its name: a class made at
+    run time (``pendverify mutate``'s mutants, a class inside a function) is not known by its file."""
+    module = sys.modules.get(cls.__module__)
+    return module is not None and getattr(module, cls.__qualname__, None) is cls
+
+
 def _model_key(model_cls) -> str | None:
+    if not _defined_by_its_file(model_cls):
+        return None
     files: set[str] = set()
     try:
         classes = [
