@@ -22,7 +22,7 @@ from pendverify.analytic import DoublePendulum, DoublePendulumParams
 from pendverify.analytic.params import default_parameter_file, load_parameter_file, read_toml
 from pendverify.analytic.plugin import validate_model_class
 from pendverify.checks.report import Report
-from pendverify.checks.targets import committed_urdf, model_target, params_target
+from pendverify.targets import committed_urdf, model_target, params_target
 from pendverify.cli import main
 from pendverify.errors import PendverifyError
 from pendverify.robot.system import PinocchioSystem

@@ -1,6 +1,6 @@
 """pendverify as a Python library: the calls behind ``pendverify check`` and ``simulate``, without the CLI.
 
-Everything here composes the functions the commands call (``pendverify.checks.targets``,
+Everything here composes the functions the commands call (``pendverify.targets``,
 ``pendverify.checks.verification``, ``pendverify.simulation``); nothing re-implements them, so
 a report made here has the same results, verdicts and table as the command line::
 
@@ -16,7 +16,7 @@ a report made here has the same results, verdicts and table as the command line:
     run.t, run.q, run.v, run.passed
 
 ``check`` and ``pendverify check`` choose their targets through one dispatcher
-(``pendverify.checks.targets.select_targets``), so the same arguments check the same models.
+(``pendverify.targets.select_targets``), so the same arguments check the same models.
 
 Models are given as a built-in name (``pendverify.analytic.MODELS``), a model file (``.py``,
 one ``ClosedFormModel`` subclass, as ``--analytic``) or a ``ClosedFormModel`` subclass.  Bad
@@ -41,12 +41,12 @@ from pendverify.certify.issue import certification_input, issue
 from pendverify.certify.signing import load_private_key
 from pendverify.checks.report import CheckReport
 from pendverify.checks.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
-from pendverify.checks.targets import is_builtin, parameter_values, select_targets
 from pendverify.checks.verification import build_report
 from pendverify.errors import InputError, PendverifyError, UnknownNameError
 from pendverify.robot import erd as erd_data
 from pendverify.robot.geometry import MODEL_FORM_RTOL
 from pendverify.robot.system import PinocchioSystem
+from pendverify.targets import is_builtin, parameter_values, select_targets
 
 if TYPE_CHECKING:
     from pendverify.simulation.scene import Scene
@@ -178,7 +178,7 @@ def check(
     """Compare Pinocchio on a URDF with a hand-derived closed form: ``pendverify check``.
 
     The arguments select the same targets as the command line's (one dispatcher,
-    ``pendverify.checks.targets.select_targets``):
+    ``pendverify.targets.select_targets``):
 
     * ``check()``: every built-in model's default parameter set against its committed URDF,
       and example-robot-data's double-pendulum URDFs (``pendverify check``);

@@ -78,7 +78,7 @@ def run(args: argparse.Namespace) -> int:
     from pendverify.checks.junit import to_junit
     from pendverify.checks.report import format_table
     from pendverify.checks.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
-    from pendverify.checks.targets import select_targets
+    from pendverify.targets import select_targets
     from pendverify.checks.verification import build_report
     from pendverify.robot.geometry import MODEL_FORM_RTOL
 

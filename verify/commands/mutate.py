@@ -49,7 +49,7 @@ def run(args: argparse.Namespace) -> int:
 
     from pendverify.atomic import check_report_output
     from pendverify.checks.sampling import DEFAULT_SEED
-    from pendverify.checks.targets import default_target, plugin_target
+    from pendverify.targets import default_target, plugin_target
     from pendverify.errors import PendverifyError
     from pendverify.jsonio import to_json
     from pendverify.symbolic.mutate import DEFAULT_MUTATION_STATES, run_mutation
