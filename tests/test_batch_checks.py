@@ -27,12 +27,12 @@ from pendverify.checks.elementwise import elementwise
 from pendverify.checks.judge import collect_per_state
 from pendverify.checks.lanes import Lanes
 from pendverify.checks.sampling import sample_states
-from pendverify.checks.targets import default_target, erd_targets, plugin_target
 from pendverify.checks.trust import assess
 from pendverify.checks.trust_batch import assess_batch
 from pendverify.stress.cases import ReducedAngleSystem, shifted_states
 from pendverify.stress.framework import QUICK
 from pendverify.stress.generic import run_generic
+from pendverify.targets import default_target, erd_targets, plugin_target
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 SEEDS = ("double_pendulum", "cart_double_pendulum")
