@@ -250,8 +250,8 @@ def simulate(
     (engine ``both``); ``passed``; ``notes``; ``metadata()``, ``to_npz_bytes()``, ``to_csv()``.
     """
     # deferred on purpose: the simulator brings SciPy (0.7 s), which check() does not need
-    from pendverify.simulation.scene import ENGINES, Scene, load_scene, parse_scene
-    from pendverify.simulation.simulate import simulate as run_scene
+    from pendverify.simulation.scene import SCENE_ENGINE_CHOICES, Scene, load_scene, parse_scene
+    from pendverify.simulation.simulate import run_scene
 
     if isinstance(scene, Scene):
         loaded = scene
@@ -261,8 +261,8 @@ def simulate(
         loaded = load_scene(scene)
     else:
         raise PendverifyError(f"a scene is a scene file, a mapping or a Scene; got a {type(scene).__name__}")
-    if engine is not None and engine not in ENGINES:
-        raise UnknownNameError("engine", str(engine), ENGINES)
+    if engine is not None and engine not in SCENE_ENGINE_CHOICES:
+        raise UnknownNameError("engine", str(engine), SCENE_ENGINE_CHOICES)
     if urdf is not None and (engine or loaded.engine) == "closed_form":
         raise PendverifyError(
             f"{loaded.source}: engine closed_form does not use a URDF; use engine aba or both"

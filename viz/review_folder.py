@@ -41,7 +41,7 @@ from pendverify.errors import InputError, SceneError
 from pendverify.progress import bar
 from pendverify.robot import erd as erd_data
 from pendverify.simulation.scene import Scene, load_scene
-from pendverify.simulation.simulate import simulate
+from pendverify.simulation.simulate import run_scene
 from pendverify.targets import (
     Selection,
     Target,
@@ -112,7 +112,7 @@ def _shown(path: Path) -> str:
 
 
 def _review(path: Path, scene: Scene, out: Path, trace: bool) -> SceneReview:
-    result = simulate(scene)
+    result = run_scene(scene)
     animation, plot = f"scenes/{path.stem}.html", f"plots/{path.stem}.svg"
     write_atomic(out / animation, render_html(Trajectory.from_run(result), trace=trace))
     write_atomic(out / plot, energy_plot_svg(result))

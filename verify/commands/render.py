@@ -73,11 +73,11 @@ def run(args: argparse.Namespace) -> int:
         for note in traj.notes:
             print(f"note: {note}")
     else:
-        from pendverify.simulation.simulate import simulate
+        from pendverify.simulation.simulate import run_scene
 
         scene = load_scene(args.scene)
         check_frame_count(scene.source, "time.duration", scene.duration, scene.duration)  # before simulating
-        result = simulate(scene, args.engine, urdf_argument(args.urdf))
+        result = run_scene(scene, args.engine, urdf_argument(args.urdf))
         traj = Trajectory.from_run(result)
         if not result.passed:
             print(f"note: {traj.title}: an invariant FAILS (see `pendverify simulate {args.scene}`)")

@@ -78,7 +78,7 @@ def run(args: argparse.Namespace) -> int:
     from pendverify.atomic import check_output, check_report_output, write_atomic
     from pendverify.commands import refuse_together
     from pendverify.simulation.scene import load_scene
-    from pendverify.simulation.simulate import simulate
+    from pendverify.simulation.simulate import run_scene
 
     if args.csv and not args.output:
         refuse_together(
@@ -93,7 +93,7 @@ def run(args: argparse.Namespace) -> int:
         from pendverify.viz.animation import check_frame_count
 
         check_frame_count(scene.source, "time.duration", scene.duration, scene.duration)  # before simulating
-    result = simulate(scene, args.engine, urdf_argument(args.urdf))
+    result = run_scene(scene, args.engine, urdf_argument(args.urdf))
     text = summary(result)
     print(text.splitlines()[-1] if args.quiet else text)  # its last line is the verdict
     say = (lambda line: None) if args.quiet else print
