@@ -105,7 +105,7 @@ class PinocchioBatch:
     def inverse_mass_matrix(self) -> np.ndarray:
         def compute():
             n = self.system.model.nv
-            Ti = self.system.cmap._T_inv
+            Ti = self.system.cmap.T_inv
             return Ti @ _symmetric(self._loop(pin.computeMinverse, self.q, shape=(n, n))) @ Ti.T
 
         return self._once("Minv", compute)
@@ -153,9 +153,9 @@ class PinocchioBatch:
         if not np.all(np.isfinite(tau_theta)):
             raise ValueError("a generalized force that is not finite")
         cmap = self.system.cmap
-        tau = _mv(cmap._T_inv.T, np.ascontiguousarray(tau_theta, dtype=float))
+        tau = _mv(cmap.T_inv.T, np.ascontiguousarray(tau_theta, dtype=float))
         self.aba_torques = tau
-        return _mv(cmap._T_inv, self._loop(pin.aba, self.q, self.v, tau))
+        return _mv(cmap.T_inv, self._loop(pin.aba, self.q, self.v, tau))
 
     def kinetic_energy(self) -> np.ndarray:
         return self._once("KE", lambda: self._loop(pin.computeKineticEnergy, self.q, self.v, shape=()))

@@ -43,7 +43,6 @@ class CoordinateMap:
         object.__setattr__(self, "T", T)
         object.__setattr__(self, "theta0", np.asarray(self.theta0, dtype=float))
         object.__setattr__(self, "T_inv", np.linalg.inv(T))
-        object.__setattr__(self, "_T_inv", self.T_inv)  # robot/batch.py's name, until it reads T_inv
 
     # --- states ------------------------------------------------------------------------
     def joint_positions(self, theta: np.ndarray) -> np.ndarray:
