@@ -340,6 +340,12 @@ def test_a_urdf_with_the_closed_form_engine_is_the_one_an_lqr_is_designed_on():
     np.testing.assert_array_equal(run.q, written.q)  # the committed URDF is that one, byte for byte
 
 
+def test_the_simulate_command_refuses_a_urdf_its_engine_does_not_use(capsys):
+    scene, urdf = SCENES / "damped_double_pendulum.toml", committed_urdf("double_pendulum")
+    assert main(["simulate", str(scene), "--engine", "closed_form", "--urdf", str(urdf)]) == 2
+    assert "engine closed_form does not use a URDF" in capsys.readouterr().err
+
+
 # --- bad input: one line, a PendverifyError -------------------------------------------------------------
 SYNTAX_ERROR = "import numpy\ndef broken(:\n"
 
