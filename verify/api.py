@@ -265,7 +265,7 @@ def load_scene(scene: str | Path | Mapping[str, Any] | Scene) -> Scene:
     """A scene: a scene file (TOML), a scene document as a mapping (the TOML's tables as dicts;
     a ``params`` file named there is found relative to the current directory) or a ``Scene``,
     returned as is."""
-    # the simulator imports SciPy, which check() does not need: imported when a scene is
+    # imported when a scene is loaded: the simulation sub-package is of no use to check()
     from pendverify.simulation.scene import Scene, parse_scene
     from pendverify.simulation.scene import load_scene as read_scene_file
 
