@@ -22,11 +22,11 @@ from pendverify.analytic import DoublePendulum, DoublePendulumParams
 from pendverify.analytic.params import default_parameter_file, load_parameter_file, read_toml
 from pendverify.analytic.plugin import validate_model_class
 from pendverify.checks.report import Report
-from pendverify.checks.targets import committed_urdf, model_target, params_target
 from pendverify.cli import main
 from pendverify.errors import PendverifyError
 from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
+from pendverify.targets import committed_urdf, model_target, params_target
 from pendverify.testing import assert_verified
 
 REPO = Path(__file__).resolve().parents[1]
@@ -327,6 +327,23 @@ def test_simulate_a_scene_mapping_with_both_engines():
     run = pendverify.simulate(scene, engine="both")
     assert run.passed and run.engine_comparison is not None and run.engine_comparison.passed
     assert len(run.t) == 51
+
+
+def test_a_urdf_with_the_closed_form_engine_is_the_one_an_lqr_is_designed_on():
+    # the closed form integrates without a URDF; a scene's LQR controller is designed on one
+    urdf = committed_urdf("cart_double_pendulum")
+    run = pendverify.simulate(SCENES / "cart_lqr_push.toml", urdf, "closed_form")
+    assert run.passed and run.dynamics.engine == "closed_form"
+    written = pendverify.simulate(
+        SCENES / "cart_lqr_push.toml", engine="closed_form"
+    )  # the URDF the project writes
+    np.testing.assert_array_equal(run.q, written.q)  # the committed URDF is that one, byte for byte
+
+
+def test_the_simulate_command_refuses_a_urdf_its_engine_does_not_use(capsys):
+    scene, urdf = SCENES / "damped_double_pendulum.toml", committed_urdf("double_pendulum")
+    assert main(["simulate", str(scene), "--engine", "closed_form", "--urdf", str(urdf)]) == 2
+    assert "engine closed_form does not use a URDF" in capsys.readouterr().err
 
 
 # --- bad input: one line, a PendverifyError -------------------------------------------------------------

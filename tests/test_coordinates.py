@@ -39,7 +39,7 @@ def test_transforms_preserve_power_and_energy():
     assert_close(cmap.acceleration_to_model(cmap.T @ a_theta), a_theta, 1e-14)
     # states: θ → q → θ
     theta = RNG.normal(size=3)
-    assert_close(cmap.model_coordinates(cmap.joint_positions(theta)), theta, 1e-15)
+    assert_close(cmap.T_inv @ cmap.joint_positions(theta) + cmap.theta0, theta, 1e-15)
 
 
 def test_continuous_joints_get_cos_sin():

@@ -12,7 +12,7 @@ import pytest
 from pendverify.cli import main
 from pendverify.simulation.invariants import evaluate, figures_of
 from pendverify.simulation.scene import load_scene
-from pendverify.simulation.simulate import simulate
+from pendverify.simulation.simulate import run_scene
 
 CHAOTIC = Path(__file__).resolve().parents[1] / "scenes" / "chaotic_double_pendulum.toml"
 
@@ -53,7 +53,7 @@ def test_a_state_beyond_its_tolerance_fails_whatever_the_largest_error():
 
 @pytest.fixture(scope="module")
 def chaotic():
-    return simulate(load_scene(CHAOTIC))
+    return run_scene(load_scene(CHAOTIC))
 
 
 def test_chaotic_scene_reports_its_largest_energy_error(chaotic):

@@ -15,7 +15,6 @@ import pytest
 
 from pendverify.analytic import DoublePendulum
 from pendverify.analytic.forms import ClosedForm
-from pendverify.checks.targets import Target
 from pendverify.checks.verdict import CHRISTOFFEL_CONSISTENT, NON_CHRISTOFFEL
 from pendverify.cli import main
 from pendverify.robot.system import PinocchioSystem
@@ -24,6 +23,7 @@ from pendverify.symbolic.model import SymbolicModel
 from pendverify.symbolic.mutants import OPERATORS, generate
 from pendverify.symbolic.mutate import numeric_model, run_mutation
 from pendverify.symbolic.mutation_report import DETECTED, EQUIVALENT, SURVIVED
+from pendverify.targets import Target
 
 from .conftest import default_params
 

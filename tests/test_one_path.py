@@ -25,9 +25,9 @@ from pendverify.checks.catalogue import CHECKS, applicable_checks, run_checks
 from pendverify.checks.judge import collect
 from pendverify.checks.report import Report
 from pendverify.checks.sampling import sample_states
-from pendverify.checks.targets import Target, default_target, plugin_target
 from pendverify.checks.verification import verify_target
 from pendverify.stress.cases import reduced_angles, shifted_states
+from pendverify.targets import Target, default_target, plugin_target
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 EPS = float(np.finfo(float).eps)

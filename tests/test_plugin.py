@@ -18,9 +18,9 @@ import pytest
 from pendverify.analytic.plugin import load_model_class
 from pendverify.checks.catalogue import CHECK_NAMES, run_checks
 from pendverify.checks.sampling import sample_states
-from pendverify.checks.targets import plugin_target
 from pendverify.cli import main
 from pendverify.errors import PendverifyError
+from pendverify.targets import plugin_target
 
 from .conftest import SEED
 

@@ -18,11 +18,11 @@ from pendverify.analytic.params import default_parameter_file, load_parameter_fi
 from pendverify.analytic.plugin import load_model_class
 from pendverify.checks.report import CheckRows, Report
 from pendverify.checks.result import CheckResult
-from pendverify.checks.targets import Selection, Target, committed_urdf, model_target, select_targets
 from pendverify.cli import main
 from pendverify.display import REPR_LIMIT, shortened
 from pendverify.robot.system import PinocchioSystem
 from pendverify.simulation.simulate import Run
+from pendverify.targets import Selection, Target, committed_urdf, model_target, select_targets
 
 REPO = Path(__file__).resolve().parents[1]
 EXAMPLES = REPO / "examples"

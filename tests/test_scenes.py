@@ -17,7 +17,7 @@ from pendverify.cli import main
 from pendverify.errors import IntegrationError, SceneError
 from pendverify.simulation.dynamics import build_dynamics
 from pendverify.simulation.scene import load_scene, parse_scene
-from pendverify.simulation.simulate import simulate
+from pendverify.simulation.simulate import run_scene
 
 REPO = Path(__file__).resolve().parents[1]
 SHIPPED = sorted((REPO / "scenes").glob("*.toml"))
@@ -46,19 +46,19 @@ def cart_scene(**effects) -> dict:
 
 
 def run(doc, engine=None):
-    return simulate(parse_scene(doc, "<test>"), engine)
+    return run_scene(parse_scene(doc, "<test>"), engine)
 
 
 # --- shipped scenes -----------------------------------------------------------------------
 @pytest.mark.parametrize("path", SHIPPED, ids=[p.stem for p in SHIPPED])
 def test_shipped_scene_passes_its_invariants(path):
-    result = simulate(load_scene(path))
+    result = run_scene(load_scene(path))
     assert result.passed, [(i.name, i.error, i.tolerance) for i in result.invariants]
     assert np.all(np.isfinite(result.q))
 
 
 def test_lqr_brings_the_rods_back_upright():
-    result = simulate(load_scene(REPO / "scenes" / "cart_lqr_push.toml"))
+    result = run_scene(load_scene(REPO / "scenes" / "cart_lqr_push.toml"))
     pushed = np.max(np.abs(result.q[:, 1:]))
     assert pushed > 0.02, "the push did not move the rods"
     final = np.concatenate([result.q[-1], result.v[-1]])
@@ -76,7 +76,7 @@ def test_damping_off_evaluates_no_friction(monkeypatch):
     doc = dp_scene(gravity=True)
     scene = parse_scene(doc, "<test>")  # parsing may read the set's damping; simulating may not
     monkeypatch.setattr(DoublePendulum, "damping_matrix", forbidden)
-    result = simulate(scene)
+    result = run_scene(scene)
     assert not any("friction" in t for t in result.dynamics.terms)
     assert result.invariants[0].name.startswith("energy drift")
 
@@ -366,11 +366,11 @@ def test_the_default_step_limit_is_stated_and_a_raised_one_is_used():
         dp_scene(gravity=True) | {"integrator": {"method": "DOP853", "max_steps": 5}}, "x.toml"
     )
     with pytest.raises(IntegrationError, match=r"key 'integrator.max_steps'.*more than 5 steps"):
-        simulate(scene)
+        run_scene(scene)
     enough = parse_scene(
         dp_scene(gravity=True) | {"integrator": {"method": "DOP853", "max_steps": 5000}}, "x.toml"
     )
-    assert all(r.passed for r in simulate(enough).invariants)
+    assert all(r.passed for r in run_scene(enough).invariants)
 
 
 @pytest.mark.parametrize(

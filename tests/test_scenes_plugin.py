@@ -15,7 +15,7 @@ import pytest
 from pendverify.cli import main
 from pendverify.errors import SceneError
 from pendverify.simulation.scene import load_scene
-from pendverify.simulation.simulate import simulate
+from pendverify.simulation.simulate import run_scene
 
 REPO = Path(__file__).resolve().parents[1]
 EXAMPLES = REPO / "examples"
@@ -59,7 +59,7 @@ def test_each_plugin_example_simulates_with_both_engines(tmp_path, stem):
     amplitude = [0.3] * _inputs(stem)
     sine = f'[effects.actuation]\ntype = "sine"\namplitude = {amplitude}\nfrequency = 1.0\n'
     path = _scene(tmp_path, str(EXAMPLES / f"{stem}.py"), _example(stem, PLUGINS[stem], effects=sine))
-    result = simulate(load_scene(path))
+    result = run_scene(load_scene(path))
     assert result.scene.model == stem and result.scene.model_file == str(EXAMPLES / f"{stem}.py")
     assert result.passed, [(c.name, c.error, c.tolerance) for c in result.invariants]
     assert result.engine_comparison is not None and result.engine_comparison.passed
@@ -121,7 +121,7 @@ type = "pd"
 kp = [5.0, 2.0]
 kd = [0.5, 0.2]
 '''
-    result = simulate(load_scene(_scene(tmp_path, "my_pendulum.py", body)))
+    result = run_scene(load_scene(_scene(tmp_path, "my_pendulum.py", body)))
     assert result.scene.model_cls.__name__ == "MyPendulum"
     assert result.passed and result.engine_comparison.passed
 
@@ -133,7 +133,7 @@ def test_pd_through_b_inverse_on_the_triple_pendulum(tmp_path):
         str(EXAMPLES / "triple_pendulum.py"),
         _example("triple_pendulum", [0.5, 0.2, 0.1], effects=effects),
     )
-    result = simulate(load_scene(path))
+    result = run_scene(load_scene(path))
     assert result.passed
     law, model = result.scene.actuation, result.dynamics.model
     q, v = result.q[10], result.v[10]
@@ -151,7 +151,7 @@ def test_lqr_keeps_the_triple_pendulum_inverted(tmp_path):
         str(EXAMPLES / "triple_pendulum.py"),
         _example("triple_pendulum", [pi + 0.05, pi - 0.03, pi + 0.02], effects=effects),
     )
-    result = simulate(load_scene(path))
+    result = run_scene(load_scene(path))
     assert result.passed
     assert np.max(np.abs(result.q[-1] - pi)) < 0.05
     assert float(result.notes[0].split("differ by ")[1].split()[0]) < 1e-12
@@ -167,7 +167,7 @@ def test_planted_coriolis_error_in_a_plugin_breaks_the_work_balance(tmp_path):
         "        return C\n",
     )
     actuation = '[effects.actuation]\ntype = "sine"\namplitude = [2.0]\nfrequency = 1.0\n'
-    good = simulate(
+    good = run_scene(
         load_scene(
             _scene(
                 tmp_path,
@@ -177,7 +177,7 @@ def test_planted_coriolis_error_in_a_plugin_breaks_the_work_balance(tmp_path):
             )
         )
     )
-    bad = simulate(
+    bad = run_scene(
         load_scene(
             _scene(
                 tmp_path,
@@ -193,14 +193,14 @@ def test_planted_coriolis_error_in_a_plugin_breaks_the_work_balance(tmp_path):
 
 
 def test_shipped_plugin_scenes_pass():
-    lqr = simulate(load_scene(REPO / "scenes" / "cart_pole_lqr_push.toml"))
+    lqr = run_scene(load_scene(REPO / "scenes" / "cart_pole_lqr_push.toml"))
     assert lqr.passed and lqr.engine_comparison.passed
     assert np.max(np.abs(lqr.q[:, 1])) > 0.01, "the tap did not move the pole"
     assert np.linalg.norm(np.concatenate([lqr.q[-1], lqr.v[-1]])) < 1e-2
-    damped = simulate(load_scene(REPO / "scenes" / "damped_triple_pendulum.toml"))
+    damped = run_scene(load_scene(REPO / "scenes" / "damped_triple_pendulum.toml"))
     assert damped.passed and damped.engine_comparison.passed
     assert damped.energy[-1] < damped.energy[0]
-    furuta = simulate(load_scene(REPO / "scenes" / "furuta_arm_turning.toml"))  # not planar
+    furuta = run_scene(load_scene(REPO / "scenes" / "furuta_arm_turning.toml"))  # not planar
     assert furuta.passed and furuta.engine_comparison.passed
     assert np.ptp(furuta.q[:, 0]) > 0.1 and np.ptp(furuta.q[:, 1]) > 1.0, "arm turned, pendulum fell"
 
@@ -236,7 +236,7 @@ def _error(path: Path, engine_run: bool = False) -> str:
     with pytest.raises(SceneError) as info:
         scene = load_scene(path)
         if engine_run:
-            simulate(scene)
+            run_scene(scene)
     return str(info.value)
 
 

@@ -11,8 +11,8 @@ from pathlib import Path
 
 import pytest
 
+from pendverify.api import review_scenes
 from pendverify.cli import build_parser
-from pendverify.commands.report import shipped_scenes
 from pendverify.errors import InputError
 from pendverify.shipped import FOLDERS, shipped_file, shipped_folder
 from pendverify.worked_examples import EXAMPLES
@@ -52,8 +52,8 @@ def test_the_shipped_scenes_relative_paths_resolve_to_shipped_files():
 
 
 def test_report_reviews_the_shipped_scenes_by_default():
-    assert shipped_scenes(None) == sorted(shipped_folder("scenes").glob("*.toml"))
-    assert shipped_file("scenes", "cart_pole_lqr_push.toml") in shipped_scenes(None)
+    assert review_scenes(None) == sorted(shipped_folder("scenes").glob("*.toml"))
+    assert shipped_file("scenes", "cart_pole_lqr_push.toml") in review_scenes(None)
     assert shipped_folder("scenes").samefile(REPO / "scenes")  # this checkout is the one installed
 
 
@@ -65,7 +65,7 @@ def test_report_names_its_default_in_its_help(capsys):
 
 def test_report_refuses_a_folder_without_scenes(tmp_path):
     with pytest.raises(InputError, match="no scene files"):
-        shipped_scenes(str(tmp_path))
+        review_scenes(str(tmp_path))
 
 
 def _copy_sources(target: Path) -> None:

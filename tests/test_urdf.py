@@ -132,8 +132,7 @@ def test_non_finite_states_are_refused_not_propagated(call, key):
 
 
 def test_a_model_without_a_urdf_writer_is_a_clear_error():
-    from pendverify.analytic.plugin import load_model_class
-    from pendverify.checks.targets import plugin_parameters
+    from pendverify.analytic.plugin import load_model_class, plugin_parameters
     from pendverify.errors import PendverifyError
     from pendverify.robot.writer import WRITERS, urdf_for
 

@@ -30,7 +30,7 @@ from pendverify.cli import main
 from pendverify.errors import TrajectoryError
 from pendverify.robot.writer import COLOURS, urdf_for
 from pendverify.simulation.scene import load_scene, parse_scene
-from pendverify.simulation.simulate import simulate
+from pendverify.simulation.simulate import run_scene
 from pendverify.viz.animation import DEFAULT_FPS, Trajectory, build_scene, render_html
 from pendverify.viz.browser import Chromium, find_chromium
 from pendverify.viz.geometry import LINK_COLOURS, VisualSystem
@@ -103,7 +103,7 @@ def hex_colour(rgba: str) -> int:
 @pytest.mark.parametrize("model", ["double_pendulum", "cart_double_pendulum"])
 def test_every_urdf_visual_is_sent_once_with_its_colour(model):
     params = default_params(model)
-    run = simulate(parse_scene(short_scene(model), "<test>"))
+    run = run_scene(parse_scene(short_scene(model), "<test>"))
     commands = decoded(build_scene(Trajectory.from_run(run)))
     objects = {c["path"]: c["object"] for c in commands if c["type"] == "set_object"}
     sent = [c["path"] for c in commands if c["type"] == "set_object"]
@@ -122,7 +122,7 @@ def test_every_urdf_visual_is_sent_once_with_its_colour(model):
 
 @pytest.mark.parametrize("model", ["double_pendulum", "cart_double_pendulum"])
 def test_keyframes_are_pinocchio_poses_in_real_time(model):
-    run = simulate(parse_scene(short_scene(model, duration=2.0), "<test>"))
+    run = run_scene(parse_scene(short_scene(model, duration=2.0), "<test>"))
     traj = Trajectory.from_run(run)
     commands = decoded(build_scene(traj))
     (anim,) = [c for c in commands if c["type"] == "set_animation"]
@@ -151,7 +151,7 @@ def test_keyframes_are_pinocchio_poses_in_real_time(model):
 
 
 def test_ten_second_animation_is_small():
-    run = simulate(load_scene(REPO / "scenes" / "chaotic_double_pendulum.toml"))
+    run = run_scene(load_scene(REPO / "scenes" / "chaotic_double_pendulum.toml"))
     assert run.t[-1] == pytest.approx(10.0)
     for trace in (False, True):
         size = len(render_html(Trajectory.from_run(run), trace=trace).encode())
@@ -169,7 +169,7 @@ def test_page_needs_no_network_and_no_server(monkeypatch):
     monkeypatch.setattr(meshcat.visualizer, "start_zmq_server_as_subprocess", forbidden)
     me = psutil.Process()
     children, sockets = {p.pid for p in me.children(recursive=True)}, len(me.net_connections())
-    run = simulate(parse_scene(short_scene("cart_double_pendulum"), "<test>"))
+    run = run_scene(parse_scene(short_scene("cart_double_pendulum"), "<test>"))
     page = render_html(Trajectory.from_run(run), trace=True)
     assert {p.pid for p in me.children(recursive=True)} == children, "a process was left behind"
     assert len(me.net_connections()) == sockets, "a socket was left open"
@@ -187,7 +187,7 @@ def test_trajectory_from_npz_round_trips_and_renders(tmp_path, capsys):
     npz = tmp_path / "run.npz"
     assert main(["simulate", str(scene), "-o", str(npz), "--html", str(tmp_path / "a.html")]) == 0
     traj = Trajectory.from_npz(npz)
-    direct = Trajectory.from_run(simulate(load_scene(scene)))
+    direct = Trajectory.from_run(run_scene(load_scene(scene)))
     np.testing.assert_array_equal(traj.q, direct.q)
     assert traj.params == direct.params
     assert main(["render", "--trajectory", str(npz), "-o", str(tmp_path / "b.html")]) == 0
@@ -217,7 +217,7 @@ def test_render_errors_are_exit_2(tmp_path, capsys):
 
 
 def test_energy_plot_and_review_page_escape_user_strings():
-    run = simulate(
+    run = run_scene(
         parse_scene(short_scene("double_pendulum", effects={"gravity": True, "damping": True}), "<t>")
     )
     svg = energy_plot_svg(run)
@@ -237,7 +237,7 @@ def test_a_urdf_without_materials_is_drawn_in_one_visible_colour_per_link():
     params = default_params("double_pendulum")
     bare = re.sub(r"<material[^>]*/>|<material[^>]*>.*?</material>", "", urdf_for(params), flags=re.S)
     assert "<material" not in bare and "<visual" in bare
-    run = simulate(parse_scene(short_scene("double_pendulum"), "<test>"))
+    run = run_scene(parse_scene(short_scene("double_pendulum"), "<test>"))
     traj = Trajectory(
         np.asarray(run.t), np.asarray(run.q), params, "bare", model_cls=run.scene.model_cls, urdf=bare
     )

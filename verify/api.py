@@ -1,8 +1,8 @@
-"""pendverify as a Python library: the calls behind ``pendverify check`` and ``simulate``, without the CLI.
+"""pendverify as a Python library, and the one dispatcher the commands call.
 
-Everything here composes the functions the commands call (``pendverify.checks.targets``,
-``pendverify.checks.verification``, ``pendverify.simulation``); nothing re-implements them, so
-a report made here has the same results, verdicts and table as the command line::
+Every command of the command line parses its options, calls one function here and formats
+what it returns; so the library and the command line share every result, verdict and
+table::
 
     import pendverify
 
@@ -15,8 +15,11 @@ a report made here has the same results, verdicts and table as the command line:
     run = pendverify.simulate("scenes/damped_double_pendulum.toml")
     run.t, run.q, run.v, run.passed
 
-``check`` and ``pendverify check`` choose their targets through one dispatcher
-(``pendverify.checks.targets.select_targets``), so the same arguments check the same models.
+``check`` chooses its targets through ``pendverify.targets.select_targets``, so the same
+arguments check the same models.  The other functions are those behind ``mutate``,
+``sympy``, ``show``, ``simulate``, ``render``, ``report``, ``stress``, ``bench``,
+``keygen``, ``certify``, ``recheck`` and ``example``; each imports what it needs when it
+is called, so importing this module imports neither SymPy nor SciPy.
 
 Models are given as a built-in name (``pendverify.analytic.MODELS``), a model file (``.py``,
 one ``ClosedFormModel`` subclass, as ``--analytic``) or a ``ClosedFormModel`` subclass.  Bad
@@ -31,26 +34,33 @@ import math
 import time
 from collections.abc import Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
 from pendverify.analytic.params import check_value
 from pendverify.analytic.plugin import load_model_class, validate_model_class
-from pendverify.certify.battery import BatterySettings
-from pendverify.certify.issue import certification_input, issue
-from pendverify.certify.signing import load_private_key
 from pendverify.checks.report import CheckReport
 from pendverify.checks.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
-from pendverify.checks.targets import is_builtin, parameter_values, select_targets
 from pendverify.checks.verification import build_report
 from pendverify.errors import InputError, PendverifyError, UnknownNameError
 from pendverify.robot import erd as erd_data
 from pendverify.robot.geometry import MODEL_FORM_RTOL
 from pendverify.robot.system import PinocchioSystem
+from pendverify.targets import is_builtin, parameter_values, select_targets
 
 if TYPE_CHECKING:
+    from pendverify.bench.certify import SetCost
+    from pendverify.bench.run import Results
+    from pendverify.certify.battery import BatterySettings
+    from pendverify.certify.issue import Issued, Rechecked
     from pendverify.simulation.scene import Scene
     from pendverify.simulation.simulate import Run
+    from pendverify.stress.catalogue import StressReport
+    from pendverify.symbolic.compare import SymbolicReport
+    from pendverify.symbolic.mutation_report import MutationReport
+    from pendverify.viz.animation import Trajectory
+    from pendverify.viz.review_folder import ReviewFolder
+    from pendverify.worked_examples import WorkedExample
 
 #: A model: a built-in name, a model file (``.py``) or a ``ClosedFormModel`` subclass.
 ModelLike = str | Path | type[ClosedFormModel]
@@ -63,15 +73,34 @@ UrdfLike = str | Path
 OPTIONS_SOURCE = "<pendverify API arguments>"
 
 __all__ = [
+    "Equation",
     "ModelLike",
+    "ModelReading",
     "ParamsLike",
     "UrdfLike",
+    "animation_html",
+    "bench_accuracy",
+    "bench_certify",
     "certify_set",
     "check",
+    "check_animation_length",
+    "compare_symbolic",
+    "copy_example",
+    "generate_keys",
     "load_model",
     "load_params",
+    "load_scene",
     "load_urdf",
+    "mutate",
+    "read_model",
+    "recheck",
+    "review",
+    "review_scenes",
     "simulate",
+    "stress",
+    "trajectory",
+    "worked_example",
+    "worked_examples",
 ]
 
 
@@ -178,7 +207,7 @@ def check(
     """Compare Pinocchio on a URDF with a hand-derived closed form: ``pendverify check``.
 
     The arguments select the same targets as the command line's (one dispatcher,
-    ``pendverify.checks.targets.select_targets``):
+    ``pendverify.targets.select_targets``):
 
     * ``check()``: every built-in model's default parameter set against its committed URDF,
       and example-robot-data's double-pendulum URDFs (``pendverify check``);
@@ -231,7 +260,24 @@ def check(
     return CheckReport.from_report(report)
 
 
-# --- simulate --------------------------------------------------------------------------------------
+# --- simulate and draw -----------------------------------------------------------------------------
+def load_scene(scene: str | Path | Mapping[str, Any] | Scene) -> Scene:
+    """A scene: a scene file (TOML), a scene document as a mapping (the TOML's tables as dicts;
+    a ``params`` file named there is found relative to the current directory) or a ``Scene``,
+    returned as is."""
+    # imported when a scene is loaded: the simulation sub-package is of no use to check()
+    from pendverify.simulation.scene import Scene, parse_scene
+    from pendverify.simulation.scene import load_scene as read_scene_file
+
+    if isinstance(scene, Scene):
+        return scene
+    if isinstance(scene, Mapping):
+        return parse_scene(dict(scene), "<inline scene>")
+    if isinstance(scene, (str, Path)):
+        return read_scene_file(scene)
+    raise PendverifyError(f"a scene is a scene file, a mapping or a Scene; got a {type(scene).__name__}")
+
+
 def simulate(
     scene: str | Path | Mapping[str, Any] | Scene,
     urdf: UrdfLike | None = None,
@@ -239,37 +285,266 @@ def simulate(
 ) -> Run:
     """Run a scene and check its invariants: ``pendverify simulate``.
 
-    ``scene`` is a scene file (TOML), a scene document as a mapping (the TOML's tables as dicts;
-    a ``params`` file named there is found relative to the current directory) or a ``Scene``.
-    ``urdf`` (path or XML text) replaces the URDF the project writes for the scene's parameter
-    set, for the ``aba`` and ``both`` engines.  ``engine`` (``aba``, ``closed_form`` or ``both``)
-    overrides the scene's.
+    ``scene`` is taken as ``load_scene`` takes it.  ``urdf`` (path or XML text) replaces the
+    URDF the project writes for the scene's parameter set: the URDF ABA integrates (engines
+    ``aba`` and ``both``) and an LQR controller is designed on.  ``engine`` (``aba``,
+    ``closed_form`` or ``both``) overrides the scene's.
 
     Returns the ``pendverify.simulation.simulate.Run``: arrays ``t``, ``q``, ``v``, ``u``, ``w``,
     ``energy``; ``invariants`` (name, error, tolerance, passed, detail); ``engine_comparison``
     (engine ``both``); ``passed``; ``notes``; ``metadata()``, ``to_npz_bytes()``, ``to_csv()``.
     """
-    # deferred on purpose: the simulator brings SciPy (0.7 s), which check() does not need
-    from pendverify.simulation.scene import ENGINES, Scene, load_scene, parse_scene
-    from pendverify.simulation.simulate import simulate as run_scene
+    from pendverify.simulation.scene import SCENE_ENGINE_CHOICES
+    from pendverify.simulation.simulate import run_scene
 
-    if isinstance(scene, Scene):
-        loaded = scene
-    elif isinstance(scene, Mapping):
-        loaded = parse_scene(dict(scene), "<inline scene>")
-    elif isinstance(scene, (str, Path)):
-        loaded = load_scene(scene)
-    else:
-        raise PendverifyError(f"a scene is a scene file, a mapping or a Scene; got a {type(scene).__name__}")
-    if engine is not None and engine not in ENGINES:
-        raise UnknownNameError("engine", str(engine), ENGINES)
-    if urdf is not None and (engine or loaded.engine) == "closed_form":
+    loaded = load_scene(scene)
+    if engine is not None and engine not in SCENE_ENGINE_CHOICES:
+        raise UnknownNameError("engine", str(engine), SCENE_ENGINE_CHOICES)
+    lqr = loaded.actuation is not None and loaded.actuation.kind == "lqr"
+    if urdf is not None and (engine or loaded.engine) == "closed_form" and not lqr:
         raise PendverifyError(
             f"{loaded.source}: engine closed_form does not use a URDF; use engine aba or both"
         )
     return run_scene(loaded, engine, None if urdf is None else _urdf_arg(urdf))
 
 
+def check_animation_length(scene: Scene) -> None:
+    """Refuse, before it is simulated, a scene whose animation would hold more frames than
+    ``pendverify.viz.animation.max_frames()`` (the error names ``time.duration``)."""
+    from pendverify.viz.animation import check_frame_count
+
+    check_frame_count(scene.source, "time.duration", scene.duration, scene.duration)
+
+
+def trajectory(run: Run | str | Path, model_file: str | Path | None = None) -> Trajectory:
+    """What an animation draws: of a ``Run``, or of a saved run (the npz ``pendverify simulate -o``
+    writes: its t, q and the metadata's model and parameters, from which the same URDF is
+    written again).  A saved run of a Python model file is drawn only with that file given as
+    ``model_file``: the npz is data and never makes pendverify import what it names."""
+    from pendverify.viz.animation import Trajectory
+
+    if isinstance(run, (str, Path)):
+        return Trajectory.from_npz(run, model_file)
+    if model_file is not None:
+        raise PendverifyError("model_file is for a saved run (npz); a Run carries its model")
+    return Trajectory.from_run(run)
+
+
+def animation_html(source: Trajectory, trace: bool = False) -> str:
+    """The self-contained HTML page (meshcat, plays from file://) that animates ``source`` in
+    real time; ``trace`` draws the path of the tip.  ``pendverify render``."""
+    from pendverify.viz.animation import render_html
+
+    return render_html(source, trace=_flag("trace", trace))
+
+
+def review_scenes(folder: str | Path | None = None) -> list[Path]:
+    """The scene files ``review`` runs: those in ``folder``, or the scenes installed with
+    pendverify (``pendverify.shipped``) when None."""
+    from pendverify.shipped import shipped_folder
+
+    path = Path(folder) if folder else shipped_folder("scenes")
+    scenes = sorted(path.glob("*.toml")) if path.is_dir() else []
+    if not scenes:
+        raise InputError(OPTIONS_SOURCE, "scenes", str(path), "no scene files (*.toml) in that folder")
+    return scenes
+
+
+def review(
+    output: str | Path,
+    scenes: str | Path | None = None,
+    *,
+    samples: int = DEFAULT_RANDOM_STATES,
+    seed: int = DEFAULT_SEED,
+    erd: bool = True,
+    trace: bool = False,
+    force: bool = False,
+    log=print,
+) -> ReviewFolder:
+    """Write the review page ``output/index.html``: ``pendverify report``.
+
+    Every model the scenes (``review_scenes(scenes)``) simulate is checked (``samples``
+    random states drawn with ``seed``; example-robot-data's URDFs too when ``erd``), and
+    every scene is run, animated (``trace``: the tip's path) and plotted.  An existing
+    ``output`` is refused unless ``force``.  ``log`` takes each progress line.  Returns
+    the ``pendverify.viz.review_folder.ReviewFolder`` (``report``, ``reviews``, ``index``,
+    ``passed``).
+    """
+    from pendverify.viz.review_folder import write_review
+
+    paths = review_scenes(scenes)
+    samples, seed = _count("samples", samples), _count("seed", seed)
+    erd, trace, force = _flag("erd", erd), _flag("trace", trace), _flag("force", force)
+    return write_review(paths, Path(output), samples, seed, erd, trace, log=log, force=force)
+
+
+# --- the symbolic tools ----------------------------------------------------------------------------
+def _model_targets(model: str | Path | None, urdf: str | Path | None, params: str | Path | None) -> list:
+    """Targets of ``mutate``: every built-in model's default set (None), a built-in model's
+    (its name), or a model file with its URDF and parameter file."""
+    from pendverify.targets import default_target, plugin_target
+
+    if model is None or (isinstance(model, str) and model in MODELS):
+        if urdf is not None or params is not None:
+            raise PendverifyError(
+                "urdf and params go with a model file; built-in models use their default set and URDF"
+            )
+        return [default_target(name) for name in ([model] if model else MODELS)]
+    return [
+        plugin_target(
+            str(model), None if urdf is None else str(urdf), None if params is None else str(params)
+        )
+    ]
+
+
+def mutate(
+    model: str | Path | None = None,
+    urdf: str | Path | None = None,
+    params: str | Path | None = None,
+    *,
+    samples: int | None = None,
+    seed: int = DEFAULT_SEED,
+    all_checks: bool = False,
+    methods: tuple[str, ...] | None = None,
+) -> list[MutationReport]:
+    """Mutation sensitivity: ``pendverify mutate``.
+
+    Every single-term mutant of the closed forms (of ``methods`` only, if given) is run
+    through the checks on ``samples`` states (default ``DEFAULT_MUTATION_STATES``) drawn with
+    ``seed``; ``all_checks`` runs every check on every mutant instead of stopping at the first
+    that fails.  ``model``: None (both reference systems), a built-in model's name, or a
+    model file (``.py``) with its ``urdf`` and ``params`` file.  One
+    ``pendverify.symbolic.mutation_report.MutationReport`` per model.
+    """
+    from pendverify.symbolic.mutate import DEFAULT_MUTATION_STATES, run_mutation
+
+    samples = DEFAULT_MUTATION_STATES if samples is None else _count("samples", samples)
+    seed, all_checks = _count("seed", seed), _flag("all_checks", all_checks)
+    methods = None if methods is None else tuple(methods)
+    return [run_mutation(t, samples, seed, all_checks, methods) for t in _model_targets(model, urdf, params)]
+
+
+def compare_symbolic(model: ModelLike | None = None) -> list[SymbolicReport]:
+    """Each closed form against the one SymPy derives from the model's energies by Lagrange's
+    equations, term by term: ``pendverify sympy``.  ``model``: as ``load_model`` takes it, or
+    None for both reference systems.  One ``pendverify.symbolic.compare.SymbolicReport`` per model."""
+    from pendverify.symbolic.compare import compare
+
+    classes = list(MODELS.values()) if model is None else [load_model(model)]
+    return [compare(cls) for cls in classes]
+
+
+class Equation(NamedTuple):
+    """One closed form of a model as SymPy reads it."""
+
+    method: str  # e.g. "mass_matrix"
+    derived: str | None  # for a text model's derived closed form: how it is derived
+    value: Any  # a SymPy expression or matrix
+
+
+class ModelReading(NamedTuple):
+    """A model as SymPy reads it: its class, its parameters' symbols and its equations."""
+
+    model_cls: type[ClosedFormModel]
+    parameters: tuple[str, ...]
+    equations: list[Equation]
+
+
+def read_model(model: ModelLike) -> ModelReading:
+    """Each closed form of ``model`` (as ``load_model`` takes it) as SymPy reads it, to confirm
+    the reading: ``pendverify show``."""
+    from pendverify.analytic.text_model import METHODS
+    from pendverify.symbolic.model import SymbolicModel
+
+    cls = load_model(model)
+    sm = SymbolicModel.of(cls)
+    spec = getattr(cls, "text_spec", None)
+    derived = spec.derived if spec is not None else {}
+    keys = {method: key for key, (method, _) in METHODS.items()}
+    equations = [
+        Equation(method, derived.get(keys.get(method, "")) or None, sm.evaluate(method, form.args))
+        for method, form in cls.written_closed_forms().items()
+    ]
+    return ModelReading(cls, tuple(sm.parameters), equations)
+
+
+# --- stress and benchmarks -------------------------------------------------------------------------
+def stress(
+    model: str | Path | None = None,
+    urdf: str | Path | None = None,
+    params: str | Path | None = None,
+    *,
+    quick: bool = False,
+    cases: list[str] | None = None,
+    seed: int | None = None,
+) -> StressReport:
+    """The catalogue of numerically hard cases: ``pendverify stress``.
+
+    ``model`` None runs the catalogue of the reference systems (``cases``: only these);
+    a model file (``.py``) with its ``urdf`` and ``params`` file runs the hard cases derived
+    from its parameters' kinds.  ``quick``: fewer states and shorter horizons, same cases;
+    ``seed``: the state sampler's (default ``pendverify.stress.framework.SEED``).
+    """
+    from pendverify.stress.catalogue import CASE_NAMES, run_catalogue
+    from pendverify.stress.framework import FULL, QUICK, SEED
+
+    settings = QUICK if _flag("quick", quick) else FULL
+    seed = SEED if seed is None else _count("seed", seed)
+    if model is not None:
+        from pendverify.stress.generic import run_generic
+
+        if urdf is None or params is None:
+            raise PendverifyError(f"{model}: a model file needs its urdf and params")
+        return run_generic(str(model), str(urdf), str(params), settings, cases, seed)
+    if urdf is not None or params is not None:
+        raise PendverifyError("urdf and params go with a model file")
+    for name in cases or ():
+        if name not in CASE_NAMES:
+            raise UnknownNameError("stress case", name, CASE_NAMES)
+    return run_catalogue(settings, names=cases, seed=seed)
+
+
+def bench_accuracy(
+    quick: bool = False, scene: str | Path | None = None, *, log=print, blas: str = "not limited"
+) -> Results:
+    """The work–precision benchmark: ``pendverify bench accuracy``.
+
+    Error against wall time for each integrator and engine, on the two reference systems'
+    problems, or with ``scene`` on a user's scene (``pendverify.bench.problems.scene_problems``
+    says which problems, and refuses what the benchmark cannot run).  ``quick``: fewer
+    tolerances and shorter runs.  ``log`` takes each progress line; ``blas`` says how BLAS
+    was limited, for the report.  Returns ``pendverify.bench.run.Results``.
+    """
+    from pendverify.bench.problems import scene_problems
+    from pendverify.bench.run import run_benchmark
+    from pendverify.bench.workprecision import FULL, QUICK
+
+    config, specs = QUICK if _flag("quick", quick) else FULL, None
+    if scene is not None:
+        config, specs = scene_problems(str(scene), config)
+    return run_benchmark(config, log=log, blas=blas, specs=specs)
+
+
+def bench_certify(
+    params: list[str] | None = None,
+    quick: bool = False,
+    repeats: int | None = None,
+) -> tuple[list[SetCost], BatterySettings, int]:
+    """The certification battery's cost per parameter set on one core: ``pendverify bench certify``.
+
+    ``params``: parameter files (default: each built-in model's own set).  ``quick``: 100
+    states and short simulations; ``repeats`` runs per figure, least kept (default 7, 1 with
+    ``quick``).  Returns (the costs, the battery settings measured, the repeats).
+    """
+    from pendverify.bench.certify import measure, quick_settings
+    from pendverify.certify.battery import BatterySettings
+
+    settings = quick_settings() if _flag("quick", quick) else BatterySettings()
+    repeats = repeats or (1 if quick else 7)
+    return measure(params, settings, repeats), settings, repeats
+
+
+# --- certificates ----------------------------------------------------------------------------------
 def certify_set(
     output: str | Path,
     params: str | Path | None = None,
@@ -282,7 +557,7 @@ def certify_set(
     samples: int | None = None,
     seed: int | None = None,
     force: bool = False,
-):
+) -> Issued:
     """Run the full battery and, if every item passes, write a certificate bundle into ``output``.
 
     As ``pendverify certify``: a parameter file ``params``; or a ``urdf`` (a path or
@@ -293,6 +568,10 @@ def certify_set(
     Returns the issued result (``items``, ``certified``, ``certificate``, ``path``).
     (Not ``certify``: that name is the ``pendverify.certify`` sub-package.)
     """
+    from pendverify.certify.battery import BatterySettings
+    from pendverify.certify.issue import certification_input, issue
+    from pendverify.certify.signing import load_private_key
+
     settings = BatterySettings()
     if samples is not None:
         settings = dataclasses.replace(settings, samples=_count("samples", samples))
@@ -307,3 +586,47 @@ def certify_set(
     )
     signer = None if key is None else load_private_key(key)  # a bad key fails before any work
     return issue(target, settings, str(output), force, key=signer)
+
+
+def recheck(
+    certificate: str | Path, trust: str | Path | None = None, run_embedded_code: bool = False
+) -> Rechecked:
+    """Verify a certificate's digest (and signature, against ``trust``: a public key file) and
+    re-run its battery: ``pendverify recheck``.  A certificate's embedded Python model runs
+    only when ``trust`` vouches for it or ``run_embedded_code``.  Returns the
+    ``pendverify.certify.issue.Rechecked`` (``items``, ``differences``, ``signature``, ``passed``)."""
+    from pendverify.certify.issue import recheck as recheck_certificate
+
+    trust = None if trust is None else str(trust)
+    return recheck_certificate(str(certificate), trust, _flag("run_embedded_code", run_embedded_code))
+
+
+def generate_keys(folder: str | Path, force: bool = False) -> tuple[Path, Path, str]:
+    """Write an Ed25519 key pair for signing certificates into ``folder``: ``pendverify keygen``.
+    Returns (the private key's path, the public key's path, the fingerprint)."""
+    from pendverify.certify.signing import generate_keys as write_key_pair
+
+    return write_key_pair(folder, _flag("force", force))
+
+
+# --- worked examples -------------------------------------------------------------------------------
+def worked_examples() -> tuple[WorkedExample, ...]:
+    """The worked examples installed with pendverify (``pendverify example``)."""
+    from pendverify.worked_examples import EXAMPLES
+
+    return EXAMPLES
+
+
+def worked_example(name: str) -> WorkedExample:
+    """The worked example called ``name`` (an error listing the names if none is)."""
+    from pendverify.worked_examples import find_example
+
+    return find_example(name)
+
+
+def copy_example(name: str, folder: str | Path, force: bool = False) -> list[Path]:
+    """Copy the worked example ``name`` into ``folder`` (created if missing), ready to run; files
+    already there are refused unless ``force``.  The paths written, in the catalogue's order."""
+    from pendverify.worked_examples import copy_example as copy_files
+
+    return copy_files(worked_example(name), Path(folder), force=_flag("force", force))

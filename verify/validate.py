@@ -13,8 +13,6 @@ the rule, e.g. ``<state>: key 'q[1]' = nan: a state entry must be a finite numbe
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from pendverify.errors import InputError
@@ -44,16 +42,6 @@ def finite_state(key: str, value, size: int | None = None, source: str = STATE_S
         i = int(bad[0])
         raise InputError(source, f"{key}[{i}]", float(array[i]), "a state entry must be a finite number")
     return array
-
-
-def finite_scalar(key: str, value, source: str = STATE_SOURCE) -> float:
-    """``value`` as a finite float, or an ``InputError``."""
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
-        raise InputError(source, key, value, f"must be a finite number; got a {type(value).__name__}")
-    x = float(value)
-    if not math.isfinite(x):
-        raise InputError(source, key, x, "must be a finite number")
-    return x
 
 
 def model_state(model, q, v=None, u=None, w=None, source: str = STATE_SOURCE):

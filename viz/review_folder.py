@@ -36,7 +36,13 @@ from pathlib import Path
 
 from pendverify.analytic.params import default_parameter_file, load_parameter_file
 from pendverify.atomic import write_atomic
-from pendverify.checks.targets import (
+from pendverify.checks.verification import build_report
+from pendverify.errors import InputError, SceneError
+from pendverify.progress import bar
+from pendverify.robot import erd as erd_data
+from pendverify.simulation.scene import Scene, load_scene
+from pendverify.simulation.simulate import run_scene
+from pendverify.targets import (
     Selection,
     Target,
     default_target,
@@ -44,12 +50,6 @@ from pendverify.checks.targets import (
     model_target,
     params_target,
 )
-from pendverify.checks.verification import build_report
-from pendverify.errors import InputError, SceneError
-from pendverify.progress import bar
-from pendverify.robot import erd as erd_data
-from pendverify.simulation.scene import Scene, load_scene
-from pendverify.simulation.simulate import simulate
 from pendverify.viz.animation import Trajectory, render_html
 from pendverify.viz.plots import energy_plot_svg
 from pendverify.viz.review import SceneReview, review_page
@@ -112,7 +112,7 @@ def _shown(path: Path) -> str:
 
 
 def _review(path: Path, scene: Scene, out: Path, trace: bool) -> SceneReview:
-    result = simulate(scene)
+    result = run_scene(scene)
     animation, plot = f"scenes/{path.stem}.html", f"plots/{path.stem}.svg"
     write_atomic(out / animation, render_html(Trajectory.from_run(result), trace=trace))
     write_atomic(out / plot, energy_plot_svg(result))

@@ -62,7 +62,7 @@ def engine_study(problem: Problem, tol: float, config: Config, ref) -> list[Engi
     from scipy.integrate import solve_ivp
 
     rows = []
-    for name in engines.ENGINES:
+    for name in engines.RHS_ENGINES:
         rhs = engine_rhs(problem, name)
         if rhs is None:  # crba_cholesky, minverse on a URDF with continuous joints
             continue

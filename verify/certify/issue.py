@@ -32,13 +32,13 @@ from pendverify.certify.reading import read_certificate
 from pendverify.certify.schema import check_derived, check_schema
 from pendverify.certify.signing import fingerprint
 from pendverify.certify.simulations import recorded_engines
-from pendverify.checks.targets import PARAMS_HINT
 from pendverify.display import listed, shortened
 from pendverify.errors import CertificateError, ParameterError, PendverifyError
 from pendverify.robot.description import load_description
 from pendverify.robot.erd import resolve_urdf
 from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
+from pendverify.targets import PARAMS_HINT
 
 
 @dataclass(frozen=True)

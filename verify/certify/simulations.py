@@ -92,7 +92,7 @@ def _run(scene, urdf: str, engine: str | None):
     """(engine, run or None, accepted steps, why it failed): on the fast path unless ``engine`` says aba
     or (``engine`` None) the scene does not compile."""
     from pendverify.numerics import fast_scene
-    from pendverify.simulation.simulate import simulate
+    from pendverify.simulation.simulate import run_scene
 
     if engine not in (None, *ENGINES):
         return engine, None, 0, f"unknown battery engine {engine!r}; expected one of {', '.join(ENGINES)}"
@@ -112,7 +112,7 @@ def _run(scene, urdf: str, engine: str | None):
             if compiled is not None:
                 run = fast_scene.simulate(scene, compiled)
                 return COMPILED, run, len(run.result.steps_t) - 1, ""
-            run = simulate(scene, "aba", urdf)
+            run = run_scene(scene, "aba", urdf)
             return ABA, run, len(run.integration.steps_t) - 1, ""
     except (PendverifyError, RuntimeError, FloatingPointError) as exc:
         return (ABA if compiled is None else COMPILED), None, 0, str(exc)

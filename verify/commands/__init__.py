@@ -5,9 +5,11 @@ A module here defines ``register(subparsers)``, which adds its parser with
 options it takes) and sets ``func`` to a function taking the parsed arguments and
 returning an exit status (0 success, 1 a check or invariant failed; bad input raises a
 PendverifyError, which the CLI turns into status 2; anything else is an internal error,
-status 3: ``pendverify.exitcodes``).  Output paths go through
-``pendverify.atomic.check_output`` (``check_report_output`` for ``--json``) before any
-work.  Heavy imports belong inside ``func``.
+status 3: ``pendverify.exitcodes``).  ``func`` checks the options, calls the library
+through ``pendverify.api`` (one function per command) and formats what it returns; a
+command module imports nothing else of the library but formatters.  Output paths go
+through ``pendverify.atomic.check_output`` (``check_report_output`` for ``--json``) before
+any work.  Heavy imports, ``pendverify.api`` among them, belong inside ``func``.
 
 The global options, accepted before or after the command's name:
 

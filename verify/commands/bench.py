@@ -102,18 +102,13 @@ def run(args: argparse.Namespace) -> int:
     with guard:
         from pathlib import Path
 
+        from pendverify import api
         from pendverify.atomic import write_atomic
         from pendverify.bench.plot import render
-        from pendverify.bench.problems import scene_problems
         from pendverify.bench.report import fraction, ratios, to_csv, to_markdown
-        from pendverify.bench.run import run_benchmark
-        from pendverify.bench.workprecision import FULL, QUICK
 
-        config, specs = QUICK if args.quick else FULL, None
-        if args.scene is not None:
-            config, specs = scene_problems(args.scene, config)
         log = (lambda msg: None) if args.quiet else (lambda msg: print(msg, flush=True))
-        results = run_benchmark(config, log=log, blas=blas, specs=specs)
+        results = api.bench_accuracy(args.quick, args.scene, log=log, blas=blas)
         out = Path(args.output)
         markdown = to_markdown(results)
         write_atomic(out / "work_precision.csv", to_csv(results))
@@ -147,14 +142,11 @@ def run_certify(args: argparse.Namespace) -> int:
         import numpy as np
         import pinocchio
 
-        from pendverify.bench.certify import measure, quick_settings
+        from pendverify import api
         from pendverify.bench.certify_report import table, to_json
         from pendverify.bench.timing import cpu_model
-        from pendverify.certify.battery import BatterySettings
 
-        settings = quick_settings() if args.quick else BatterySettings()
-        repeats = args.repeats or (1 if args.quick else 7)
-        costs = measure(args.params, settings, repeats)
+        costs, settings, repeats = api.bench_certify(args.params, args.quick, args.repeats)
     lines = table(costs, settings, repeats, blas).splitlines()
     print("\n".join(line for line in lines if line.startswith("target ")) if args.quiet else "\n".join(lines))
     if args.json:

@@ -72,31 +72,26 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from pendverify.analytic import MODELS
-    from pendverify.analytic.plugin import load_model_class
+    from pathlib import Path
+
+    from pendverify import api
     from pendverify.atomic import check_output, check_report_output, write_atomic
     from pendverify.checks.junit import to_junit
-    from pendverify.checks.report import format_table
-    from pendverify.checks.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
-    from pendverify.checks.targets import select_targets
-    from pendverify.checks.verification import build_report
-    from pendverify.robot.geometry import MODEL_FORM_RTOL
 
     check_report_output(args.json)
     check_output(args.junit)
-    samples = DEFAULT_RANDOM_STATES if args.samples is None else args.samples
-    seed = DEFAULT_SEED if args.seed is None else args.seed
     builtin_models(args.model, args.analytic)  # refuses --model with --analytic, and unknown names
-    if args.analytic:
-        model_cls = load_model_class(args.analytic)
-    else:
-        model_cls = MODELS[args.model] if args.model else None
-    selection = select_targets(model_cls, args.urdf, args.params, erd_urdfs=args.erd)
-    rtol = MODEL_FORM_RTOL if args.model_form_rtol is None else args.model_form_rtol
-    report = build_report(selection.targets, samples, seed, strict=args.strict, model_form_rtol=rtol)
-    report.skipped = selection.skipped
+    given = {"samples": args.samples, "seed": args.seed, "model_form_rtol": args.model_form_rtol}
+    report = api.check(
+        Path(args.analytic) if args.analytic else args.model,
+        args.urdf,
+        args.params,
+        erd=args.erd,
+        strict=args.strict,
+        **{key: value for key, value in given.items() if value is not None},
+    )
     report.elapsed_s = time.perf_counter() - args.started
-    table = format_table(report)
+    table = report.table()
     print(table.splitlines()[-1] if args.quiet else table)
     if args.junit:
         write_atomic(args.junit, to_junit(report))

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 from pendverify.commands import add_command
 
@@ -48,23 +47,25 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from pendverify.worked_examples import EXAMPLES, copy_example, find_example, next_commands
+    from pendverify import api
+    from pendverify.worked_examples import next_commands
 
     if args.name is None:
-        width = max(len(e.name) for e in EXAMPLES)
-        for e in EXAMPLES:
+        examples = api.worked_examples()
+        width = max(len(e.name) for e in examples)
+        for e in examples:
             files = ", ".join(f.name for f in e.files)
             print(f"{e.name.ljust(width)}  {e.dof} dof  {e.summary}; files: {files}")
         print("copy one with: pendverify example NAME DIR")
         return 0
-    example = find_example(args.name)
+    example = api.worked_example(args.name)
     if args.folder is None:
         print(f"{example.name}: {example.summary} ({example.dof} dof)")
         for f in example.files:
             print(f"  {f.name:<40} {f.role}")
         print(f"copy it with: pendverify example {example.name} DIR")
         return 0
-    written = copy_example(example, Path(args.folder), force=args.force)
+    written = api.copy_example(example.name, args.folder, force=args.force)
     print(f"{example.name}: {example.summary} ({example.dof} dof), copied into {args.folder}:")
     for f, path in zip(example.files, written, strict=True):
         print(f"  {path!s:<48} {f.role}")

@@ -22,11 +22,11 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from pendverify import api
     from pendverify.atomic import check_output
-    from pendverify.certify.signing import generate_keys
 
     check_output(args.output, folder=True)
-    private, public, keyid = generate_keys(args.output, args.force)
+    private, public, keyid = api.generate_keys(args.output, args.force)
     if not args.quiet:
         print(f"private key: {private} (mode 0600: keep it secret; certify --key {private})")
         print(f"public key:  {public} (give it to whoever rechecks: recheck --trust {public})")

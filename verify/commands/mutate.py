@@ -46,27 +46,27 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from pathlib import Path
 
+    from pendverify import api
     from pendverify.atomic import check_report_output
-    from pendverify.checks.sampling import DEFAULT_SEED
-    from pendverify.checks.targets import default_target, plugin_target
     from pendverify.errors import PendverifyError
     from pendverify.jsonio import to_json
-    from pendverify.symbolic.mutate import DEFAULT_MUTATION_STATES, run_mutation
     from pendverify.symbolic.mutation_report import format_report
 
     check_report_output(args.json)
-    names = builtin_models(args.model, args.analytic)
-    if args.analytic:
-        targets = [plugin_target(args.analytic, args.urdf, args.params)]
-    elif args.urdf or args.params:
+    builtin_models(args.model, args.analytic)  # refuses --model with --analytic, and unknown names
+    if (args.urdf or args.params) and not args.analytic:
         raise PendverifyError("--urdf and --params go with --analytic; built-in models use their defaults")
-    else:
-        targets = [default_target(n) for n in names]
-    samples = DEFAULT_MUTATION_STATES if args.samples is None else args.samples
-    seed = DEFAULT_SEED if args.seed is None else args.seed
-    methods = tuple(args.method) if args.method else None
-    reports = [run_mutation(t, samples, seed, args.all_checks, methods) for t in targets]
+    options = {"samples": args.samples, "seed": args.seed}
+    reports = api.mutate(
+        Path(args.analytic) if args.analytic else args.model,
+        args.urdf,
+        args.params,
+        all_checks=args.all_checks,
+        methods=tuple(args.method) if args.method else None,
+        **{key: value for key, value in options.items() if value is not None},
+    )
     texts = [format_report(r) for r in reports]  # each ends with its verdict line
     print("\n".join(t.splitlines()[-1] for t in texts) if args.quiet else "\n\n".join(texts))
     if args.json:

@@ -49,12 +49,11 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from pendverify import api
     from pendverify.atomic import check_output, write_atomic
     from pendverify.commands import refuse_together
     from pendverify.commands.simulate import urdf_argument
     from pendverify.errors import InputError
-    from pendverify.simulation.scene import load_scene
-    from pendverify.viz.animation import Trajectory, check_frame_count, render_html
 
     if args.scene is None and args.trajectory is None:
         raise InputError("<command line>", "scene", None, "give a scene file, or --trajectory FILE.npz")
@@ -69,20 +68,18 @@ def run(args: argparse.Namespace) -> int:
     check_output(args.output)
     status = 0
     if args.trajectory:
-        traj = Trajectory.from_npz(args.trajectory, args.analytic)
+        traj = api.trajectory(args.trajectory, args.analytic)
         for note in traj.notes:
             print(f"note: {note}")
     else:
-        from pendverify.simulation.simulate import simulate
-
-        scene = load_scene(args.scene)
-        check_frame_count(scene.source, "time.duration", scene.duration, scene.duration)  # before simulating
-        result = simulate(scene, args.engine, urdf_argument(args.urdf))
-        traj = Trajectory.from_run(result)
+        scene = api.load_scene(args.scene)
+        api.check_animation_length(scene)  # before simulating
+        result = api.simulate(scene, urdf_argument(args.urdf), args.engine)
+        traj = api.trajectory(result)
         if not result.passed:
             print(f"note: {traj.title}: an invariant FAILS (see `pendverify simulate {args.scene}`)")
             status = 1
-    page = render_html(traj, trace=args.trace)
+    page = api.animation_html(traj, trace=args.trace)
     write_atomic(args.output, page)
     duration = traj.t[-1] - traj.t[0]
     size_mb = len(page.encode()) / 1e6

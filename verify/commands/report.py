@@ -11,13 +11,12 @@ beside ``DIR`` and renamed into place at the end; an existing ``DIR`` is
 refused unless ``--force``.
 
 Without ``--scenes DIR`` it reviews the scenes installed with pendverify
-(``pendverify.shipped``).
+(``pendverify.shipped``); ``pendverify.api.review`` does the work.
 """
 
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 from pendverify.commands import add_command, add_sampling_options
 
@@ -50,34 +49,20 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def shipped_scenes(folder: str | None) -> list[Path]:
-    """The scene files ``report`` reviews: those in ``folder``, or the installed ones when None."""
-    from pendverify.errors import InputError
-    from pendverify.shipped import shipped_folder
-
-    path = Path(folder) if folder else shipped_folder("scenes")
-    scenes = sorted(path.glob("*.toml")) if path.is_dir() else []
-    if not scenes:
-        raise InputError("<command line>", "--scenes", str(path), "no scene files (*.toml) in that folder")
-    return scenes
-
-
 def run(args: argparse.Namespace) -> int:
+    from pendverify import api
     from pendverify.atomic import check_output
-    from pendverify.checks.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
-    from pendverify.viz.review_folder import write_review
 
     check_output(args.output, folder=True)
-
-    folder = write_review(
-        shipped_scenes(args.scenes),
-        Path(args.output),
-        DEFAULT_RANDOM_STATES if args.samples is None else args.samples,
-        DEFAULT_SEED if args.seed is None else args.seed,
-        args.erd,
-        args.trace,
-        log=(lambda line: None) if args.quiet else (lambda line: print(line, flush=True)),
+    options = {"samples": args.samples, "seed": args.seed}
+    folder = api.review(
+        args.output,
+        args.scenes,
+        erd=args.erd,
+        trace=args.trace,
         force=args.force,
+        log=(lambda line: None) if args.quiet else (lambda line: print(line, flush=True)),
+        **{key: value for key, value in options.items() if value is not None},
     )
     print(f"review page written to {folder.index}")
     return 0 if folder.passed else 1

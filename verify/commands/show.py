@@ -24,28 +24,23 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
     import sympy as sp
 
-    from pendverify.analytic.plugin import load_model_class
-    from pendverify.analytic.text_model import METHODS
-    from pendverify.symbolic.model import SymbolicModel
+    from pendverify import api
 
-    cls = load_model_class(args.model)
-    sm = SymbolicModel.of(cls)
-    spec = getattr(cls, "text_spec", None)
-    derived = spec.derived if spec is not None else {}
-    keys = {method: key for key, (method, _) in METHODS.items()}
+    reading = api.read_model(Path(args.model))
+    cls = reading.model_cls
     kinds = ", ".join(
         f"{c} ({'angle' if a else 'position'})" for c, a in zip(cls.coordinates, cls.angular, strict=True)
     )
     print(f"model {cls.name}: coordinates {kinds}; rates {', '.join('d' + c for c in cls.coordinates)}")
     if cls.inputs or cls.disturbances:
         print(f"inputs {', '.join(cls.inputs) or '-'}; disturbances {', '.join(cls.disturbances) or '-'}")
-    print(f"parameters {', '.join(sm.parameters)}")
-    for method, form in cls.written_closed_forms().items():
-        value = sm.evaluate(method, form.args)
-        how = derived.get(keys.get(method, ""))
-        note = f" (derived: {how})" if how else ""
+    print(f"parameters {', '.join(reading.parameters)}")
+    for method, derived, value in reading.equations:
+        note = f" (derived: {derived})" if derived else ""
         if args.pretty:
             text = sp.pretty(value, use_unicode=True)
         elif isinstance(value, sp.MatrixBase):

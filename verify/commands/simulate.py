@@ -75,10 +75,9 @@ def _joules(value: float) -> str:
 def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
+    from pendverify import api
     from pendverify.atomic import check_output, check_report_output, write_atomic
     from pendverify.commands import refuse_together
-    from pendverify.simulation.scene import load_scene
-    from pendverify.simulation.simulate import simulate
 
     if args.csv and not args.output:
         refuse_together(
@@ -88,12 +87,10 @@ def run(args: argparse.Namespace) -> int:
     for path in (args.output, csv, args.html):
         check_output(path)
     check_report_output(args.json)
-    scene = load_scene(args.scene)
+    scene = api.load_scene(args.scene)
     if args.html:
-        from pendverify.viz.animation import check_frame_count
-
-        check_frame_count(scene.source, "time.duration", scene.duration, scene.duration)  # before simulating
-    result = simulate(scene, args.engine, urdf_argument(args.urdf))
+        api.check_animation_length(scene)  # before simulating
+    result = api.simulate(scene, urdf_argument(args.urdf), args.engine)
     text = summary(result)
     print(text.splitlines()[-1] if args.quiet else text)  # its last line is the verdict
     say = (lambda line: None) if args.quiet else print
@@ -104,9 +101,7 @@ def run(args: argparse.Namespace) -> int:
             write_atomic(csv, result.to_csv())
             say(f"CSV written to {csv}")
     if args.html:
-        from pendverify.viz.animation import Trajectory, render_html
-
-        write_atomic(args.html, render_html(Trajectory.from_run(result)))
+        write_atomic(args.html, api.animation_html(api.trajectory(result)))
         say(f"animation written to {args.html}")
     if args.json:
         write_json_report(args, _json(result))

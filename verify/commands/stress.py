@@ -181,28 +181,27 @@ def report_dict(report) -> dict:
 
 
 def run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from pendverify import api
     from pendverify.atomic import check_report_output
-    from pendverify.errors import PendverifyError, UnknownNameError
+    from pendverify.errors import PendverifyError
     from pendverify.jsonio import to_json
-    from pendverify.stress.catalogue import CASE_NAMES, run_catalogue
-    from pendverify.stress.framework import FULL, QUICK, SEED
 
     check_report_output(args.json)
-    seed = SEED if args.seed is None else args.seed
-    settings = QUICK if args.quick else FULL
-    if args.analytic:
-        from pendverify.stress.generic import run_generic
-
-        if not args.urdf or not args.params:
-            raise PendverifyError(f"{args.analytic}: give --urdf and --params with --analytic")
-        report = run_generic(args.analytic, args.urdf, args.params, settings, args.case, seed)
-    else:
-        if args.urdf or args.params:
-            raise PendverifyError("--urdf and --params go with --analytic (a model file)")
-        for name in args.case or ():
-            if name not in CASE_NAMES:
-                raise UnknownNameError("stress case", name, CASE_NAMES)
-        report = run_catalogue(settings, names=args.case, seed=seed)
+    if args.analytic and (not args.urdf or not args.params):
+        raise PendverifyError(f"{args.analytic}: give --urdf and --params with --analytic")
+    if not args.analytic and (args.urdf or args.params):
+        raise PendverifyError("--urdf and --params go with --analytic (a model file)")
+    report = api.stress(
+        Path(args.analytic) if args.analytic else None,
+        args.urdf,
+        args.params,
+        quick=args.quick,
+        cases=args.case,
+        seed=args.seed,
+    )
+    seed = report.seed
     if not args.quiet:
         print(format_table(report))
         if report.study is not None:

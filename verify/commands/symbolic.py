@@ -28,17 +28,17 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from pathlib import Path
 
-    from pendverify.analytic import MODELS
-    from pendverify.analytic.plugin import load_model_class
+    from pendverify import api
     from pendverify.atomic import check_report_output
     from pendverify.jsonio import to_json
-    from pendverify.symbolic.compare import compare, format_report
+    from pendverify.symbolic.compare import format_report
 
     check_report_output(args.json)
     names = builtin_models(args.model, args.analytic)
-    classes = [load_model_class(args.analytic)] if args.analytic else [MODELS[n] for n in names]
-    reports = [compare(cls) for cls in classes]
+    models = [Path(args.analytic)] if args.analytic else names
+    reports = [report for model in models for report in api.compare_symbolic(model)]
     texts = [format_report(r) for r in reports]  # each ends with its verdict line
     print("\n".join(t.splitlines()[-1] for t in texts) if args.quiet else "\n\n".join(texts))
     if args.json:

@@ -121,7 +121,7 @@ class PinocchioBatch:
 
         def compute():
             n = self.system.model.nv
-            Ti = self.system.cmap._T_inv
+            Ti = self.system.cmap.T_inv
             return Ti @ symmetrised(self._loop(pin.computeMinverse, self.q, shape=(n, n))) @ Ti.T
 
         return self._once("Minv", compute)
@@ -176,9 +176,9 @@ class PinocchioBatch:
         """θ̈ by ABA for generalized forces given in the model's coordinates (N, n)."""
         cmap = self.system.cmap
         tau_theta = _finite_rows("tau", tau_theta, self.system.model.nv, self.system.source)
-        tau = np.ascontiguousarray(_mv(cmap._T_inv.T, tau_theta))
+        tau = np.ascontiguousarray(_mv(cmap.T_inv.T, tau_theta))
         self.aba_torques = tau
-        return _mv(cmap._T_inv, self._loop(pin.aba, self.q, self.v, tau))
+        return _mv(cmap.T_inv, self._loop(pin.aba, self.q, self.v, tau))
 
     def kinetic_energy(self) -> np.ndarray:
         """T(θ, θ̇) by computeKineticEnergy."""

@@ -22,7 +22,7 @@ Pinocchio; ``configuration`` writes them from the angle.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -33,6 +33,8 @@ class CoordinateMap:
     theta0: np.ndarray
     #: Configuration entries per joint: 1 (angle or position) or 2 (cos, sin).
     joint_nq: tuple[int, ...]
+    #: T⁻¹, computed once from T.
+    T_inv: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         T = np.asarray(self.T, dtype=float)
@@ -40,11 +42,7 @@ class CoordinateMap:
             raise ValueError(f"T must be square and invertible, got {T!r}")
         object.__setattr__(self, "T", T)
         object.__setattr__(self, "theta0", np.asarray(self.theta0, dtype=float))
-        object.__setattr__(self, "_T_inv", np.linalg.inv(T))
-
-    @classmethod
-    def identity(cls, n: int) -> CoordinateMap:
-        return cls(np.eye(n), np.zeros(n), (1,) * n)
+        object.__setattr__(self, "T_inv", np.linalg.inv(T))
 
     # --- states ------------------------------------------------------------------------
     def joint_positions(self, theta: np.ndarray) -> np.ndarray:
@@ -61,10 +59,6 @@ class CoordinateMap:
     def velocity(self, theta_dot: np.ndarray) -> np.ndarray:
         return self.T @ theta_dot
 
-    def model_coordinates(self, q_joint: np.ndarray) -> np.ndarray:
-        """θ from joint angles/positions (the inverse of ``joint_positions``)."""
-        return self._T_inv @ q_joint + self.theta0
-
     # --- quantities --------------------------------------------------------------------
     def matrix_to_model(self, A_q: np.ndarray) -> np.ndarray:
         """M, C or Ṁ: Tᵀ A T."""
@@ -74,13 +68,13 @@ class CoordinateMap:
         return self.T.T @ tau_q
 
     def force_to_joints(self, tau_theta: np.ndarray) -> np.ndarray:
-        return self._T_inv.T @ tau_theta
+        return self.T_inv.T @ tau_theta
 
     def acceleration_to_model(self, a_q: np.ndarray) -> np.ndarray:
-        return self._T_inv @ a_q
+        return self.T_inv @ a_q
 
     def inverse_to_model(self, Minv_q: np.ndarray) -> np.ndarray:
-        return self._T_inv @ Minv_q @ self._T_inv.T
+        return self.T_inv @ Minv_q @ self.T_inv.T
 
     @property
     def amplification(self) -> float:

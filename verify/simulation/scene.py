@@ -62,7 +62,9 @@ MIN_RTOL = 100 * 2.220446049250313e-16
 
 ADAPTIVE_METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 FIXED_STEP_METHODS = ("rk4",)
-ENGINES = ("aba", "closed_form", "both")
+#: what a scene's ``engine`` may be: ABA integrated, the closed form integrated, or ABA integrated
+#: with the closed form compared along the trajectory
+SCENE_ENGINE_CHOICES = ("aba", "closed_form", "both")
 TOP_KEYS = (
     "name",
     "model",
@@ -223,7 +225,7 @@ def parse_scene(data: dict, source: str, base: Path | None = None) -> Scene:
             "model", top.get("model"), f"the {model} parameter set has no g; a scene sets gravity through g"
         )
     name = top.string("name", default=Path(source).stem)
-    engine = top.string("engine", ENGINES, default="aba")
+    engine = top.string("engine", SCENE_ENGINE_CHOICES, default="aba")
     urdf = _urdf(top, scene_path)
 
     initial = top.sub("initial")

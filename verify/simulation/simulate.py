@@ -1,6 +1,6 @@
 """Run a scene: integrate, sample, check its invariants, compare engines.
 
-``simulate(scene)`` returns a ``Run`` holding the samples (t, q, v, u, w, E),
+``run_scene(scene)`` returns a ``Run`` holding the samples (t, q, v, u, w, E),
 the integrator's own steps, the invariant results and, with engine ``both``,
 the comparison of Pinocchio's ABA with the closed-form right-hand side
 evaluated at the *same* states along the trajectory (two chaotic trajectories
@@ -192,7 +192,7 @@ def _engine_comparison(dyn: Dynamics, steps_t, steps_x) -> InvariantResult:
     return replace(result, scale=float("nan"))  # each state's error is relative to its own scale
 
 
-def simulate(scene: Scene, engine: str | None = None, urdf: str | None = None) -> Run:
+def run_scene(scene: Scene, engine: str | None = None, urdf: str | None = None) -> Run:
     """Integrate ``scene`` (with ``engine`` instead of the scene's, and ``urdf`` instead of the
     URDF the project writes for its parameters, when given) and check its invariants."""
     engine = engine or scene.engine

@@ -27,7 +27,6 @@ import time
 
 from pendverify.checks.applicability import derived_notes
 from pendverify.checks.catalogue import skipped_notes
-from pendverify.checks.targets import plugin_target
 from pendverify.errors import PendverifyError, UnknownNameError
 from pendverify.robot.description import urdf_text
 from pendverify.robot.rebind import Binding
@@ -35,6 +34,7 @@ from pendverify.stress.cases import high_speed_case, large_angle_case
 from pendverify.stress.catalogue import StressReport, run_case
 from pendverify.stress.framework import SEED, Case, Context, Settings, StressResult, checks_case
 from pendverify.stress.singular import near_singular_case
+from pendverify.targets import plugin_target
 
 MASS_FACTORS = (1e-6, 1e6)
 LENGTH_FACTORS = (1e-3, 1e3)
