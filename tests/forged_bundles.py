@@ -10,7 +10,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from pendverify.certify.battery import BatteryItem, BatterySettings
+from pendverify.certify.battery import BatterySettings
+from pendverify.certify.battery_item import BatteryItem
 from pendverify.certify.certificate import build_certificate, certificate_text, digest_of, summary_of
 from pendverify.certify.model_source import ModelSource, sha256_text
 from pendverify.certify.names import envelope_name

@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 from pendverify.analytic import MODELS, DoublePendulum
-from pendverify.certify.battery import BatterySettings, invariant_items, run_battery
+from pendverify.certify.battery import BatterySettings, run_battery
 from pendverify.certify.certificate import build_certificate, certificate_text, digest_of
 from pendverify.certify.issue import recheck
 from pendverify.certify.model_source import ModelSource
-from pendverify.certify.simulations import ABA, COMPILED, CROSS_CHECK_STATES
+from pendverify.certify.simulations import ABA, COMPILED, CROSS_CHECK_STATES, invariant_items
 from pendverify.numerics import fast_scene
 from pendverify.numerics.energies import GeneratedEnergies
 from pendverify.robot.writer import urdf_for

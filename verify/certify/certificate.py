@@ -59,7 +59,8 @@ import math
 from datetime import datetime, timezone
 
 from pendverify.analytic import ParameterSet
-from pendverify.certify.battery import BatteryItem, BatterySettings
+from pendverify.certify.battery import BatterySettings
+from pendverify.certify.battery_item import BatteryItem
 from pendverify.certify.model_source import ModelSource, source_problem
 from pendverify.certify.names import envelope_name
 from pendverify.certify.simulations import UNRECORDED

@@ -23,7 +23,8 @@ from pathlib import Path
 from pendverify.analytic import ParameterSet
 from pendverify.analytic.params import load_parameter_file
 from pendverify.analytic.plugin import plugin_parameters
-from pendverify.certify.battery import BatteryItem, BatterySettings, run_battery
+from pendverify.certify.battery import BatterySettings, run_battery
+from pendverify.certify.battery_item import BatteryItem
 from pendverify.certify.bundle import check_files_beside, refuse_existing, verify_signature, write_bundle
 from pendverify.certify.certificate import build_certificate, compare_items, derived_constants, verify_digest
 from pendverify.certify.model_source import ModelSource

@@ -42,6 +42,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from pendverify.certify.battery_item import BatteryItem
 from pendverify.certify.scenes import effect_scenes
 from pendverify.errors import FastPathError, FileAccessError, PendverifyError
 
@@ -172,8 +173,6 @@ def cross_check(run, system):
 
 def _item(name: str, inv, samples: int, settings, engine: str, failure: str = ""):
     """A battery item from an ``InvariantResult`` (or a failed run's message, ``inv`` None)."""
-    from pendverify.certify.battery import BatteryItem
-
     if inv is None:
         return BatteryItem(
             name, "invariant", np.inf, 0.0, 0, settings.seed, False, failure, max_error=np.inf, engine=engine
