@@ -6,6 +6,7 @@ import argparse
 
 from pendverify.atomic import check_output, check_report_output
 from pendverify.certify.settings_rules import samples_option, seed_option
+from pendverify.certify.sweep_limits import DEFAULT_MAX_SETS, WORKER_TIMEOUT_S
 from pendverify.commands import (
     add_analytic_option,
     add_command,
@@ -14,9 +15,6 @@ from pendverify.commands import (
     refuse_together,
     write_json_report,
 )
-
-DEFAULT_MAX_SETS = 100_000  # pendverify.certify.sweep.DEFAULT_MAX_SETS, without importing NumPy here
-WORKER_TIMEOUT_S = 60.0  # pendverify.certify.sweep_run.WORKER_TIMEOUT_S, without importing it here
 
 
 def register(sub) -> None:
