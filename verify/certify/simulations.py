@@ -47,7 +47,7 @@ from pendverify.certify.scenes import effect_scenes
 from pendverify.errors import FastPathError, FileAccessError, PendverifyError
 
 COMPILED, ABA = "compiled", "aba"
-ENGINES = {
+BATTERY_ENGINES = {  # what may run a battery invariant item → its description in the item
     COMPILED: "compiled DOP853 on the generated closed form",
     ABA: "scipy DOP853 on Pinocchio's ABA",
 }
@@ -95,8 +95,9 @@ def _run(scene, urdf: str, engine: str | None):
     from pendverify.numerics import fast_scene
     from pendverify.simulation.simulate import simulate
 
-    if engine not in (None, *ENGINES):
-        return engine, None, 0, f"unknown battery engine {engine!r}; expected one of {', '.join(ENGINES)}"
+    if engine not in (None, *BATTERY_ENGINES):
+        expected = ", ".join(BATTERY_ENGINES)
+        return engine, None, 0, f"unknown battery engine {engine!r}; expected one of {expected}"
     compiled = None
     if engine in (None, COMPILED):
         try:
@@ -185,7 +186,7 @@ def _item(name: str, inv, samples: int, settings, engine: str, failure: str = ""
         samples,
         settings.seed,
         inv.passed,
-        f"{inv.name} [{ENGINES[engine]}]",
+        f"{inv.name} [{BATTERY_ENGINES[engine]}]",
         at=f"t = {inv.worst_t:.6g} s",
         max_error=inv.max_error,
         max_error_at=f"t = {inv.max_error_t:.6g} s",
