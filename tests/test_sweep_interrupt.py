@@ -236,7 +236,7 @@ def test_a_sweep_task_never_draws_a_bar(tmp_path, monkeypatch):
     import tqdm
 
     from pendverify.certify.sweep import load_sweep
-    from pendverify.certify.sweep_task import certify_task
+    from pendverify.certify.sweep_task import certify_chunk
 
     bars = []
 
@@ -249,7 +249,7 @@ def test_a_sweep_task_never_draws_a_bar(tmp_path, monkeypatch):
     monkeypatch.setattr(sys.stderr, "isatty", lambda: True)
     sweep = load_sweep(_sweep(tmp_path, 1))
     name, values = sweep.sets[0]
-    certify_task(sweep.model, name, values, sweep.settings.as_dict())
+    certify_chunk(sweep.model, [(name, values)], sweep.settings.as_dict())
     assert bars and all(disabled for _, disabled in bars), bars
 
 

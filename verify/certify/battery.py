@@ -47,6 +47,20 @@ class BatterySettings:
         return asdict(self)
 
 
+@dataclass(frozen=True)
+class BatteryRun:
+    """The battery's evidence on one set: every item, and what reading the URDF being
+    certified noticed (``PinocchioSystem.notes``), which its certificate records as ``notes``."""
+
+    items: list[BatteryItem]
+    notes: list[str]
+
+    @property
+    def passed(self) -> bool:
+        """Whether every item passed."""
+        return all(i.passed for i in self.items)
+
+
 def check_items(model, system, settings: BatterySettings) -> list[BatteryItem]:
     states = sample_states(model, settings.samples, settings.seed)
     return [
@@ -120,8 +134,9 @@ def model_class(model) -> type[ClosedFormModel]:
 
 def run_battery(
     model, params: ParameterSet, urdf: str, settings: BatterySettings, engines: dict | None = None
-) -> list[BatteryItem]:
-    """The battery for a model (a class, or a built-in model's name), its parameters and URDF.
+) -> BatteryRun:
+    """The battery for a model (a class, or a built-in model's name), its parameters and URDF:
+    its items, and the notes of the URDF read once for all of them.
 
     ``engines``: effect → the engine its invariant items ran on (``recheck``: the certificate's)."""
     cls = model_class(model)
@@ -137,4 +152,4 @@ def run_battery(
         for part in parts:
             items += part()
             progress.update(1)
-    return items
+    return BatteryRun(items, system.notes)

@@ -59,7 +59,7 @@ import math
 from datetime import datetime, timezone
 
 from pendverify.analytic import ParameterSet
-from pendverify.certify.battery import BatterySettings
+from pendverify.certify.battery import BatteryRun, BatterySettings
 from pendverify.certify.battery_item import BatteryItem
 from pendverify.certify.model_source import ModelSource, source_problem
 from pendverify.certify.names import envelope_name
@@ -121,13 +121,13 @@ def build_certificate(
     params: ParameterSet,
     urdf: str,
     settings: BatterySettings,
-    items: list[BatteryItem],
+    battery: BatteryRun,
     date: datetime | None = None,
-    notes: list[str] | None = None,
     keyid: str | None = None,
 ) -> dict:
-    """The certificate; with ``keyid`` (the signing key's fingerprint) it names its envelope."""
-    checks = [item.as_dict() for item in items]
+    """The certificate of a set and its battery's evidence (items and notes, made dicts here,
+    once); with ``keyid`` (the signing key's fingerprint) it names its envelope."""
+    checks = [item.as_dict() for item in battery.items]
     cert = {
         "schema": SCHEMA,
         "name": name,
@@ -140,7 +140,7 @@ def build_certificate(
         "versions": versions(),
         "checks": checks,
         "summary": summary_of(checks),
-        "notes": list(notes or []),
+        "notes": list(battery.notes),
         "date": (date or datetime.now(timezone.utc)).isoformat(timespec="seconds"),
     }
     if keyid is not None:

@@ -316,7 +316,7 @@ def run_sweep(
                     for result in results:
                         run.summary.add(result)
                         with interrupts.writing():
-                            run.written += write(result, result["name"] in replace)
+                            run.written += write(result, result.name in replace)
                         progress.update(1)
                 if run.lost:
                     break

@@ -193,7 +193,7 @@ def _run_sweep(args) -> int:
 
     folder = SameFolder(args.output)
 
-    def write(result: dict, replace: bool) -> int:
+    def write(result, replace: bool) -> int:
         folder.check()
         try:
             written = write_sweep_certificates(sweep, [result], args.output, args.force or replace, key)
