@@ -67,7 +67,7 @@ def invariant_items(model_cls, params, urdf: str, settings, engines=None, system
     scenes = effect_scenes(model_cls, params, settings.sim_duration, settings.sim_rtol, settings.seed)
     for effect, doc in scenes.items():
         scene = parse_scene(doc, f"<battery {effect}>")
-        engine, run, steps, failure = _run(scene, urdf, (engines or {}).get(effect))
+        engine, run, steps, failure = run_battery_scene(scene, urdf, (engines or {}).get(effect))
         if run is None:  # a run that diverges or dies is a failed item, not a crash of the battery
             items.append(_item(f"invariant:{effect}", None, 0, settings, engine, failure))
             continue
@@ -89,7 +89,7 @@ def invariant_items(model_cls, params, urdf: str, settings, engines=None, system
     return items
 
 
-def _run(scene, urdf: str, engine: str | None):
+def run_battery_scene(scene, urdf: str, engine: str | None):
     """(engine, run or None, accepted steps, why it failed): on the fast path unless ``engine`` says aba
     or (``engine`` None) the scene does not compile."""
     from pendverify.numerics import fast_scene
