@@ -29,7 +29,7 @@ checks             every battery item: name, kind (check | stress | invariant);
                    samples, seed, passed, detail; invariant items also engine
                    (compiled | aba: what ran the simulation,
                    ``pendverify.certify.simulations``; an invariant item without one
-                   ran on aba, as every item issued before the key existed)
+                   ran on aba)
 summary            derived from ``checks``: items, passed, failed (names),
                    result (PASSED | FAILED), worst_item, worst_ratio
 notes              what the URDF reader noticed (angle offsets, a centre of mass

@@ -1,6 +1,6 @@
 """The battery's invariant items: one short run per effect (``pendverify.certify.scenes``), on the fast path.
 
-Engines, recorded in each invariant item's ``engine``:
+Engines, recorded in each invariant item's ``engine`` (``BATTERY_ENGINES``):
 
 * ``compiled`` — the compiled DOP853 on the model's generated closed form
   (``pendverify.numerics.fast_scene``), the invariants evaluated on its own accepted steps
@@ -11,29 +11,28 @@ Engines, recorded in each invariant item's ``engine``:
   never because of the code cache: one that cannot be used is replaced by a temporary
   folder, and when no folder can be written the battery stops with that one line;
 * ``aba`` — scipy's DOP853 on Pinocchio's ABA on the URDF being certified, with
-  Pinocchio's energy (``pendverify.simulation.simulate``): the engine of every invariant
-  item issued before the fast path, so an item that records no engine ran on it.
+  Pinocchio's energy (``pendverify.simulation.simulate``).  An invariant item that records
+  no engine ran on it (``UNRECORDED``).
 
 ``recheck`` runs each item on the engine its certificate records, so it reproduces the
-figures of certificates from before as well as after.
+figures of an item whatever engine ran it.
 
-What changed in meaning.  On ``aba`` the run and the energy were both Pinocchio's: the
-items judged the integrator and Pinocchio's physics, which conserve Pinocchio's energy
-whatever the hand derivation says.  On ``compiled`` they are both the closed form's: the
-items judge the derivation's own consistency — a C that is not Christoffel-consistent with
-M, or an H that is not ∇V, makes the closed form gain or lose energy, and the drift or
-balance fails (``tests/test_fast_battery.py`` plants both).  That the closed form is the
-URDF's dynamics is what the core checks establish (ε-level, 2000 states).
+What the items judge.  On ``compiled`` the run and the energy are both the closed form's:
+the items judge the derivation's own consistency — a C that is not Christoffel-consistent
+with M, or an H that is not ∇V, makes the closed form gain or lose energy, and the drift or
+balance fails (``tests/test_fast_battery.py`` plants both).  On ``aba`` they are both
+Pinocchio's: the items judge the integrator and Pinocchio's physics, which conserve
+Pinocchio's energy whatever the hand derivation says.  That the closed form is the URDF's
+dynamics is what the core checks establish (ε-level, 2000 states).
 
-Cross-check, decided.  A full ABA run of the gravity scene as well would cost ≈ 0.15–0.3 s
-a set (measured on the two reference systems at the default settings, as much as the whole per-set budget)
-and would compare two chaotic trajectories, which separate for reasons that are not model
-errors.  Instead ``invariant:gravity:engines`` compares the compiled q̈ with Pinocchio's
-ABA on the URDF being certified at ``CROSS_CHECK_STATES`` of the gravity run's own
-accepted steps (evenly spread, first and last included), each state judged as the core
-``aba`` check judges one (``cross_check``): it ties the very trajectory the invariants
-judged — the generated code, not only the Python closed form the core checks read — to
-the URDF, for ≈ 3–5 ms a set.
+Cross-check.  ``invariant:gravity:engines`` compares the compiled q̈ with Pinocchio's ABA
+on the URDF being certified at ``CROSS_CHECK_STATES`` of the gravity run's own accepted
+steps (evenly spread, first and last included), each state judged as the core ``aba``
+check judges one (``cross_check``): it ties the very trajectory the invariants judged — the
+generated code, not only the Python closed form the core checks read — to the URDF, at the
+cost of a few ABA calls.  A full ABA run of the gravity scene would cost as much as the
+rest of a set's battery and would compare two chaotic trajectories, which separate for
+reasons that are not model errors.
 """
 
 from __future__ import annotations
@@ -51,7 +50,7 @@ BATTERY_ENGINES = {  # what may run a battery invariant item → its description
     COMPILED: "compiled DOP853 on the generated closed form",
     ABA: "scipy DOP853 on Pinocchio's ABA",
 }
-UNRECORDED = ABA  # the engine of an invariant item that records none (issued before the fast path)
+UNRECORDED = ABA  # the engine of an invariant item that records none
 CROSS_CHECK_STATES = 8
 
 
