@@ -49,9 +49,9 @@ from pendverify.certify.sweep_summary import SweepSummary
 from pendverify.certify.sweep_task import certify_chunk
 from pendverify.display import shortened
 from pendverify.errors import InputError, PendverifyError
-from pendverify.exitcodes import INTERRUPTED
+from pendverify.exitcodes import INTERRUPTED, TERMINATED
 from pendverify.progress import bar
-from pendverify.signals import TERMINATED, die_with_parent
+from pendverify.signals import die_with_parent
 
 STATUS = {signal.SIGINT: INTERRUPTED, signal.SIGTERM: TERMINATED}  # a stopping signal's exit status
 POLL_S = 0.2  # how often the run looks for an interruption

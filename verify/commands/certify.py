@@ -178,8 +178,7 @@ def _run_sweep(args) -> int:
     from pendverify.certify.sweep_output import SameFolder, certificates_in, prepare_output
     from pendverify.certify.sweep_run import Workers, run_sweep
     from pendverify.errors import PendverifyError
-    from pendverify.exitcodes import BAD_INPUT
-    from pendverify.signals import TERMINATED
+    from pendverify.exitcodes import BAD_INPUT, TERMINATED
 
     sweep = load_sweep(args.sweep, args.max_sets)
     check_sweep_names(sweep, args.sweep)
