@@ -180,11 +180,12 @@ def write_certificate(
     ``key`` if given): (the certificate, its path).
 
     The one way a certificate is made, for a set certified alone (``issue``) and for each
-    set of a sweep (``write_sweep_certificates``): the same set, URDF and settings give the
-    same certificate either way.  What differs between two runs is what each run is:
-    ``date`` (the time of certification), ``digest`` (which covers the date) and, when
-    signed, ``signature``'s key; a sweep's set is named by the sweep (the model's name
-    and the set's index), a set certified alone by its parameter file or URDF."""
+    set of a sweep (``write_sweep_certificates``): one set under one name, with its URDF
+    and settings, gets the same certificate either way, items, figures and notes included.
+    Only what is each run's own differs: ``date`` (the time of certification), ``digest``
+    (which covers it) and, when signed, ``signature``'s key.  (A sweep names its sets
+    itself, by the model's name and the set's index; a set certified alone is named by its
+    parameter file or URDF.)"""
     check_name(name, "<certify>", "name")
     keyid = fingerprint(key.public_key()) if key is not None else None
     cert = build_certificate(name, model, params, urdf, settings, battery, keyid=keyid)
