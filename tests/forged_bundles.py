@@ -10,7 +10,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from pendverify.certify.battery import BatteryItem, BatterySettings
+from pendverify.certify.battery import BatteryRun, BatterySettings
+from pendverify.certify.battery_item import BatteryItem
 from pendverify.certify.certificate import build_certificate, certificate_text, digest_of, summary_of
 from pendverify.certify.model_source import ModelSource, sha256_text
 from pendverify.certify.names import envelope_name
@@ -26,8 +27,9 @@ def make_certificate(name: str = "double_pendulum", key=None) -> dict:
     params = default_params("double_pendulum")
     items = [BatteryItem("check:crba", "check", 1e-15, 1e-9, 2, SETTINGS.seed, True, max_error=1e-15)]
     keyid = fingerprint(key.public_key()) if key is not None else None
+    battery = BatteryRun(items, notes=[])
     return build_certificate(
-        name, ModelSource("double_pendulum"), params, urdf_for(params), SETTINGS, items, keyid=keyid
+        name, ModelSource("double_pendulum"), params, urdf_for(params), SETTINGS, battery, keyid=keyid
     )
 
 

@@ -154,7 +154,9 @@ def test_example_robot_data_urdf_is_certified(tmp_path, capsys):
     assert main(["recheck", str(tmp_path / "erd_double_pendulum.cert.json")]) == 0
 
 
-def _certs(directory: Path) -> dict[str, dict]:
+def certificates_by_file(directory: Path) -> dict[str, dict]:
+    """File name → certificate of every certificate in ``directory``, without ``date`` and
+    ``digest`` (what differs between two runs on one set)."""
     out = {}
     for path in sorted(directory.glob("*.cert.json")):
         cert = json.loads(path.read_text())
@@ -190,7 +192,7 @@ def test_sweep_runs_locally_and_on_dask_alike(tmp_path, capsys):
             )
             == 0
         )
-    local_certs, remote_certs = _certs(local), _certs(remote)
+    local_certs, remote_certs = certificates_by_file(local), certificates_by_file(remote)
     assert len(local_certs) == 3
     assert local_certs == remote_certs
 

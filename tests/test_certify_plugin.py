@@ -11,7 +11,7 @@ import pytest
 from pendverify.certify.certificate import digest_of
 from pendverify.cli import main
 
-from .test_certify import _certs
+from .test_certify import certificates_by_file
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 FAST = ["--samples", "20"]
@@ -197,7 +197,7 @@ def test_sweep_over_a_model_file_locally_and_on_dask(tmp_path, capsys):
     local = tmp_path / "local"
     assert main(["certify", "--sweep", str(sweep), "-o", str(local), "--workers", "1"]) == 0
     assert "2 passed, 0 failed, 2 sets" in capsys.readouterr().out
-    certs = _certs(local)
+    certs = certificates_by_file(local)
     assert len(certs) == 2
     for name, cert in certs.items():
         assert cert["model_source"]["file"] == "hanging.py"
@@ -209,7 +209,7 @@ def test_sweep_over_a_model_file_locally_and_on_dask(tmp_path, capsys):
         remote = tmp_path / "dask"
         args = ["certify", "--sweep", str(sweep), "-o", str(remote), "--scheduler", cluster.scheduler_address]
         assert main(args) == 0
-    assert _certs(remote) == certs
+    assert certificates_by_file(remote) == certs
 
 
 def test_sweep_over_a_parameter_the_urdf_does_not_show_is_refused(tmp_path, capsys):

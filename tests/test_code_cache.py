@@ -274,7 +274,7 @@ def test_the_battery_stops_rather_than_change_engine_when_no_folder_can_be_writt
     monkeypatch.setattr(fast_scene, "compile_scene", unwritable)
     scene = type("Scene", (), {})()
     with pytest.raises(FileAccessError):
-        simulations._run(scene, "robot.urdf", None)
+        simulations.run_battery_scene(scene, "robot.urdf", None)
 
 
 # --- the Taylor reference cache ----------------------------------------------------------------------

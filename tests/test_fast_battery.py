@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 from pendverify.analytic import MODELS, DoublePendulum
-from pendverify.certify.battery import BatterySettings, invariant_items, run_battery
+from pendverify.certify.battery import BatteryRun, BatterySettings, run_battery
 from pendverify.certify.certificate import build_certificate, certificate_text, digest_of
 from pendverify.certify.issue import recheck
 from pendverify.certify.model_source import ModelSource
-from pendverify.certify.simulations import ABA, COMPILED, CROSS_CHECK_STATES
+from pendverify.certify.simulations import ABA, COMPILED, CROSS_CHECK_STATES, invariant_items
 from pendverify.numerics import fast_scene
 from pendverify.numerics.energies import GeneratedEnergies
 from pendverify.robot.writer import urdf_for
@@ -98,11 +98,11 @@ def test_a_planted_error_in_the_closed_form_fails_an_invariant_on_the_fast_path(
 
 
 def test_a_certificate_without_engines_is_rechecked_on_aba(tmp_path):
-    """Items issued before the fast path record no engine: recheck runs them on ABA, as they ran."""
+    """An invariant item that records no engine ran on ABA: recheck runs it there, as it ran."""
     cls, params = MODELS["double_pendulum"], default_params("double_pendulum")
     urdf = urdf_for(params)
-    items = run_battery(cls, params, urdf, SETTINGS, dict.fromkeys(EFFECTS, ABA))
-    cert = build_certificate("before", ModelSource("double_pendulum"), params, urdf, SETTINGS, items)
+    battery = run_battery(cls, params, urdf, SETTINGS, dict.fromkeys(EFFECTS, ABA))
+    cert = build_certificate("before", ModelSource("double_pendulum"), params, urdf, SETTINGS, battery)
     for item in cert["checks"]:
         item.pop("engine", None)
     cert["digest"]["value"] = digest_of(cert)
@@ -134,8 +134,8 @@ def test_an_unknown_engine_is_refused_by_the_schema(tmp_path):
     from pendverify.errors import CertificateError
 
     cls, params = MODELS["double_pendulum"], default_params("double_pendulum")
-    items = invariant_items(cls, params, urdf_for(params), SETTINGS)
-    cert = build_certificate("x", ModelSource("double_pendulum"), params, urdf_for(params), SETTINGS, items)
+    battery = BatteryRun(invariant_items(cls, params, urdf_for(params), SETTINGS), notes=[])
+    cert = build_certificate("x", ModelSource("double_pendulum"), params, urdf_for(params), SETTINGS, battery)
     check_schema(cert, "x.cert.json")
     cert["checks"][0]["engine"] = "euler"
     expected = r"checks\[0\]\.engine' = 'euler': expected one of compiled, aba"

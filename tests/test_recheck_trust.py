@@ -1,9 +1,8 @@
 """What recheck runs and when: embedded Python only when trusted; every check before the model.
 
-Each test plants the problem of issue 22 (items 1, 5, 6, 8, 9 and the exit-3 cases of
-14): a certificate whose embedded model writes a marker file at import, non-finite
-figures, another set's certificate under a bundle's name, subjects outside the
-bundle, settings out of bounds, malformed files.  Certificates are built by hand
+Each test plants one problem: a certificate whose embedded model writes a marker file at
+import, non-finite figures, another set's certificate under a bundle's name, subjects
+outside the bundle, settings out of bounds, malformed files.  Certificates are built by hand
 (``tests.forged_bundles``), so nothing here runs a battery.
 """
 

@@ -236,7 +236,7 @@ def test_a_sweep_task_never_draws_a_bar(tmp_path, monkeypatch):
     import tqdm
 
     from pendverify.certify.sweep import load_sweep
-    from pendverify.certify.sweep_task import certify_task
+    from pendverify.certify.sweep_task import certify_chunk
 
     bars = []
 
@@ -249,7 +249,7 @@ def test_a_sweep_task_never_draws_a_bar(tmp_path, monkeypatch):
     monkeypatch.setattr(sys.stderr, "isatty", lambda: True)
     sweep = load_sweep(_sweep(tmp_path, 1))
     name, values = sweep.sets[0]
-    certify_task(sweep.model, name, values, sweep.settings.as_dict())
+    certify_chunk(sweep.model, [(name, values)], sweep.settings.as_dict())
     assert bars and all(disabled for _, disabled in bars), bars
 
 
@@ -298,14 +298,14 @@ def test_an_error_mid_report_leaves_no_folder(tmp_path, monkeypatch):
         short_scene(scenes / f"{stem}.toml")
     calls = []
 
-    def failing_review(*args):
+    def failing_plot(*args):  # each scene's energy plot: Ctrl-C during the second scene
         calls.append(args)
         if len(calls) == 2:
             raise KeyboardInterrupt
         return real(*args)
 
-    real = review_folder._review
-    monkeypatch.setattr(review_folder, "_review", failing_review)
+    real = review_folder.energy_plot_svg
+    monkeypatch.setattr(review_folder, "energy_plot_svg", failing_plot)
     site = tmp_path / "site"
     site.mkdir()
     out = site / "review"
@@ -314,7 +314,7 @@ def test_an_error_mid_report_leaves_no_folder(tmp_path, monkeypatch):
     assert len(calls) == 2 and list(site.iterdir()) == []
     out.mkdir()
     (out / "old.txt").write_text("old")
-    monkeypatch.setattr(review_folder, "_review", real)
+    monkeypatch.setattr(review_folder, "energy_plot_svg", real)
     assert main(["report", "-o", str(out), "--scenes", str(scenes), "--samples", "5", "--no-erd"]) == 2
     assert (out / "old.txt").exists()
     args = ["report", "-o", str(out), "--scenes", str(scenes), "--samples", "5", "--no-erd", "--force"]

@@ -13,9 +13,12 @@ import numpy as np
 import pytest
 
 from pendverify.certify import sweep_run
+from pendverify.certify.battery import BatteryRun
+from pendverify.certify.battery_item import BatteryItem
 from pendverify.certify.sweep import load_sweep
 from pendverify.certify.sweep_run import MAX_CHUNK, chunk_size, run_sweep
 from pendverify.certify.sweep_summary import FAILURES_SHOWN, SweepSummary
+from pendverify.certify.sweep_task import SetResult
 
 SWEEP = """
 model = "double_pendulum"
@@ -86,8 +89,8 @@ def _fake_chunk(model, sets, settings, base_urdf, base_values):
     out = []
     for name, values in sets:
         k = int(name.rsplit("-", 1)[1])
-        item = {"name": "check:x", "error": float(k % 10), "tolerance": 10.0, "passed": k % 7 != 3}
-        out.append({"name": name, "values": values, "error": None, "items": [item]})
+        item = BatteryItem("check:x", "check", float(k % 10), 10.0, 1, 0, k % 7 != 3)
+        out.append(SetResult(name, values, BatteryRun([item], notes=[])))
     return out
 
 
@@ -102,7 +105,7 @@ def test_sets_results_and_tasks_in_flight_are_bounded(tmp_path, monkeypatch, cou
 
     def write(result, replace):
         nonlocal most_held
-        written.append(result["name"])
+        written.append(result.name)
         most_held = max(most_held, counted.made - len(written))  # made, not yet written and dropped
         return 1
 
@@ -122,7 +125,7 @@ def test_resumed_sets_are_never_made_into_tasks(tmp_path, monkeypatch):
     sweep = _load(tmp_path, 50)
     done = {name for name, _ in sweep.sets[:30]}
     written = []
-    run = run_sweep(sweep, ThreadWorkers(2), lambda r, replace: written.append(r["name"]) or 1, skip=done)
+    run = run_sweep(sweep, ThreadWorkers(2), lambda r, replace: written.append(r.name) or 1, skip=done)
     assert run.skipped == 30 and run.written == 20 and not set(written) & done
 
 
@@ -147,9 +150,9 @@ def test_chunks_are_small_enough_to_share_the_work():
     assert chunk_size(0, 2) == 1
 
 
-def _result(k: int, passed: bool, ratio: float) -> dict:
-    item = {"name": "check:x", "error": ratio, "tolerance": 1.0, "passed": passed}
-    return {"name": f"m-{k:03d}", "values": {}, "error": None, "items": [item]}
+def _result(k: int, passed: bool, ratio: float) -> SetResult:
+    item = BatteryItem("check:x", "check", ratio, 1.0, 1, 0, passed)
+    return SetResult(f"m-{k:03d}", {}, BatteryRun([item], notes=[]))
 
 
 def test_the_summary_does_not_depend_on_the_order_results_arrive_in():

@@ -136,7 +136,7 @@ def test_certificates_removed_mid_sweep_are_not_counted(tmp_path, monkeypatch, c
 
     def write_then_lose_the_first(sweep, results, output, *args):
         n = real(sweep, results, output, *args)
-        written.extend(r["name"] for r in results)
+        written.extend(r.name for r in results)
         if len(written) == 2:
             (Path(output) / f"{written[0]}.cert.json").unlink()
         return n

@@ -24,14 +24,15 @@ import traceback
 
 from pendverify.analytic.plugin import user_code_error
 from pendverify.errors import PendverifyError
-from pendverify.signals import TERMINATED, Terminated
+from pendverify.signals import Terminated
 
 PASSED = 0
 FAILED = 1
 BAD_INPUT = 2
 INTERNAL_ERROR = 3
-INTERRUPTED = 130
-PIPE_CLOSED = 141
+INTERRUPTED = 130  # 128 + SIGINT
+PIPE_CLOSED = 141  # 128 + SIGPIPE
+TERMINATED = 143  # 128 + SIGTERM
 
 REPORT_BUGS = (
     "this is a bug in pendverify, not in your input: please report it on the project's issues "

@@ -22,7 +22,6 @@ import sys
 import threading
 from contextlib import contextmanager
 
-TERMINATED = 143  # 128 + SIGTERM
 WATCH_S = 0.5  # how often a worker without prctl looks for its parent
 _PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
 

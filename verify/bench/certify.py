@@ -33,11 +33,11 @@ from pendverify.analytic.params import default_parameter_file
 from pendverify.certify.battery import (
     BatterySettings,
     check_items,
-    invariant_items,
     run_battery,
     stress_items,
 )
 from pendverify.certify.issue import certification_input
+from pendverify.certify.simulations import invariant_items
 from pendverify.checks.batch import recording_batches
 from pendverify.checks.closed_forms import ClosedForms
 from pendverify.robot.batch import configurations

@@ -26,6 +26,8 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
+from pendverify.certify.battery_item import BatteryItem
+from pendverify.certify.simulations import invariant_items
 from pendverify.checks.sampling import sample_states
 from pendverify.checks.verdict import REFUSED
 from pendverify.checks.verification import guarded_checks
@@ -46,38 +48,17 @@ class BatterySettings:
 
 
 @dataclass(frozen=True)
-class BatteryItem:
-    """One battery item's evidence: the worst error/tolerance ratio and, apart, the largest error.
+class BatteryRun:
+    """The battery's evidence on one set: every item, and what reading the URDF being
+    certified noticed (``PinocchioSystem.notes``), which its certificate records as ``notes``."""
 
-    ``error`` and ``tolerance`` are relative (as in the tables) and belong to the same
-    state or step, ``at``: the one with the worst ratio, which decides ``passed``.
-    ``max_error`` is the largest error over the item, at ``max_error_at`` (checks and
-    invariants); the stress cases keep only their worst ratio, so it is None there.
-    """
-
-    name: str
-    kind: str  # check | stress | invariant
-    error: float
-    tolerance: float
-    samples: int
-    seed: int
-    passed: bool
-    detail: str = ""
-    at: str = ""
-    max_error: float | None = None
-    max_error_at: str = ""
-    engine: str = ""  # invariant items: what ran the simulation (pendverify.certify.simulations)
-
-    def as_dict(self) -> dict:
-        record = asdict(self)
-        if not record["engine"]:
-            del record["engine"]  # checks and stress cases run no simulation
-        return record
+    items: list[BatteryItem]
+    notes: list[str]
 
     @property
-    def margin(self) -> float:
-        """error / tolerance: below 1 passes."""
-        return self.error / self.tolerance if self.tolerance > 0 else float("inf")
+    def passed(self) -> bool:
+        """Whether every item passed."""
+        return all(i.passed for i in self.items)
 
 
 def check_items(model, system, settings: BatterySettings) -> list[BatteryItem]:
@@ -98,17 +79,6 @@ def check_items(model, system, settings: BatterySettings) -> list[BatteryItem]:
         )
         for r in guarded_checks(model.name, model, system, states, settings.seed)[0]
     ]
-
-
-def invariant_items(
-    model_cls, params, urdf: str, settings: BatterySettings, engines=None, system=None
-) -> list[BatteryItem]:
-    """One simulation per effect the model has (``pendverify.certify.scenes``), on the fast path
-    where it compiles, else ABA on ``urdf``; ``engines``: effect → engine, as a certificate
-    records them (``pendverify.certify.simulations``)."""
-    from pendverify.certify import simulations
-
-    return simulations.invariant_items(model_cls, params, urdf, settings, engines, system)
 
 
 def stress_items(
@@ -164,8 +134,9 @@ def model_class(model) -> type[ClosedFormModel]:
 
 def run_battery(
     model, params: ParameterSet, urdf: str, settings: BatterySettings, engines: dict | None = None
-) -> list[BatteryItem]:
-    """The battery for a model (a class, or a built-in model's name), its parameters and URDF.
+) -> BatteryRun:
+    """The battery for a model (a class, or a built-in model's name), its parameters and URDF:
+    its items, and the notes of the URDF read once for all of them.
 
     ``engines``: effect → the engine its invariant items ran on (``recheck``: the certificate's)."""
     cls = model_class(model)
@@ -181,4 +152,4 @@ def run_battery(
         for part in parts:
             items += part()
             progress.update(1)
-    return items
+    return BatteryRun(items, system.notes)

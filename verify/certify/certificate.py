@@ -29,7 +29,7 @@ checks             every battery item: name, kind (check | stress | invariant);
                    samples, seed, passed, detail; invariant items also engine
                    (compiled | aba: what ran the simulation,
                    ``pendverify.certify.simulations``; an invariant item without one
-                   ran on aba, as every item issued before the key existed)
+                   ran on aba)
 summary            derived from ``checks``: items, passed, failed (names),
                    result (PASSED | FAILED), worst_item, worst_ratio
 notes              what the URDF reader noticed (angle offsets, a centre of mass
@@ -59,7 +59,8 @@ import math
 from datetime import datetime, timezone
 
 from pendverify.analytic import ParameterSet
-from pendverify.certify.battery import BatteryItem, BatterySettings
+from pendverify.certify.battery import BatteryRun, BatterySettings
+from pendverify.certify.battery_item import BatteryItem
 from pendverify.certify.model_source import ModelSource, source_problem
 from pendverify.certify.names import envelope_name
 from pendverify.certify.simulations import UNRECORDED
@@ -120,13 +121,13 @@ def build_certificate(
     params: ParameterSet,
     urdf: str,
     settings: BatterySettings,
-    items: list[BatteryItem],
+    battery: BatteryRun,
     date: datetime | None = None,
-    notes: list[str] | None = None,
     keyid: str | None = None,
 ) -> dict:
-    """The certificate; with ``keyid`` (the signing key's fingerprint) it names its envelope."""
-    checks = [item.as_dict() for item in items]
+    """The certificate of a set and its battery's evidence (items and notes, made dicts here,
+    once); with ``keyid`` (the signing key's fingerprint) it names its envelope."""
+    checks = [item.as_dict() for item in battery.items]
     cert = {
         "schema": SCHEMA,
         "name": name,
@@ -139,7 +140,7 @@ def build_certificate(
         "versions": versions(),
         "checks": checks,
         "summary": summary_of(checks),
-        "notes": list(notes or []),
+        "notes": list(battery.notes),
         "date": (date or datetime.now(timezone.utc)).isoformat(timespec="seconds"),
     }
     if keyid is not None:

@@ -23,7 +23,8 @@ from pathlib import Path
 from pendverify.analytic import ParameterSet
 from pendverify.analytic.params import load_parameter_file
 from pendverify.analytic.plugin import plugin_parameters
-from pendverify.certify.battery import BatteryItem, BatterySettings, run_battery
+from pendverify.certify.battery import BatteryRun, BatterySettings, run_battery
+from pendverify.certify.battery_item import BatteryItem
 from pendverify.certify.bundle import check_files_beside, refuse_existing, verify_signature, write_bundle
 from pendverify.certify.certificate import build_certificate, compare_items, derived_constants, verify_digest
 from pendverify.certify.model_source import ModelSource
@@ -32,6 +33,7 @@ from pendverify.certify.reading import read_certificate
 from pendverify.certify.schema import check_derived, check_schema
 from pendverify.certify.signing import fingerprint
 from pendverify.certify.simulations import recorded_engines
+from pendverify.certify.sweep_task import SetResult
 from pendverify.display import listed, shortened
 from pendverify.errors import CertificateError, ParameterError, PendverifyError
 from pendverify.robot.description import load_description
@@ -154,33 +156,54 @@ def issue(
     ``key`` (an Ed25519 private key, ``signing.load_private_key``) signs the certificate."""
     check_name(target.name, "<certify>", "name")
     refuse_existing(output, target.name, force)
-    cls = target.model.load()
-    items = run_battery(cls, target.params, target.urdf, settings)
-    if not all(i.passed for i in items):
-        return Issued(items)
-    notes = PinocchioSystem.for_model(cls, target.urdf, target.params.g).notes
-    keyid = fingerprint(key.public_key()) if key is not None else None
-    cert = build_certificate(
-        target.name, target.model, target.params, target.urdf, settings, items, notes=notes, keyid=keyid
+    battery = run_battery(target.model.load(), target.params, target.urdf, settings)
+    if not battery.passed:
+        return Issued(battery.items)
+    cert, path = write_certificate(
+        target.name, target.model, target.params, target.urdf, settings, battery, output, force, key
     )
-    path = write_bundle(output, target.name, target.params, target.urdf, cert, force, target.model, key)
-    return Issued(items, cert, path)
+    return Issued(battery.items, cert, path)
 
 
-def write_sweep_certificates(sweep, results, output, force: bool = False, key=None) -> int:
+def write_certificate(
+    name: str,
+    model: ModelSource,
+    params: ParameterSet,
+    urdf: str,
+    settings: BatterySettings,
+    battery: BatteryRun,
+    output,
+    force: bool = False,
+    key=None,
+) -> tuple[dict, Path]:
+    """Build the certificate of a set whose battery passed and write its bundle (signed by
+    ``key`` if given): (the certificate, its path).
+
+    The one way a certificate is made, for a set certified alone (``issue``) and for each
+    set of a sweep (``write_sweep_certificates``): one set under one name, with its URDF
+    and settings, gets the same certificate either way, items, figures and notes included.
+    Only what is each run's own differs: ``date`` (the time of certification), ``digest``
+    (which covers it) and, when signed, ``signature``'s key.  (A sweep names its sets
+    itself, by the model's name and the set's index; a set certified alone is named by its
+    parameter file or URDF.)"""
+    check_name(name, "<certify>", "name")
+    keyid = fingerprint(key.public_key()) if key is not None else None
+    cert = build_certificate(name, model, params, urdf, settings, battery, keyid=keyid)
+    path = write_bundle(output, name, params, urdf, cert, force, model, key)
+    return cert, path
+
+
+def write_sweep_certificates(sweep, results: list[SetResult], output, force: bool = False, key=None) -> int:
     """Write the bundle of every set of a finished sweep whose battery passed (each signed by
     ``key`` if given); return how many."""
     written = 0
-    keyid = fingerprint(key.public_key()) if key is not None else None
     params_type = sweep.model.load().params_type
     for r in results:
-        if r["error"] is None and all(i["passed"] for i in r["items"]):
-            params = params_type.from_mapping(r["values"])
-            items = [BatteryItem(**i) for i in r["items"]]
-            settings = BatterySettings(**sweep.settings.as_dict())
-            check_name(r["name"], "<sweep>", "set name")
-            cert = build_certificate(r["name"], sweep.model, params, r["urdf"], settings, items, keyid=keyid)
-            write_bundle(output, r["name"], params, r["urdf"], cert, force, sweep.model, key)
+        if r.passed:
+            params = params_type.from_mapping(r.values)
+            write_certificate(
+                r.name, sweep.model, params, r.urdf, sweep.settings, r.battery, output, force, key
+            )
             written += 1
     return written
 
@@ -232,5 +255,5 @@ def recheck(path: str, trust: str | None = None, run_embedded_code: bool = False
     check_derived(cert, derived_constants(source, params), path)
     settings = BatterySettings(**cert["settings"])
     engines = recorded_engines(cert["checks"])  # each invariant item on the engine it ran on
-    items = run_battery(cls, params, cert["urdf"]["text"], settings, engines)
+    items = run_battery(cls, params, cert["urdf"]["text"], settings, engines).items
     return Rechecked(cert, items, compare_items(cert["checks"], items), signature)

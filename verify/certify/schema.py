@@ -17,7 +17,7 @@ from pendverify.certify.certificate import OLD_SCHEMAS, SCHEMA, figures_agree, s
 from pendverify.certify.model_source import MODEL_FILE_RULE, model_file_problem
 from pendverify.certify.names import check_name
 from pendverify.certify.settings_rules import settings_problem
-from pendverify.certify.simulations import ENGINES
+from pendverify.certify.simulations import BATTERY_ENGINES
 from pendverify.errors import CertificateError, PendverifyError
 
 NONFINITE = ("inf", "-inf", "nan")  # how pendverify.jsonio writes non-finite numbers
@@ -123,7 +123,11 @@ ITEM = {
     "seed": (True, _integer, "an integer"),
     "passed": (True, lambda v: isinstance(v, bool), "true or false"),
     "detail": (True, _string, "a string"),
-    "engine": (False, lambda v: v in ENGINES, f"one of {', '.join(ENGINES)} (invariant items)"),
+    "engine": (
+        False,
+        lambda v: v in BATTERY_ENGINES,
+        f"one of {', '.join(BATTERY_ENGINES)} (invariant items)",
+    ),
 }
 
 

@@ -260,11 +260,3 @@ def statement_subjects(stmt: dict, source: str) -> dict[str, str]:
     if not isinstance(predicate.get("configuration"), list):
         raise bad("predicate.configuration", predicate.get("configuration"), "expected a list")
     return found
-
-
-def signer_keyids(text: str) -> list[str]:
-    """The keyids an envelope names (unverified), for messages; [] if it cannot be read."""
-    try:
-        return [s["keyid"] for s in json.loads(text)["signatures"]]
-    except (ValueError, KeyError, TypeError, RecursionError):
-        return []

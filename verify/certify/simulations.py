@@ -1,6 +1,6 @@
 """The battery's invariant items: one short run per effect (``pendverify.certify.scenes``), on the fast path.
 
-Engines, recorded in each invariant item's ``engine``:
+Engines, recorded in each invariant item's ``engine`` (``BATTERY_ENGINES``):
 
 * ``compiled`` — the compiled DOP853 on the model's generated closed form
   (``pendverify.numerics.fast_scene``), the invariants evaluated on its own accepted steps
@@ -11,29 +11,28 @@ Engines, recorded in each invariant item's ``engine``:
   never because of the code cache: one that cannot be used is replaced by a temporary
   folder, and when no folder can be written the battery stops with that one line;
 * ``aba`` — scipy's DOP853 on Pinocchio's ABA on the URDF being certified, with
-  Pinocchio's energy (``pendverify.simulation.simulate``): the engine of every invariant
-  item issued before the fast path, so an item that records no engine ran on it.
+  Pinocchio's energy (``pendverify.simulation.simulate``).  An invariant item that records
+  no engine ran on it (``UNRECORDED``).
 
 ``recheck`` runs each item on the engine its certificate records, so it reproduces the
-figures of certificates from before as well as after.
+figures of an item whatever engine ran it.
 
-What changed in meaning.  On ``aba`` the run and the energy were both Pinocchio's: the
-items judged the integrator and Pinocchio's physics, which conserve Pinocchio's energy
-whatever the hand derivation says.  On ``compiled`` they are both the closed form's: the
-items judge the derivation's own consistency — a C that is not Christoffel-consistent with
-M, or an H that is not ∇V, makes the closed form gain or lose energy, and the drift or
-balance fails (``tests/test_fast_battery.py`` plants both).  That the closed form is the
-URDF's dynamics is what the core checks establish (ε-level, 2000 states).
+What the items judge.  On ``compiled`` the run and the energy are both the closed form's:
+the items judge the derivation's own consistency — a C that is not Christoffel-consistent
+with M, or an H that is not ∇V, makes the closed form gain or lose energy, and the drift or
+balance fails (``tests/test_fast_battery.py`` plants both).  On ``aba`` they are both
+Pinocchio's: the items judge the integrator and Pinocchio's physics, which conserve
+Pinocchio's energy whatever the hand derivation says.  That the closed form is the URDF's
+dynamics is what the core checks establish (ε-level, 2000 states).
 
-Cross-check, decided.  A full ABA run of the gravity scene as well would cost ≈ 0.15–0.3 s
-a set (measured on the two reference systems at the default settings, as much as the whole per-set budget)
-and would compare two chaotic trajectories, which separate for reasons that are not model
-errors.  Instead ``invariant:gravity:engines`` compares the compiled q̈ with Pinocchio's
-ABA on the URDF being certified at ``CROSS_CHECK_STATES`` of the gravity run's own
-accepted steps (evenly spread, first and last included), each state judged as the core
-``aba`` check judges one (``cross_check``): it ties the very trajectory the invariants
-judged — the generated code, not only the Python closed form the core checks read — to
-the URDF, for ≈ 3–5 ms a set.
+Cross-check.  ``invariant:gravity:engines`` compares the compiled q̈ with Pinocchio's ABA
+on the URDF being certified at ``CROSS_CHECK_STATES`` of the gravity run's own accepted
+steps (evenly spread, first and last included), each state judged as the core ``aba``
+check judges one (``cross_check``): it ties the very trajectory the invariants judged — the
+generated code, not only the Python closed form the core checks read — to the URDF, at the
+cost of a few ABA calls.  A full ABA run of the gravity scene would cost as much as the
+rest of a set's battery and would compare two chaotic trajectories, which separate for
+reasons that are not model errors.
 """
 
 from __future__ import annotations
@@ -42,15 +41,16 @@ from dataclasses import replace
 
 import numpy as np
 
+from pendverify.certify.battery_item import BatteryItem
 from pendverify.certify.scenes import effect_scenes
 from pendverify.errors import FastPathError, FileAccessError, PendverifyError
 
 COMPILED, ABA = "compiled", "aba"
-ENGINES = {
+BATTERY_ENGINES = {  # what may run a battery invariant item → its description in the item
     COMPILED: "compiled DOP853 on the generated closed form",
     ABA: "scipy DOP853 on Pinocchio's ABA",
 }
-UNRECORDED = ABA  # the engine of an invariant item that records none (issued before the fast path)
+UNRECORDED = ABA  # the engine of an invariant item that records none
 CROSS_CHECK_STATES = 8
 
 
@@ -66,7 +66,7 @@ def invariant_items(model_cls, params, urdf: str, settings, engines=None, system
     scenes = effect_scenes(model_cls, params, settings.sim_duration, settings.sim_rtol, settings.seed)
     for effect, doc in scenes.items():
         scene = parse_scene(doc, f"<battery {effect}>")
-        engine, run, steps, failure = _run(scene, urdf, (engines or {}).get(effect))
+        engine, run, steps, failure = run_battery_scene(scene, urdf, (engines or {}).get(effect))
         if run is None:  # a run that diverges or dies is a failed item, not a crash of the battery
             items.append(_item(f"invariant:{effect}", None, 0, settings, engine, failure))
             continue
@@ -88,14 +88,15 @@ def invariant_items(model_cls, params, urdf: str, settings, engines=None, system
     return items
 
 
-def _run(scene, urdf: str, engine: str | None):
+def run_battery_scene(scene, urdf: str, engine: str | None):
     """(engine, run or None, accepted steps, why it failed): on the fast path unless ``engine`` says aba
     or (``engine`` None) the scene does not compile."""
     from pendverify.numerics import fast_scene
     from pendverify.simulation.simulate import run_scene
 
-    if engine not in (None, *ENGINES):
-        return engine, None, 0, f"unknown battery engine {engine!r}; expected one of {', '.join(ENGINES)}"
+    if engine not in (None, *BATTERY_ENGINES):
+        expected = ", ".join(BATTERY_ENGINES)
+        return engine, None, 0, f"unknown battery engine {engine!r}; expected one of {expected}"
     compiled = None
     if engine in (None, COMPILED):
         try:
@@ -118,62 +119,56 @@ def _run(scene, urdf: str, engine: str | None):
         return (ABA if compiled is None else COMPILED), None, 0, str(exc)
 
 
-class _CompiledModel:
-    """The closed-form model with q̈ from its generated code (friction and inputs included)."""
+def compiled_accelerations(model, states) -> np.ndarray:
+    """q̈ from the model's generated code (friction and inputs included) at each state (no disturbance)."""
+    from pendverify.numerics.generate import GeneratedSystem
 
-    def __init__(self, model):
-        from pendverify.numerics.generate import GeneratedSystem
-
-        self._model = model
-        self._compiled = GeneratedSystem.from_model(model, D=model.damping_matrix(), B=model.input_matrix())
-
-    def __getattr__(self, name):
-        return getattr(self._model, name)
-
-    def acceleration(self, q, v, u, w):
-        if np.any(w):  # the gravity run's states have none
+    compiled = GeneratedSystem.from_model(model, D=model.damping_matrix(), B=model.input_matrix())
+    out = np.empty((len(states), model.nv))
+    for i, s in enumerate(states):
+        if np.any(s.w):  # the gravity run's states have none
             raise ValueError("the compiled cross-check takes states without disturbance")
-        compiled = replace(self._compiled, u0=np.asarray(u, float).reshape(-1))
-        return compiled.rhs(np.concatenate([q, v]))[self._model.nv :]
+        at = replace(compiled, u0=np.asarray(s.u, float).reshape(-1))
+        out[i] = at.rhs(np.concatenate([s.q, s.v]))[model.nv :]
+    return out
 
 
 def cross_check(run, system):
     """The compiled q̈ against ABA on ``system`` at ``CROSS_CHECK_STATES`` of the run's accepted steps.
 
-    Each state is judged as the core ``aba`` check judges one (``pendverify.checks``: its
+    The states are judged by the core ``aba`` check itself (``pendverify.checks``: its
     quantity, scale, K, c_T, world-frame amplification A and model-form allowance), with
-    the generated code in place of the hand-written q̈; a state beyond the trust limit fails.
+    the generated code's q̈ in place of the hand-written one; a state beyond the trust
+    limit fails.
     """
-    from pendverify.checks.batch import world_lever
+    from pendverify.checks.batch import CheckBatch
     from pendverify.checks.catalogue import CHECKS
-    from pendverify.checks.quantities import aba
+    from pendverify.checks.judge import collect
     from pendverify.checks.sampling import State
-    from pendverify.checks.trust import EPS, REFUSE_REL
     from pendverify.simulation.invariants import figures_of
 
     steps_t, steps_x = run.result.steps_t, run.result.steps_x
     rows = np.unique(np.linspace(0, len(steps_t) - 1, CROSS_CHECK_STATES).round().astype(int))
-    model = _CompiledModel(run.dynamics.model)
-    n, K, c_T = model.nv, next(c.K for c in CHECKS if c.name == "aba"), system.cmap.amplification
-    zeros = (np.zeros(len(model.inputs)), np.zeros(len(model.disturbances)))
-    errors, tolerances = [], []
-    for t, x in zip(steps_t[rows], steps_x[rows], strict=True):
-        state = State(f"t = {t:.6g} s", x[:n], x[n : 2 * n], *zeros)
-        angle = float(np.max(np.abs(state.q[np.array(model.angular)]), initial=0.0))
-        rounding = K * EPS * ((1.0 + angle) * c_T + (world_lever(model, system, state.q) - 1.0))
-        sample = aba(model, system, state)
-        refused = not rounding <= REFUSE_REL
-        errors.append(np.inf if refused else sample.error / sample.scale)
-        tolerances.append(rounding + sample.allowance / sample.scale)
+    model = run.dynamics.model
+    n, zeros = model.nv, (np.zeros(len(model.inputs)), np.zeros(len(model.disturbances)))
+    states = [
+        State(f"t = {t:.6g} s", x[:n], x[n : 2 * n], *zeros)
+        for t, x in zip(steps_t[rows], steps_x[rows], strict=True)
+    ]
+    replaced = {"acceleration": compiled_accelerations(model, states)}
+    aba = next(c for c in CHECKS if c.name == "aba")
+    evidence = collect(aba, CheckBatch(model, system, states, replaced=replaced))
+    errors, tolerances = np.full(len(states), np.inf), np.full(len(states), np.nan)
+    errors[evidence.judged], tolerances[evidence.judged] = evidence.rel_err, evidence.rel_tol
+    for i, rounding in evidence.refused:
+        tolerances[i] = rounding
     name = f"engines agree: compiled q̈ vs ABA on the URDF at {len(rows)} of the run's {len(steps_t)} states"
-    result = figures_of(name, np.array(errors), np.array(tolerances), steps_t[rows], 1.0, "as the aba check")
+    result = figures_of(name, errors, tolerances, steps_t[rows], 1.0, "as the aba check")
     return replace(result, scale=float("nan"))  # each state's error is relative to its own scale
 
 
 def _item(name: str, inv, samples: int, settings, engine: str, failure: str = ""):
     """A battery item from an ``InvariantResult`` (or a failed run's message, ``inv`` None)."""
-    from pendverify.certify.battery import BatteryItem
-
     if inv is None:
         return BatteryItem(
             name, "invariant", np.inf, 0.0, 0, settings.seed, False, failure, max_error=np.inf, engine=engine
@@ -186,7 +181,7 @@ def _item(name: str, inv, samples: int, settings, engine: str, failure: str = ""
         samples,
         settings.seed,
         inv.passed,
-        f"{inv.name} [{ENGINES[engine]}]",
+        f"{inv.name} [{BATTERY_ENGINES[engine]}]",
         at=f"t = {inv.worst_t:.6g} s",
         max_error=inv.max_error,
         max_error_at=f"t = {inv.max_error_t:.6g} s",

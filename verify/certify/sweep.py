@@ -44,6 +44,7 @@ from pendverify.analytic.plugin import plugin_parameters
 from pendverify.certify.battery import BatterySettings
 from pendverify.certify.model_source import ModelSource
 from pendverify.certify.settings_rules import settings_problem
+from pendverify.certify.sweep_limits import DEFAULT_MAX_SETS
 from pendverify.errors import PendverifyError, SweepError
 from pendverify.robot.description import urdf_text
 from pendverify.robot.rebind import Binding
@@ -87,9 +88,6 @@ def _range(source, key, value):
     if isinstance(points, bool) or not isinstance(points, int) or points < 1:
         raise SweepError(source, f"ranges.{key}.points", points, "expected an integer >= 1")
     return float(spec["min"]), float(spec["max"]), scale, points
-
-
-DEFAULT_MAX_SETS = 100_000  # --max-sets raises it
 
 
 def _count(source, mode: str, count: int, specs: dict, max_sets: int) -> int:

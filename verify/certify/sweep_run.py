@@ -44,20 +44,20 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 
 from pendverify.certify.sweep import Sweep
+from pendverify.certify.sweep_limits import WORKER_TIMEOUT_S
 from pendverify.certify.sweep_summary import SweepSummary
 from pendverify.certify.sweep_task import certify_chunk
 from pendverify.display import shortened
 from pendverify.errors import InputError, PendverifyError
+from pendverify.exitcodes import INTERRUPTED, TERMINATED
 from pendverify.progress import bar
-from pendverify.signals import TERMINATED, die_with_parent
+from pendverify.signals import die_with_parent
 
-INTERRUPTED = 130  # 128 + SIGINT
 STATUS = {signal.SIGINT: INTERRUPTED, signal.SIGTERM: TERMINATED}  # a stopping signal's exit status
 POLL_S = 0.2  # how often the run looks for an interruption
 MAX_CHUNK = 8  # sets per task at most: a chunk's results arrive together
 CHUNKS_PER_WORKER = 4  # smaller chunks below this many per worker, so the workers finish together
 SCHEDULER_SCHEMES = ("tcp", "tls", "ws", "wss")  # Dask's comms that need no extra package
-WORKER_TIMEOUT_S = 60.0  # a Dask cluster without a worker this long stops the sweep (--worker-timeout)
 WORKER_CHECK_S = 1.0  # how often the run asks the Dask scheduler how many workers it has
 
 
@@ -316,7 +316,7 @@ def run_sweep(
                     for result in results:
                         run.summary.add(result)
                         with interrupts.writing():
-                            run.written += write(result, result["name"] in replace)
+                            run.written += write(result, result.name in replace)
                         progress.update(1)
                 if run.lost:
                     break

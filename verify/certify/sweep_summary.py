@@ -13,6 +13,8 @@ import heapq
 import re
 from dataclasses import dataclass, field
 
+from pendverify.certify.sweep_task import SetResult
+
 FAILURES_SHOWN = 20
 _INDEX = re.compile(r"-(\d+)$")  # a set's name ends with its index in the sweep
 
@@ -33,19 +35,17 @@ class SweepSummary:
     def failed(self) -> int:
         return self.sets - self.passed
 
-    def add(self, result: dict) -> None:
+    def add(self, result: SetResult) -> None:
         self.sets += 1
-        ok = result["error"] is None and all(i["passed"] for i in result["items"])
-        self.passed += ok
-        index = _index(result["name"])
-        for item in result["items"]:
-            ratio = item["error"] / item["tolerance"] if item["tolerance"] > 0 else float("inf")
-            entry = (ratio, -index, result["name"])
-            if item["name"] not in self.worst or entry > self.worst[item["name"]]:
-                self.worst[item["name"]] = entry
-        if not ok:
-            reason = result["error"] or ", ".join(i["name"] for i in result["items"] if not i["passed"])
-            heapq.heappush(self._failures, (-index, result["name"], reason))
+        self.passed += result.passed
+        index = _index(result.name)
+        for item in result.items:
+            entry = (item.margin, -index, result.name)
+            if item.name not in self.worst or entry > self.worst[item.name]:
+                self.worst[item.name] = entry
+        if not result.passed:
+            reason = result.error or ", ".join(i.name for i in result.items if not i.passed)
+            heapq.heappush(self._failures, (-index, result.name, reason))
             if len(self._failures) > FAILURES_SHOWN:
                 heapq.heappop(self._failures)  # the latest in the sweep
 

@@ -54,12 +54,15 @@ def recording_batches():
 class CheckBatch:
     """``model`` and ``system`` at ``states``: the quantities of every check, once for all states."""
 
-    def __init__(self, model, system, states, pinocchio_angles=None, python_only: bool = False):
+    def __init__(
+        self, model, system, states, pinocchio_angles=None, python_only: bool = False, replaced=None
+    ):
         if not states:
             raise ValueError("a batch needs at least one state")
         self.model, self.system, self.states = model, system, list(states)
         self.pinocchio_angles = pinocchio_angles
         self.python_only = python_only
+        self.replaced = replaced or {}
         self.Q = _rows(states, "q", model.nv)
         self.V = _rows(states, "v", model.nv)
         self.U = _rows(states, "u", None)
@@ -78,7 +81,9 @@ class CheckBatch:
 
     @cached_property
     def forms(self) -> ClosedForms:
-        return ClosedForms(self.model, self.Q, self.V, self.U, self.W, self.python_only)
+        forms = ClosedForms(self.model, self.Q, self.V, self.U, self.W, self.python_only)
+        forms.replace(self.replaced)
+        return forms
 
     @cached_property
     def pin(self) -> PinocchioBatch:

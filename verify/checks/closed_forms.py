@@ -65,6 +65,11 @@ class ClosedForms:
             self._constants[key] = getattr(self.model, name)(*args)
         return self._constants[key]
 
+    def replace(self, values: dict[str, np.ndarray]) -> None:
+        """Method ``name``'s values at every state are ``values[name]`` (computed elsewhere)."""
+        for name, value in values.items():
+            self._values[name] = np.asarray(value, dtype=float)
+
     # --- how ----------------------------------------------------------------------------
     def _evaluate(self, name: str) -> np.ndarray:
         if name in self.written:

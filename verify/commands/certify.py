@@ -6,6 +6,7 @@ import argparse
 
 from pendverify.atomic import check_output, check_report_output
 from pendverify.certify.settings_rules import samples_option, seed_option
+from pendverify.certify.sweep_limits import DEFAULT_MAX_SETS, WORKER_TIMEOUT_S
 from pendverify.commands import (
     add_analytic_option,
     add_command,
@@ -14,9 +15,6 @@ from pendverify.commands import (
     refuse_together,
     write_json_report,
 )
-
-DEFAULT_MAX_SETS = 100_000  # pendverify.certify.sweep.DEFAULT_MAX_SETS, without importing NumPy here
-WORKER_TIMEOUT_S = 60.0  # pendverify.certify.sweep_run.WORKER_TIMEOUT_S, without importing it here
 
 
 def register(sub) -> None:
@@ -180,8 +178,7 @@ def _run_sweep(args) -> int:
     from pendverify.certify.sweep_output import SameFolder, certificates_in, prepare_output
     from pendverify.certify.sweep_run import Workers, run_sweep
     from pendverify.errors import PendverifyError
-    from pendverify.exitcodes import BAD_INPUT
-    from pendverify.signals import TERMINATED
+    from pendverify.exitcodes import BAD_INPUT, TERMINATED
 
     sweep = load_sweep(args.sweep, args.max_sets)
     check_sweep_names(sweep, args.sweep)
@@ -195,7 +192,7 @@ def _run_sweep(args) -> int:
 
     folder = SameFolder(args.output)
 
-    def write(result: dict, replace: bool) -> int:
+    def write(result, replace: bool) -> int:
         folder.check()
         try:
             written = write_sweep_certificates(sweep, [result], args.output, args.force or replace, key)
