@@ -52,7 +52,7 @@ class SetCost:
 
     name: str
     battery: float
-    batch: dict[str, float]
+    parts: dict[str, float]
     floor: dict[str, float]
     states: int
     contexts: dict[str, int] = field(default_factory=dict)
@@ -196,7 +196,7 @@ def measure(params_files=None, settings: BatterySettings | None = None, repeats:
     runs = [_prepare(f, settings) for f in files]
     figures = {}
     for i, run in enumerate(runs):
-        figures.update({(i, "batch", part): fn for part, fn in run.parts.items()})
+        figures.update({(i, "part", part): fn for part, fn in run.parts.items()})
         figures[(i, "battery")] = run.battery
         figures.update({(i, "floor", part): fn for part, fn in run.floors.items()})
     best = least_in_rounds(figures, repeats)
@@ -204,7 +204,7 @@ def measure(params_files=None, settings: BatterySettings | None = None, repeats:
         SetCost(
             run.name,
             best[(i, "battery")],
-            {part: best[(i, "batch", part)] for part in PARTS},
+            {part: best[(i, "part", part)] for part in PARTS},
             {part: best[(i, "floor", part)] for part in ("checks", "stress")},
             settings.samples,
             run.contexts,

@@ -16,8 +16,8 @@ def rows(cost) -> list[dict]:
     """One row per part and one for the battery: seconds and ratios."""
     out = []
     for part in ("checks", "stress", "invariants"):
-        out.append(_row(cost.name, part, cost.batch[part], cost.floor.get(part)))
-    invariants = cost.batch["invariants"]
+        out.append(_row(cost.name, part, cost.parts[part], cost.floor.get(part)))
+    invariants = cost.parts["invariants"]
     floor = cost.floor["checks"] + cost.floor["stress"] + invariants
     out.append(_row(cost.name, "battery", cost.battery, floor))
     return out
