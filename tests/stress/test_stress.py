@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -62,32 +63,62 @@ def test_catalogue_covers_the_issue():
     assert len(set(stress.CASE_NAMES)) == len(stress.CASE_NAMES)
 
 
-def test_cli_quick_table_json_and_exit_status(tmp_path, capsys):
+BUILT_IN_CASES = ["cart g = 0", "cart m1 → 0: trust study", "double pendulum l1 1e3 m, l2 1e-3 m"]
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+
+
+@pytest.mark.parametrize(
+    ("argv", "texts", "cases", "trust_limit_kg"),
+    [
+        pytest.param(
+            [arg for name in BUILT_IN_CASES for arg in ("--case", name)],
+            ("3 stress cases", "measured trust limit (every quantity): m1 ≥ 1e-08 kg"),
+            BUILT_IN_CASES,
+            1e-8,
+            id="built-in",
+        ),
+        pytest.param(
+            [
+                "--analytic",
+                str(EXAMPLES / "cart_pole.py"),
+                "--urdf",
+                str(EXAMPLES / "cart_pole.urdf"),
+                "--params",
+                str(EXAMPLES / "cart_pole.toml"),
+            ],
+            ("mc ×1e-6", "near-singular M", "not varied:", "parameter bx (damping)"),
+            None,
+            None,
+            id="plug-in",
+        ),
+    ],
+)
+def test_cli_quick_table_json_and_exit_status(tmp_path, capsys, argv, texts, cases, trust_limit_kg):
+    """The table, its notes and the JSON: of catalogue cases, or of a model file's generic cases."""
     out_json = tmp_path / "stress.json"
-    cases = ["cart g = 0", "cart m1 → 0: trust study", "double pendulum l1 1e3 m, l2 1e-3 m"]
-    argv = ["stress", "--quick", "--json", str(out_json)]
-    for name in cases:
-        argv += ["--case", name]
-    assert main(argv) == 0
+    assert main(["stress", "--quick", *argv, "--json", str(out_json)]) == 0
     out = capsys.readouterr().out
     for text in (
         "case",
         "error",
         "tolerance",
+        "ratio",
         "κ̃(M)",
         "result",
         "refused",
-        "3 stress cases",
+        "worst error/tolerance",
         "all cases pass",
+        *texts,
     ):
         assert text in out
-    assert "measured trust limit (every quantity): m1 ≥ 1e-08 kg" in out
     report = json.loads(out_json.read_text())
     assert report["passed"] is True and report["seed"] == framework.SEED
-    assert sorted(r["case"] for r in report["results"]) == sorted(cases)  # in catalogue order
+    if cases is not None:
+        assert sorted(r["case"] for r in report["results"]) == sorted(cases)  # in catalogue order
     for r in report["results"]:
         assert {"error", "tolerance", "kappa_raw", "kappa_scaled", "invariant", "passed", "verdict"} <= set(r)
-    assert report["near_singular"]["measured_limit_kg"] == 1e-8
+    if trust_limit_kg is not None:
+        assert report["near_singular"]["measured_limit_kg"] == trust_limit_kg
 
 
 def test_cli_unknown_case_is_exit_2(capsys):

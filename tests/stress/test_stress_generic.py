@@ -1,4 +1,5 @@
-"""stress on model files: generic hard cases from the parameters' kinds and the coordinates."""
+"""stress on model files (``pendverify.stress.generic``): hard cases from the parameters' kinds and
+the coordinates.  The command's table and JSON on a model file: ``test_stress.py``."""
 
 from __future__ import annotations
 
@@ -90,26 +91,6 @@ def test_a_planted_error_fails_a_generic_case(tmp_path):
     report = run_generic(*files("furuta_pendulum", planted), QUICK)
     assert not report.passed
     assert any(r.case != "nominal" and not r.passed for r in report.results)
-
-
-def test_cli_table_notes_and_json(tmp_path, capsys):
-    out = tmp_path / "stress.json"
-    model, urdf, params = files("cart_pole")
-    argv = ["stress", "--quick", "--analytic", model, "--urdf", urdf, "--params", params, "--json", str(out)]
-    assert main(argv) == 0
-    text = capsys.readouterr().out
-    for expected in (
-        "ratio",
-        "refused",
-        "mc ×1e-6",
-        "near-singular M",
-        "worst error/tolerance",
-        "not varied:",
-    ):
-        assert expected in text
-    assert "parameter bx (damping)" in text
-    report = json.loads(out.read_text())
-    assert report["passed"] is True and all("verdict" in r for r in report["results"])
 
 
 def test_cli_needs_the_three_files(capsys):
