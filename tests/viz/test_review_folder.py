@@ -1,15 +1,19 @@
-"""``pendverify report`` on a user's scenes: it checks every model the scenes simulate.
+"""``pendverify report`` on a user's scenes (``pendverify.viz.review_folder``): it checks every model
+the scenes simulate.
 
-A folder with a triple-pendulum scene and a Furuta scene gives a page whose check
-table holds both plug-in models against their URDFs; a plug-in whose mass matrix
-is wrong (planted) makes the page and the exit code fail; a plug-in scene without
-a URDF is refused before any work.
+A folder with built-in scenes gives a page whose check table holds their models (and
+example-robot-data's double pendulums); a folder with a triple-pendulum scene and a Furuta
+scene gives one holding both plug-in models against their URDFs; a plug-in whose mass matrix
+is wrong (planted) makes the page and the exit code fail; a plug-in scene without a URDF is
+refused before any work.
 """
 
 from __future__ import annotations
 
 import json
 from pathlib import Path
+
+import pytest
 
 from pendverify.cli import main
 
@@ -35,17 +39,56 @@ def _report(tmp_path: Path, scenes: Path) -> tuple[int, dict, str]:
     return code, json.loads((out / "report.json").read_text()), (out / "index.html").read_text()
 
 
-def test_report_checks_the_plugin_models_its_scenes_use(tmp_path, capsys):
+def _built_in_scene(folder: Path, model: str, q: list[float]) -> Path:
+    path = folder / f"{model}.toml"
+    path.write_text(
+        f'name = "{model} swing"\nmodel = "{model}"\n'
+        f'engine = "closed_form"\n[initial]\nq = {q}\n[time]\nduration = 0.5\nsample_rate = 20.0\n'
+        '[integrator]\nmethod = "DOP853"\nrtol = 1e-10\natol = 1e-10\n[effects]\ngravity = true\n'
+    )
+    return path
+
+
+def _built_in_scenes(folder: Path) -> list[str]:
+    _built_in_scene(folder, "double_pendulum", [1.0, 0.4])
+    _built_in_scene(folder, "cart_double_pendulum", [0.0, 0.1, -0.05])
+    return ["double_pendulum", "cart_double_pendulum"]
+
+
+def _plugin_scenes(folder: Path) -> list[str]:
+    _scene(folder, "triple_pendulum", [1.0, 0.4, -0.3])
+    _scene(folder, "furuta_pendulum", [0.2, 0.3])
+    return ["triple_pendulum", "furuta_pendulum"]
+
+
+ERD_DOUBLE_PENDULUMS = {"erd:double_pendulum", "erd:double_pendulum_continuous", "erd:double_pendulum_simple"}
+
+
+@pytest.mark.parametrize(
+    ("write_scenes", "models"),
+    [
+        pytest.param(
+            _built_in_scenes,
+            {"double_pendulum", "cart_double_pendulum", *ERD_DOUBLE_PENDULUMS},
+            id="built-in",
+        ),
+        pytest.param(
+            _plugin_scenes,
+            {"triple_pendulum:triple_pendulum", "furuta_pendulum:furuta_pendulum"},
+            id="plug-in",
+        ),
+    ],
+)
+def test_report_checks_the_models_its_scenes_use(write_scenes, models, tmp_path, capsys):
     scenes = tmp_path / "scenes"
     scenes.mkdir()
-    _scene(scenes, "triple_pendulum", [1.0, 0.4, -0.3])
-    _scene(scenes, "furuta_pendulum", [0.2, 0.3])
+    stems = write_scenes(scenes)
     code, report, page = _report(tmp_path, scenes)
     assert code == 0, capsys.readouterr().out
-    models = {r["model"] for r in report["results"]}
-    assert models == {"triple_pendulum:triple_pendulum", "furuta_pendulum:furuta_pendulum"}, models
+    assert {r["model"] for r in report["results"]} == models, {r["model"] for r in report["results"]}
     assert all(r["passed"] for r in report["results"])
-    assert "triple_pendulum swing" in page and "furuta_pendulum swing" in page
+    for stem in stems:
+        assert f"{stem} swing" in page
 
 
 def test_a_planted_mass_matrix_error_in_a_scenes_model_fails_the_report(tmp_path, capsys):
