@@ -12,7 +12,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pendverify.analytic import CartDoublePendulum, DoublePendulum
+from pendverify.analytic import MODELS, CartDoublePendulum, DoublePendulum
+from pendverify.analytic.plugin import load_model_class
 from pendverify.cli import main
 from pendverify.errors import IntegrationError, SceneError
 from pendverify.simulation.dynamics import build_dynamics
@@ -20,6 +21,7 @@ from pendverify.simulation.scene import load_scene, parse_scene
 from pendverify.simulation.simulate import simulate
 
 REPO = Path(__file__).resolve().parents[2]
+EXAMPLES = REPO / "examples"
 SHIPPED = sorted((REPO / "scenes").glob("*.toml"))
 
 
@@ -57,15 +59,26 @@ def test_shipped_scene_passes_its_invariants(path):
     assert np.all(np.isfinite(result.q))
 
 
-def test_lqr_brings_the_rods_back_upright():
-    result = simulate(load_scene(REPO / "scenes" / "cart_lqr_push.toml"))
-    pushed = np.max(np.abs(result.q[:, 1:]))
-    assert pushed > 0.02, "the push did not move the rods"
+@pytest.mark.parametrize(
+    ("scene", "rods", "pushed_by", "engines"),
+    [("cart_lqr_push", slice(1, None), 0.02, None), ("cart_pole_lqr_push", slice(1, 2), 0.01, "both")],
+    ids=["built-in", "plug-in"],
+)
+def test_lqr_brings_the_rods_back_upright(scene, rods, pushed_by, engines):
+    """The cart's two rods (built-in model) and the cart-pole's pole (a model file), pushed."""
+    result = simulate(load_scene(REPO / "scenes" / f"{scene}.toml"))
+    assert result.passed
+    pushed = np.max(np.abs(result.q[:, rods]))
+    assert pushed > pushed_by, "the push did not move the rods"
     final = np.concatenate([result.q[-1], result.v[-1]])
     assert np.linalg.norm(final) < 1e-2, f"not back near upright: |x(T)| = {np.linalg.norm(final):.3g}"
     (note,) = result.notes
     assert "linearisation differ by" in note
     assert float(note.split("differ by ")[1].split()[0]) < 1e-12
+    if engines == "both":  # the hand model's q̈ compared with ABA's along the run
+        assert result.engine_comparison.passed
+    else:
+        assert result.engine_comparison is None
 
 
 # --- effects: off means not evaluated, on means it matters ---------------------------------
@@ -133,6 +146,49 @@ def test_actuation_laws_keep_the_work_balance(actuation):
     assert result.passed, [(i.name, i.error, i.tolerance) for i in result.invariants]
     assert result.invariants[0].name.startswith("work–energy balance")
     assert np.any(result.u != 0)
+
+
+# --- every model, built-in or a model file -----------------------------------------------------
+INITIAL_Q = {
+    "double_pendulum": [0.4, 0.9],
+    "cart_double_pendulum": [0.0, 0.1, -0.05],
+    "cart_pole": [0.0, 0.3],
+    "hanging_double_pendulum": [0.8, -0.4],
+    "triple_pendulum": [1.0, 0.4, -0.3],
+    "furuta_pendulum": [0.2, 0.3],
+}
+
+
+def _model_class(name: str):
+    return MODELS[name] if name in MODELS else load_model_class(EXAMPLES / f"{name}.py")
+
+
+@pytest.mark.parametrize("name", list(INITIAL_Q))
+def test_each_model_simulates_with_both_engines(tmp_path, name):
+    """A built-in model by name; a plug-in example by its model file, parameters and URDF."""
+    q0 = INITIAL_Q[name]
+    if name in MODELS:
+        model_file, files = None, f'model = "{name}"\n'
+    else:
+        model_file = str(EXAMPLES / f"{name}.py")
+        files = (
+            f'model = "{model_file}"\nparams = "{EXAMPLES / f"{name}.toml"}"\n'
+            f'urdf = "{EXAMPLES / f"{name}.urdf"}"\n'
+        )
+    amplitude = [0.3] * len(_model_class(name).inputs)
+    path = tmp_path / "scene.toml"
+    path.write_text(
+        f'{files}engine = "both"\n[initial]\nq = {q0}\n[time]\nduration = 1.0\nsample_rate = 50.0\n'
+        '[integrator]\nmethod = "DOP853"\nrtol = 1e-10\natol = 1e-10\n'
+        "[effects]\ngravity = true\ndamping = true\n"
+        f'[effects.actuation]\ntype = "sine"\namplitude = {amplitude}\nfrequency = 1.0\n'
+    )
+    result = simulate(load_scene(path))
+    assert result.scene.model == name and result.scene.model_file == model_file
+    assert result.passed, [(c.name, c.error, c.tolerance) for c in result.invariants]
+    assert result.invariants[0].name.startswith("work–energy balance")
+    assert result.engine_comparison is not None and result.engine_comparison.passed
+    assert result.q.shape == (51, len(q0)) and np.any(result.u != 0)
 
 
 def test_noise_disturbance_is_seeded_and_balanced():

@@ -85,6 +85,17 @@ def test_a_saved_run_of_a_model_file_renders_with_that_file_given(plugin_run, tm
     assert f"{MINIMAL}.py" in note
 
 
+def test_a_saved_plugin_run_renders_with_its_model_file_given_and_its_recorded_urdf(tmp_path, capsys):
+    run = tmp_path / "cart_pole.npz"
+    assert main(["simulate", str(REPO / "scenes" / "cart_pole_lqr_push.toml"), "-o", str(run)]) == 0
+    out = tmp_path / "replay.html"
+    assert main(["render", "--trajectory", str(run), "-o", str(out)]) == 2  # the npz does not run code
+    assert "--analytic FILE" in capsys.readouterr().err
+    model = str(EXAMPLES / "cart_pole.py")
+    assert main(["render", "--trajectory", str(run), "--analytic", model, "-o", str(out)]) == 0
+    assert "cart-pole LQR after a push" in out.read_text()
+
+
 def test_the_analytic_file_must_define_the_runs_model(plugin_run, tmp_path, capsys):
     npz, _, _ = plugin_run
     other = EXAMPLES / "cart_pole.py"

@@ -216,6 +216,14 @@ def test_render_errors_are_exit_2(tmp_path, capsys):
     assert not (tmp_path / "x.html").exists()
 
 
+def test_render_draws_a_plugin_scene_from_its_urdf(tmp_path, capsys):
+    out = tmp_path / "cart_pole.html"
+    assert main(["render", str(REPO / "scenes" / "cart_pole_lqr_push.toml"), "-o", str(out)]) == 0
+    page = out.read_text()
+    assert page.startswith("<!DOCTYPE html>") or "<html" in page[:500]
+    assert "cart-pole LQR after a push" in page and "cart_pole" in page
+
+
 def test_energy_plot_and_review_page_escape_user_strings():
     run = simulate(
         parse_scene(short_scene("double_pendulum", effects={"gravity": True, "damping": True}), "<t>")

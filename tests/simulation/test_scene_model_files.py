@@ -1,8 +1,9 @@
 """Scenes on a user's own model: a model file (``model = "PATH.py"``), its parameters and URDF.
 
-Every plug-in example simulates with engine ``both`` and passes its invariants; a model
-written here simulates; a planted Coriolis error in a plug-in breaks the work balance;
-every new scene error is literal; ``pendverify render`` draws a plug-in from its URDF.
+A model written here simulates; PD through B⁻¹ and LQR run on a model file's own matrices;
+a planted Coriolis error in a plug-in breaks the work balance; the shipped plug-in scenes do
+what they show; ``simulate --urdf`` gives the URDF; every error of a model file's scene is
+literal.  Every model, built-in or plug-in, simulating with both engines: ``test_scenes.py``.
 """
 
 from __future__ import annotations
@@ -19,12 +20,6 @@ from pendverify.simulation.simulate import simulate
 
 REPO = Path(__file__).resolve().parents[2]
 EXAMPLES = REPO / "examples"
-PLUGINS = {
-    "cart_pole": [0.0, 0.3],
-    "hanging_double_pendulum": [0.8, -0.4],
-    "triple_pendulum": [1.0, 0.4, -0.3],
-    "furuta_pendulum": [0.2, 0.3],
-}
 
 
 def _scene(tmp_path: Path, model: str, body: str, name: str = "scene.toml") -> Path:
@@ -51,25 +46,6 @@ atol = 1e-10
 gravity = true
 damping = true
 {effects}'''
-
-
-@pytest.mark.parametrize("stem", list(PLUGINS))
-def test_each_plugin_example_simulates_with_both_engines(tmp_path, stem):
-    n = len(PLUGINS[stem])
-    amplitude = [0.3] * _inputs(stem)
-    sine = f'[effects.actuation]\ntype = "sine"\namplitude = {amplitude}\nfrequency = 1.0\n'
-    path = _scene(tmp_path, str(EXAMPLES / f"{stem}.py"), _example(stem, PLUGINS[stem], effects=sine))
-    result = simulate(load_scene(path))
-    assert result.scene.model == stem and result.scene.model_file == str(EXAMPLES / f"{stem}.py")
-    assert result.passed, [(c.name, c.error, c.tolerance) for c in result.invariants]
-    assert result.engine_comparison is not None and result.engine_comparison.passed
-    assert result.q.shape == (51, n) and np.any(result.u != 0)
-
-
-def _inputs(stem: str) -> int:
-    from pendverify.analytic.plugin import load_model_class
-
-    return len(load_model_class(EXAMPLES / f"{stem}.py").inputs)
 
 
 # --- models written here ----------------------------------------------------------------------
@@ -193,35 +169,13 @@ def test_planted_coriolis_error_in_a_plugin_breaks_the_work_balance(tmp_path):
 
 
 def test_shipped_plugin_scenes_pass():
-    lqr = simulate(load_scene(REPO / "scenes" / "cart_pole_lqr_push.toml"))
-    assert lqr.passed and lqr.engine_comparison.passed
-    assert np.max(np.abs(lqr.q[:, 1])) > 0.01, "the tap did not move the pole"
-    assert np.linalg.norm(np.concatenate([lqr.q[-1], lqr.v[-1]])) < 1e-2
+    """(The cart-pole LQR scene: ``test_scenes.py``, with the built-in cart's.)"""
     damped = simulate(load_scene(REPO / "scenes" / "damped_triple_pendulum.toml"))
     assert damped.passed and damped.engine_comparison.passed
     assert damped.energy[-1] < damped.energy[0]
     furuta = simulate(load_scene(REPO / "scenes" / "furuta_arm_turning.toml"))  # not planar
     assert furuta.passed and furuta.engine_comparison.passed
     assert np.ptp(furuta.q[:, 0]) > 0.1 and np.ptp(furuta.q[:, 1]) > 1.0, "arm turned, pendulum fell"
-
-
-def test_render_draws_a_plugin_scene_from_its_urdf(tmp_path, capsys):
-    out = tmp_path / "cart_pole.html"
-    assert main(["render", str(REPO / "scenes" / "cart_pole_lqr_push.toml"), "-o", str(out)]) == 0
-    page = out.read_text()
-    assert page.startswith("<!DOCTYPE html>") or "<html" in page[:500]
-    assert "cart-pole LQR after a push" in page and "cart_pole" in page
-
-
-def test_a_saved_plugin_run_renders_with_its_model_file_given_and_its_recorded_urdf(tmp_path, capsys):
-    run = tmp_path / "cart_pole.npz"
-    assert main(["simulate", str(REPO / "scenes" / "cart_pole_lqr_push.toml"), "-o", str(run)]) == 0
-    out = tmp_path / "replay.html"
-    assert main(["render", "--trajectory", str(run), "-o", str(out)]) == 2  # the npz does not run code
-    assert "--analytic FILE" in capsys.readouterr().err
-    model = str(EXAMPLES / "cart_pole.py")
-    assert main(["render", "--trajectory", str(run), "--analytic", model, "-o", str(out)]) == 0
-    assert "cart-pole LQR after a push" in out.read_text()
 
 
 def test_simulate_urdf_option_replaces_the_scenes(tmp_path, capsys):
