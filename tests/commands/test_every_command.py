@@ -4,9 +4,10 @@ The issue's promise is that a user's model file reaches every command.  Each row
 ``COMMANDS`` builds one command line for a model file (with its URDF and parameter
 file); each is run on each example of ``examples/`` that has a URDF and on a model
 written here (the cart-pole's formulas in a file of its own), and must exit 0.  Each
-command's power to fail on a planted error is tested where the command is (test_plugin,
-test_scenes_plugin, test_report_plugin, test_certify_plugin, test_stress_plugin, ...);
-here one planted mass-matrix error must fail ``check`` through the same rows.
+command's power to fail on a planted error is tested where the command is (analytic/test_plugin,
+simulation/test_scene_model_files, viz/test_review_folder, certify/test_certify,
+stress/test_stress_generic, ...); here one planted mass-matrix error must fail ``check``
+through the same rows.
 """
 
 from __future__ import annotations

@@ -23,7 +23,7 @@ from pendverify.simulation.scene import load_scene, parse_scene
 from ..conftest import SEED, assert_close
 
 REPO = Path(__file__).resolve().parents[2]
-RHS_RTOL = 1e-12  # the same closed form, summed in another order (as tests/test_fastpath.py)
+RHS_RTOL = 1e-12  # the same closed form, summed in another order (as tests/numerics/test_fastpath.py)
 ACCURACY_FACTOR = 100.0  # the fast path's stated accuracy: ≤ 100 · rtol · (1 + ‖x‖∞), T ≤ 2 s
 
 NOISY_CART = {

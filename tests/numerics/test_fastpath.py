@@ -387,6 +387,6 @@ def test_fast_path_passes_the_simulators_invariants(name):
 
 
 def test_laws_with_jumps_are_refused_by_name():
-    """A sine compiles (tests/test_fast_forcing.py); an impulse does not."""
+    """A sine compiles (tests/numerics/test_fast_forcing.py); an impulse does not."""
     with pytest.raises(FastPathError, match=r"effects\.disturbance"):
         fast_scene.simulate(load_scene(REPO / "scenes" / "cart_lqr_push.toml"))

@@ -28,7 +28,7 @@ kernels these replaced were checked the same way, to ≤ 2β, before they were d
 and the cancellation between τ, Coriolis and gravity terms): over the sampled
 states it runs from ≈ 50 u at benign states up to ≈ 2e5 u (seeds) and 6e5 u
 (triple pendulum) relative to max(1, |a|) — tighter than the fixed 1e-12 ≈ 9e3 u
-of ``tests/test_fastpath.py`` where the state is benign, looser where it is
+of ``tests/numerics/test_fastpath.py`` where the state is benign, looser where it is
 ill-conditioned.  The errors observed are ≤ 4 % of β (≤ 40 u ≈ 4e-15 relative to
 max(1, |a|)); the last test prints them.
 """
@@ -440,7 +440,7 @@ def test_generated_stepper_is_scipys_dop853(name):
 
     Both runs are DOP853 at rtol = atol = 1e-10 over 1 s (T ≤ 2 s): each is within the fast
     path's stated accuracy 100 · rtol · (1 + ‖x‖∞) of the exact flow, so they differ by at
-    most twice that (``tests/test_fastpath.py`` compares the steps themselves to rounding).
+    most twice that (``tests/numerics/test_fastpath.py`` compares the steps themselves to rounding).
     """
     model = _seed(name)
     rng = np.random.default_rng(SEED)

@@ -4,7 +4,7 @@ methods, the generic field and energy of the Taylor references, V_min, plug-in s
 Every check below is paired with a planted error it must catch.  Bounds are first-order
 rounding bounds in u = ε/2 (Higham, §3.1: a sum of products with k roundings is within
 γ_k·|e| of exact, |e| the expression with every term replaced by its magnitude), as in
-``tests/test_generate.py``, whose exact reference and bound β they reuse.
+``tests/numerics/test_generate.py``, whose exact reference and bound β they reuse.
 """
 
 from __future__ import annotations
