@@ -22,7 +22,7 @@ items judged the integrator and Pinocchio's physics, which conserve Pinocchio's 
 whatever the hand derivation says.  On ``compiled`` they are both the closed form's: the
 items judge the derivation's own consistency — a C that is not Christoffel-consistent with
 M, or an H that is not ∇V, makes the closed form gain or lose energy, and the drift or
-balance fails (``tests/test_fast_battery.py`` plants both).  That the closed form is the
+balance fails (``tests/certify/test_fast_battery.py`` plants both).  That the closed form is the
 URDF's dynamics is what the core checks establish (ε-level, 2000 states).
 
 Cross-check, decided.  A full ABA run of the gravity scene as well would cost ≈ 0.15–0.3 s

@@ -9,7 +9,7 @@ on the batch's terms and forms its tolerances as arrays, K·ε·((1 + |θ|max)·
 + a/s per state — the argument for them is in ``pendverify.checks.catalogue``; the
 verdict is ``pendverify.checks.judge.conclude``, shared with the per-state path.
 
-The numbers are the per-state path's, bit for bit (``tests/test_batch_checks.py``
+The numbers are the per-state path's, bit for bit (``tests/checks/test_batch_checks.py``
 compares the two on every check).  Whatever the batch cannot do exactly as the per-state
 path does — a system wrapper without a batch, an error state, an exception anywhere,
 NumPy set to raise on floating-point errors — falls back to ``run_check_per_state`` for

@@ -33,7 +33,7 @@ Two ways, one set of numbers: ``run_check`` and ``run_checks`` evaluate a check 
 states at once (``pendverify.checks.batch``: the tolerance above as arrays), and
 ``run_check_per_state`` one state at a time, the reference the batch falls back to
 wherever it cannot follow it exactly; both hand their evidence to
-``pendverify.checks.judge.conclude``.  ``tests/test_batch_checks.py`` holds them equal,
+``pendverify.checks.judge.conclude``.  ``tests/checks/test_batch_checks.py`` holds them equal,
 state by state, bit for bit.
 """
 

@@ -14,7 +14,7 @@ How, per method (``ClosedFormBatch.value``):
 Whatever ran on the batch is compared bit for bit with state-by-state calls at a few
 probe states, and a method that differs there is evaluated state by state everywhere;
 states whose lanes are ``unsure`` are evaluated one by one.  So the numbers are the
-reference path's numbers; ``tests/test_batch_checks.py`` compares the two on every check.
+reference path's numbers; ``tests/checks/test_batch_checks.py`` compares the two on every check.
 
 Measured (2010 states, every method the checks call, one core): 11 ms on the batch for
 either seed against 150–165 ms calling each method once per state.  Why not the
