@@ -16,7 +16,7 @@ whole measurement instead of putting them all into one spell):
   functions over all states, the model's own Python where SymPy cannot read a method).
 
 The battery's floor counts the invariants at their own cost (their simulations are not
-split further here).  Nothing here is asserted on time: ``tests/test_bench_certify.py``
+split further here).  Nothing here is asserted on time: ``tests/bench/test_bench_certify.py``
 runs ``--quick`` and checks the table's shape and that the ratios are finite.
 """
 

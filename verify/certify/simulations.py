@@ -20,7 +20,7 @@ figures of an item whatever engine ran it.
 What the items judge.  On ``compiled`` the run and the energy are both the closed form's:
 the items judge the derivation's own consistency — a C that is not Christoffel-consistent
 with M, or an H that is not ∇V, makes the closed form gain or lose energy, and the drift or
-balance fails (``tests/test_fast_battery.py`` plants both).  On ``aba`` they are both
+balance fails (``tests/certify/test_fast_battery.py`` plants both).  On ``aba`` they are both
 Pinocchio's: the items judge the integrator and Pinocchio's physics, which conserve
 Pinocchio's energy whatever the hand derivation says.  That the closed form is the URDF's
 dynamics is what the core checks establish (ε-level, 2000 states).

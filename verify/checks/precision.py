@@ -25,7 +25,7 @@ python_only=True)``).  The state is then judged by the same check, tolerance and
   knowing (a controller evaluates it in double) but is not a derivation error.
   ``--strict`` makes it a failure.
 * A wrong formula is wrong in any precision: the state still fails, and so does
-  the check (a planted error in the same M⁻¹ is caught, ``tests/test_stress_plugin.py``).
+  the check (a planted error in the same M⁻¹ is caught, ``tests/stress/test_stress_generic.py``).
 * A closed form that cannot run on mpmath numbers (it calls ``np.cos`` or
   ``np.linalg`` rather than ``self.math`` and plain arithmetic) is judged in double
   only; the note says why.

@@ -28,7 +28,7 @@ rtol and atol: the same nfev and step count, each step equal to scipy's step fro
 the same state within the rounding of its stage sums (computed in another order),
 step sizes within the jitter that rounding of the error estimate explains (up to
 ≈ 1e-7 relative; on a chaotic trajectory the final states of the two then differ
-by a change of truncation error, ≈ 1e-10 at rtol 1e-5); ``tests/test_fastpath.py``
+by a change of truncation error, ≈ 1e-10 at rtol 1e-5); ``tests/numerics/test_fastpath.py``
 derives each bound.  So the fast path is as accurate as scipy's DOP853.
 Against the high-precision references (``pendverify.numerics.reference``), the tests
 check a final-state error ≤ 100 · rtol · (1 + ‖x‖∞) for rtol ≤ 1e-8 over

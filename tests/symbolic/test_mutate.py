@@ -1,0 +1,158 @@
+"""Mutation sensitivity: every non-equivalent single-term mutant of a seed is detected.
+
+Also: equivalent mutants carry their reason, a method no check looks at leaves
+survivors (the report says so and the command fails), and a mutant changes only
+its own entry.
+"""
+
+from __future__ import annotations
+
+import json
+from collections import Counter
+
+import numpy as np
+import pytest
+
+from pendverify.analytic import DoublePendulum
+from pendverify.analytic.forms import ClosedForm
+from pendverify.checks.verdict import CHRISTOFFEL_CONSISTENT, NON_CHRISTOFFEL
+from pendverify.cli import main
+from pendverify.robot.system import PinocchioSystem
+from pendverify.robot.writer import urdf_for
+from pendverify.symbolic.model import SymbolicModel
+from pendverify.symbolic.mutants import OPERATORS, generate
+from pendverify.symbolic.mutate import numeric_model, run_mutation
+from pendverify.symbolic.mutation_report import DETECTED, EQUIVALENT, SURVIVED
+from pendverify.targets import Target
+
+from ..conftest import default_params
+
+
+def test_every_double_pendulum_mutant_is_detected_or_proved_equivalent(tmp_path, capsys):
+    out_json = tmp_path / "mutants.json"
+    assert main(["mutate", "--model", "double_pendulum", "--json", str(out_json)]) == 0
+    out = capsys.readouterr().out
+    assert "detection rate 100.0% (417/417 non-equivalent mutants), 6 equivalent" in out
+    (report,) = json.loads(out_json.read_text())
+    assert report["detection_rate"] == 1.0 and report["survived"] == 0
+    assert report["mutants"] == 423 and report["detected"] == 417
+    assert set(report["controls"]) == set(DoublePendulum.closed_forms) - {"disturbance_matrix"}  # W is 2×0
+    equivalent = [o for o in report["outcomes"] if o["verdict"] == EQUIVALENT]
+    reasons = Counter(o["operator"] for o in equivalent)
+    assert reasons == {"swap θ": 3, "swap θ̇": 1, "move": 2}
+    for o in equivalent:
+        if o["operator"] == "move":  # a different C factorisation: same C·q̇, flagged, a warning
+            assert o["reason"].startswith(NON_CHRISTOFFEL)
+            assert "flagged by coriolis, skew (warning)" in o["reason"]
+        else:
+            assert o["reason"] == "identical expression after SymPy's canonical ordering"
+    for o in report["outcomes"]:
+        if o["verdict"] == DETECTED:
+            assert o["checks"], o
+
+
+def test_cart_mutants_of_m_c_and_f_are_all_detected(capsys):
+    argv = ["mutate", "--model", "cart_double_pendulum"]
+    for method in ("mass_matrix", "coriolis_matrix", "f"):
+        argv += ["--method", method]
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert "detection rate 100.0% (202/202 non-equivalent mutants), 2 equivalent" in out
+    assert "mass_matrix[1,2]: theta1 ↔ theta2 in cos(theta1 - theta2) — identical expression" in out
+
+
+def test_generation_covers_every_operator():
+    mutants = generate(SymbolicModel.of(DoublePendulum))
+    assert set(OPERATORS) == {m.operator for m in mutants}
+    assert len(
+        {(m.method, tuple(c[0] for c in m.changes), tuple(c[2] for c in m.changes)) for m in mutants}
+    ) == len(mutants)
+    drop = next(m for m in mutants if m.description == "mass_matrix[0,0]: drop m1*r1**2")
+    assert drop.operator == "drop" and len(drop.changes) == 1
+
+
+def test_a_mutant_changes_only_its_own_entry():
+    params = default_params("double_pendulum")
+    model = DoublePendulum(params)
+    sm = SymbolicModel.of(DoublePendulum)
+    drop = next(m for m in generate(sm) if m.description == "mass_matrix[0,0]: drop m1*r1**2")
+    mutated = numeric_model(model, sm, drop.method, drop.changes)
+    q = np.array([0.3, -1.1])
+    diff = model.mass_matrix(q) - mutated.mass_matrix(q)
+    assert diff[0, 0] == pytest.approx(params.m1 * params.r1**2, rel=1e-14)
+    assert np.all(diff.ravel()[1:] == 0)
+    assert np.array_equal(model.gravity(q), mutated.gravity(q))
+
+
+# --- what the verdicts look like when the checks cannot see a change ---------------------------
+class WithDrawing(DoublePendulum):
+    """Declares a closed form that no check reads: its mutants must survive."""
+
+    closed_forms = {**DoublePendulum.closed_forms, "drawing_length": ClosedForm("")}  # noqa: RUF012
+
+    def drawing_length(self):
+        return np.array([self.params.l2])
+
+
+def _target(cls, params):
+    return Target(
+        cls.name, cls(params), PinocchioSystem.for_model(DoublePendulum, urdf_for(params), params.g), "<test>"
+    )
+
+
+def test_survivors_are_reported_as_a_gap():
+    report = run_mutation(
+        _target(WithDrawing, default_params("double_pendulum")), 4, methods=("drawing_length",)
+    )
+    assert [o.verdict for o in report.outcomes] == [SURVIVED] * 3
+    assert not report.passed and report.rate == 0.0
+    assert all("not zero: a gap in the checks" in o.reason for o in report.outcomes)
+
+
+def test_equivalence_for_one_parameter_set_is_named():
+    params = default_params("double_pendulum").replace(b2=0.0)
+    report = run_mutation(_target(DoublePendulum, params), 4, methods=("damping_matrix",))
+    verdicts = {o.description: (o.verdict, o.reason) for o in report.outcomes}
+    assert verdicts["damping_matrix[0,0]: drop b1"][0] == DETECTED
+    verdict, reason = verdicts["damping_matrix[1,1]: drop b2"]
+    assert verdict == EQUIVALENT
+    assert reason == "equivalent for this parameter set only (the change vanishes at b2 as given)"
+    assert report.passed
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--model", "triple"], "unknown model 'triple'"),
+        (["--urdf", "x.urdf"], "--urdf and --params go with --analytic"),
+        (["--model", "double_pendulum", "--method", "nosuch"], "unknown closed form 'nosuch'"),
+        (["--model", "double_pendulum", "--analytic", "x.py"], "not both"),
+    ],
+)
+def test_bad_mutate_command_lines_are_errors(capsys, argv, message):
+    assert main(["mutate", *argv]) == 2
+    assert message in capsys.readouterr().err
+
+
+def test_a_christoffel_consistent_refactoring_is_an_equivalent_mutant():
+    """C + m1·[q̇]× keeps C·q̇ and the skew property: reported as Christoffel-consistent, a warning."""
+    import sympy as sp
+
+    from pendverify.analytic import CartDoublePendulum
+    from pendverify.checks.sampling import sample_states
+    from pendverify.symbolic.mutants import Mutant
+    from pendverify.symbolic.mutate import classify
+
+    params = default_params("cart_double_pendulum")
+    model = CartDoublePendulum(params)
+    system = PinocchioSystem.for_model(CartDoublePendulum, urdf_for(params), params.g)
+    sm = SymbolicModel.of(CartDoublePendulum)
+    C = sm.closed_forms["coriolis_matrix"]
+    v, m1 = sm.symbols["v"], sm.parameters["m1"]
+    cross = sp.Matrix([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+    changes = tuple((i, C[i], C[i] + m1 * cross[i]) for i in range(9) if cross[i] != 0)
+    mutant = Mutant("coriolis_matrix", "move", "C + m1·[q̇]×", changes)
+    outcome = classify(model, system, sm, mutant, [sample_states(model, 4, 1)], 1)
+    assert outcome.verdict == EQUIVALENT
+    assert outcome.reason.startswith(CHRISTOFFEL_CONSISTENT)
+    assert "flagged by coriolis (warning)" in outcome.reason  # Pinocchio's C is another one
