@@ -149,9 +149,12 @@ def conditioning(
     """Judge one mass matrix; ``scale`` is S (default |diag M|), ``angle`` the largest |θ|."""
     M = np.asarray(M, dtype=float)
     S = np.abs(np.diag(M)) if scale is None else np.asarray(scale, dtype=float)
-    kappa_raw, kappa_scaled, bound, spread, by_spread = (
-        x[0] for x in conditionings(M[None], S[None], np.array([angle]), np.array([amplification]))
-    )
+    figures = conditionings(M[None], S[None], np.array([angle]), np.array([amplification]))
+    return _verdict(*(x[0] for x in figures), amplification)
+
+
+def _verdict(kappa_raw, kappa_scaled, bound, spread, by_spread, amplification) -> Conditioning:
+    """The ``Conditioning`` of one matrix's figures (as ``conditionings`` gives them)."""
     return Conditioning(
         float(kappa_raw),
         float(kappa_scaled),
@@ -204,18 +207,7 @@ class Verdicts:
         return not self.bound[i] <= REFUSE_REL
 
     def __getitem__(self, i: int) -> Conditioning:
-        kappa_raw, kappa_scaled, bound, spread, by_spread, amplification = (
-            x[self.best[i], i] for x in self.fields
-        )
-        return Conditioning(
-            float(kappa_raw),
-            float(kappa_scaled),
-            float(bound),
-            _level(float(bound)),
-            float(amplification),
-            float(spread),
-            bool(by_spread),
-        )
+        return _verdict(*(x[self.best[i], i] for x in self.fields))
 
 
 def assess(model, q, system=None) -> Conditioning:

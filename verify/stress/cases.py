@@ -23,12 +23,12 @@ from pendverify.stress.framework import (
     Case,
     Context,
     StressResult,
-    _model,
-    _ratio,
-    _refusals_ok,
-    _result_from,
-    _states,
     compare,
+    error_ratio,
+    model_of,
+    refusals_as_expected,
+    sampled_states,
+    stress_result,
 )
 from pendverify.stress.seed_params import default
 from pendverify.stress.trust_study import det_accuracy, study_states
@@ -70,24 +70,24 @@ def large_angle_case(
 
     def run(ctx: Context, name: str) -> StressResult:
         params = params_fn()
-        model = _model(params, model_cls)
+        model = model_of(params, model_cls)
         system = ctx.system(params)
-        states = shifted_states(model, _states(model, ctx), shift)
+        states = shifted_states(model, sampled_states(model, ctx), shift)
         direct = compare(name, model, system, states, ctx.seed)
         invariance = compare(name, model, system, states, ctx.seed, reduced_angles(model.angular))
-        inv_ok = all(r.passed for r in invariance.results) and _refusals_ok(invariance, expect)
+        inv_ok = all(r.passed for r in invariance.results) and refusals_as_expected(invariance, expect)
         angle = max(float(np.max(np.abs(s.q[np.array(model.angular)]))) for s in states)
         if not invariance.results:  # every state refused by the trust rule
             invariant = f"2πk invariance: no state could be verified; |θ| up to {angle:.3g} rad"
             note = "" if inv_ok else "FAIL invariance: every state refused"
-            return _result_from(name, direct, expect, invariant, inv_ok, note)
-        inv_worst = max(invariance.results, key=_ratio)
+            return stress_result(name, direct, expect, invariant, inv_ok, note)
+        inv_worst = max(invariance.results, key=error_ratio)
         invariant = (
             f"2πk invariance (closed form at θ vs Pinocchio at θ mod 2π): {inv_worst.max_error:.2g} "
             f"≤ {inv_worst.tolerance:.2g} ({inv_worst.check}); |θ| up to {angle:.3g} rad"
         )
         note = "" if inv_ok else f"FAIL invariance {inv_worst.check} at {inv_worst.worst_state['label']}"
-        return _result_from(name, direct, expect, invariant, inv_ok, note)
+        return stress_result(name, direct, expect, invariant, inv_ok, note)
 
     return Case(name, "large angle", run)
 
@@ -96,14 +96,16 @@ def high_speed_case(name: str, params_fn, model_cls=None) -> Case:
     def run(ctx: Context, name: str) -> StressResult:
 
         params = params_fn()
-        model = _model(params, model_cls)
+        model = model_of(params, model_cls)
         system = ctx.system(params)
-        states = [dataclasses.replace(s, v=s.v * (HIGH_RATE / RATE_RANGE)) for s in _states(model, ctx)]
+        states = [
+            dataclasses.replace(s, v=s.v * (HIGH_RATE / RATE_RANGE)) for s in sampled_states(model, ctx)
+        ]
         comp = compare(name, model, system, states, ctx.seed)
         finite = all(np.isfinite(r.max_abs_error) for r in comp.results)
         rate = max(float(np.max(np.abs(s.v))) for s in states)
         invariant = f"|q̇| up to {rate:.3g}; all quantities finite: {'yes' if finite else 'NO'}"
-        return _result_from(name, comp, "none", invariant, finite)
+        return stress_result(name, comp, "none", invariant, finite)
 
     return Case(name, "high speed", run)
 

@@ -16,8 +16,6 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-import numpy as np
-
 from pendverify.analytic import MODELS
 from pendverify.checks.batch import CheckBatch
 from pendverify.checks.catalogue import applicable_checks, run_checks
@@ -30,7 +28,6 @@ from pendverify.stress.trust_study import StudyResult, cart_study
 from pendverify.validate import model_states
 
 SEED = DEFAULT_SEED
-TINY = float(np.finfo(float).tiny)
 ANGLE_SHIFT = 1e6  # rad: large-angle states sit near ±ANGLE_SHIFT
 HIGH_RATE = 1e3  # rad/s (m/s for the cart): the largest rate of the high-speed states
 STIFF_DAMPING = 1e4  # N·m·s/rad (N·s/m on the cart)
@@ -156,12 +153,12 @@ def system_for(params):
     return PinocchioSystem.for_params(params)
 
 
-def _ratio(r) -> float:
+def error_ratio(r) -> float:
     return r.max_error / r.tolerance if r.tolerance > 0 else math.inf
 
 
 @dataclass
-class _Comparison:
+class Comparison:
     results: list
     kept: int
     refused: list[str]
@@ -171,7 +168,7 @@ class _Comparison:
     level: str
 
 
-def compare(name: str, model, system, states: list[State], seed: int, pinocchio_angles=None) -> _Comparison:
+def compare(name: str, model, system, states: list[State], seed: int, pinocchio_angles=None) -> Comparison:
     """Guard every state (validity, conditioning), then run the checks on the accepted ones.
 
     ``pinocchio_angles``: the map of the states' angles to those Pinocchio is evaluated at
@@ -185,12 +182,12 @@ def compare(name: str, model, system, states: list[State], seed: int, pinocchio_
     amplification = max((c.amplification for c in verdicts), default=0.0)
     level = "warn" if any(c.level == "warn" for c in verdicts) else "ok"
     if not kept:
-        return _Comparison([], 0, refused, kappa_raw, kappa_scaled, amplification, level)
+        return Comparison([], 0, refused, kappa_raw, kappa_scaled, amplification, level)
     if refused:
         batch = batch.subset(kept)
     names = applicable_checks(model, system)
     results = run_checks(name, model, system, batch.states, seed, names, batch)
-    return _Comparison(results, len(kept), refused, kappa_raw, kappa_scaled, amplification, level)
+    return Comparison(results, len(kept), refused, kappa_raw, kappa_scaled, amplification, level)
 
 
 #: What a case expects of the trust rule: no refusal, some states refused (and some
@@ -199,7 +196,7 @@ def compare(name: str, model, system, states: list[State], seed: int, pinocchio_
 EXPECT = ("none", "some", "all", "any", "allowed")
 
 
-def _refusals_ok(comp: _Comparison, expect: str) -> bool:
+def refusals_as_expected(comp: Comparison, expect: str) -> bool:
     refused, kept = len(comp.refused), comp.kept
     return {
         "none": refused == 0,
@@ -210,11 +207,11 @@ def _refusals_ok(comp: _Comparison, expect: str) -> bool:
     }[expect]
 
 
-def _result_from(name, comp: _Comparison, expect: str = "none", invariant=None, extra_ok=True, note=""):
+def stress_result(name, comp: Comparison, expect: str = "none", invariant=None, extra_ok=True, note=""):
     notes = [note] if note else []
     failed = [r for r in comp.results if not r.passed]
     if comp.results:
-        worst = max(comp.results, key=_ratio)
+        worst = max(comp.results, key=error_ratio)
         error, tolerance = worst.max_error, worst.tolerance
         quantity = f"{worst.check} (worst of {len(comp.results)} checks, {comp.kept} states)"
         if failed:
@@ -237,7 +234,7 @@ def _result_from(name, comp: _Comparison, expect: str = "none", invariant=None, 
         notes.append(
             f"refused {len(comp.refused)} of {len(comp.refused) + comp.kept} states, e.g. {comp.refused[0]}"
         )
-    refusals_ok = _refusals_ok(comp, expect)
+    refusals_ok = refusals_as_expected(comp, expect)
     if not refusals_ok:
         notes.append(
             f"refusals: expected {expect!r}, got {len(comp.refused)} of {len(comp.refused) + comp.kept}"
@@ -257,12 +254,12 @@ def _result_from(name, comp: _Comparison, expect: str = "none", invariant=None, 
     )
 
 
-def _model(params, model_cls=None):
+def model_of(params, model_cls=None):
     """The closed-form model of a parameter set (``model_cls`` plants a different one, for tests)."""
     return (model_cls or MODELS[params.model])(params)
 
 
-def _states(model, ctx: Context) -> list[State]:
+def sampled_states(model, ctx: Context) -> list[State]:
     return sample_states(model, ctx.settings.random_states, ctx.seed)
 
 
@@ -274,9 +271,9 @@ def checks_case(
 
     def run(ctx: Context, name: str) -> StressResult:
         params = params_fn()
-        model = _model(params, model_cls)
-        states = _states(model, ctx) + (extra_states(model) if extra_states else [])
+        model = model_of(params, model_cls)
+        states = sampled_states(model, ctx) + (extra_states(model) if extra_states else [])
         comp = compare(name, model, ctx.system(params), states, ctx.seed)
-        return _result_from(name, comp, expect)
+        return stress_result(name, comp, expect)
 
     return Case(name, group, run)

@@ -33,7 +33,6 @@ from dataclasses import dataclass
 import numpy as np
 
 EPS = float(np.finfo(float).eps)
-RK4_REAL_AXIS = 2.785  # |hλ| limit of RK4's stability region on the negative real axis
 FIXED_POINT_MAX = 60  # iterations per implicit stage before giving up
 FIXED_POINT_TOL = 1e-14  # relative update at which a stage counts as solved (rate ≲ 0.1: error ≲ 1e-15)
 NEWTON_MAX = 30
@@ -62,7 +61,8 @@ def energies(model, traj: Trajectory) -> np.ndarray:
     return np.array([energy(model, q, v) for q, v in zip(traj.q, traj.v, strict=True)])
 
 
-def _accel(model):
+def state_derivative_of(model):
+    """x ↦ ẋ = (q̇, q̈) of the model's closed form, with no input and no disturbance."""
     u, w = np.zeros(len(model.inputs)), np.zeros(len(model.disturbances))
 
     def f(x):
@@ -94,7 +94,7 @@ class _Recorder:
 
 
 def rk4(model, q0, v0, h: float, n: int, record: int = 1) -> Trajectory:
-    f = _accel(model)
+    f = state_derivative_of(model)
     x = np.concatenate([q0, v0]).astype(float)
     rec = _Recorder(model.nv, x, record)
     evaluations = 0
@@ -123,7 +123,7 @@ def rk45(model, q0, v0, t_end: float, rtol: float = 1e-6, atol: float = 1e-9) ->
     """SciPy's RK45; stops at a blow-up (|x| > ``BLOW_UP``) or after ``RK45_MAX_EVALUATIONS``."""
     from scipy.integrate import solve_ivp
 
-    f = _accel(model)
+    f = state_derivative_of(model)
     x0 = np.concatenate([q0, v0]).astype(float)
     count = [0]
 
@@ -180,7 +180,7 @@ def rk4_growth(J: np.ndarray, h: float) -> float:
 
 def implicit_euler(model, q0, v0, h: float, n: int, record: int = 1, tol: float = 1e-13) -> Trajectory:
     """Backward Euler; Newton on G(x₊) = x₊ − x − h F(x₊) with a Jacobian per step."""
-    f = _accel(model)
+    f = state_derivative_of(model)
     x = np.concatenate([q0, v0]).astype(float)
     rec = _Recorder(model.nv, x, record)
     evaluations = 0

@@ -21,7 +21,7 @@ from pendverify.stress.framework import (
     Case,
     Context,
     StressResult,
-    _model,
+    model_of,
 )
 from pendverify.stress.seed_params import default, dp_scaled
 
@@ -42,7 +42,7 @@ def stiff_sim_case(name: str, params_fn, q0, model_cls=None) -> Case:
 
         st = ctx.settings
         params = params_fn()
-        model = _model(params, model_cls)
+        model = model_of(params, model_cls)
         q0_, v0 = np.asarray(q0, dtype=float), np.zeros(model.nv)
         n = round(st.stiff_horizon / st.stiff_step)
         implicit = si.implicit_euler(model, q0_, v0, st.stiff_step, n)
@@ -69,7 +69,9 @@ def stiff_sim_case(name: str, params_fn, q0, model_cls=None) -> Case:
         if not monotone:
             result.note = "; ".join(filter(None, [result.note, "explicit methods skipped"]))
             return result
-        growth = si.rk4_growth(si.jacobian(si._accel(model), np.concatenate([q0_, v0])), st.stiff_step)
+        growth = si.rk4_growth(
+            si.jacobian(si.state_derivative_of(model), np.concatenate([q0_, v0])), st.stiff_step
+        )
         explicit = si.rk4(model, q0_, v0, st.stiff_step, n)
         predicted, observed = growth > RK4_UNSTABLE, explicit.blew_up_at is not None
         adaptive = si.rk45(model, q0_, v0, st.explicit_horizon)
@@ -105,7 +107,7 @@ def long_horizon_case(name: str, params_fn=long_horizon_params, model_cls=None) 
 
         st = ctx.settings
         params = params_fn()
-        model = _model(params, model_cls)
+        model = model_of(params, model_cls)
         q0, v0 = np.array(LONG_HORIZON_Q0), np.zeros(2)
         h, T = st.long_step, st.long_horizon
         n = round(T / h)
@@ -165,7 +167,7 @@ def zero_gravity_sim_case(name: str, params_fn, q0, v0, cyclic: int, label: str,
 
         st = ctx.settings
         params = params_fn()
-        model = _model(params, model_cls)
+        model = model_of(params, model_cls)
         q0_, v0_ = np.asarray(q0, dtype=float), np.asarray(v0, dtype=float)
         traj = si.stormer_verlet(model, q0_, v0_, st.zero_g_step, st.zero_g_steps, record=10)
         p = si.momenta(model, traj)[:, cyclic]

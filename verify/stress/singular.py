@@ -23,7 +23,7 @@ from pendverify.checks.sampling import State, sample_states
 from pendverify.checks.trust import REFUSE_REL, assess, conditioning
 from pendverify.errors import PendverifyError
 from pendverify.robot.system import PinocchioSystem
-from pendverify.stress.framework import Case, Context, StressResult, _ratio, compare
+from pendverify.stress.framework import Case, Context, StressResult, compare, error_ratio
 
 WALK_EXPONENTS = tuple(range(0, 17, 2))  # the parameter × 10^-k
 SEARCH_KINDS = ("mass", "length", "offset")  # alone; inertias go with their link's mass
@@ -116,7 +116,7 @@ def near_singular_case(model_cls, params, binding, name: str = "near-singular M"
         verified = [k for k, kept, _, _ in steps if kept]
         refusing = [k for k, _, n, _ in steps if n]
         passed = not failed and steps[0][1] > 0 and (refusing or not crossed)
-        worst = max(results, key=_ratio) if results else None
+        worst = max(results, key=error_ratio) if results else None
         walk = (
             f"{key} × 10^{'-' if sign < 0 else ''}k at q = {np.array2string(state.q, precision=3)}: "
             "verified at k = "
