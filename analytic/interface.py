@@ -66,13 +66,16 @@ from __future__ import annotations
 
 import types
 from abc import ABCMeta, abstractmethod
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
 from pendverify.analytic.forms import NUMERIC_MATH, STANDARD_CLOSED_FORMS, BatteryMotion, ClosedForm, Energies
-from pendverify.analytic.params import ParameterSet
+from pendverify.analytic.parameter_set import ParameterSet
 from pendverify.display import REPR_LIMIT, listed, shortened
+
+if TYPE_CHECKING:
+    from pendverify.analytic.derived_scales import DerivedScales
 
 
 def _shape(cls) -> str:
@@ -204,9 +207,9 @@ class ClosedFormModel(metaclass=ModelClass):
         """Σ |coefficients| of each H_i: a bound of |H_i(q)| over all q (units of H).
 
         Derived by default from the model's own H, read by SymPy: every H_i expanded
-        into terms, each sin/cos bounded by 1 (``pendverify.symbolic.scales``).
+        into terms, each sin/cos bounded by 1 (``pendverify.analytic.derived_scales``).
         """
-        return self._derived_scales().gravity()
+        return self.derived_scales().gravity()
 
     # --- derived quantities, shared ------------------------------------------------
     def bias(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -226,7 +229,7 @@ class ClosedFormModel(metaclass=ModelClass):
         bounded by 1 (so an M_ii whose terms cancel, α + 2β cos θ2, is scaled by
         α + 2|β|); |M_ii(q)| if SymPy cannot read M.
         """
-        return self._derived_scales().diagonal(q)
+        return self.derived_scales().diagonal(q)
 
     def special_states(self) -> dict[str, np.ndarray]:
         """Named configurations every check visits (upright, folded...); the zero state by default."""
@@ -254,16 +257,27 @@ class ClosedFormModel(metaclass=ModelClass):
         written = set(cls.hand_written())
         return {k: f for k, f in cls.closed_forms.items() if k not in STANDARD_CLOSED_FORMS or k in written}
 
-    def _derived_scales(self):
-        """The scales derived from M and H (``pendverify.symbolic.scales``), cached on the instance."""
+    def derived_scales(self) -> DerivedScales:
+        """The tolerance scales derived from this model's M and H (``pendverify.analytic.derived_scales``).
+
+        Derived once per instance, or the scales handed over by ``use_derived_scales``.
+        """
         scales = self.__dict__.get("_derived_scales_cache")
         if scales is None:
-            # deferred on purpose: SymPy (symbolic.scales) loads only for a model that leaves a scale
-            # to be derived, so `pendverify check` on the built-in models does not import it
-            from pendverify.symbolic.scales import DerivedScales
+            # deferred on purpose: SymPy (analytic.derived_scales) loads only for a model that leaves
+            # a scale to be derived, so `pendverify check` on the built-in models does not import it
+            from pendverify.analytic.derived_scales import DerivedScales
 
             scales = self.__dict__["_derived_scales_cache"] = DerivedScales.of(self)
         return scales
+
+    def use_derived_scales(self, scales: DerivedScales) -> None:
+        """Take ``scales`` (another instance's ``derived_scales()``) instead of deriving this model's own.
+
+        A model made from another one, as ``pendverify mutate`` makes each mutant, keeps the
+        original's tolerance scales, as it keeps hand-written ones.
+        """
+        self.__dict__["_derived_scales_cache"] = scales
 
     # --- optional hooks ------------------------------------------------------------------
     def derived_constants(self) -> dict[str, float]:

@@ -37,17 +37,8 @@ import numpy as np
 from pendverify.analytic import ClosedFormModel, ParameterSet
 from pendverify.analytic.module_names import module_name
 from pendverify.analytic.params import parse_parameter_document, read_toml
-from pendverify.analytic.source_file import defining_file
+from pendverify.analytic.source_file import where
 from pendverify.errors import FileAccessError, ParameterError, PendverifyError, UserCodeError
-
-
-def where(cls: type) -> str:
-    """The file that defines a class (for error messages), or its module's name."""
-    try:
-        return defining_file(cls)
-    except (TypeError, OSError):  # pragma: no cover - classes built at run time
-        return cls.__module__
-
 
 #: the model files imported so far (resolved paths): an exception raised in one is the user's
 _LOADED: set[str] = set()

@@ -53,7 +53,8 @@ from scipy.integrate import solve_ivp
 
 from pendverify.analytic import MODELS
 from pendverify.analytic.interface import BiasOnlyModel
-from pendverify.analytic.params import ParameterSet, default_parameter_file, load_parameter_file, quantity
+from pendverify.analytic.parameter_set import ParameterSet, quantity
+from pendverify.analytic.params import default_parameter_file, load_parameter_file
 from pendverify.analytic.plugin import load_model_class
 from pendverify.checks.sampling import sample_states
 from pendverify.errors import PendverifyError

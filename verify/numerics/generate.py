@@ -1,6 +1,6 @@
 """Every numeric back end generated from the model: the model is the one source.
 
-What is generated.  For a model class with n coordinates, ``pendverify.symbolic.model``
+What is generated.  For a model class with n coordinates, ``pendverify.analytic.symbolic_reading``
 reads its closed forms as SymPy expressions (the model's own code, called with
 symbols for q, q̇ and the parameters): M(q) from ``mass_matrix``, the bias
 C(q, q̇)·q̇ + H(q) from ``bias`` (the interface's ``coriolis_matrix @ v + gravity``,

@@ -24,9 +24,10 @@ from dataclasses import dataclass
 import sympy as sp
 
 from pendverify.analytic.forms import Energies
-from pendverify.analytic.plugin import where
+from pendverify.analytic.source_file import where
+from pendverify.analytic.symbolic_reading import SymbolicModel
 from pendverify.errors import PendverifyError
-from pendverify.symbolic.model import SymbolicModel, canonical, is_zero
+from pendverify.symbolic.zero_test import canonical, is_zero
 
 
 @dataclass
