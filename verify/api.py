@@ -34,7 +34,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
-from pendverify.analytic.params import check_value
+from pendverify.analytic.parameter_set import check_value
 from pendverify.analytic.plugin import load_model_class, validate_model_class
 from pendverify.certify.battery import BatterySettings
 from pendverify.certify.issue import certification_input, issue

@@ -28,7 +28,7 @@ def run(args: argparse.Namespace) -> int:
 
     from pendverify.analytic.plugin import load_model_class
     from pendverify.analytic.text_model import METHODS
-    from pendverify.symbolic.model import SymbolicModel
+    from pendverify.analytic.symbolic_reading import SymbolicModel
 
     cls = load_model_class(args.model)
     sm = SymbolicModel.of(cls)
