@@ -15,7 +15,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from pendverify.errors import FastPathError, PendverifyError
-from pendverify.numerics import fast_scene, fastpath, fixedstep, taylor
+from pendverify.numerics import fast_scene, fastpath, fixedstep_runner, taylor
 from pendverify.numerics.generate import GeneratedSystem
 from pendverify.simulation.dynamics import build_dynamics
 from pendverify.simulation.scene import load_scene, parse_scene
@@ -103,6 +103,6 @@ def test_laws_that_jump_are_refused_by_name(effect, law):
 def test_the_time_invariant_back_ends_refuse_forcing():
     system = GeneratedSystem.from_dynamics(build_dynamics(_scenes()["sine+noise"], "closed_form"))
     with pytest.raises(PendverifyError, match="time-invariant"):
-        fixedstep.integrate_fixed("rk4", system, np.zeros(6), 0.1, 2)
+        fixedstep_runner.integrate_fixed("rk4", system, np.zeros(6), 0.1, 2)
     with pytest.raises(PendverifyError, match="time-invariant"):
         taylor.float_system(system)

@@ -363,13 +363,13 @@ seed = MODELS["double_pendulum"](load_parameter_file(default_parameter_file("dou
 cls = load_model_class(sys.argv[1])  # a plug-in: imported under a name salted per process
 plugin = cls(load_parameter_file(sys.argv[1][:-3] + ".toml", {cls.name: cls.params_type})[2])
 result = {}
-from pendverify.numerics import fastpath, fixedstep, taylor
+from pendverify.numerics import fastpath, fixedstep_runner, taylor
 for model in (seed, plugin):
     system = generate.GeneratedSystem.from_model(model)
     x = np.array([0.3, -0.2, 0.5, 0.1])
     out = system.rhs(x).tolist()
     out += fastpath.integrate(system, x, 0.05, 1e-8, 1e-8).x.tolist()
-    out += fixedstep.integrate_fixed("implicit_midpoint", system, x, 0.05, 4)[0][-1].tolist()
+    out += fixedstep_runner.integrate_fixed("implicit_midpoint", system, x, 0.05, 4)[0][-1].tolist()
     out += [float(v) for v in taylor.field(taylor.float_system(system), list(x))]
     entry = dict(origin=system.kernel.origin, out=out)
     for name in ("_rhs", "_dop853", "_run"):

@@ -23,7 +23,7 @@ from pendverify.analytic import MODELS
 from pendverify.bench.workprecision import make_problem
 from pendverify.checks.sampling import sample_states
 from pendverify.errors import PendverifyError
-from pendverify.numerics import fast_scene, fastpath, fixedstep, generate, reference, taylor
+from pendverify.numerics import fast_scene, fastpath, fixedstep, fixedstep_runner, generate, reference, taylor
 from pendverify.numerics.codegen.expressions import momentum_rate
 from pendverify.numerics.generate import GeneratedSystem
 from pendverify.simulation.scene import load_scene
@@ -150,8 +150,8 @@ def _fixed_errors(system, reference_system, method: str, x0, T: float) -> tuple[
     failing by orders of magnitude, not by tuning), ‖x_h − x*‖∞ ≤ 2E + the DOP853 error,
     ≤ 100 · 1e-13 · (1 + ‖x‖∞) (the fast path's stated accuracy)."""
     steps, p = STEPS[method], fixedstep.METHODS[method]
-    coarse, _, ok1 = fixedstep.integrate_fixed(method, system, x0, T, steps, steps)
-    fine, _, ok2 = fixedstep.integrate_fixed(method, system, x0, T, 2 * steps, 2 * steps)
+    coarse, _, ok1 = fixedstep_runner.integrate_fixed(method, system, x0, T, steps, steps)
+    fine, _, ok2 = fixedstep_runner.integrate_fixed(method, system, x0, T, 2 * steps, 2 * steps)
     assert ok1 and ok2
     exact = fastpath.integrate(reference_system, x0, T, 1e-13, 1e-13).x
     estimate = np.max(np.abs(coarse[-1] - fine[-1])) / (1 - 2.0**-p)

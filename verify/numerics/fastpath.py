@@ -59,7 +59,7 @@ import numpy as np
 
 from pendverify.errors import FastPathError
 from pendverify.numerics.dop853 import OK, STEP_TOO_SMALL
-from pendverify.numerics.generate import GeneratedSystem, record_compiled
+from pendverify.numerics.generate import GeneratedSystem, distinct_modules, record_compiled
 
 __all__ = ["FastPathError", "FastResult", "integrate", "integrate_ensemble", "warm_up"]
 
@@ -148,11 +148,3 @@ def warm_up(systems) -> float:
         integrate(system, np.append(x0, [0.0, 0.0]), 0.01, 1e-6, 1e-6)
         integrate_ensemble(system, np.tile(x0, (2, 1)), 0.01, 1e-6, 1e-6)
     return time.perf_counter() - start
-
-
-def distinct_modules(systems) -> list[GeneratedSystem]:
-    """The first of ``systems`` for each generated module (compilation is per module)."""
-    seen = {}
-    for system in systems:
-        seen.setdefault(id(system.module), system)
-    return list(seen.values())

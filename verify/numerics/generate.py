@@ -75,6 +75,7 @@ __all__ = [
     "GeneratedKernel",
     "GeneratedSystem",
     "cache_dir",
+    "distinct_modules",
     "expressions",
     "forget",
     "kernel",
@@ -267,3 +268,11 @@ class GeneratedSystem:
             if np.isfinite(res.fun):
                 values.append(float(res.fun))
         return min(values)
+
+
+def distinct_modules(systems) -> list[GeneratedSystem]:
+    """The first of ``systems`` for each generated module (compilation is per module)."""
+    seen = {}
+    for system in systems:
+        seen.setdefault(id(system.module), system)
+    return list(seen.values())
