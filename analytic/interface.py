@@ -22,7 +22,8 @@ W (zero).  Optional and *derived* when not written: ``det_mass_matrix`` (LU of M
 ``inverse_mass_matrix`` (solving with M), ``acceleration`` (M⁻¹(B u + W w − D q̇ −
 C q̇ − H)), ``special_states`` (the zero state only), and the tolerance scales
 ``gravity_scale`` and ``diagonal_scale`` (Σ |terms| of H_i and of M_ii, read by
-SymPy from the model's own H and M).  ``hand_written()`` names the methods a model
+SymPy from the model's own H and M); ``pendverify.analytic.forms.INTERFACE`` is the
+table of these methods.  ``hand_written()`` names the methods a model
 writes itself; a derived det M or M⁻¹ is not checked (nothing to check), and a
 derived q̈ is checked by ``aba`` as the composition of the parts, with a note.
 A hand-written ``acceleration`` must be the model's *own* closed form (as the
@@ -49,7 +50,8 @@ the abstract methods below it declares:
 * optionally ``closed_forms``: which methods hold hand-written formulas (the ones
   ``pendverify mutate`` mutates); extra methods name what they equal in terms of
   the Lagrangian quantities, e.g. ``ClosedForm("qvuw", "-C*v - H - D*v + B*u + W*w")``.
-  (``Energies``, ``ClosedForm`` and ``STANDARD_CLOSED_FORMS`` are in ``pendverify.analytic.forms``.)
+  (``Energies``, ``ClosedForm`` and ``STANDARD_CLOSED_FORMS`` are in ``pendverify.analytic.forms``,
+  with ``INTERFACE``, the table of the interface's methods.)
 
 A model that has no matrix C, only the force C(q, q̇)·q̇, subclasses ``BiasOnlyModel``
 and writes ``coriolis_force`` instead; the checks that need a matrix C (``coriolis``,
@@ -70,7 +72,15 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
-from pendverify.analytic.forms import NUMERIC_MATH, STANDARD_CLOSED_FORMS, BatteryMotion, ClosedForm, Energies
+from pendverify.analytic.forms import (
+    COMPOSED,
+    INTERFACE,
+    NUMERIC_MATH,
+    STANDARD_CLOSED_FORMS,
+    BatteryMotion,
+    ClosedForm,
+    Energies,
+)
 from pendverify.analytic.parameter_set import ParameterSet
 from pendverify.display import REPR_LIMIT, listed, shortened
 
@@ -238,14 +248,16 @@ class ClosedFormModel(metaclass=ModelClass):
     # --- which quantities are hand-written --------------------------------------------------
     @classmethod
     def hand_written(cls) -> tuple[str, ...]:
-        """The interface methods this model writes itself (in ``INTERFACE_METHODS`` order).
+        """The interface methods this model writes itself, in the order of ``forms.INTERFACE``.
 
         A method counts as hand-written when the class, or a base that is a real
         model, defines it; the interface's own defaults (``ClosedFormModel``,
         ``BiasOnlyModel``) are derived, and the checks do not count them as evidence.
         """
         written = []
-        for name in INTERFACE_METHODS:
+        for name, method in INTERFACE.items():
+            if method.kind == COMPOSED:  # bias and T: composed from the others, never the model's own
+                continue
             owner = next((k for k in cls.__mro__ if name in vars(k)), None)
             if owner is not None and owner not in _INTERFACE_CLASSES:
                 written.append(name)
@@ -303,7 +315,7 @@ class BiasOnlyModel(ClosedFormModel):
     has_coriolis_matrix: ClassVar[bool] = False
     closed_forms: ClassVar[dict[str, ClosedForm]] = {
         **{k: f for k, f in STANDARD_CLOSED_FORMS.items() if k != "coriolis_matrix"},
-        "coriolis_force": ClosedForm("qv", "C*v"),
+        "coriolis_force": ClosedForm(INTERFACE["coriolis_force"].args, "C*v"),
     }
 
     @abstractmethod
@@ -317,21 +329,5 @@ class BiasOnlyModel(ClosedFormModel):
         return self.coriolis_force(q, v) + self.gravity(q)
 
 
-#: The interface's methods, in order: ``hand_written`` says which a model writes itself.
-INTERFACE_METHODS: tuple[str, ...] = (
-    "mass_matrix",
-    "coriolis_matrix",
-    "coriolis_force",
-    "gravity",
-    "potential_energy",
-    "damping_matrix",
-    "input_matrix",
-    "disturbance_matrix",
-    "det_mass_matrix",
-    "inverse_mass_matrix",
-    "acceleration",
-    "gravity_scale",
-    "diagonal_scale",
-    "special_states",
-)
+#: the classes whose methods are the interface's own defaults, not a model's
 _INTERFACE_CLASSES = (ClosedFormModel, BiasOnlyModel)
