@@ -11,7 +11,7 @@ from H), optional ``D``, ``B``, ``W``, ``det_M``, ``M_inv``, ``qddot`` — or, i
 of C, H, D, B and W, ``f``, the right-hand side of M q̈ = f(q, q̇, u, w) — with the
 rates named ``d<coordinate>``; and ``[urdf]`` (``joints``, ``transform``,
 ``offset``).  With ``notation = "latex"`` the equations are LaTeX and a
-``[symbols]`` table maps the document's symbols (``pendverify.analytic.text_latex``).
+``[symbols]`` table maps the document's symbols (``pendverify.analytic.text_model_latex``).
 
 Parsing is safe: no Python is run.  Each string may hold only numbers, the
 declared names, + − * / ** and calls of sin, cos, tan, sqrt, exp (and pi); it is
@@ -34,7 +34,7 @@ import sympy as sp
 from pendverify.analytic.parameter_set import KIND_RULES
 from pendverify.analytic.params import read_toml
 from pendverify.analytic.text_expression import FUNCTIONS, ExpressionError, fragment, read_expression
-from pendverify.analytic.text_latex import parse_latex_equation, read_symbol_table
+from pendverify.analytic.text_model_latex import parse_latex_equation, read_symbol_table
 from pendverify.display import shortened
 from pendverify.errors import PendverifyError
 

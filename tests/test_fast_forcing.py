@@ -79,7 +79,7 @@ def test_each_stage_is_evaluated_at_its_own_time(which):
 
 @pytest.mark.parametrize("which", ["sine", "sine+noise"])
 def test_the_work_energy_balance_holds_on_the_fast_path(which):
-    run = fast_scene.simulate(_scenes()[which])
+    run = fast_scene.simulate_compiled(_scenes()[which])
     assert [i.name.split(" ")[0] for i in run.invariants] == ["work–energy"]
     assert run.passed, [(i.name, i.error, i.tolerance) for i in run.invariants]
 
@@ -97,7 +97,7 @@ def test_laws_that_jump_are_refused_by_name(effect, law):
     if effect == "actuation":
         doc["model"], doc["initial"] = "double_pendulum", {"q": [0.3, 0.2]}
     with pytest.raises(FastPathError, match=f"effects.{effect}"):
-        fast_scene.simulate(parse_scene(doc, "<jumps>"))
+        fast_scene.simulate_compiled(parse_scene(doc, "<jumps>"))
 
 
 def test_the_time_invariant_back_ends_refuse_forcing():

@@ -319,6 +319,6 @@ def test_short_reference_agrees_with_scipys_dop853():
 
 
 def test_fast_path_runs_a_plugin_scene():
-    run = fast_scene.simulate(load_scene(REPO / "scenes" / "damped_triple_pendulum.toml"))
+    run = fast_scene.simulate_compiled(load_scene(REPO / "scenes" / "damped_triple_pendulum.toml"))
     assert run.system.model == "triple_pendulum" and run.invariants
     assert run.passed, [(i.name, i.error, i.tolerance) for i in run.invariants]

@@ -37,7 +37,7 @@ chaotic pendulum over 2 s.
 
 The fast path is the model's closed form; that the closed form agrees with
 Pinocchio is what ``pendverify check`` establishes (ε-level, every check).
-``pendverify.numerics.fast_scene.simulate`` runs a scene — a reference system's or a plug-in
+``pendverify.numerics.fast_scene.simulate_compiled`` runs a scene — a reference system's or a plug-in
 model's — on the fast path and evaluates the *same* invariants as ``pendverify.simulation.simulate``
 (``pendverify.simulation.invariants``), on the fast path's own steps, with the same
 adaptive bound.
