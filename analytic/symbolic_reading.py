@@ -135,7 +135,3 @@ class SymbolicModel:
 
     def column(self, kind: str) -> sp.Matrix:
         return sp.Matrix(len(self.symbols[kind]), 1, list(self.symbols[kind]))
-
-    def values(self, params) -> dict[sp.Symbol, sp.Float]:
-        """{parameter symbol: value} for a numeric parameter set."""
-        return {s: sp.Float(getattr(params, name)) for name, s in self.parameters.items()}
