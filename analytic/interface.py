@@ -92,8 +92,11 @@ def _shape(cls) -> str:
     """ "2 dof (theta1, theta2), 1 input": a model class's coordinates, inputs and disturbances."""
     coordinates = tuple(str(c) for c in getattr(cls, "coordinates", ()) or ())
     parts = [f"{len(coordinates)} dof ({listed(coordinates, 60)})"]
-    for what in ("input", "disturbance"):
-        names = tuple(getattr(cls, f"{what}s", ()) or ())
+    for what, declared in (
+        ("input", getattr(cls, "inputs", ())),
+        ("disturbance", getattr(cls, "disturbances", ())),
+    ):
+        names = tuple(declared or ())
         if names:
             parts.append(f"{len(names)} {what}{'s' if len(names) > 1 else ''}")
     return ", ".join(parts)
