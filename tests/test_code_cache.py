@@ -206,7 +206,7 @@ def test_a_full_disk_generates_into_a_temporary_folder(fresh_cache, monkeypatch,
         return real(path, data)
 
     monkeypatch.setattr(code_cache, "write_atomic", full)
-    k = generate.kernel(MODELS["double_pendulum"])
+    k = code_cache.kernel(MODELS["double_pendulum"])
     assert k.origin == "generated" and not k.path.is_relative_to(fresh_cache) and k.path.is_file()
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and str(fresh_cache) in err[0] and "No space left on device" in err[0], err
@@ -218,7 +218,7 @@ def test_a_full_disk_everywhere_is_one_line_naming_the_folder(fresh_cache, monke
 
     monkeypatch.setattr(code_cache, "write_atomic", full)
     with pytest.raises(FileAccessError) as caught:
-        generate.kernel(MODELS["double_pendulum"])
+        code_cache.kernel(MODELS["double_pendulum"])
     line = str(caught.value)
     assert "\n" not in line and "pendverify-code-" in line and "No space left on device" in line
 

@@ -58,7 +58,8 @@ from pendverify.analytic.params import default_parameter_file, load_parameter_fi
 from pendverify.analytic.plugin import load_model_class
 from pendverify.checks.sampling import sample_states
 from pendverify.errors import PendverifyError
-from pendverify.numerics import fastpath, generate
+from pendverify.numerics import fastpath
+from pendverify.numerics.codegen import cache as code_cache
 from pendverify.numerics.codegen import expressions as codegen_expressions
 from pendverify.numerics.generate import GeneratedSystem
 
@@ -75,9 +76,9 @@ OBSERVED: dict[str, float] = {}
 def _cache():
     """The run's cache (``conftest``), nothing from memory: each model is generated and compiled
     once per run, and the module's kernels come from the disk or the generator, not another module."""
-    generate.forget()
+    code_cache.forget()
     yield
-    generate.forget()
+    code_cache.forget()
 
 
 def _gamma(k: int) -> float:
@@ -106,7 +107,7 @@ class Reference:
     """The exact solution and the bound β for one model class and parameter set."""
 
     model: object
-    ex: generate.Expressions
+    ex: codegen_expressions.Expressions
 
     def __post_init__(self):
         ex, p = self.ex, self.model.params
@@ -158,7 +159,7 @@ def _check_model(model, forced: bool, work: bool, tag: str = ""):
     rng = np.random.default_rng(SEED)
     D, B, K, u0 = _forces(model, forced, rng)
     system = GeneratedSystem.from_model(model, D, B, K, u0)
-    ref = Reference(model, generate.expressions(type(model)))
+    ref = Reference(model, codegen_expressions.expressions(type(model)))
     n, nu = model.nv, system.B.shape[1]
     for state in sample_states(model, STATES, SEED):
         x = np.concatenate([state.q, state.v, [0.0, 0.0] if work else []])
@@ -318,7 +319,7 @@ def test_asymmetric_mass_matrix_is_refused():
             return m
 
     with pytest.raises(PendverifyError, match="not symmetric"):
-        generate.kernel(Skewed)
+        code_cache.kernel(Skewed)
 
 
 # --- the cache (fixture fresh_cache: conftest.py) ----------------------------------------------------
@@ -337,7 +338,7 @@ def test_cache_is_used_on_a_second_call(fresh_cache, monkeypatch):
     assert first.kernel.path.parent == fresh_cache
     assert first.kernel.path.name.endswith(f"{first.kernel.digest[:24]}.py")
     assert GeneratedSystem.from_model(model).kernel.origin == "memory"
-    generate.forget()  # as a new process: only the disk remains (numba's files recorded first)
+    code_cache.forget()  # as a new process: only the disk remains (numba's files recorded first)
     before = _listing(fresh_cache)
     assert any(name.endswith(".nbi") for name in before)  # numba's cache of the compiled rhs
 

@@ -23,8 +23,8 @@ from pendverify.analytic import MODELS
 from pendverify.bench.workprecision import make_problem
 from pendverify.checks.sampling import sample_states
 from pendverify.errors import PendverifyError
-from pendverify.numerics import fast_scene, fastpath, fixedstep, fixedstep_runner, generate, reference, taylor
-from pendverify.numerics.codegen.expressions import momentum_rate
+from pendverify.numerics import fast_scene, fastpath, fixedstep, fixedstep_runner, reference, taylor
+from pendverify.numerics.codegen.expressions import expressions, momentum_rate
 from pendverify.numerics.generate import GeneratedSystem
 from pendverify.simulation.scene import load_scene
 
@@ -73,7 +73,7 @@ class _Canonical:
 
     def __init__(self, model, system: GeneratedSystem):
         self.model, self.system = model, system
-        self.ref = Reference(model, generate.expressions(type(model)))
+        self.ref = Reference(model, expressions(type(model)))
         ex, values = self.ref.ex, self.ref.values
         rate = [r.xreplace(values) for r in momentum_rate(ex)]
         args = (*ex.q, *ex.v)
@@ -194,7 +194,7 @@ def test_generic_field_on_mpmath_is_the_models_closed_form(case):
     model = _model(case)
     D, B, K, u0 = _forces(model, True, np.random.default_rng(SEED))
     system = GeneratedSystem.from_model(model, D, B, K, u0)
-    ref = Reference(model, generate.expressions(type(model)))
+    ref = Reference(model, expressions(type(model)))
     n, nu = model.nv, system.B.shape[1]
     worst_planted = 0.0
     for state in sample_states(model, STATES, SEED):

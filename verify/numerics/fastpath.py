@@ -58,8 +58,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from pendverify.errors import FastPathError
+from pendverify.numerics.codegen.cache import record_compiled
 from pendverify.numerics.dop853 import OK, STEP_TOO_SMALL
-from pendverify.numerics.generate import GeneratedSystem, distinct_modules, record_compiled
+from pendverify.numerics.generate import GeneratedSystem, distinct_modules
 
 __all__ = ["FastPathError", "FastResult", "integrate", "integrate_ensemble", "warm_up"]
 

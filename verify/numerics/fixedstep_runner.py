@@ -12,8 +12,9 @@ import time
 import numpy as np
 
 from pendverify.errors import PendverifyError
+from pendverify.numerics.codegen.cache import record_compiled
 from pendverify.numerics.fixedstep import METHOD_IDS, OK
-from pendverify.numerics.generate import GeneratedSystem, distinct_modules, record_compiled
+from pendverify.numerics.generate import GeneratedSystem, distinct_modules
 
 
 def integrate_fixed(method: str, system: GeneratedSystem, x0, duration: float, steps: int, every: int = 1):

@@ -56,33 +56,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from pendverify.errors import FastPathError, PendverifyError
-from pendverify.numerics.codegen.cache import (
-    GeneratedKernel,
-    cache_dir,
-    forget,
-    kernel,
-    model_key,
-    record_compiled,
-)
-from pendverify.numerics.codegen.expressions import Expressions, expressions
-from pendverify.numerics.codegen.module import GENERATOR, render
+from pendverify.numerics.codegen.cache import GeneratedKernel, kernel
 from pendverify.numerics.forcing import NO_FORCING, Forcing, forcing_of
-
-__all__ = [
-    "GENERATOR",
-    "Expressions",
-    "Forcing",
-    "GeneratedKernel",
-    "GeneratedSystem",
-    "cache_dir",
-    "distinct_modules",
-    "expressions",
-    "forget",
-    "kernel",
-    "model_key",
-    "record_compiled",
-    "render",
-]
 
 HEADER = 2  # P[0] = n, P[1] = nu
 #: V_min search: grid points over the angles (a full grid up to this many, else random)
