@@ -57,12 +57,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pendverify.errors import FastPathError
 from pendverify.numerics.codegen.cache import record_compiled
 from pendverify.numerics.dop853 import OK, STEP_TOO_SMALL
 from pendverify.numerics.generate import GeneratedSystem, distinct_modules
 
-__all__ = ["FastPathError", "FastResult", "integrate", "integrate_ensemble", "warm_up"]
+__all__ = ["FastResult", "integrate", "integrate_ensemble", "warm_up"]
 
 
 # --- the Python side ---------------------------------------------------------------------
