@@ -18,6 +18,7 @@ import pickle
 import shutil
 import subprocess
 import sys
+import types
 from pathlib import Path
 
 import numpy as np
@@ -264,7 +265,7 @@ def test_certify_with_an_unusable_cache_issues_the_same_items(tmp_path):
 
 
 def test_the_battery_stops_rather_than_change_engine_when_no_folder_can_be_written(monkeypatch):
-    """The silent fall-back to ABA is gone: a cache error reaches the command as its one line."""
+    """A cache error reaches the command as its one line: the battery does not fall back to ABA."""
     from pendverify.certify import simulations
     from pendverify.numerics import fast_scene
 
@@ -272,7 +273,7 @@ def test_the_battery_stops_rather_than_change_engine_when_no_folder_can_be_writt
         raise FileAccessError("/nowhere/generated/rhs.py", "write", "Read-only file system")
 
     monkeypatch.setattr(fast_scene, "compile_scene", unwritable)
-    scene = type("Scene", (), {})()
+    scene = types.SimpleNamespace()  # compile_scene fails before it reads the scene
     with pytest.raises(FileAccessError):
         simulations._run(scene, "robot.urdf", None)
 

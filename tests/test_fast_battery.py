@@ -98,7 +98,8 @@ def test_a_planted_error_in_the_closed_form_fails_an_invariant_on_the_fast_path(
 
 
 def test_a_certificate_without_engines_is_rechecked_on_aba(tmp_path):
-    """Items issued before the fast path record no engine: recheck runs them on ABA, as they ran."""
+    """Items that record no engine (a certificate of a pendverify without the fast path): recheck
+    runs them on ABA, as they ran."""
     cls, params = MODELS["double_pendulum"], default_params("double_pendulum")
     urdf = urdf_for(params)
     items = run_battery(cls, params, urdf, SETTINGS, dict.fromkeys(EFFECTS, ABA))

@@ -22,8 +22,7 @@ Hence |â − a| ≤ β = |M⁻¹| (γ_k (|M|·|a| + |τ| + |b|) + γ_{3n+1} |C|
 entry: the generated value is checked against the exact value (mpmath, 40
 digits, on the same double inputs) to β.  The models' own closed forms (adjugate /
 det, n ≤ 3) are checked against the exact value to the same β, so the two differ
-by at most 2β; that is the tolerance of the pairwise comparison.  (The hand-written
-kernels these replaced were checked the same way, to ≤ 2β, before they were deleted.)
+by at most 2β; that is the tolerance of the pairwise comparison.
 β carries the conditioning of the state (|M⁻¹||M|,
 and the cancellation between τ, Coriolis and gravity terms): over the sampled
 states it runs from ≈ 50 u at benign states up to ≈ 2e5 u (seeds) and 6e5 u
