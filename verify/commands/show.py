@@ -27,8 +27,8 @@ def run(args: argparse.Namespace) -> int:
     import sympy as sp
 
     from pendverify.analytic.plugin import load_model_class
-    from pendverify.analytic.text_model import METHODS
     from pendverify.analytic.symbolic_reading import SymbolicModel
+    from pendverify.analytic.text_model import METHODS
 
     cls = load_model_class(args.model)
     sm = SymbolicModel.of(cls)
