@@ -16,10 +16,12 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from pendverify.analytic.parameter_set import ParameterSet
 from pendverify.errors import FileAccessError, ParameterError
+
+if TYPE_CHECKING:
+    from pendverify.analytic.parameter_set import ParameterSet
 
 if sys.version_info >= (3, 11):
     import tomllib

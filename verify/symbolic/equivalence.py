@@ -17,13 +17,17 @@ as rationals of their decimal repr) is reported as equivalent *for these paramet
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import sympy as sp
 
-from pendverify.analytic.symbolic_reading import SymbolicModel
 from pendverify.checks.verdict import CHRISTOFFEL_CONSISTENT, NON_CHRISTOFFEL
 from pendverify.symbolic.lagrange import mass_matrix_rate
-from pendverify.symbolic.mutants import Mutant
 from pendverify.symbolic.zero_test import is_zero, probe
+
+if TYPE_CHECKING:
+    from pendverify.analytic.symbolic_reading import SymbolicModel
+    from pendverify.symbolic.mutants import Mutant
 
 
 def coriolis_equivalence(sm: SymbolicModel, mutant: Mutant) -> str | None:
