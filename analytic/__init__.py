@@ -3,7 +3,7 @@
 from pendverify.analytic.cart_double_pendulum import CartDoublePendulum, CartDoublePendulumParams
 from pendverify.analytic.double_pendulum import DoublePendulum, DoublePendulumParams
 from pendverify.analytic.interface import ClosedFormModel
-from pendverify.analytic.params import ParameterSet
+from pendverify.analytic.parameter_set import ParameterSet
 
 MODELS: dict[str, type[ClosedFormModel]] = {
     DoublePendulum.name: DoublePendulum,

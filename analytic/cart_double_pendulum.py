@@ -60,7 +60,7 @@ import numpy as np
 
 from pendverify.analytic.forms import STANDARD_CLOSED_FORMS, BatteryMotion, ClosedForm, Energies
 from pendverify.analytic.interface import ClosedFormModel
-from pendverify.analytic.params import ParameterSet, quantity
+from pendverify.analytic.parameter_set import ParameterSet, quantity
 
 
 @dataclasses.dataclass(frozen=True)

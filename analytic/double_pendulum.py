@@ -50,7 +50,7 @@ import numpy as np
 
 from pendverify.analytic.forms import STANDARD_CLOSED_FORMS, BatteryMotion, ClosedForm, Energies
 from pendverify.analytic.interface import ClosedFormModel
-from pendverify.analytic.params import ParameterSet, quantity
+from pendverify.analytic.parameter_set import ParameterSet, quantity
 from pendverify.errors import ParameterError
 
 

@@ -1,5 +1,10 @@
 """What a closed form is made of: its arguments, its Lagrangian data, the functions it may call.
 
+* ``INTERFACE``: the model interface's methods, one ``InterfaceMethod`` each: its
+  arguments, whether a model must write it, may (with an exact default, or derived
+  from the others) or does not, how a derived one is derived, and its result's shape;
+  every other description of the interface (``ClosedFormModel.hand_written``, the
+  checks' applicability, the plug-in loader's checks) is read from it.
 * ``ClosedForm``: one method holding a hand-written formula, its arguments from
   q, q̇, u, w, and (for methods beyond the interface) what it equals in terms of the
   Lagrangian quantities M, C, H, D, B, W, e.g. ``"-C*v - H - D*v + B*u + W*w"``;
@@ -65,17 +70,73 @@ class ClosedForm:
     equals: str = ""
 
 
+#: The kinds of interface method (``InterfaceMethod.kind``).
+REQUIRED = "required"  # abstract: every model writes it (C or C·q̇: ``coriolis_force`` in a BiasOnlyModel)
+DEFAULT = "default"  # optional; the interface's default is exact (no friction, no disturbances)
+DERIVED = "derived"  # optional; derived from the other methods when not written, then not checked alone
+TOLERANCE = "tolerance"  # a tolerance scale, derived from M or H when not written
+STATES = "states"  # the named states every check visits
+COMPOSED = "composed"  # always composed from the others by the interface: a model does not write it
+
+
+@dataclass(frozen=True)
+class InterfaceMethod:
+    """One method of the model interface (``pendverify.analytic.interface.ClosedFormModel``).
+
+    ``args`` names its arguments in order from "q", "v", "u", "w" (``""``: none).
+    ``kind`` is one of REQUIRED, DEFAULT, DERIVED, TOLERANCE, STATES, COMPOSED (above).
+    ``derived``: for a method the interface can derive, its name in reports and how it is
+    derived, e.g. ``("det M", "from M (LU)")``; ``("", "")`` otherwise.
+    ``shape``: its result's shape in the dimensions "n" (coordinates), "u" (inputs) and
+    "w" (disturbances); None for the special states (a dict of states).
+    ``closed_form``: one of the interface's own closed forms (``STANDARD_CLOSED_FORMS``),
+    the methods ``pendverify mutate`` mutates unless a model says otherwise.
+    """
+
+    args: str
+    kind: str
+    derived: tuple[str, str] = ("", "")
+    shape: tuple[str, ...] | None = ()
+    closed_form: bool = False
+
+    @property
+    def equation(self) -> bool:
+        """A part of the equations of motion (required, defaulted or derived), not a tolerance,
+        the states or a composition of the others."""
+        return self.kind in (REQUIRED, DEFAULT, DERIVED)
+
+
+#: The model interface, in its order: each method's arguments, kind and result.
+INTERFACE: dict[str, InterfaceMethod] = {
+    "mass_matrix": InterfaceMethod("q", REQUIRED, shape=("n", "n"), closed_form=True),
+    "coriolis_matrix": InterfaceMethod("qv", REQUIRED, shape=("n", "n"), closed_form=True),
+    "coriolis_force": InterfaceMethod("qv", REQUIRED, shape=("n",)),
+    "gravity": InterfaceMethod("q", REQUIRED, shape=("n",), closed_form=True),
+    "potential_energy": InterfaceMethod("q", REQUIRED, closed_form=True),
+    "damping_matrix": InterfaceMethod("", DEFAULT, shape=("n", "n"), closed_form=True),
+    "input_matrix": InterfaceMethod("", DEFAULT, shape=("n", "u"), closed_form=True),
+    "disturbance_matrix": InterfaceMethod("", DEFAULT, shape=("n", "w"), closed_form=True),
+    "det_mass_matrix": InterfaceMethod("q", DERIVED, ("det M", "from M (LU)"), closed_form=True),
+    "inverse_mass_matrix": InterfaceMethod(
+        "q", DERIVED, ("M⁻¹", "from M (solving with M)"), shape=("n", "n"), closed_form=True
+    ),
+    "acceleration": InterfaceMethod(
+        "qvuw", DERIVED, ("q̈", "from M, C, H, D, B, W (M⁻¹(B u + W w − D q̇ − C q̇ − H))"), shape=("n",)
+    ),
+    "gravity_scale": InterfaceMethod("", TOLERANCE, ("the gravity scale", "from H (Σ|terms|)"), shape=("n",)),
+    "diagonal_scale": InterfaceMethod(
+        "q", TOLERANCE, ("the inertia scale", "from M (Σ|terms| of M_ii)"), shape=("n",)
+    ),
+    "special_states": InterfaceMethod(
+        "", STATES, ("the special states", "(the zero state only)"), shape=None
+    ),
+    "bias": InterfaceMethod("qv", COMPOSED, ("the bias C·q̇ + H", "from C (or C·q̇) and H"), shape=("n",)),
+    "kinetic_energy": InterfaceMethod("qv", COMPOSED, ("T", "from M (½ q̇ᵀ M q̇)")),
+}
+
 #: The interface's own closed forms, in the order the tools report them.
 STANDARD_CLOSED_FORMS: dict[str, ClosedForm] = {
-    "mass_matrix": ClosedForm("q"),
-    "coriolis_matrix": ClosedForm("qv"),
-    "gravity": ClosedForm("q"),
-    "potential_energy": ClosedForm("q"),
-    "damping_matrix": ClosedForm(""),
-    "input_matrix": ClosedForm(""),
-    "disturbance_matrix": ClosedForm(""),
-    "det_mass_matrix": ClosedForm("q"),
-    "inverse_mass_matrix": ClosedForm("q"),
+    name: ClosedForm(method.args) for name, method in INTERFACE.items() if method.closed_form
 }
 
 

@@ -22,7 +22,8 @@ W (zero).  Optional and *derived* when not written: ``det_mass_matrix`` (LU of M
 ``inverse_mass_matrix`` (solving with M), ``acceleration`` (M⁻¹(B u + W w − D q̇ −
 C q̇ − H)), ``special_states`` (the zero state only), and the tolerance scales
 ``gravity_scale`` and ``diagonal_scale`` (Σ |terms| of H_i and of M_ii, read by
-SymPy from the model's own H and M).  ``hand_written()`` names the methods a model
+SymPy from the model's own H and M); ``pendverify.analytic.forms.INTERFACE`` is the
+table of these methods.  ``hand_written()`` names the methods a model
 writes itself; a derived det M or M⁻¹ is not checked (nothing to check), and a
 derived q̈ is checked by ``aba`` as the composition of the parts, with a note.
 A hand-written ``acceleration`` must be the model's *own* closed form (as the
@@ -49,7 +50,8 @@ the abstract methods below it declares:
 * optionally ``closed_forms``: which methods hold hand-written formulas (the ones
   ``pendverify mutate`` mutates); extra methods name what they equal in terms of
   the Lagrangian quantities, e.g. ``ClosedForm("qvuw", "-C*v - H - D*v + B*u + W*w")``.
-  (``Energies``, ``ClosedForm`` and ``STANDARD_CLOSED_FORMS`` are in ``pendverify.analytic.forms``.)
+  (``Energies``, ``ClosedForm`` and ``STANDARD_CLOSED_FORMS`` are in ``pendverify.analytic.forms``,
+  with ``INTERFACE``, the table of the interface's methods.)
 
 A model that has no matrix C, only the force C(q, q̇)·q̇, subclasses ``BiasOnlyModel``
 and writes ``coriolis_force`` instead; the checks that need a matrix C (``coriolis``,
@@ -66,21 +68,35 @@ from __future__ import annotations
 
 import types
 from abc import ABCMeta, abstractmethod
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
-from pendverify.analytic.forms import NUMERIC_MATH, STANDARD_CLOSED_FORMS, BatteryMotion, ClosedForm, Energies
-from pendverify.analytic.params import ParameterSet
+from pendverify.analytic.forms import (
+    COMPOSED,
+    INTERFACE,
+    NUMERIC_MATH,
+    STANDARD_CLOSED_FORMS,
+    BatteryMotion,
+    ClosedForm,
+    Energies,
+)
+from pendverify.analytic.parameter_set import ParameterSet
 from pendverify.display import REPR_LIMIT, listed, shortened
+
+if TYPE_CHECKING:
+    from pendverify.analytic.derived_scales import DerivedScales
 
 
 def _shape(cls) -> str:
     """ "2 dof (theta1, theta2), 1 input": a model class's coordinates, inputs and disturbances."""
     coordinates = tuple(str(c) for c in getattr(cls, "coordinates", ()) or ())
     parts = [f"{len(coordinates)} dof ({listed(coordinates, 60)})"]
-    for what in ("input", "disturbance"):
-        names = tuple(getattr(cls, f"{what}s", ()) or ())
+    for what, declared in (
+        ("input", getattr(cls, "inputs", ())),
+        ("disturbance", getattr(cls, "disturbances", ())),
+    ):
+        names = tuple(declared or ())
         if names:
             parts.append(f"{len(names)} {what}{'s' if len(names) > 1 else ''}")
     return ", ".join(parts)
@@ -204,9 +220,9 @@ class ClosedFormModel(metaclass=ModelClass):
         """Σ |coefficients| of each H_i: a bound of |H_i(q)| over all q (units of H).
 
         Derived by default from the model's own H, read by SymPy: every H_i expanded
-        into terms, each sin/cos bounded by 1 (``pendverify.symbolic.scales``).
+        into terms, each sin/cos bounded by 1 (``pendverify.analytic.derived_scales``).
         """
-        return self._derived_scales().gravity()
+        return self.derived_scales().gravity()
 
     # --- derived quantities, shared ------------------------------------------------
     def bias(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -226,7 +242,7 @@ class ClosedFormModel(metaclass=ModelClass):
         bounded by 1 (so an M_ii whose terms cancel, α + 2β cos θ2, is scaled by
         α + 2|β|); |M_ii(q)| if SymPy cannot read M.
         """
-        return self._derived_scales().diagonal(q)
+        return self.derived_scales().diagonal(q)
 
     def special_states(self) -> dict[str, np.ndarray]:
         """Named configurations every check visits (upright, folded...); the zero state by default."""
@@ -235,14 +251,16 @@ class ClosedFormModel(metaclass=ModelClass):
     # --- which quantities are hand-written --------------------------------------------------
     @classmethod
     def hand_written(cls) -> tuple[str, ...]:
-        """The interface methods this model writes itself (in ``INTERFACE_METHODS`` order).
+        """The interface methods this model writes itself, in the order of ``forms.INTERFACE``.
 
         A method counts as hand-written when the class, or a base that is a real
         model, defines it; the interface's own defaults (``ClosedFormModel``,
         ``BiasOnlyModel``) are derived, and the checks do not count them as evidence.
         """
         written = []
-        for name in INTERFACE_METHODS:
+        for name, method in INTERFACE.items():
+            if method.kind == COMPOSED:  # bias and T: composed from the others, never the model's own
+                continue
             owner = next((k for k in cls.__mro__ if name in vars(k)), None)
             if owner is not None and owner not in _INTERFACE_CLASSES:
                 written.append(name)
@@ -254,16 +272,27 @@ class ClosedFormModel(metaclass=ModelClass):
         written = set(cls.hand_written())
         return {k: f for k, f in cls.closed_forms.items() if k not in STANDARD_CLOSED_FORMS or k in written}
 
-    def _derived_scales(self):
-        """The scales derived from M and H (``pendverify.symbolic.scales``), cached on the instance."""
+    def derived_scales(self) -> DerivedScales:
+        """The tolerance scales derived from this model's M and H (``pendverify.analytic.derived_scales``).
+
+        Derived once per instance, or the scales handed over by ``use_derived_scales``.
+        """
         scales = self.__dict__.get("_derived_scales_cache")
         if scales is None:
-            # deferred on purpose: SymPy (symbolic.scales) loads only for a model that leaves a scale
-            # to be derived, so `pendverify check` on the built-in models does not import it
-            from pendverify.symbolic.scales import DerivedScales
+            # deferred on purpose: SymPy (analytic.derived_scales) loads only for a model that leaves
+            # a scale to be derived, so `pendverify check` on the built-in models does not import it
+            from pendverify.analytic.derived_scales import DerivedScales
 
             scales = self.__dict__["_derived_scales_cache"] = DerivedScales.of(self)
         return scales
+
+    def use_derived_scales(self, scales: DerivedScales) -> None:
+        """Take ``scales`` (another instance's ``derived_scales()``) instead of deriving this model's own.
+
+        A model made from another one, as ``pendverify mutate`` makes each mutant, keeps the
+        original's tolerance scales, as it keeps hand-written ones.
+        """
+        self.__dict__["_derived_scales_cache"] = scales
 
     # --- optional hooks ------------------------------------------------------------------
     def derived_constants(self) -> dict[str, float]:
@@ -289,7 +318,7 @@ class BiasOnlyModel(ClosedFormModel):
     has_coriolis_matrix: ClassVar[bool] = False
     closed_forms: ClassVar[dict[str, ClosedForm]] = {
         **{k: f for k, f in STANDARD_CLOSED_FORMS.items() if k != "coriolis_matrix"},
-        "coriolis_force": ClosedForm("qv", "C*v"),
+        "coriolis_force": ClosedForm(INTERFACE["coriolis_force"].args, "C*v"),
     }
 
     @abstractmethod
@@ -303,21 +332,5 @@ class BiasOnlyModel(ClosedFormModel):
         return self.coriolis_force(q, v) + self.gravity(q)
 
 
-#: The interface's methods, in order: ``hand_written`` says which a model writes itself.
-INTERFACE_METHODS: tuple[str, ...] = (
-    "mass_matrix",
-    "coriolis_matrix",
-    "coriolis_force",
-    "gravity",
-    "potential_energy",
-    "damping_matrix",
-    "input_matrix",
-    "disturbance_matrix",
-    "det_mass_matrix",
-    "inverse_mass_matrix",
-    "acceleration",
-    "gravity_scale",
-    "diagonal_scale",
-    "special_states",
-)
+#: the classes whose methods are the interface's own defaults, not a model's
 _INTERFACE_CLASSES = (ClosedFormModel, BiasOnlyModel)

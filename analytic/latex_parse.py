@@ -40,7 +40,7 @@ from lark import Lark, Token, Transformer, v_args
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken, VisitError
 
 from pendverify.analytic import expression_limits as limits
-from pendverify.analytic.latex_text import Stop, Text, canonical_symbol, normalise
+from pendverify.analytic.latex_normalise import Stop, Text, normalise
 from pendverify.errors import PendverifyError
 
 #: commands that only typeset their argument: dropped around it
@@ -309,4 +309,4 @@ def _equal(a, b) -> bool:
     return diff == 0 or sp.simplify(diff) == 0
 
 
-__all__ = ["LatexError", "LatexReader", "SymbolTable", "canonical_symbol", "normalise"]
+__all__ = ["LatexError", "LatexReader", "SymbolTable"]

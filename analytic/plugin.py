@@ -35,19 +35,11 @@ from pathlib import Path
 import numpy as np
 
 from pendverify.analytic import ClosedFormModel, ParameterSet
+from pendverify.analytic.forms import INTERFACE
 from pendverify.analytic.module_names import module_name
 from pendverify.analytic.params import parse_parameter_document, read_toml
-from pendverify.analytic.source_file import defining_file
+from pendverify.analytic.source_file import where
 from pendverify.errors import FileAccessError, ParameterError, PendverifyError, UserCodeError
-
-
-def where(cls: type) -> str:
-    """The file that defines a class (for error messages), or its module's name."""
-    try:
-        return defining_file(cls)
-    except (TypeError, OSError):  # pragma: no cover - classes built at run time
-        return cls.__module__
-
 
 #: the model files imported so far (resolved paths): an exception raised in one is the user's
 _LOADED: set[str] = set()
@@ -211,21 +203,18 @@ def plugin_parameters(cls: type[ClosedFormModel], model_file: str, params_file: 
 
 
 def _expected_shapes(model: ClosedFormModel) -> dict[str, tuple[tuple, tuple[int, ...]]]:
-    """method → (arguments at the zero state, the shape of its result)."""
-    n, nu, nw = model.nv, len(model.inputs), len(model.disturbances)
-    q, v, u, w = np.zeros(n), np.zeros(n), np.zeros(nu), np.zeros(nw)
+    """equation method → (its arguments at the zero state, the shape of its result), from ``INTERFACE``."""
+    sizes = {"n": model.nv, "u": len(model.inputs), "w": len(model.disturbances)}
+    zero = {
+        "q": np.zeros(model.nv),
+        "v": np.zeros(model.nv),
+        "u": np.zeros(sizes["u"]),
+        "w": np.zeros(sizes["w"]),
+    }
     return {
-        "mass_matrix": ((q,), (n, n)),
-        "coriolis_matrix": ((q, v), (n, n)),
-        "coriolis_force": ((q, v), (n,)),
-        "gravity": ((q,), (n,)),
-        "potential_energy": ((q,), ()),
-        "damping_matrix": ((), (n, n)),
-        "input_matrix": ((), (n, nu)),
-        "disturbance_matrix": ((), (n, nw)),
-        "det_mass_matrix": ((q,), ()),
-        "inverse_mass_matrix": ((q,), (n, n)),
-        "acceleration": ((q, v, u, w), (n,)),
+        name: (tuple(zero[a] for a in method.args), tuple(sizes[d] for d in method.shape))
+        for name, method in INTERFACE.items()
+        if method.equation
     }
 
 

@@ -1,5 +1,7 @@
 """The file that defines a model or parameter class: its Python source, or a text model's file.
 
+``where(cls)`` names it in error messages (the module's name when there is no file).
+
 A text model's classes live in a stand-in module (``pendverify.analytic.text_model``)
 that names its text file in ``TEXT_FILE`` and has no ``__file__``: tools that take a
 module's ``__file__`` for Python source (``inspect.getsource``, Hypothesis's search
@@ -22,3 +24,11 @@ def defining_file(cls: type) -> str:
     if text_file is not None:
         return text_file
     return inspect.getfile(cls)
+
+
+def where(cls: type) -> str:
+    """The file that defines a class (for error messages), or its module's name."""
+    try:
+        return defining_file(cls)
+    except (TypeError, OSError):  # pragma: no cover - classes built at run time
+        return cls.__module__

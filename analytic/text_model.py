@@ -9,7 +9,7 @@ q̇), B = ∂f/∂u and W = ∂f/∂w (required constant, f affine in u and w)),
 class whose methods evaluate them: numerically through ``sympy.lambdify`` onto
 ``self.math``'s functions (Python's ``math``, mpmath for the high-precision judge,
 complex functions for the LQR's complex step), and as the SymPy expressions
-themselves when ``self.math`` is SymPy's (``pendverify.symbolic.model``), so that
+themselves when ``self.math`` is SymPy's (``pendverify.analytic.symbolic_reading``), so that
 ``sympy``, ``mutate`` and the code generator read the text model as they read a
 Python one.  Only the methods whose equations the file gives are defined, so
 ``hand_written()`` tells the truth.  The class's module is a stand-in that names
@@ -30,7 +30,7 @@ import sympy as sp
 from pendverify.analytic.forms import Energies
 from pendverify.analytic.interface import BiasOnlyModel, ClosedFormModel
 from pendverify.analytic.module_names import module_name
-from pendverify.analytic.params import ParameterSet
+from pendverify.analytic.parameter_set import ParameterSet
 from pendverify.analytic.source_file import TEXT_FILE
 from pendverify.analytic.text_parse import Reader, TextModelSpec, read_text_model
 from pendverify.display import shortened

@@ -11,7 +11,7 @@ from H), optional ``D``, ``B``, ``W``, ``det_M``, ``M_inv``, ``qddot`` — or, i
 of C, H, D, B and W, ``f``, the right-hand side of M q̈ = f(q, q̇, u, w) — with the
 rates named ``d<coordinate>``; and ``[urdf]`` (``joints``, ``transform``,
 ``offset``).  With ``notation = "latex"`` the equations are LaTeX and a
-``[symbols]`` table maps the document's symbols (``pendverify.analytic.text_latex``).
+``[symbols]`` table maps the document's symbols (``pendverify.analytic.text_model_latex``).
 
 Parsing is safe: no Python is run.  Each string may hold only numbers, the
 declared names, + − * / ** and calls of sin, cos, tan, sqrt, exp (and pi); it is
@@ -31,9 +31,10 @@ from pathlib import Path
 
 import sympy as sp
 
-from pendverify.analytic.params import _RULES, read_toml
+from pendverify.analytic.parameter_set import KIND_RULES
+from pendverify.analytic.params import read_toml
 from pendverify.analytic.text_expression import FUNCTIONS, ExpressionError, fragment, read_expression
-from pendverify.analytic.text_latex import parse_latex_equation, read_symbol_table
+from pendverify.analytic.text_model_latex import parse_latex_equation, read_symbol_table
 from pendverify.display import shortened
 from pendverify.errors import PendverifyError
 
@@ -182,14 +183,14 @@ def read_text_model(path: str | Path) -> TextModelSpec:
         reader.identifier(f"parameters.{p}", p)
         if (
             not isinstance(decl, dict)
-            or decl.get("kind") not in _RULES
+            or decl.get("kind") not in KIND_RULES
             or set(decl) - {"kind", "unit", "doc"}
         ):
             reader.fail(
                 f"parameters.{p}",
-                f"must be {{ kind = ..., unit = ... }} with kind one of {', '.join(_RULES)}",
+                f"must be {{ kind = ..., unit = ... }} with kind one of {', '.join(KIND_RULES)}",
             )
-        unit = decl.get("unit", _RULES[decl["kind"]][1])
+        unit = decl.get("unit", KIND_RULES[decl["kind"]][1])
         if not isinstance(unit, str):
             reader.fail(f"parameters.{p}.unit", "must be a string")
         parameters[p] = (decl["kind"], unit)

@@ -51,7 +51,7 @@ import numpy as np
 
 from pendverify.analytic import ClosedFormModel
 from pendverify.analytic.forms import STANDARD_CLOSED_FORMS, ClosedForm, Energies
-from pendverify.analytic.params import ParameterSet, quantity
+from pendverify.analytic.parameter_set import ParameterSet, quantity
 
 
 @dataclasses.dataclass(frozen=True)

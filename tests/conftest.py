@@ -49,12 +49,12 @@ def _generated_code_cache(tmp_path_factory):
 def fresh_cache(tmp_path, monkeypatch):
     """An empty generated-code cache of this test's own (its ``generated`` folder), forgotten in
     this process before and after."""
-    from pendverify.numerics import generate
+    from pendverify.numerics.codegen import cache as code_cache
 
     monkeypatch.setenv("PENDVERIFY_CACHE", str(tmp_path / "cache"))
-    generate.forget()
+    code_cache.forget()
     yield tmp_path / "cache" / "generated"
-    generate.forget()
+    code_cache.forget()
 
 
 def default_params(name: str):

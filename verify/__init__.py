@@ -17,8 +17,6 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
-__version__ = "0.1.0"
-
 #: public name -> the module that defines it, imported when the name is first used
 _LAZY = {
     "check": "pendverify.api",
@@ -58,6 +56,11 @@ if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
 
 
 def __getattr__(name: str) -> Any:
+    if name == "__version__":  # the installed distribution's (pyproject.toml), read on first use
+        from importlib.metadata import version
+
+        value = globals()[name] = version("pendverify")
+        return value
     module = _LAZY.get(name)
     if module is None:
         raise AttributeError(f"module 'pendverify' has no attribute {name!r}")

@@ -37,7 +37,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
 from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
-from pendverify.analytic.params import check_value
+from pendverify.analytic.parameter_set import check_value
 from pendverify.analytic.plugin import load_model_class, validate_model_class
 from pendverify.checks.report import CheckReport
 from pendverify.checks.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
@@ -453,8 +453,8 @@ class ModelReading(NamedTuple):
 def read_model(model: ModelLike) -> ModelReading:
     """Each closed form of ``model`` (as ``load_model`` takes it) as SymPy reads it, to confirm
     the reading: ``pendverify show``."""
+    from pendverify.analytic.symbolic_reading import SymbolicModel
     from pendverify.analytic.text_model import METHODS
-    from pendverify.symbolic.model import SymbolicModel
 
     cls = load_model(model)
     sm = SymbolicModel.of(cls)

@@ -10,6 +10,7 @@ value that slips through an error rather than invalid JSON.
 
 from __future__ import annotations
 
+import importlib.metadata
 import json
 import math
 import platform
@@ -17,8 +18,6 @@ from typing import Any
 
 import numpy as np
 import pinocchio
-
-from pendverify import __version__
 
 
 def plain(value: Any) -> Any:
@@ -48,7 +47,7 @@ def to_json(value: Any, canonical: bool = False) -> str:
 def versions() -> dict[str, str]:
     """The versions that produced a result: pendverify, Pinocchio, numpy, Python."""
     return {
-        "pendverify": __version__,
+        "pendverify": importlib.metadata.version("pendverify"),
         "pinocchio": pinocchio.__version__,
         "numpy": np.__version__,
         "python": platform.python_version(),

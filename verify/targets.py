@@ -27,7 +27,8 @@ from pathlib import Path
 
 from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
 from pendverify.analytic.params import default_parameter_file, load_parameter_file
-from pendverify.analytic.plugin import check_model_outputs, load_model_class, plugin_parameters, where
+from pendverify.analytic.plugin import check_model_outputs, load_model_class, plugin_parameters
+from pendverify.analytic.source_file import where
 from pendverify.errors import ParameterError, PendverifyError, UnknownNameError
 from pendverify.robot import erd
 from pendverify.robot.description import description_stem, is_description_text

@@ -16,7 +16,8 @@ from pathlib import Path
 import pytest
 import sympy as sp
 
-from pendverify.analytic.latex_parse import LatexError, LatexReader, SymbolTable, canonical_symbol
+from pendverify.analytic.latex_normalise import canonical_symbol
+from pendverify.analytic.latex_parse import LatexError, LatexReader, SymbolTable
 from pendverify.cli import main
 
 REPO = Path(__file__).resolve().parents[2]

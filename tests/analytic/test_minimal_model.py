@@ -16,9 +16,9 @@ import pytest
 
 import pendverify
 from pendverify.analytic import MODELS, ClosedFormModel
+from pendverify.analytic.derived_scales import term_bound
 from pendverify.analytic.plugin import load_model_class
 from pendverify.cli import main
-from pendverify.symbolic.scales import term_bound
 
 from ..conftest import default_params
 

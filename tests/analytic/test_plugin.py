@@ -267,3 +267,119 @@ def test_a_model_with_only_the_force_c_qdot_is_verified(tmp_path, capsys):
     mutate = ["mutate", "--analytic", str(path), *HANGING[2:], "--method", "coriolis_force"]
     assert main(mutate) == 0
     assert "detection rate 100.0% (22/22 non-equivalent mutants)" in capsys.readouterr().out
+
+
+# --- the interface table ----------------------------------------------------------------------------
+#: what each shipped model writes itself (``hand_written``), in the interface's order
+MINIMAL = "mass_matrix coriolis_matrix gravity potential_energy damping_matrix input_matrix"
+HAND_WRITTEN = {
+    "double_pendulum": (
+        "mass_matrix coriolis_matrix gravity potential_energy damping_matrix input_matrix det_mass_matrix "
+        "inverse_mass_matrix acceleration gravity_scale diagonal_scale special_states"
+    ),
+    "cart_double_pendulum": (
+        "mass_matrix coriolis_matrix gravity potential_energy damping_matrix input_matrix disturbance_matrix "
+        "det_mass_matrix inverse_mass_matrix acceleration gravity_scale diagonal_scale special_states"
+    ),
+    "cart_pole.py": (
+        "mass_matrix coriolis_matrix gravity potential_energy damping_matrix input_matrix disturbance_matrix "
+        "det_mass_matrix inverse_mass_matrix acceleration gravity_scale special_states"
+    ),
+    "furuta_pendulum.py": (
+        "mass_matrix coriolis_matrix gravity potential_energy damping_matrix input_matrix disturbance_matrix "
+        "det_mass_matrix inverse_mass_matrix acceleration gravity_scale diagonal_scale special_states"
+    ),
+    "hanging_double_pendulum.py": (
+        "mass_matrix coriolis_matrix gravity potential_energy damping_matrix input_matrix det_mass_matrix "
+        "inverse_mass_matrix acceleration gravity_scale diagonal_scale special_states"
+    ),
+    "triple_pendulum.py": (
+        "mass_matrix coriolis_matrix gravity potential_energy damping_matrix input_matrix det_mass_matrix "
+        "inverse_mass_matrix acceleration gravity_scale diagonal_scale special_states"
+    ),
+    "minimal_double_pendulum.py": MINIMAL,
+    "minimal_double_pendulum_text.toml": MINIMAL,
+    "double_pendulum_latex.toml": MINIMAL,
+    "cart_pole_latex.toml": (
+        "mass_matrix coriolis_matrix gravity potential_energy damping_matrix input_matrix disturbance_matrix "
+        "det_mass_matrix"
+    ),
+    "cart_double_pendulum_latex.toml": (
+        "mass_matrix coriolis_force gravity potential_energy damping_matrix input_matrix disturbance_matrix "
+        "det_mass_matrix"
+    ),
+}
+
+
+@pytest.mark.parametrize("name", sorted(HAND_WRITTEN))
+def test_hand_written_is_read_from_the_interface_table(name):
+    from pendverify.analytic import MODELS
+
+    cls = MODELS[name] if name in MODELS else load_model_class(EXAMPLES / name)
+    assert cls.hand_written() == tuple(HAND_WRITTEN[name].split())
+
+
+def test_the_interface_table_gives_arguments_kinds_and_the_standard_closed_forms():
+    from pendverify.analytic.forms import (
+        COMPOSED,
+        DEFAULT,
+        DERIVED,
+        INTERFACE,
+        REQUIRED,
+        STANDARD_CLOSED_FORMS,
+        STATES,
+        TOLERANCE,
+        ClosedForm,
+    )
+    from pendverify.analytic.interface import BiasOnlyModel, ClosedFormModel
+
+    assert {name: m.args for name, m in INTERFACE.items()} == {
+        "mass_matrix": "q",
+        "coriolis_matrix": "qv",
+        "coriolis_force": "qv",
+        "gravity": "q",
+        "potential_energy": "q",
+        "damping_matrix": "",
+        "input_matrix": "",
+        "disturbance_matrix": "",
+        "det_mass_matrix": "q",
+        "inverse_mass_matrix": "q",
+        "acceleration": "qvuw",
+        "gravity_scale": "",
+        "diagonal_scale": "q",
+        "special_states": "",
+        "bias": "qv",
+        "kinetic_energy": "qv",
+    }
+    kinds = {
+        kind: [n for n, m in INTERFACE.items() if m.kind == kind]
+        for kind in {m.kind for m in INTERFACE.values()}
+    }
+    assert kinds == {
+        REQUIRED: ["mass_matrix", "coriolis_matrix", "coriolis_force", "gravity", "potential_energy"],
+        DEFAULT: ["damping_matrix", "input_matrix", "disturbance_matrix"],
+        DERIVED: ["det_mass_matrix", "inverse_mass_matrix", "acceleration"],
+        TOLERANCE: ["gravity_scale", "diagonal_scale"],
+        STATES: ["special_states"],
+        COMPOSED: ["bias", "kinetic_energy"],
+    }
+    # every method the interface derives says how, and nothing else does
+    assert all(bool(m.derived[0]) == (m.kind not in (REQUIRED, DEFAULT)) for m in INTERFACE.values())
+    assert INTERFACE["det_mass_matrix"].derived == ("det M", "from M (LU)")
+    # the abstract methods of the interface are the required ones (C·q̇ in a BiasOnlyModel)
+    assert ClosedFormModel.__abstractmethods__ == set(kinds[REQUIRED]) - {"coriolis_force"}
+    assert BiasOnlyModel.__abstractmethods__ == set(kinds[REQUIRED]) - {"coriolis_matrix"}
+    # every method of the table is a method of the interface
+    assert all(callable(getattr(BiasOnlyModel, name)) for name in INTERFACE)
+    assert STANDARD_CLOSED_FORMS == {
+        "mass_matrix": ClosedForm("q"),
+        "coriolis_matrix": ClosedForm("qv"),
+        "gravity": ClosedForm("q"),
+        "potential_energy": ClosedForm("q"),
+        "damping_matrix": ClosedForm(""),
+        "input_matrix": ClosedForm(""),
+        "disturbance_matrix": ClosedForm(""),
+        "det_mass_matrix": ClosedForm("q"),
+        "inverse_mass_matrix": ClosedForm("q"),
+    }
+    assert list(STANDARD_CLOSED_FORMS) == [n for n in INTERFACE if n in STANDARD_CLOSED_FORMS]

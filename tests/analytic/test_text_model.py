@@ -161,8 +161,7 @@ def test_a_text_models_module_does_not_claim_its_text_as_python_source():
     import sys
     import warnings
 
-    from pendverify.analytic.plugin import where
-    from pendverify.analytic.source_file import defining_file
+    from pendverify.analytic.source_file import defining_file, where
     from pendverify.numerics.codegen.cache import model_key
 
     latex = REPO / "examples" / "double_pendulum_latex.toml"

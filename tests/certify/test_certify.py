@@ -41,7 +41,7 @@ SINGLE_PENDULUM = """
 import dataclasses
 import numpy as np
 from pendverify.analytic import ClosedFormModel
-from pendverify.analytic.params import ParameterSet, quantity
+from pendverify.analytic.parameter_set import ParameterSet, quantity
 
 
 @dataclasses.dataclass(frozen=True)

@@ -29,7 +29,7 @@ ENERGY_RTOL = 1e-12  # the same closed forms, read by SymPy and summed in anothe
 
 @pytest.mark.parametrize("name", ["damped_double_pendulum", "cart_rods_falling", "furuta_arm_turning"])
 def test_generated_energies_are_the_closed_forms(name):
-    run = fast_scene.simulate(load_scene(REPO / "scenes" / f"{name}.toml"))
+    run = fast_scene.simulate_compiled(load_scene(REPO / "scenes" / f"{name}.toml"))
     xs = run.result.steps_x
     fast = GeneratedEnergies.of(run.dynamics, run.system)
     slow = invariants.Energies(run.dynamics)

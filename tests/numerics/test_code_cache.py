@@ -18,6 +18,7 @@ import pickle
 import shutil
 import subprocess
 import sys
+import types
 from pathlib import Path
 
 import numpy as np
@@ -206,7 +207,7 @@ def test_a_full_disk_generates_into_a_temporary_folder(fresh_cache, monkeypatch,
         return real(path, data)
 
     monkeypatch.setattr(code_cache, "write_atomic", full)
-    k = generate.kernel(MODELS["double_pendulum"])
+    k = code_cache.kernel(MODELS["double_pendulum"])
     assert k.origin == "generated" and not k.path.is_relative_to(fresh_cache) and k.path.is_file()
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and str(fresh_cache) in err[0] and "No space left on device" in err[0], err
@@ -218,7 +219,7 @@ def test_a_full_disk_everywhere_is_one_line_naming_the_folder(fresh_cache, monke
 
     monkeypatch.setattr(code_cache, "write_atomic", full)
     with pytest.raises(FileAccessError) as caught:
-        generate.kernel(MODELS["double_pendulum"])
+        code_cache.kernel(MODELS["double_pendulum"])
     line = str(caught.value)
     assert "\n" not in line and "pendverify-code-" in line and "No space left on device" in line
 
@@ -264,7 +265,7 @@ def test_certify_with_an_unusable_cache_issues_the_same_items(tmp_path):
 
 
 def test_the_battery_stops_rather_than_change_engine_when_no_folder_can_be_written(monkeypatch):
-    """The silent fall-back to ABA is gone: a cache error reaches the command as its one line."""
+    """A cache error reaches the command as its one line: the battery does not fall back to ABA."""
     from pendverify.certify import simulations
     from pendverify.numerics import fast_scene
 
@@ -272,7 +273,7 @@ def test_the_battery_stops_rather_than_change_engine_when_no_folder_can_be_writt
         raise FileAccessError("/nowhere/generated/rhs.py", "write", "Read-only file system")
 
     monkeypatch.setattr(fast_scene, "compile_scene", unwritable)
-    scene = type("Scene", (), {})()
+    scene = types.SimpleNamespace()  # compile_scene fails before it reads the scene
     with pytest.raises(FileAccessError):
         simulations.run_battery_scene(scene, "robot.urdf", None)
 

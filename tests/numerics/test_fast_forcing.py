@@ -15,7 +15,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from pendverify.errors import FastPathError, PendverifyError
-from pendverify.numerics import fast_scene, fastpath, fixedstep, taylor
+from pendverify.numerics import fast_scene, fastpath, fixedstep_runner, taylor
 from pendverify.numerics.generate import GeneratedSystem
 from pendverify.simulation.dynamics import build_dynamics
 from pendverify.simulation.scene import load_scene, parse_scene
@@ -79,7 +79,7 @@ def test_each_stage_is_evaluated_at_its_own_time(which):
 
 @pytest.mark.parametrize("which", ["sine", "sine+noise"])
 def test_the_work_energy_balance_holds_on_the_fast_path(which):
-    run = fast_scene.simulate(_scenes()[which])
+    run = fast_scene.simulate_compiled(_scenes()[which])
     assert [i.name.split(" ")[0] for i in run.invariants] == ["work–energy"]
     assert run.passed, [(i.name, i.error, i.tolerance) for i in run.invariants]
 
@@ -97,12 +97,12 @@ def test_laws_that_jump_are_refused_by_name(effect, law):
     if effect == "actuation":
         doc["model"], doc["initial"] = "double_pendulum", {"q": [0.3, 0.2]}
     with pytest.raises(FastPathError, match=f"effects.{effect}"):
-        fast_scene.simulate(parse_scene(doc, "<jumps>"))
+        fast_scene.simulate_compiled(parse_scene(doc, "<jumps>"))
 
 
 def test_the_time_invariant_back_ends_refuse_forcing():
     system = GeneratedSystem.from_dynamics(build_dynamics(_scenes()["sine+noise"], "closed_form"))
     with pytest.raises(PendverifyError, match="time-invariant"):
-        fixedstep.integrate_fixed("rk4", system, np.zeros(6), 0.1, 2)
+        fixedstep_runner.integrate_fixed("rk4", system, np.zeros(6), 0.1, 2)
     with pytest.raises(PendverifyError, match="time-invariant"):
         taylor.float_system(system)

@@ -380,7 +380,7 @@ def test_ensemble_is_the_single_runs():
 
 @pytest.mark.parametrize("name", ["chaotic_double_pendulum", "damped_double_pendulum", "cart_rods_falling"])
 def test_fast_path_passes_the_simulators_invariants(name):
-    run = fast_scene.simulate(load_scene(REPO / "scenes" / f"{name}.toml"))
+    run = fast_scene.simulate_compiled(load_scene(REPO / "scenes" / f"{name}.toml"))
     assert run.invariants, name
     assert run.passed, [(i.name, i.error, i.tolerance) for i in run.invariants]
     assert np.all(np.isfinite(run.x))
@@ -389,4 +389,4 @@ def test_fast_path_passes_the_simulators_invariants(name):
 def test_laws_with_jumps_are_refused_by_name():
     """A sine compiles (tests/numerics/test_fast_forcing.py); an impulse does not."""
     with pytest.raises(FastPathError, match=r"effects\.disturbance"):
-        fast_scene.simulate(load_scene(REPO / "scenes" / "cart_lqr_push.toml"))
+        fast_scene.simulate_compiled(load_scene(REPO / "scenes" / "cart_lqr_push.toml"))

@@ -22,8 +22,7 @@ Hence |â − a| ≤ β = |M⁻¹| (γ_k (|M|·|a| + |τ| + |b|) + γ_{3n+1} |C|
 entry: the generated value is checked against the exact value (mpmath, 40
 digits, on the same double inputs) to β.  The models' own closed forms (adjugate /
 det, n ≤ 3) are checked against the exact value to the same β, so the two differ
-by at most 2β; that is the tolerance of the pairwise comparison.  (The hand-written
-kernels these replaced were checked the same way, to ≤ 2β, before they were deleted.)
+by at most 2β; that is the tolerance of the pairwise comparison.
 β carries the conditioning of the state (|M⁻¹||M|,
 and the cancellation between τ, Coriolis and gravity terms): over the sampled
 states it runs from ≈ 50 u at benign states up to ≈ 2e5 u (seeds) and 6e5 u
@@ -53,11 +52,13 @@ from scipy.integrate import solve_ivp
 
 from pendverify.analytic import MODELS
 from pendverify.analytic.interface import BiasOnlyModel
-from pendverify.analytic.params import ParameterSet, default_parameter_file, load_parameter_file, quantity
+from pendverify.analytic.parameter_set import ParameterSet, quantity
+from pendverify.analytic.params import default_parameter_file, load_parameter_file
 from pendverify.analytic.plugin import load_model_class
 from pendverify.checks.sampling import sample_states
 from pendverify.errors import PendverifyError
-from pendverify.numerics import fastpath, generate
+from pendverify.numerics import fastpath
+from pendverify.numerics.codegen import cache as code_cache
 from pendverify.numerics.codegen import expressions as codegen_expressions
 from pendverify.numerics.generate import GeneratedSystem
 
@@ -74,9 +75,9 @@ OBSERVED: dict[str, float] = {}
 def _cache():
     """The run's cache (``conftest``), nothing from memory: each model is generated and compiled
     once per run, and the module's kernels come from the disk or the generator, not another module."""
-    generate.forget()
+    code_cache.forget()
     yield
-    generate.forget()
+    code_cache.forget()
 
 
 def _gamma(k: int) -> float:
@@ -105,7 +106,7 @@ class Reference:
     """The exact solution and the bound β for one model class and parameter set."""
 
     model: object
-    ex: generate.Expressions
+    ex: codegen_expressions.Expressions
 
     def __post_init__(self):
         ex, p = self.ex, self.model.params
@@ -157,7 +158,7 @@ def _check_model(model, forced: bool, work: bool, tag: str = ""):
     rng = np.random.default_rng(SEED)
     D, B, K, u0 = _forces(model, forced, rng)
     system = GeneratedSystem.from_model(model, D, B, K, u0)
-    ref = Reference(model, generate.expressions(type(model)))
+    ref = Reference(model, codegen_expressions.expressions(type(model)))
     n, nu = model.nv, system.B.shape[1]
     for state in sample_states(model, STATES, SEED):
         x = np.concatenate([state.q, state.v, [0.0, 0.0] if work else []])
@@ -317,7 +318,7 @@ def test_asymmetric_mass_matrix_is_refused():
             return m
 
     with pytest.raises(PendverifyError, match="not symmetric"):
-        generate.kernel(Skewed)
+        code_cache.kernel(Skewed)
 
 
 # --- the cache (fixture fresh_cache: conftest.py) ----------------------------------------------------
@@ -336,7 +337,7 @@ def test_cache_is_used_on_a_second_call(fresh_cache, monkeypatch):
     assert first.kernel.path.parent == fresh_cache
     assert first.kernel.path.name.endswith(f"{first.kernel.digest[:24]}.py")
     assert GeneratedSystem.from_model(model).kernel.origin == "memory"
-    generate.forget()  # as a new process: only the disk remains (numba's files recorded first)
+    code_cache.forget()  # as a new process: only the disk remains (numba's files recorded first)
     before = _listing(fresh_cache)
     assert any(name.endswith(".nbi") for name in before)  # numba's cache of the compiled rhs
 
@@ -362,13 +363,13 @@ seed = MODELS["double_pendulum"](load_parameter_file(default_parameter_file("dou
 cls = load_model_class(sys.argv[1])  # a plug-in: imported under a name salted per process
 plugin = cls(load_parameter_file(sys.argv[1][:-3] + ".toml", {cls.name: cls.params_type})[2])
 result = {}
-from pendverify.numerics import fastpath, fixedstep, taylor
+from pendverify.numerics import fastpath, fixedstep_runner, taylor
 for model in (seed, plugin):
     system = generate.GeneratedSystem.from_model(model)
     x = np.array([0.3, -0.2, 0.5, 0.1])
     out = system.rhs(x).tolist()
     out += fastpath.integrate(system, x, 0.05, 1e-8, 1e-8).x.tolist()
-    out += fixedstep.integrate_fixed("implicit_midpoint", system, x, 0.05, 4)[0][-1].tolist()
+    out += fixedstep_runner.integrate_fixed("implicit_midpoint", system, x, 0.05, 4)[0][-1].tolist()
     out += [float(v) for v in taylor.field(taylor.float_system(system), list(x))]
     entry = dict(origin=system.kernel.origin, out=out)
     for name in ("_rhs", "_dop853", "_run"):

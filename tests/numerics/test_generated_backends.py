@@ -23,8 +23,8 @@ from pendverify.analytic import MODELS
 from pendverify.bench.workprecision import make_problem
 from pendverify.checks.sampling import sample_states
 from pendverify.errors import PendverifyError
-from pendverify.numerics import fast_scene, fastpath, fixedstep, generate, reference, taylor
-from pendverify.numerics.codegen.expressions import momentum_rate
+from pendverify.numerics import fast_scene, fastpath, fixedstep, fixedstep_runner, reference, taylor
+from pendverify.numerics.codegen.expressions import expressions, momentum_rate
 from pendverify.numerics.generate import GeneratedSystem
 from pendverify.simulation.scene import load_scene
 
@@ -73,7 +73,7 @@ class _Canonical:
 
     def __init__(self, model, system: GeneratedSystem):
         self.model, self.system = model, system
-        self.ref = Reference(model, generate.expressions(type(model)))
+        self.ref = Reference(model, expressions(type(model)))
         ex, values = self.ref.ex, self.ref.values
         rate = [r.xreplace(values) for r in momentum_rate(ex)]
         args = (*ex.q, *ex.v)
@@ -150,8 +150,8 @@ def _fixed_errors(system, reference_system, method: str, x0, T: float) -> tuple[
     failing by orders of magnitude, not by tuning), ‖x_h − x*‖∞ ≤ 2E + the DOP853 error,
     ≤ 100 · 1e-13 · (1 + ‖x‖∞) (the fast path's stated accuracy)."""
     steps, p = STEPS[method], fixedstep.METHODS[method]
-    coarse, _, ok1 = fixedstep.integrate_fixed(method, system, x0, T, steps, steps)
-    fine, _, ok2 = fixedstep.integrate_fixed(method, system, x0, T, 2 * steps, 2 * steps)
+    coarse, _, ok1 = fixedstep_runner.integrate_fixed(method, system, x0, T, steps, steps)
+    fine, _, ok2 = fixedstep_runner.integrate_fixed(method, system, x0, T, 2 * steps, 2 * steps)
     assert ok1 and ok2
     exact = fastpath.integrate(reference_system, x0, T, 1e-13, 1e-13).x
     estimate = np.max(np.abs(coarse[-1] - fine[-1])) / (1 - 2.0**-p)
@@ -194,7 +194,7 @@ def test_generic_field_on_mpmath_is_the_models_closed_form(case):
     model = _model(case)
     D, B, K, u0 = _forces(model, True, np.random.default_rng(SEED))
     system = GeneratedSystem.from_model(model, D, B, K, u0)
-    ref = Reference(model, generate.expressions(type(model)))
+    ref = Reference(model, expressions(type(model)))
     n, nu = model.nv, system.B.shape[1]
     worst_planted = 0.0
     for state in sample_states(model, STATES, SEED):
@@ -319,6 +319,6 @@ def test_short_reference_agrees_with_scipys_dop853():
 
 
 def test_fast_path_runs_a_plugin_scene():
-    run = fast_scene.simulate(load_scene(REPO / "scenes" / "damped_triple_pendulum.toml"))
+    run = fast_scene.simulate_compiled(load_scene(REPO / "scenes" / "damped_triple_pendulum.toml"))
     assert run.system.model == "triple_pendulum" and run.invariants
     assert run.passed, [(i.name, i.error, i.tolerance) for i in run.invariants]

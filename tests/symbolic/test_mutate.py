@@ -15,11 +15,11 @@ import pytest
 
 from pendverify.analytic import DoublePendulum
 from pendverify.analytic.forms import ClosedForm
+from pendverify.analytic.symbolic_reading import SymbolicModel
 from pendverify.checks.verdict import CHRISTOFFEL_CONSISTENT, NON_CHRISTOFFEL
 from pendverify.cli import main
 from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
-from pendverify.symbolic.model import SymbolicModel
 from pendverify.symbolic.mutants import OPERATORS, generate
 from pendverify.symbolic.mutate import numeric_model, run_mutation
 from pendverify.symbolic.mutation_report import DETECTED, EQUIVALENT, SURVIVED

@@ -20,6 +20,7 @@ import sympy as sp
 from pendverify.analytic import MODELS, CartDoublePendulum, DoublePendulum
 from pendverify.analytic.forms import Energies
 from pendverify.analytic.plugin import load_model_class
+from pendverify.analytic.symbolic_reading import SymbolicModel
 from pendverify.checks.catalogue import run_checks
 from pendverify.checks.sampling import sample_states
 from pendverify.checks.verdict import CHRISTOFFEL_CONSISTENT, NON_CHRISTOFFEL
@@ -29,8 +30,8 @@ from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
 from pendverify.symbolic.compare import DIFFERS, EQUAL, SKIPPED, WARNING, compare
 from pendverify.symbolic.lagrange import derive
-from pendverify.symbolic.model import SymbolicModel, is_zero
 from pendverify.symbolic.work import DEFAULT_MAX_SYMBOLIC, MAX_SYMBOLIC_VARIABLE, symbolic_work
+from pendverify.symbolic.zero_test import is_zero
 
 from ..conftest import SEED, default_params
 

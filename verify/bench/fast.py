@@ -36,7 +36,7 @@ import numpy as np
 from pendverify.bench.problems import Problem, engine_rhs
 from pendverify.bench.timing import measure
 from pendverify.bench.workprecision import Config, Point
-from pendverify.numerics.fast_scene import simulate
+from pendverify.numerics.fast_scene import simulate_compiled
 from pendverify.numerics.fastpath import integrate, integrate_ensemble
 from pendverify.simulation import engines
 
@@ -220,12 +220,12 @@ def ensemble_study(problem: Problem, tol: float, config: Config, member_refs: li
 
 
 def fast_invariants(problems: list[Problem]) -> list[tuple[str, list]]:
-    """The scene invariants of each state problem, run on the fast path (``numerics.fast_scene.simulate``)."""
+    """The scene invariants of each state problem, on the fast path (``fast_scene.simulate_compiled``)."""
 
     out = []
     for problem in problems:
         if problem.metric != "state":
             continue
-        run = simulate(problem.scene)
+        run = simulate_compiled(problem.scene)
         out.append((problem.key, run.invariants, run.result.steps))
     return out

@@ -33,7 +33,7 @@ from pendverify.bench.workprecision import (
     order_fits,
     scipy_sweep,
 )
-from pendverify.numerics import fastpath, fixedstep
+from pendverify.numerics import fastpath, fixedstep_runner
 from pendverify.numerics.reference import references
 
 
@@ -125,7 +125,7 @@ def run_benchmark(
     results.references = {p.key: r for p, r in zip(state, refs[: len(state)], strict=True)}
     results.reference_seconds = time.perf_counter() - t0
     systems = [p.fast for p in problems]
-    results.compile_seconds = fastpath.warm_up(systems) + fixedstep.warm_up(systems)
+    results.compile_seconds = fastpath.warm_up(systems) + fixedstep_runner.warm_up(systems)
     log(f"generated back ends compiled or loaded in {results.compile_seconds:.1f} s; sweeping")
     results.points = run_sweeps(problems, results.references, config, log)
     results.orders = order_fits(results.points)

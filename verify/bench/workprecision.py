@@ -46,7 +46,7 @@ import numpy as np
 from pendverify.bench import seed_problems
 from pendverify.bench.problems import Problem, ProblemSpec, build_problem
 from pendverify.bench.timing import measure
-from pendverify.numerics import fixedstep
+from pendverify.numerics import fixedstep, fixedstep_runner
 from pendverify.numerics.fastpath import integrate as fast_integrate
 from pendverify.numerics.reference import energy_errors
 
@@ -267,7 +267,7 @@ def fixed_sweep(
         point = Point(problem.key, method, "compiled", "fixed", h, problem.metric, steps=steps)
 
         def run(steps=steps):
-            return fixedstep.integrate_fixed(
+            return fixedstep_runner.integrate_fixed(
                 method, problem.fast, problem.x0, problem.duration, steps, steps // g
             )
 

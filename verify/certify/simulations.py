@@ -111,7 +111,7 @@ def run_battery_scene(scene, urdf: str, engine: str | None):
     try:
         with np.errstate(over="ignore", invalid="ignore"):  # a diverging run is judged by its items
             if compiled is not None:
-                run = fast_scene.simulate(scene, compiled)
+                run = fast_scene.simulate_compiled(scene, compiled)
                 return COMPILED, run, len(run.result.steps_t) - 1, ""
             run = run_scene(scene, "aba", urdf)
             return ABA, run, len(run.integration.steps_t) - 1, ""

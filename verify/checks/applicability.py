@@ -5,10 +5,13 @@ matrix C (a ``BiasOnlyModel`` gives only C·q̇); ``det`` and ``minverse`` need 
 hand-written det M and M⁻¹ (the interface's defaults derive them from M, by LU and by
 solving); ``damping`` needs a URDF that declares ``<dynamics damping>``.  Each
 ``requires`` function returns "" when its check applies, else the reason, which the
-report prints.  ``derived_notes`` says what the model left to the interface's defaults.
+report prints.  ``derived_notes`` says what the model left to the interface's defaults
+(what is derived, and how: ``pendverify.analytic.forms.INTERFACE``).
 """
 
 from __future__ import annotations
+
+from pendverify.analytic.forms import INTERFACE, STATES, TOLERANCE
 
 
 def needs_matrix_c(model, system) -> str:
@@ -25,24 +28,13 @@ def _class(model) -> type:
     return model if isinstance(model, type) else type(model)
 
 
-#: The quantities a model may leave to the interface's defaults: (method, name, how it is derived).
-DERIVED = {
-    "det_mass_matrix": ("det M", "from M (LU)"),
-    "inverse_mass_matrix": ("M⁻¹", "from M (solving with M)"),
-    "acceleration": ("q̈", "from M, C, H, D, B, W (M⁻¹(B u + W w − D q̇ − C q̇ − H))"),
-    "gravity_scale": ("the gravity scale", "from H (Σ|terms|)"),
-    "diagonal_scale": ("the inertia scale", "from M (Σ|terms| of M_ii)"),
-    "special_states": ("the special states", "(the zero state only)"),
-}
-
-
 def hand_written(method: str):
     """A ``requires``: the check compares a hand-written closed form, so a derived one is not run."""
 
     def requires(model, system) -> str:
         if method in _class(model).hand_written():
             return ""
-        what, how = DERIVED[method]
+        what, how = INTERFACE[method].derived
         return f"not run: {what} is derived {how}, not hand-written: nothing to check"
 
     return requires
@@ -67,9 +59,9 @@ def derived_notes(model) -> list[str]:
             "closed form of q̈; B and W are compared only by pendverify sympy"
         )
     derived = [
-        f"{what} {how}"
-        for method, (what, how) in DERIVED.items()
-        if method not in written and method in ("gravity_scale", "diagonal_scale", "special_states")
+        " ".join(method.derived)
+        for name, method in INTERFACE.items()
+        if method.kind in (TOLERANCE, STATES) and name not in written
     ]
     if derived:
         notes.append("derived, not hand-written: " + "; ".join(derived))

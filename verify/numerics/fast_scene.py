@@ -1,6 +1,6 @@
 """A scene run on the fast path: the compiled DOP853 of the model's generated back ends, with invariants.
 
-``simulate(scene)`` integrates any scene whose effects compile (τ = B (u0 − K x) − D q̇
+``simulate_compiled(scene)`` integrates any scene whose effects compile (τ = B (u0 − K x) − D q̇
 plus a sine input and seeded noise, ``pendverify.numerics.forcing``;
 ``GeneratedSystem.from_dynamics`` refuses the others with a ``FastPathError``) at the
 scene's rtol and atol, samples it at the scene's rate and checks the scene's invariants
@@ -52,7 +52,7 @@ def compile_scene(scene):
     return dyn, GeneratedSystem.from_dynamics(dyn, scene.source)
 
 
-def simulate(scene, compiled=None) -> FastRun:
+def simulate_compiled(scene, compiled=None) -> FastRun:
     """Run a scene with the compiled DOP853 (at the scene's rtol, atol) and check its invariants.
 
     Any model a scene names, seed or plug-in file: its module is generated on first use.

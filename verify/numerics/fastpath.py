@@ -37,7 +37,7 @@ chaotic pendulum over 2 s.
 
 The fast path is the model's closed form; that the closed form agrees with
 Pinocchio is what ``pendverify check`` establishes (ε-level, every check).
-``pendverify.numerics.fast_scene.simulate`` runs a scene — a reference system's or a plug-in
+``pendverify.numerics.fast_scene.simulate_compiled`` runs a scene — a reference system's or a plug-in
 model's — on the fast path and evaluates the *same* invariants as ``pendverify.simulation.simulate``
 (``pendverify.simulation.invariants``), on the fast path's own steps, with the same
 adaptive bound.
@@ -57,11 +57,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pendverify.errors import FastPathError
+from pendverify.numerics.codegen.cache import record_compiled
 from pendverify.numerics.dop853 import OK, STEP_TOO_SMALL
-from pendverify.numerics.generate import GeneratedSystem, record_compiled
+from pendverify.numerics.generate import GeneratedSystem, distinct_modules
 
-__all__ = ["FastPathError", "FastResult", "integrate", "integrate_ensemble", "warm_up"]
+__all__ = ["FastResult", "integrate", "integrate_ensemble", "warm_up"]
 
 
 # --- the Python side ---------------------------------------------------------------------
@@ -148,11 +148,3 @@ def warm_up(systems) -> float:
         integrate(system, np.append(x0, [0.0, 0.0]), 0.01, 1e-6, 1e-6)
         integrate_ensemble(system, np.tile(x0, (2, 1)), 0.01, 1e-6, 1e-6)
     return time.perf_counter() - start
-
-
-def distinct_modules(systems) -> list[GeneratedSystem]:
-    """The first of ``systems`` for each generated module (compilation is per module)."""
-    seen = {}
-    for system in systems:
-        seen.setdefault(id(system.module), system)
-    return list(seen.values())

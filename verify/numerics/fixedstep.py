@@ -5,7 +5,8 @@ same parameters, same force law τ = B (u0 − K x) − D q̇), compiled with nu
 that a million Euler steps cost milliseconds and the methods are compared on
 equal terms.  The functions below are templates (``numerics.codegen.templates``),
 copied into each model's generated module, where ``_run`` calls that model's
-``_rhs`` and ``_hamilton`` inlined; ``integrate_fixed`` runs the module's copy.
+``_rhs`` and ``_hamilton`` inlined; ``pendverify.numerics.fixedstep_runner.integrate_fixed``
+runs the module's copy.  This module holds the templates and their constants only.
 
 =====================  =====  ===========================================================
 method                 order  one step, h
@@ -35,14 +36,10 @@ marks the run as failed.  ``nfev`` counts evaluations of f or g.
 from __future__ import annotations
 
 import math
-import time
 
 import numpy as np
 
-from pendverify.errors import PendverifyError
 from pendverify.numerics.codegen.templates import placeholder, template
-from pendverify.numerics.fastpath import distinct_modules
-from pendverify.numerics.generate import GeneratedSystem, record_compiled
 
 METHODS = {"euler": 1, "symplectic_euler": 1, "implicit_midpoint": 2, "rk4": 4}
 MAX_ITERATIONS = 200
@@ -152,32 +149,5 @@ def _run(method, P, x0, h, steps, every):
     return out, nfev, status
 
 
-_IDS = {"euler": 0, "symplectic_euler": 1, "implicit_midpoint": 2, "rk4": 3}
-
-
-def integrate_fixed(method: str, system: GeneratedSystem, x0, duration: float, steps: int, every: int = 1):
-    """States (q, q̇) at t = k·every·h, h = duration / steps; plus nfev and whether it succeeded.
-
-    ``steps`` must be a multiple of ``every``.  A failed run (an implicit step
-    that did not converge, or a non-finite state) returns ok = False.
-    """
-    if method not in _IDS:
-        raise ValueError(f"unknown fixed-step method {method!r}; expected one of {', '.join(_IDS)}")
-    if steps % every:
-        raise ValueError(f"steps ({steps}) must be a multiple of every ({every})")
-    if system.forcing:
-        raise PendverifyError(f"{system.model}: the fixed-step methods integrate a time-invariant force law")
-    x0 = np.ascontiguousarray(x0, dtype=float)
-    run = system.kernel.module._run
-    out, nfev, status = run(_IDS[method], system.packed(), x0, duration / steps, steps, every)
-    record_compiled()  # numba's files of a first call go into the cache's signed record
-    return out, int(nfev), status == OK
-
-
-def warm_up(systems) -> float:
-    """Compile (or load from numba's cache) the fixed-step methods of each distinct generated module
-    among ``systems`` (``GeneratedSystem``s); the seconds it took."""
-    start = time.perf_counter()
-    for system in distinct_modules(systems):
-        integrate_fixed("rk4", system, np.full(2 * system.nv, 0.1), 0.01, 2)
-    return time.perf_counter() - start
+#: the id ``_run`` takes for each method
+METHOD_IDS = {"euler": 0, "symplectic_euler": 1, "implicit_midpoint": 2, "rk4": 3}

@@ -1,6 +1,6 @@
 """Every numeric back end generated from the model: the model is the one source.
 
-What is generated.  For a model class with n coordinates, ``pendverify.symbolic.model``
+What is generated.  For a model class with n coordinates, ``pendverify.analytic.symbolic_reading``
 reads its closed forms as SymPy expressions (the model's own code, called with
 symbols for q, q̇ and the parameters): M(q) from ``mass_matrix``, the bias
 C(q, q̇)·q̇ + H(q) from ``bias`` (the interface's ``coriolis_matrix @ v + gravity``,
@@ -56,32 +56,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from pendverify.errors import FastPathError, PendverifyError
-from pendverify.numerics.codegen.cache import (
-    GeneratedKernel,
-    cache_dir,
-    forget,
-    kernel,
-    model_key,
-    record_compiled,
-)
-from pendverify.numerics.codegen.expressions import Expressions, expressions
-from pendverify.numerics.codegen.module import GENERATOR, render
+from pendverify.numerics.codegen.cache import GeneratedKernel, kernel
 from pendverify.numerics.forcing import NO_FORCING, Forcing, forcing_of
-
-__all__ = [
-    "GENERATOR",
-    "Expressions",
-    "Forcing",
-    "GeneratedKernel",
-    "GeneratedSystem",
-    "cache_dir",
-    "expressions",
-    "forget",
-    "kernel",
-    "model_key",
-    "record_compiled",
-    "render",
-]
 
 HEADER = 2  # P[0] = n, P[1] = nu
 #: V_min search: grid points over the angles (a full grid up to this many, else random)
@@ -267,3 +243,11 @@ class GeneratedSystem:
             if np.isfinite(res.fun):
                 values.append(float(res.fun))
         return min(values)
+
+
+def distinct_modules(systems) -> list[GeneratedSystem]:
+    """The first of ``systems`` for each generated module (compilation is per module)."""
+    seen = {}
+    for system in systems:
+        seen.setdefault(id(system.module), system)
+    return list(seen.values())

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from pendverify.analytic.plugin import where
+from pendverify.analytic.source_file import where
 from pendverify.errors import PendverifyError, UrdfShapeError
 from pendverify.robot.coordinates import CoordinateMap
 from pendverify.robot.geometry import UrdfGeometry

@@ -5,7 +5,7 @@ pivot written into both the URDF and the formulas); the energies written from
 the model's stated conventions are a third, independent account.  Each closed
 form is compared with its derivation (``pendverify.symbolic.lagrange``) entry by entry,
 each entry passing when ``simplify(hand − derived) == 0`` (decided exactly by
-``pendverify.symbolic.model.is_zero``):
+``pendverify.symbolic.zero_test.is_zero``):
 
 =============================  =============================================
 closed form                    compared with
@@ -38,12 +38,13 @@ from dataclasses import dataclass, field
 import sympy as sp
 
 from pendverify.analytic import ClosedFormModel
-from pendverify.analytic.plugin import where
+from pendverify.analytic.source_file import where
+from pendverify.analytic.symbolic_reading import SymbolicModel, entries, to_sympy
 from pendverify.checks.verdict import CHRISTOFFEL_CONSISTENT, NON_CHRISTOFFEL
 from pendverify.errors import PendverifyError
 from pendverify.symbolic.lagrange import Lagrangian, derive, mass_matrix_rate
-from pendverify.symbolic.model import SymbolicModel, entries, is_zero, show, to_sympy
 from pendverify.symbolic.work import check_symbolic_work
+from pendverify.symbolic.zero_test import is_zero, show
 
 EQUAL, DIFFERS, WARNING, SKIPPED = "equal", "DIFFERS", "warning", "skipped"
 

@@ -2,7 +2,7 @@
 
 A mutant (``pendverify.symbolic.mutants``) replaces some entries e of a closed form
 by e'.  It is equivalent when every difference e' − e is zero
-(``pendverify.symbolic.model.is_zero``), with two refinements:
+(``pendverify.symbolic.zero_test.is_zero``), with two refinements:
 
 * V matters up to a constant: for ``potential_energy`` the differences compared are
   the gradients ∂(V' − V)/∂q_k.
@@ -17,12 +17,17 @@ as rationals of their decimal repr) is reported as equivalent *for these paramet
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import sympy as sp
 
 from pendverify.checks.verdict import CHRISTOFFEL_CONSISTENT, NON_CHRISTOFFEL
 from pendverify.symbolic.lagrange import mass_matrix_rate
-from pendverify.symbolic.model import SymbolicModel, is_zero, probe
-from pendverify.symbolic.mutants import Mutant
+from pendverify.symbolic.zero_test import is_zero, probe
+
+if TYPE_CHECKING:
+    from pendverify.analytic.symbolic_reading import SymbolicModel
+    from pendverify.symbolic.mutants import Mutant
 
 
 def coriolis_equivalence(sm: SymbolicModel, mutant: Mutant) -> str | None:

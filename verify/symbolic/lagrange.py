@@ -20,13 +20,17 @@ q̇ and (u, w)) are rejected with a message naming the model.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import sympy as sp
 
 from pendverify.analytic.forms import Energies
-from pendverify.analytic.plugin import where
+from pendverify.analytic.source_file import where
 from pendverify.errors import PendverifyError
-from pendverify.symbolic.model import SymbolicModel, canonical, is_zero
+from pendverify.symbolic.zero_test import canonical, is_zero
+
+if TYPE_CHECKING:
+    from pendverify.analytic.symbolic_reading import SymbolicModel
 
 
 @dataclass

@@ -1,7 +1,7 @@
 """Single-term mutants of a closed-form model, made on its SymPy expression trees.
 
 Each closed form the model declares (``closed_forms``) is read as SymPy
-expressions (``pendverify.symbolic.model``), one per matrix entry, and each mutant
+expressions (``pendverify.analytic.symbolic_reading``), one per matrix entry, and each mutant
 changes one thing in one entry:
 
 =========  ==========================================================================
@@ -31,7 +31,7 @@ from itertools import combinations
 
 import sympy as sp
 
-from pendverify.symbolic.model import SymbolicModel, entries
+from pendverify.analytic.symbolic_reading import SymbolicModel, entries
 
 SCALE = sp.Rational(1001, 1000)
 OPERATORS = ("sign", "drop", "scale", "sin↔cos", "swap θ", "swap θ̇", "move")

@@ -39,14 +39,15 @@ import time
 import numpy as np
 import sympy as sp
 
+from pendverify.analytic.symbolic_reading import SymbolicModel, entries
 from pendverify.checks.catalogue import CHECKS, applicable_checks, run_check
 from pendverify.checks.sampling import sample_states
 from pendverify.errors import PendverifyError, UnknownNameError
 from pendverify.progress import bar
 from pendverify.symbolic.equivalence import coriolis_equivalence, differences, equivalence
-from pendverify.symbolic.model import SymbolicModel, entries, show
 from pendverify.symbolic.mutants import Mutant, generate, is_coriolis_form
 from pendverify.symbolic.mutation_report import DETECTED, EQUIVALENT, SURVIVED, MutationReport, Outcome
+from pendverify.symbolic.zero_test import show
 
 FIRST_RANDOM = 4  # random states in the first round, after the special ones
 #: |mutant − original| / (|original| + 1) above this at a sampled state cannot be rounding
@@ -88,7 +89,7 @@ def numeric_model(model, sm: SymbolicModel, method: str, changes):
     mutant = type(f"{cls.__name__}Mutant", (cls,), {method: mutated})(model.params)
     if {"gravity_scale", "diagonal_scale"} - set(cls.hand_written()):
         # derived tolerance scales stay the original's, as hand-written ones would
-        mutant.__dict__["_derived_scales_cache"] = model._derived_scales()
+        mutant.use_derived_scales(model.derived_scales())
     return mutant
 
 

@@ -14,13 +14,17 @@ with one line naming the estimate and the limit.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import sympy as sp
 
-from pendverify.analytic.plugin import where
+from pendverify.analytic.source_file import where
 from pendverify.errors import InputError
 from pendverify.simulation.limits import environment_limit
 from pendverify.symbolic.lagrange import energies_of
-from pendverify.symbolic.model import SymbolicModel
+
+if TYPE_CHECKING:
+    from pendverify.analytic.symbolic_reading import SymbolicModel
 
 MAX_SYMBOLIC_VARIABLE = "PENDVERIFY_MAX_SYMBOLIC"
 DEFAULT_MAX_SYMBOLIC = 20_000

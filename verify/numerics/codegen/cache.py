@@ -46,7 +46,12 @@ from pendverify.numerics.codegen import folder, numba_files, signed
 from pendverify.numerics.codegen import module as _module
 
 #: the modules the generated source depends on besides the model's own
-SOURCES = ("pendverify.symbolic.model", "pendverify.numerics.dop853", "pendverify.numerics.fixedstep")
+SOURCES = (
+    "pendverify.analytic.symbolic_reading",
+    "pendverify.symbolic.zero_test",
+    "pendverify.numerics.dop853",
+    "pendverify.numerics.fixedstep",
+)
 
 
 def cache_dir() -> Path:

@@ -19,8 +19,9 @@ cancels the shared terms (``expressions.momentum_rate``).
 
 ``_to_momentum(P, x, y)``: y = (q, M(q) q̇).
 
-``_hamilton`` has no time argument: it leaves the forcing out (``fixedstep``, its only
-caller, refuses a system with forcing).
+``_hamilton`` has no time argument: it leaves the forcing out (its only caller is the
+fixed-step methods of ``fixedstep``, and ``fixedstep_runner.integrate_fixed`` refuses a
+system with forcing).
 
 All three read the packed array P (layout in ``pendverify.numerics.generate``).
 """

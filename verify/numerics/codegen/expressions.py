@@ -33,8 +33,9 @@ def expressions(model_cls) -> Expressions:
     # deferred on purpose: SymPy loads only when a model is generated, not when its module is cached
     import sympy as sp
 
-    from pendverify.analytic.plugin import where
-    from pendverify.symbolic.model import SymbolicModel, is_zero
+    from pendverify.analytic.source_file import where
+    from pendverify.analytic.symbolic_reading import SymbolicModel
+    from pendverify.symbolic.zero_test import is_zero
 
     sm = SymbolicModel.of(model_cls)
     n = len(model_cls.coordinates)

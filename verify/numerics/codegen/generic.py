@@ -29,11 +29,14 @@ from __future__ import annotations
 
 import hashlib
 import inspect
+from typing import TYPE_CHECKING
 
 from pendverify.numerics.codegen.compiled import lower
-from pendverify.numerics.codegen.expressions import Expressions
 from pendverify.numerics.codegen.ldlt import ldlt_lines
 from pendverify.numerics.codegen.printers import Unsupported, generic_printer
+
+if TYPE_CHECKING:
+    from pendverify.numerics.codegen.expressions import Expressions
 
 
 def _force(p, x, n):

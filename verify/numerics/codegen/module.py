@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from pendverify.numerics.codegen.compiled import render_hamilton, render_rhs, render_to_momentum
-from pendverify.numerics.codegen.expressions import Expressions
 from pendverify.numerics.codegen.generic import render_generic
+
+if TYPE_CHECKING:
+    from pendverify.numerics.codegen.expressions import Expressions
 
 GENERATOR = "gen-3"  # bump when the generated code changes meaning
 

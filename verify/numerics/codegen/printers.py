@@ -109,23 +109,12 @@ def generic_printer():
         def _print_Function(self, expr):
             raise Unsupported(f"the function {expr.func.__name__}")
 
+        # the functions the base printer would print but the generic code cannot hold
+        _print_Abs = _print_Max = _print_Min = _print_sign = _print_Piecewise = _print_Function
+        _print_sqrt = _print_exp = _print_log = _print_Function
+        _print_sin = _print_cos = _print_tan = _print_atan2 = _print_Function
+
         def emptyPrinter(self, expr):
             raise Unsupported(f"{type(expr).__name__} {expr}")
 
-    printer = Printer({"standard": "python3"})
-    for name in (
-        "Abs",
-        "Max",
-        "Min",
-        "sign",
-        "Piecewise",
-        "sqrt",
-        "exp",
-        "log",
-        "sin",
-        "cos",
-        "tan",
-        "atan2",
-    ):
-        setattr(printer, f"_print_{name}", printer._print_Function)
-    return printer
+    return Printer({"standard": "python3"})

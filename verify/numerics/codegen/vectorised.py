@@ -129,8 +129,8 @@ def render(model_cls) -> str:
     """The module of ``model_cls``'s generated closed forms (see the module docstring)."""
     from sympy.printing.codeprinter import PrintMethodNotImplementedError
 
+    from pendverify.analytic.symbolic_reading import SymbolicModel
     from pendverify.errors import PendverifyError
-    from pendverify.symbolic.model import SymbolicModel
 
     written = own_methods(model_cls)
     functions: list[str] = []

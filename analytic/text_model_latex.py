@@ -13,7 +13,8 @@ from __future__ import annotations
 
 import sympy as sp
 
-from pendverify.analytic.latex_parse import LatexError, LatexReader, SymbolTable, canonical_symbol
+from pendverify.analytic.latex_normalise import canonical_symbol
+from pendverify.analytic.latex_parse import LatexError, LatexReader, SymbolTable
 from pendverify.display import shortened
 
 

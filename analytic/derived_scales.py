@@ -3,7 +3,7 @@
 ``gravity_scale`` bounds |H_i(q)| over all q and ``diagonal_scale`` is the size of
 the terms of M_ii (``pendverify.checks.catalogue``).  A model that does not write
 them gets them from its closed forms, read as SymPy expressions
-(``pendverify.symbolic.model.SymbolicModel``): each entry is expanded with the
+(``pendverify.analytic.symbolic_reading.SymbolicModel``): each entry is expanded with the
 parameters as symbols (so that terms that cancel stay separate, m1 r1 cos θ1 −
 m2 l1 cos θ1 counts |m1 r1| + |m2 l1|), every sin and cos is replaced by its
 bound 1, and the |terms| are summed and evaluated at the parameter values.
@@ -22,8 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
+from pendverify.analytic.symbolic_reading import SymbolicModel
 from pendverify.errors import PendverifyError
-from pendverify.symbolic.model import SymbolicModel
 
 
 def term_bound(expr) -> sp.Expr:
@@ -81,7 +81,7 @@ def _class_bounds(cls) -> _ClassBounds:
 
 @dataclass
 class DerivedScales:
-    """The derived scales of one model instance (``ClosedFormModel._derived_scales``)."""
+    """The derived scales of one model instance (``ClosedFormModel.derived_scales``)."""
 
     model: object
     bounds: _ClassBounds

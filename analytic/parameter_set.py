@@ -1,0 +1,135 @@
+"""Parameter sets: frozen dataclasses of physical quantities, validated at construction.
+
+Each model declares its parameters as dataclass fields whose metadata names the
+*kind* of quantity.  The kind fixes the unit and the rule a value must satisfy:
+
+========  ===========================  =========
+kind      rule                         unit
+========  ===========================  =========
+mass      finite and > 0               kg
+length    finite and > 0               m
+offset    finite and >= 0              m
+inertia   finite and >= 0              kg·m²
+damping   finite and >= 0              N·m·s/rad (revolute), N·s/m (prismatic)
+gravity   finite and >= 0              m/s²
+========  ===========================  =========
+
+A bad value raises a ParameterError naming the key, the value and the rule; the files
+that hold parameter sets are read by ``pendverify.analytic.params``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any, ClassVar, TypeVar
+
+from pendverify.errors import ParameterError
+
+#: kind → (the comparison with 0 a value must satisfy, the unit)
+KIND_RULES: dict[str, tuple[str, str]] = {
+    "mass": ("> 0", "kg"),
+    "length": ("> 0", "m"),
+    "offset": (">= 0", "m"),
+    "inertia": (">= 0", "kg·m²"),
+    "damping": (">= 0", "N·m·s/rad or N·s/m"),
+    "gravity": (">= 0", "m/s²"),
+}
+
+
+def quantity(kind: str, doc: str) -> Any:
+    """A dataclass field holding one physical quantity of the given kind."""
+    if kind not in KIND_RULES:
+        raise ValueError(f"unknown quantity kind {kind!r}")
+    return dataclasses.field(metadata={"kind": kind, "doc": doc})
+
+
+def _rule_text(kind: str) -> str:
+    comparison, unit = KIND_RULES[kind]
+    article = "an" if kind[0] in "aeiou" else "a"
+    return f"{article} {kind} must be a finite number {comparison} (in {unit})"
+
+
+def check_value(source: str, key: str, value: object, kind: str) -> float:
+    """Return ``value`` as a float, or raise a ParameterError naming the rule."""
+    rule = _rule_text(kind)
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ParameterError(source, key, value, rule + f"; got a {type(value).__name__}")
+    try:
+        x = float(value)
+    except OverflowError:  # a TOML integer beyond a double
+        x = math.inf
+    if not math.isfinite(x):
+        raise ParameterError(source, key, value, rule)
+    strict = KIND_RULES[kind][0] == "> 0"
+    if (strict and not x > 0) or (not strict and not x >= 0):
+        raise ParameterError(source, key, value, rule)
+    return x
+
+
+P = TypeVar("P", bound="ParameterSet")
+
+
+@dataclasses.dataclass(frozen=True)
+class ParameterSet:
+    """Base of every model's parameter set; validates all fields on construction."""
+
+    model: ClassVar[str] = ""
+
+    def __post_init__(self) -> None:
+        for f in dataclasses.fields(self):
+            value = check_value(
+                f"<{self.model} parameters>", f.name, getattr(self, f.name), f.metadata["kind"]
+            )
+            object.__setattr__(self, f.name, value)
+
+    @classmethod
+    def keys(cls) -> tuple[str, ...]:
+        return tuple(f.name for f in dataclasses.fields(cls))
+
+    @classmethod
+    def from_mapping(cls: type[P], data: dict[str, Any], source: str = "<inline>", prefix: str = "") -> P:
+        """Build a set from a mapping, rejecting unknown and missing keys."""
+        known = cls.keys()
+        for key, value in data.items():
+            if key not in known:
+                raise ParameterError(
+                    source,
+                    prefix + key,
+                    value,
+                    f"unknown key; the {cls.model} parameters are {', '.join(known)}",
+                )
+        values = {}
+        for f in dataclasses.fields(cls):
+            if f.name not in data:
+                raise ParameterError(source, prefix + f.name, None, f"missing key ({f.metadata['doc']})")
+            values[f.name] = check_value(source, prefix + f.name, data[f.name], f.metadata["kind"])
+        try:
+            return cls(**values)
+        except ParameterError as exc:  # a rule across fields: name the file
+            raise ParameterError(source, prefix + exc.key, exc.value, exc.rule) from None
+        except OverflowError:  # a rule across fields computed x**2 beyond a double
+            key = max(values, key=lambda k: abs(values[k]))
+            raise ParameterError(
+                source,
+                prefix + key,
+                values[key],
+                f"too large: the {cls.model} terms built from it overflow a double",
+            ) from None
+
+    def as_dict(self) -> dict[str, float]:
+        return dataclasses.asdict(self)
+
+    def replace(self: P, **changes: float) -> P:
+        return dataclasses.replace(self, **changes)
+
+    def to_toml(self, name: str = "") -> str:
+        """The set as a parameter file that ``load_parameter_file`` reads back exactly."""
+        lines = [f'model = "{self.model}"']
+        if name:
+            lines.append(f'name = "{name}"')
+        lines.append("")
+        lines.append("[parameters]")
+        for f in dataclasses.fields(self):
+            lines.append(f"{f.name} = {getattr(self, f.name)!r}  # {f.metadata['doc']}")
+        return "\n".join(lines) + "\n"

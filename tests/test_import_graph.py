@@ -1,0 +1,201 @@
+"""The installed package ``pendverify`` imports without cycles, and its code reads no bytecode or frames.
+
+The import graph is read from the source files with ``ast``, nothing is imported to
+build it: every ``import`` and ``from … import`` of a pendverify module counts, at
+module level or inside a function, except those under ``if TYPE_CHECKING:`` (type
+annotations only).  ``from pkg import name`` imports the submodule ``pkg.name`` when
+there is one, else ``pkg`` itself; ``import a.b.c`` imports ``a.b.c`` (the nearest
+module that exists).  A cycle is a strongly connected component of more than one
+module.  The modules are those of every package pyproject.toml lists, each found where
+it is installed (``importlib.util.find_spec``: the package-dir mapping puts
+``pendverify.analytic`` in analytic/, ``pendverify`` in verify/, ...).
+"""
+
+from __future__ import annotations
+
+import ast
+import importlib.util
+import sys
+from pathlib import Path
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - exercised on Python 3.10 only
+    import tomli as tomllib
+
+REPO = Path(__file__).resolve().parents[1]
+
+#: what code that reads bytecode or the call stack contains
+INTROSPECTION = ("_getframe", "co_code", "dis.", "__code__", "f_back")
+
+
+def package_names() -> list[str]:
+    """The packages of the distribution, as pyproject.toml lists them."""
+    data = tomllib.loads((REPO / "pyproject.toml").read_text(encoding="utf-8"))
+    return list(data["tool"]["setuptools"]["packages"])
+
+
+def installed_modules() -> dict[str, Path]:
+    """{dotted module name: its source file} for every module of every package, as installed."""
+    modules = {}
+    for package in package_names():
+        spec = importlib.util.find_spec(package)
+        assert spec is not None and spec.submodule_search_locations, f"{package} is not installed"
+        for location in spec.submodule_search_locations:
+            for path in sorted(Path(location).glob("*.py")):
+                name = package if path.stem == "__init__" else f"{package}.{path.stem}"
+                modules[name] = path
+    return modules
+
+
+def _type_checking_only(tree: ast.Module) -> set[int]:
+    """The ids of the nodes under ``if TYPE_CHECKING:`` (its body, not its else)."""
+    skipped = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.If):
+            test = node.test
+            name = test.id if isinstance(test, ast.Name) else getattr(test, "attr", "")
+            if name == "TYPE_CHECKING":
+                for statement in node.body:
+                    skipped.update(id(n) for n in ast.walk(statement))
+    return skipped
+
+
+def imported_modules(name: str, path: Path, modules: dict[str, Path]) -> set[str]:
+    """The modules among ``modules`` that module ``name`` (source file ``path``) imports."""
+
+    def known(target: str) -> str | None:
+        while target and target not in modules:
+            target = target.rpartition(".")[0]
+        return target or None
+
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    skipped = _type_checking_only(tree)
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    found = set()
+    for node in ast.walk(tree):
+        if id(node) in skipped:
+            continue
+        targets = []
+        if isinstance(node, ast.Import):
+            targets = [alias.name for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                parent = package
+                for _ in range(node.level - 1):
+                    parent = parent.rpartition(".")[0]
+                base = f"{parent}.{base}" if base else parent
+            targets = [f"{base}.{a.name}" if f"{base}.{a.name}" in modules else base for a in node.names]
+        for target in targets:
+            module = known(target)
+            if module is not None and module != name:
+                found.add(module)
+    return found
+
+
+def import_graph(modules: dict[str, Path]) -> dict[str, set[str]]:
+    return {name: imported_modules(name, path, modules) for name, path in modules.items()}
+
+
+def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected components of more than one module, each sorted (Tarjan, iterative)."""
+    index, low, on_stack, stack, found = {}, {}, set(), [], []
+    counter = 0
+    for root in sorted(graph):
+        if root in index:
+            continue
+        work = [(root, iter(sorted(graph[root])))]
+        index[root] = low[root] = counter
+        counter += 1
+        stack.append(root)
+        on_stack.add(root)
+        while work:
+            node, edges = work[-1]
+            advanced = False
+            for nxt in edges:
+                if nxt not in graph:
+                    continue
+                if nxt not in index:
+                    index[nxt] = low[nxt] = counter
+                    counter += 1
+                    stack.append(nxt)
+                    on_stack.add(nxt)
+                    work.append((nxt, iter(sorted(graph[nxt]))))
+                    advanced = True
+                    break
+                if nxt in on_stack:
+                    low[node] = min(low[node], index[nxt])
+            if advanced:
+                continue
+            work.pop()
+            if work:
+                low[work[-1][0]] = min(low[work[-1][0]], low[node])
+            if low[node] == index[node]:
+                component = []
+                while True:
+                    member = stack.pop()
+                    on_stack.discard(member)
+                    component.append(member)
+                    if member == node:
+                        break
+                if len(component) > 1:
+                    found.append(sorted(component))
+    return sorted(found)
+
+
+# --- the finder itself ---------------------------------------------------------------------------
+def test_the_finder_reports_a_planted_cycle_and_nothing_else():
+    graph = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a", "e"}, "e": set(), "f": {"f"}}
+    assert cycles(graph) == [["a", "b", "c"]]
+    assert cycles({"a": {"b"}, "b": set()}) == []
+    assert cycles({"x": {"y"}, "y": {"x"}, "p": {"q"}, "q": {"r"}, "r": {"p", "x"}}) == [
+        ["p", "q", "r"],
+        ["x", "y"],
+    ]
+
+
+def test_the_graph_reads_deferred_and_submodule_imports_and_skips_type_checking_ones(tmp_path):
+    sources = {
+        "pkg/__init__.py": "",
+        "pkg/low.py": "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from pkg.high import High\n",
+        "pkg/high.py": "def f():\n    from pkg import low\n    return low\n",
+        "pkg/a.py": "from . import b\n",
+        "pkg/b.py": "import pkg.a.missing_name\n",
+    }
+    modules = {}
+    for relative, text in sources.items():
+        path = tmp_path / relative
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text)
+        stem = Path(relative).stem
+        modules["pkg" if stem == "__init__" else f"pkg.{stem}"] = path
+    graph = import_graph(modules)
+    assert graph["pkg.high"] == {"pkg.low"}  # inside a function, and `from pkg import low` is the submodule
+    assert graph["pkg.low"] == set()  # under TYPE_CHECKING: not an import at run time
+    assert cycles(graph) == [["pkg.a", "pkg.b"]]  # a relative import and a dotted one close a cycle
+
+
+# --- the package ------------------------------------------------------------------------------------
+def test_every_package_is_found_where_it_is_installed():
+    modules = installed_modules()
+    for name in ("pendverify", "pendverify.analytic.interface", "pendverify.numerics.codegen.cache"):
+        assert name in modules
+    assert modules["pendverify.analytic.interface"].name == "interface.py"
+
+
+def test_pendverify_imports_without_cycles():
+    found = cycles(import_graph(installed_modules()))
+    assert not found, "import cycles, each among the modules of one line:\n" + "\n".join(
+        ", ".join(c) for c in found
+    )
+
+
+def test_no_code_reads_bytecode_or_frames():
+    hits = []
+    for folder in ("verify", "analytic", "viz"):
+        for path in sorted((REPO / folder).rglob("*.py")):
+            relative = path.relative_to(REPO).as_posix()
+            for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+                hits += [f"{relative}:{number}: {word}" for word in INTROSPECTION if word in line]
+    assert not hits, "bytecode or frame introspection:\n" + "\n".join(hits)
