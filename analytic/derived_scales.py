@@ -106,13 +106,19 @@ class DerivedScales:
         return self._gravity
 
     def diagonal(self, q) -> np.ndarray:
+        """S at configuration q (n,)."""
+        return self.diagonal_at(np.asarray(q, dtype=float)[None])[0]
+
+    def diagonal_at(self, Q) -> np.ndarray:
+        """S at each configuration of Q (N, n), as (N, n): the bounds evaluated on arrays at once."""
+        Q = np.asarray(Q, dtype=float)
         if self.bounds.diagonal is None:
-            return np.abs(np.diag(np.asarray(self.model.mass_matrix(q), dtype=float)))
-        if self.bounds.diagonal_uses_q:
-            q = np.asarray(q, dtype=float)
-            return np.asarray(self.bounds.diagonal(list(q), self.values), dtype=float).reshape(-1)
-        if self._diagonal is None:
-            self._diagonal = np.asarray(
-                self.bounds.diagonal([0.0] * self.model.nv, self.values), dtype=float
-            ).reshape(-1)
-        return self._diagonal
+            return np.array([np.abs(np.diag(np.asarray(self.model.mass_matrix(q), dtype=float))) for q in Q])
+        if self._diagonal is None or self.bounds.diagonal_uses_q:
+            at = list(Q.T) if self.bounds.diagonal_uses_q else [0.0] * self.model.nv
+            entries = self.bounds.diagonal(at, self.values)
+            S = np.stack([np.broadcast_to(np.asarray(e, dtype=float), (len(Q),)) for e in entries], axis=-1)
+            if self.bounds.diagonal_uses_q:
+                return S
+            self._diagonal = S[0]
+        return np.broadcast_to(self._diagonal, Q.shape).copy()

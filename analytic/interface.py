@@ -256,15 +256,20 @@ class ClosedFormModel(metaclass=ModelClass):
         A method counts as hand-written when the class, or a base that is a real
         model, defines it; the interface's own defaults (``ClosedFormModel``,
         ``BiasOnlyModel``) are derived, and the checks do not count them as evidence.
+        The compositions (the bias and T) are not listed: a model that writes its own is
+        evaluated as written (``own_methods``), but it is no closed form of its own.
         """
-        written = []
-        for name, method in INTERFACE.items():
-            if method.kind == COMPOSED:  # bias and T: composed from the others, never the model's own
-                continue
+        return tuple(name for name in cls.own_methods() if INTERFACE[name].kind != COMPOSED)
+
+    @classmethod
+    def own_methods(cls) -> tuple[str, ...]:
+        """Every interface method the class, or a base that is a real model, defines, in order."""
+        own = []
+        for name in INTERFACE:
             owner = next((k for k in cls.__mro__ if name in vars(k)), None)
             if owner is not None and owner not in _INTERFACE_CLASSES:
-                written.append(name)
-        return tuple(written)
+                own.append(name)
+        return tuple(own)
 
     @classmethod
     def written_closed_forms(cls) -> dict[str, ClosedForm]:

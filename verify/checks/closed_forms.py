@@ -11,8 +11,8 @@ batch axis first (``constant(name)`` for a method without arguments).  How:
   which and why, and the report names them;
 * a method the model leaves to the interface is formed from the batch of its parts as
   ``ClosedFormModel`` forms it: the bias C q̇ + H (or C·q̇ + H), T = ½ q̇ᵀ M q̇, det M by LU,
-  M⁻¹ by solving with M, q̈ = M⁻¹ (B u + W w − D q̇ − bias); the derived tolerance scales
-  are the model's own (``ClosedFormModel.diagonal_scale``, ``gravity_scale``).
+  M⁻¹ by solving with M, q̈ = M⁻¹ (B u + W w − D q̇ − bias); the derived inertia scale
+  from the bounds of M's terms at all states at once (``DerivedScales.diagonal_at``).
 
 A generated function is compared with the model's own Python at the first state before it
 is used: the generated code is SymPy's arrangement of the same formulas, so the two agree
@@ -32,7 +32,7 @@ import numpy as np
 
 from pendverify.analytic.interface import BiasOnlyModel
 from pendverify.checks.scaling import mv
-from pendverify.numerics.codegen.vectorised import METHODS, generated, own_methods
+from pendverify.numerics.codegen.vectorised import METHODS, generated
 
 #: generated and own code differ by more than this fraction of the largest entry: not the same code
 AGREEMENT = 1e-6
@@ -44,7 +44,7 @@ class ClosedForms:
     def __init__(self, model, Q, V, U, W, python_only: bool = False):
         self.model, self.n = model, len(Q)
         self.arrays = {"q": Q, "v": V, "u": U, "w": W}
-        self.written = set(own_methods(type(model)))
+        self.written = set(type(model).own_methods())
         self.python_only = python_only
         self._values: dict[str, np.ndarray] = {}
         self._constants: dict[tuple, object] = {}
@@ -83,7 +83,9 @@ class ClosedForms:
         }
         if name in derived:
             return derived[name]()
-        return self._python(name)  # the interface's own defaults (the derived scales)
+        if name == "diagonal_scale":  # derived from M's terms, evaluated on all states at once
+            return self.model.derived_scales().diagonal_at(self.arrays["q"])
+        return self._python(name)
 
     def _written(self, name: str) -> np.ndarray:
         own = np.asarray(self._call(name, 0), dtype=float)
@@ -108,7 +110,7 @@ class ClosedForms:
         return values
 
     def _call(self, name: str, i: int):
-        args = METHODS.get(name, "q")
+        args = METHODS[name]
         return getattr(self.model, name)(*(self.arrays[a][i] for a in args))
 
     def _python(self, name: str, first=None) -> np.ndarray:
@@ -117,7 +119,7 @@ class ClosedForms:
             first = np.asarray(self._call(name, 0), dtype=float)
         out = np.empty((self.n, *first.shape))
         out[0] = first
-        if METHODS.get(name, "q") == "":
+        if METHODS[name] == "":
             out[1:] = first
             return out
         for i in range(1, self.n):

@@ -1,6 +1,6 @@
 """A model class's hand-written closed forms as NumPy functions over a batch of states.
 
-Each closed form the class writes itself (``own_methods``: M, C or C·q̇, H, V, D, B, W,
+Each closed form the class writes itself (``ClosedFormModel.own_methods``: M, C or C·q̇, H, V, D, B, W,
 det M, M⁻¹, q̈, the tolerance scales, the bias and T when written) is read as SymPy
 expressions by ``SymbolicModel`` — the model's own code called with symbols for q, q̇, u, w
 and the parameters — its common subexpressions are eliminated (``sympy.cse``) and it is
@@ -37,37 +37,12 @@ from __future__ import annotations
 import dataclasses
 import types
 
-#: the methods that may be generated, each with its arguments from the state (q, q̇, u, w)
-METHODS = {
-    "mass_matrix": "q",
-    "coriolis_matrix": "qv",
-    "coriolis_force": "qv",
-    "gravity": "q",
-    "potential_energy": "q",
-    "damping_matrix": "",
-    "input_matrix": "",
-    "disturbance_matrix": "",
-    "det_mass_matrix": "q",
-    "inverse_mass_matrix": "q",
-    "acceleration": "qvuw",
-    "diagonal_scale": "q",
-    "gravity_scale": "",
-    "bias": "qv",
-    "kinetic_energy": "qv",
-}
+from pendverify.analytic.forms import INTERFACE, STATES
+
+#: the methods that may be generated (every one of the interface but the special states),
+#: each with its arguments from the state (q, q̇, u, w)
+METHODS = {name: method.args for name, method in INTERFACE.items() if method.kind != STATES}
 GENERATOR = "vectorised-1"  # bump when the generated code changes meaning
-
-
-def own_methods(model_cls) -> tuple[str, ...]:
-    """The methods of ``METHODS`` that ``model_cls`` (or a base that is a real model) writes itself."""
-    from pendverify.analytic.interface import BiasOnlyModel, ClosedFormModel
-
-    own = []
-    for name in METHODS:
-        owner = next((k for k in model_cls.__mro__ if name in vars(k)), None)
-        if owner is not None and owner not in (ClosedFormModel, BiasOnlyModel):
-            own.append(name)
-    return tuple(own)
 
 
 def _printer():
@@ -132,7 +107,7 @@ def render(model_cls) -> str:
     from pendverify.analytic.symbolic_reading import SymbolicModel
     from pendverify.errors import PendverifyError
 
-    written = own_methods(model_cls)
+    written = [m for m in model_cls.own_methods() if m in METHODS]
     functions: list[str] = []
     generated: list[str] = []
     missing: dict[str, str] = {}
