@@ -1,4 +1,7 @@
-"""SymPy printers: scalar numba code (floats), and generic code whose numbers go through ``N``.
+"""SymPy printers: NumPy code over arrays, scalar numba code (floats), and generic code whose
+numbers go through ``N``.
+
+NumPy (``numpy_printer``): SymPy's own NumPy printer, numbers written exactly (``ExactNumbers``).
 
 Numba (``numba_printer``): floats as exact ``repr`` literals, rationals as the
 correctly rounded p/q, small integer powers as products, ``math.sqrt`` for ½ powers.
@@ -41,17 +44,32 @@ def _power(printer, expr, one: str, sqrt: bool):
     return None
 
 
+class ExactNumbers:
+    """Printer methods that write numbers exactly: a float as its repr, p/q correctly rounded."""
+
+    def _print_Float(self, expr):
+        return repr(float(expr))
+
+    def _print_Rational(self, expr):
+        return repr(int(expr.p) / int(expr.q))  # correctly rounded p/q
+
+
+def numpy_printer():
+    """SymPy's NumPy printer with exact numbers; it raises on a function NumPy has no ufunc for."""
+    from sympy.printing.numpy import NumPyPrinter
+
+    class Printer(ExactNumbers, NumPyPrinter):
+        pass
+
+    return Printer({"strict": True})
+
+
 def numba_printer():
     """A PythonCodePrinter for numba: exact float literals, small powers as products."""
     from sympy.printing.precedence import PRECEDENCE, precedence
     from sympy.printing.pycode import PythonCodePrinter
 
-    class Printer(PythonCodePrinter):
-        def _print_Float(self, expr):
-            return repr(float(expr))
-
-        def _print_Rational(self, expr):
-            return repr(int(expr.p) / int(expr.q))  # correctly rounded p/q
+    class Printer(ExactNumbers, PythonCodePrinter):
 
         def _print_Pow(self, expr, rational=False):
             done = _power(self, expr, "1.0", sqrt=True)

@@ -38,25 +38,12 @@ import dataclasses
 import types
 
 from pendverify.analytic.forms import INTERFACE, STATES
+from pendverify.numerics.codegen.printers import numpy_printer
 
 #: the methods that may be generated (every one of the interface but the special states),
 #: each with its arguments from the state (q, q̇, u, w)
 METHODS = {name: method.args for name, method in INTERFACE.items() if method.kind != STATES}
 GENERATOR = "vectorised-1"  # bump when the generated code changes meaning
-
-
-def _printer():
-    """NumPy's SymPy printer with exact numbers; it raises on a function NumPy does not have."""
-    from sympy.printing.numpy import NumPyPrinter
-
-    class Printer(NumPyPrinter):
-        def _print_Float(self, expr):
-            return repr(float(expr))
-
-        def _print_Rational(self, expr):
-            return repr(int(expr.p) / int(expr.q))  # correctly rounded p/q
-
-    return Printer({"strict": True})
 
 
 def _renamed(sm) -> dict:
@@ -116,7 +103,7 @@ def render(model_cls) -> str:
     except PendverifyError as exc:
         sm, missing = None, dict.fromkeys(written, str(exc))
     if sm is not None:
-        names, printer = _renamed(sm), _printer()
+        names, printer = _renamed(sm), numpy_printer()
         for method in written:
             try:
                 lines = _function(method, sm.evaluate(method, METHODS[method]), names, printer)
