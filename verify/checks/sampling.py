@@ -25,8 +25,10 @@ RATE_RANGE = 20.0  # rad/s or m/s
 ACCEL_RANGE = 20.0  # rad/s² or m/s², times the inertia scale gives a force
 
 
-@dataclass(frozen=True)
+@dataclass(slots=True)
 class State:
+    """One state the checks visit: its label, q, q̇, the inputs u and the disturbances w."""
+
     label: str
     q: np.ndarray
     v: np.ndarray

@@ -123,12 +123,10 @@ def _level(bound: float) -> str:
     return "ok" if bound <= WARN_REL else "warn" if bound <= REFUSE_REL else "refuse"
 
 
-def conditionings(M, S, angle, amplification) -> tuple[np.ndarray, ...]:
-    """The rule's numbers for each mass matrix of a stack (N, n, n) with scales S (N, n).
+def scaled_kappas(M, S) -> tuple[np.ndarray, np.ndarray]:
+    """(κ̃, the scale spread) of each mass matrix of a stack (N, n, n) with scales S (N, n).
 
-    Returns (κ raw, κ̃, bound, spread, whether the spread decides the bound), each (N,);
-    ``angle`` is |θ|max and ``amplification`` A per state.  A scale that is not positive
-    and finite makes κ̃ and the spread infinite.
+    A scale that is not positive and finite makes both infinite.
     """
     M, S = np.asarray(M, dtype=float), np.asarray(S, dtype=float)
     usable = np.all(S > 0, axis=-1) & np.all(np.isfinite(S), axis=-1)
@@ -136,11 +134,17 @@ def conditionings(M, S, angle, amplification) -> tuple[np.ndarray, ...]:
         root = np.sqrt(np.where(usable[:, None], S, 1.0))
         kappa_scaled = np.where(usable, _cond(M / (root[:, :, None] * root[:, None, :])), np.inf)
         spread = np.where(usable, np.sqrt(np.max(S, axis=-1) / np.min(S, axis=-1)), np.inf)
+    return kappa_scaled, spread
+
+
+def bounds(kappa_scaled, spread, angle, amplification) -> tuple[np.ndarray, np.ndarray]:
+    """(the rounding bound, whether the spread decides it) per state: K·ε·max(κ̃·((1 + |θ|) +
+    (A − 1)), (1 + |θ|)·s), ``angle`` |θ|max and ``amplification`` A per state."""
+    with np.errstate(all="ignore"):
         growth = 1.0 + np.abs(angle)
         rounding = kappa_scaled * (growth + (amplification - 1.0))
         visibility = growth * spread
-        bound = KAPPA_K * EPS * np.where(visibility > rounding, visibility, rounding)
-    return _cond(M), kappa_scaled, bound, spread, visibility > rounding
+        return KAPPA_K * EPS * np.where(visibility > rounding, visibility, rounding), visibility > rounding
 
 
 def conditioning(
@@ -149,12 +153,13 @@ def conditioning(
     """Judge one mass matrix; ``scale`` is S (default |diag M|), ``angle`` the largest |θ|."""
     M = np.asarray(M, dtype=float)
     S = np.abs(np.diag(M)) if scale is None else np.asarray(scale, dtype=float)
-    figures = conditionings(M[None], S[None], np.array([angle]), np.array([amplification]))
-    return _verdict(*(x[0] for x in figures), amplification)
+    kappa_scaled, spread = scaled_kappas(M[None], S[None])
+    bound, by_spread = bounds(kappa_scaled, spread, np.array([angle]), np.array([amplification]))
+    return _verdict(_cond(M[None])[0], kappa_scaled[0], bound[0], spread[0], by_spread[0], amplification)
 
 
 def _verdict(kappa_raw, kappa_scaled, bound, spread, by_spread, amplification) -> Conditioning:
-    """The ``Conditioning`` of one matrix's figures (as ``conditionings`` gives them)."""
+    """The ``Conditioning`` of one matrix's figures (κ raw, ``scaled_kappas`` and ``bounds``)."""
     return Conditioning(
         float(kappa_raw),
         float(kappa_scaled),
@@ -173,7 +178,8 @@ class Verdicts:
     scale S, the same with Pinocchio's term amplification A, and Pinocchio's M with its own
     diagonal — and the verdict is the worst: the largest bound, then the largest κ raw, the
     first of equals.  Without a system only the first is judged.  ``verdicts[i]`` is state
-    i's ``Conditioning``.
+    i's ``Conditioning``; ``worst(name)`` one of its figures at every state.  κ raw decides
+    only between equal bounds, so it is computed only where it is asked for (``kappa_raw``).
     """
 
     def __init__(self, batch, with_system: bool = True):
@@ -181,33 +187,57 @@ class Verdicts:
         M_hand, S = forms.value("mass_matrix"), forms.value("diagonal_scale")
         n, angle = len(batch), batch.angle
         one = np.ones(n)
-        candidates = [(*conditionings(M_hand, S, angle, one), one)]
+        hand = scaled_kappas(M_hand, S)
+        candidates = [(M_hand, *hand, one)]
         if with_system:
             M_pin, A = batch.pin.mass_matrix(), batch.lever
-            diag_pin = np.abs(np.diagonal(M_pin, axis1=-2, axis2=-1))
-            candidates.append((*conditionings(M_hand, S, angle, A), A))
-            candidates.append((*conditionings(M_pin, diag_pin, angle, A), A))
-        # (κ raw, κ̃, bound, spread, by spread, A), each stacked over the candidates
-        self.fields = [np.stack([c[k] for c in candidates]) for k in range(6)]
-        kappa, bound = self.fields[0], self.fields[2]
+            candidates.append((M_hand, *hand, A))
+            candidates.append(
+                (M_pin, *scaled_kappas(M_pin, np.abs(np.diagonal(M_pin, axis1=-2, axis2=-1))), A)
+            )
+        self._matrices = [c[0] for c in candidates]
+        figures = [(kappa, *bounds(kappa, spread, angle, A), spread, A) for _, kappa, spread, A in candidates]
+        names = ("kappa_scaled", "bound", "by_spread", "spread", "amplification")
+        #: each figure of each candidate, (candidates, N)
+        self.fields = {name: np.stack([f[k] for f in figures]) for k, name in enumerate(names)}
+        bound = self.fields["bound"]
         best = np.zeros(n, dtype=int)
         for j in range(1, len(candidates)):
-            b0, k0 = np.choose(best, bound), np.choose(best, kappa)
+            b0 = np.choose(best, bound)
             with np.errstate(invalid="ignore"):
-                later = np.where(bound[j] == b0, kappa[j] > k0, bound[j] > b0)
-            best = np.where(later | (np.isnan(bound[j]) & ~np.isnan(b0)), j, best)
+                later = (bound[j] > b0) | (np.isnan(bound[j]) & ~np.isnan(b0))
+                tie = np.flatnonzero(bound[j] == b0)
+            if tie.size:  # κ raw decides, computed at those states only
+                later[tie] = self.kappa_raw(np.full(tie.size, j), tie) > self.kappa_raw(best[tie], tie)
+            best = np.where(later, j, best)
         self.best = best
         self.bound = np.choose(best, bound)
+
+    def kappa_raw(self, candidates: np.ndarray, states: np.ndarray) -> np.ndarray:
+        """κ raw of candidate ``candidates[k]``'s matrix at state ``states[k]``, for each k."""
+        out = np.empty(len(states))
+        for j in np.unique(candidates):
+            at = candidates == j
+            out[at] = _cond(self._matrices[j][states[at]])
+        return out
 
     def __len__(self) -> int:
         return len(self.best)
 
-    def refuses(self, i: int) -> bool:
-        """Whether state i's verdict is ``refuse`` (a bound above the limit, or not a number)."""
-        return not self.bound[i] <= REFUSE_REL
+    def worst(self, name: str) -> np.ndarray:
+        """Figure ``name`` (``kappa_raw``, ``kappa_scaled``, ``bound``, ``amplification``, …) of the
+        verdict at each state."""
+        if name == "kappa_raw":
+            return self.kappa_raw(self.best, np.arange(len(self.best)))
+        return np.choose(self.best, self.fields[name])
 
     def __getitem__(self, i: int) -> Conditioning:
-        return _verdict(*(x[self.best[i], i] for x in self.fields))
+        j = self.best[i]
+        f = {name: field[j, i] for name, field in self.fields.items()}
+        kappa_raw = self.kappa_raw(np.array([j]), np.array([i]))[0]
+        return _verdict(
+            kappa_raw, f["kappa_scaled"], f["bound"], f["spread"], f["by_spread"], f["amplification"]
+        )
 
 
 def assess(model, q, system=None) -> Conditioning:

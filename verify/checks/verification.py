@@ -25,28 +25,29 @@ from pendverify.checks.catalogue import CheckResult, applicable_checks, run_chec
 from pendverify.checks.diagnose import diagnose
 from pendverify.checks.report import Report
 from pendverify.checks.sampling import sample_states
-from pendverify.checks.trust import Conditioning, Verdicts, check_conditioning
+from pendverify.checks.trust import REFUSE_REL, Verdicts, check_conditioning
 from pendverify.checks.verdict import FAIL, REFUSED, WARN, apply_strict, non_christoffel_c
 from pendverify.errors import IllConditionedError
 from pendverify.progress import bar
 from pendverify.robot.geometry import MODEL_FORM_RTOL
 
 
-def trusted(label: str, batch: CheckBatch) -> tuple[list[int], list[str], list[Conditioning]]:
+def trusted(label: str, batch: CheckBatch) -> tuple[list[int], list[str], Verdicts]:
     """The trust rule at every state of ``batch``: (indices of the states it accepts, one sentence
-    per refused state, the accepted states' verdicts (ok or warn))."""
+    per refused state, every state's verdict)."""
     with np.errstate(all="ignore"):
         verdicts = Verdicts(batch)
-    kept, refused, accepted = [], [], []
-    for i, state in enumerate(batch.states):
+    refusing = ~(verdicts.bound <= REFUSE_REL)
+    kept, refused = [int(i) for i in np.flatnonzero(~refusing)], []
+    for i in np.flatnonzero(refusing):
+        state = batch.states[i]
         try:
-            verdict = check_conditioning(batch.model, state.q, batch.system, what=label, verdict=verdicts[i])
+            check_conditioning(batch.model, state.q, batch.system, what=label, verdict=verdicts[i])
         except IllConditionedError as exc:
             refused.append(f"{state.label}: {exc}")
         else:
-            kept.append(i)
-            accepted.append(verdict)
-    return kept, refused, accepted
+            kept.append(int(i))
+    return sorted(kept), refused, verdicts
 
 
 def model_form_result(target, seed: int) -> CheckResult | None:

@@ -16,10 +16,13 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from pendverify.analytic import MODELS
 from pendverify.checks.batch import CheckBatch
 from pendverify.checks.catalogue import applicable_checks, run_checks
 from pendverify.checks.sampling import DEFAULT_SEED, State, sample_states
+from pendverify.checks.trust import WARN_REL
 from pendverify.checks.verdict import WARN
 from pendverify.checks.verification import trusted
 from pendverify.robot.system import PinocchioSystem
@@ -177,10 +180,16 @@ def compare(name: str, model, system, states: list[State], seed: int, pinocchio_
     model_states(model, states, lambda s: f"<{name}: {s.label}>")
     batch = CheckBatch(model, system, states, pinocchio_angles)
     kept, refused, verdicts = trusted(name, batch)
-    kappa_raw = max((c.kappa_raw for c in verdicts), default=0.0)
-    kappa_scaled = max((c.kappa_scaled for c in verdicts), default=0.0)
-    amplification = max((c.amplification for c in verdicts), default=0.0)
-    level = "warn" if any(c.level == "warn" for c in verdicts) else "ok"
+
+    def largest(name: str) -> float:
+        return float(np.max(verdicts.worst(name)[kept], initial=0.0))
+
+    kappa_raw, kappa_scaled, amplification = (
+        largest("kappa_raw"),
+        largest("kappa_scaled"),
+        largest("amplification"),
+    )
+    level = "warn" if largest("bound") > WARN_REL else "ok"
     if not kept:
         return Comparison([], 0, refused, kappa_raw, kappa_scaled, amplification, level)
     if refused:

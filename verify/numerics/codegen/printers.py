@@ -70,7 +70,6 @@ def numba_printer():
     from sympy.printing.pycode import PythonCodePrinter
 
     class Printer(ExactNumbers, PythonCodePrinter):
-
         def _print_Pow(self, expr, rational=False):
             done = _power(self, expr, "1.0", sqrt=True)
             if done is not None:
