@@ -11,9 +11,9 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-from pendverify.checks.catalogue import CheckResult
 from pendverify.checks.junit import to_junit
 from pendverify.checks.report import Report
+from pendverify.checks.result import CheckResult
 from pendverify.checks.verdict import FAIL, PASS, REFUSED, WARN
 from pendverify.cli import main
 

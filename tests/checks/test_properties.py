@@ -32,8 +32,7 @@ from pendverify.analytic import (
     DoublePendulum,
     DoublePendulumParams,
 )
-from pendverify.checks.catalogue import EPS
-from pendverify.checks.trust import assess
+from pendverify.checks.trust import EPS, assess
 from pendverify.robot.system import PinocchioSystem
 
 K = 16

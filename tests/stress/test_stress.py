@@ -17,9 +17,9 @@ from pendverify.analytic import MODELS, CartDoublePendulum, DoublePendulum
 from pendverify.checks import trust as near_singular
 from pendverify.checks import verification
 from pendverify.checks.batch import world_lever
-from pendverify.checks.trust import Conditioning, IllConditionedError, check_conditioning
+from pendverify.checks.trust import Conditioning, check_conditioning
 from pendverify.cli import main
-from pendverify.errors import InputError
+from pendverify.errors import IllConditionedError, InputError
 from pendverify.stress import cases, framework, seed_params, sim_cases, trust_study
 from pendverify.stress import catalogue as stress
 from pendverify.stress import integrators as si

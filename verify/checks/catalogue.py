@@ -42,14 +42,10 @@ from pendverify.checks.applicability import hand_written, needs_matrix_c, needs_
 from pendverify.checks.batch import CheckBatch
 from pendverify.checks.judge import collect, conclude
 from pendverify.checks.result import Check, CheckResult
-from pendverify.checks.trust import EPS
 
 __all__ = [
     "CHECKS",
     "CHECK_NAMES",
-    "EPS",
-    "Check",
-    "CheckResult",
     "applicable_checks",
     "not_applicable",
     "run_check",

@@ -15,7 +15,7 @@ import html
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 
-from pendverify.checks.catalogue import CheckResult
+from pendverify.checks.result import CheckResult
 from pendverify.checks.verdict import FAIL, LABELS, PASS, REFUSED, WARN, worst
 from pendverify.display import REPR_LIMIT, html_lines, html_table, listed
 from pendverify.jsonio import to_json, versions

@@ -84,5 +84,5 @@ def forcing_of(dyn, source: str) -> tuple[np.ndarray | None, Forcing]:
         W = np.asarray(model.disturbance_matrix(), float).reshape(model.nv, -1)
         a = noise.std * np.sqrt(2.0 / noise.components)  # as ``laws.Noise``
         for c in range(W.shape[1]):
-            forcing = forcing.add(W[:, c], a[c], 2 * np.pi * noise._freq[c], noise._phase[c])
+            forcing = forcing.add(W[:, c], a[c], 2 * np.pi * noise.frequencies[c], noise.phases[c])
     return u0, forcing

@@ -105,23 +105,26 @@ class Pulse(Law):
 
 @dataclass
 class Noise(Law):
+    """Band-limited noise: per channel, ``components`` sines of seeded frequencies in
+    (0, bandwidth] Hz (``frequencies``) and phases (``phases``)."""
+
     std: np.ndarray = None
     bandwidth: float = 1.0
     seed: int = 0
     components: int = 32
-    _freq: np.ndarray = None
-    _phase: np.ndarray = None
+    frequencies: np.ndarray = None
+    phases: np.ndarray = None
 
     def __post_init__(self):
         rng = np.random.default_rng(self.seed)
-        self._freq = rng.uniform(0.0, self.bandwidth, (self.size, self.components))
-        self._freq = np.where(self._freq == 0.0, self.bandwidth, self._freq)
-        self._phase = rng.uniform(0.0, 2 * np.pi, (self.size, self.components))
+        self.frequencies = rng.uniform(0.0, self.bandwidth, (self.size, self.components))
+        self.frequencies = np.where(self.frequencies == 0.0, self.bandwidth, self.frequencies)
+        self.phases = rng.uniform(0.0, 2 * np.pi, (self.size, self.components))
 
     def __call__(self, t, q, v):
         # each component has variance a²/2; N of them give std² when a = std·√(2/N)
         a = self.std * np.sqrt(2.0 / self.components)
-        return a * np.sum(np.sin(2 * np.pi * self._freq * t + self._phase), axis=1)
+        return a * np.sum(np.sin(2 * np.pi * self.frequencies * t + self.phases), axis=1)
 
 
 @dataclass

@@ -12,9 +12,8 @@ from collections.abc import Callable
 import numpy as np
 
 from pendverify.analytic import MODELS
-from pendverify.checks.catalogue import EPS
 from pendverify.checks.sampling import RATE_RANGE, State
-from pendverify.checks.trust import KAPPA_K, REFUSE_REL, assess
+from pendverify.checks.trust import EPS, KAPPA_K, REFUSE_REL, assess
 from pendverify.errors import PendverifyError
 from pendverify.stress.framework import (
     ANGLE_SHIFT,

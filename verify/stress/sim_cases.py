@@ -7,8 +7,7 @@ import math
 import numpy as np
 
 from pendverify.analytic import MODELS, DoublePendulumParams
-from pendverify.checks.catalogue import EPS
-from pendverify.checks.trust import conditioning
+from pendverify.checks.trust import EPS, conditioning
 from pendverify.stress import integrators as si
 from pendverify.stress.framework import (
     BOUNDED_GROWTH,

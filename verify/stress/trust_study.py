@@ -30,7 +30,8 @@ import numpy as np
 from pendverify.analytic import MODELS, CartDoublePendulum, CartDoublePendulumParams, DoublePendulumParams
 from pendverify.analytic.params import default_parameter_file, load_parameter_file
 from pendverify.checks import trust
-from pendverify.checks.trust import REFUSE_REL, IllConditionedError
+from pendverify.checks.trust import REFUSE_REL
+from pendverify.errors import IllConditionedError
 from pendverify.robot.system import PinocchioSystem
 
 REFERENCE_DIGITS = 50
