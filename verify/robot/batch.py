@@ -30,8 +30,9 @@ def _mv(A, x):
     return (A @ x[..., None])[..., 0]
 
 
-def _finite_rows(key: str, X: np.ndarray, n: int, source: str) -> np.ndarray:
-    """``X`` as (N, n) floats; the first row that is not finite raises ``finite_state``'s error."""
+def finite_rows(key: str, X, n: int, source: str) -> np.ndarray:
+    """``X`` as (N, n) floats; the first row that is not finite, or not n long, raises
+    ``finite_state``'s error naming ``key``."""
     X = np.asarray(X, dtype=float)
     if X.ndim != 2 or X.shape[1] != n or not np.all(np.isfinite(X)):
         rows = X.reshape(-1, X.shape[-1]) if X.ndim >= 1 and X.size else [X]
@@ -43,10 +44,12 @@ def _finite_rows(key: str, X: np.ndarray, n: int, source: str) -> np.ndarray:
 
 def configurations(cmap, theta: np.ndarray) -> np.ndarray:
     """Pinocchio's configuration at each state θ (N, n) (``CoordinateMap.configuration``, row by row)."""
-    positions = _mv(cmap.T, np.asarray(theta, dtype=float) - cmap.theta0)
+    positions = np.ascontiguousarray(_mv(cmap.T, np.asarray(theta, dtype=float) - cmap.theta0))
+    if all(nq == 1 for nq in cmap.joint_nq):
+        return positions
     parts = []
     for k, nq in enumerate(cmap.joint_nq):
-        angle = np.ascontiguousarray(positions[:, k])
+        angle = positions[:, k]
         parts += [angle] if nq == 1 else [np.cos(angle), np.sin(angle)]
     return np.ascontiguousarray(np.stack(parts, axis=-1))
 
@@ -55,22 +58,15 @@ class PinocchioBatch:
     """Pinocchio's quantities at states θ (N, n), θ̇ (N, n) of ``system``, in the model's coordinates.
 
     ``system`` is a ``PinocchioSystem`` (its Pinocchio model and data, the gravity-free copy
-    for Ṁ, the coordinate map and the source named in errors).
+    for Ṁ, the coordinate map and the source named in errors); θ and θ̇ are finite (N, n)
+    float arrays (``PinocchioSystem.at`` checks them).
     """
 
-    def __init__(self, system, theta: np.ndarray, theta_dot: np.ndarray | None = None):
+    def __init__(self, system, theta: np.ndarray, theta_dot: np.ndarray):
         self.system = system
-        n = system.model.nv
-        theta = _finite_rows("q", theta, n, system.source)
-        if theta_dot is None:
-            theta_dot = np.zeros_like(theta)
-        theta_dot = _finite_rows("v", theta_dot, n, system.source)
-        if theta_dot.shape != theta.shape:
-            raise ValueError(f"{theta.shape[0]} positions but {theta_dot.shape[0]} velocities")
-        cmap = system.cmap
         self.N = len(theta)
-        self.q = configurations(cmap, theta)
-        self.v = np.ascontiguousarray(_mv(cmap.T, theta_dot))
+        self.q = configurations(system.cmap, theta)
+        self.v = np.ascontiguousarray(_mv(system.cmap.T, theta_dot))
         self._cache: dict[str, object] = {}
         #: the joint torques of the last ``acceleration`` (what ``bench certify`` times ABA on)
         self.aba_torques: np.ndarray | None = None
@@ -175,7 +171,7 @@ class PinocchioBatch:
     def acceleration(self, tau_theta: np.ndarray) -> np.ndarray:
         """θ̈ by ABA for generalized forces given in the model's coordinates (N, n)."""
         cmap = self.system.cmap
-        tau_theta = _finite_rows("tau", tau_theta, self.system.model.nv, self.system.source)
+        tau_theta = finite_rows("tau", tau_theta, self.system.model.nv, self.system.source)
         tau = np.ascontiguousarray(_mv(cmap.T_inv.T, tau_theta))
         self.aba_torques = tau
         return _mv(cmap.T_inv, self._loop(pin.aba, self.q, self.v, tau))

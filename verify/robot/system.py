@@ -3,7 +3,9 @@
 ``PinocchioSystem.for_model(cls, urdf)`` loads the URDF (``pendverify.robot.urdf``),
 asks the model's geometry reader, or its declared map, for the coordinate map
 (``pendverify.robot.geometry``), and hands every quantity Pinocchio computes back
-in the model's coordinates.
+in the model's coordinates: ``at(θ, θ̇)`` for a batch of states
+(``pendverify.robot.batch.PinocchioBatch``, the one evaluator), and one method per
+quantity for one state, which is the batch of one.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ import pinocchio as pin
 from pendverify.analytic import MODELS
 from pendverify.display import listed, shortened
 from pendverify.robot import seed_geometry  # noqa: F401  (registers the reference systems' readers)
-from pendverify.robot.batch import PinocchioBatch
+from pendverify.robot.batch import PinocchioBatch, finite_rows
 from pendverify.robot.coordinates import CoordinateMap
 from pendverify.robot.geometry import MODEL_FORM_RTOL, UrdfGeometry, reader
 from pendverify.robot.joint_map import declared_geometry
@@ -168,15 +170,21 @@ class PinocchioSystem:
         return {name: d.friction for name, d in self.urdf.facts.joint_dynamics.items() if d.friction}
 
     def at(self, theta, theta_dot=None) -> PinocchioBatch:
-        """Pinocchio at states θ (N, n) and θ̇ (N, n; default zero), in the model's coordinates."""
+        """Pinocchio at states θ (N, n) and θ̇ (N, n; default zero), in the model's coordinates;
+        a state that is not finite is refused by name."""
+        n = self.model.nv
+        theta = finite_rows("q", theta, n, self.source)
+        theta_dot = np.zeros_like(theta) if theta_dot is None else finite_rows("v", theta_dot, n, self.source)
+        if theta_dot.shape != theta.shape:
+            raise ValueError(f"{theta.shape[0]} positions but {theta_dot.shape[0]} velocities")
         return PinocchioBatch(self, theta, theta_dot)
 
     def _one(self, theta, theta_dot=None) -> PinocchioBatch:
         """The batch of the one state (θ, θ̇); a state that is not finite is refused by name."""
         n = self.model.nv
         theta = finite_state("q", theta, n, self.source)
-        theta_dot = None if theta_dot is None else finite_state("v", theta_dot, n, self.source)
-        return PinocchioBatch(self, theta[None], None if theta_dot is None else theta_dot[None])
+        theta_dot = np.zeros(n) if theta_dot is None else finite_state("v", theta_dot, n, self.source)
+        return PinocchioBatch(self, theta[None], theta_dot[None])
 
     def mass_matrix(self, theta) -> np.ndarray:
         """M(θ) by CRBA, in the model's coordinates."""

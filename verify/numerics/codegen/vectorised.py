@@ -35,6 +35,7 @@ The module is cached on disk and verified before it runs as the compiled fast pa
 from __future__ import annotations
 
 import dataclasses
+import functools
 import types
 
 from pendverify.analytic.forms import INTERFACE, STATES
@@ -60,13 +61,26 @@ def _renamed(sm) -> dict:
     return names
 
 
-def _function(method: str, value, names: dict, printer) -> list[str]:
+def _function(method: str, value, names: dict) -> list[str]:
     """The lines of one generated function (a PrintMethodNotImplementedError if NumPy cannot)."""
     import sympy as sp
 
     matrix = isinstance(value, sp.MatrixBase)
-    entries = [e.xreplace(names) for e in (value if matrix else [value])]
-    replacements, reduced = sp.cse(entries, symbols=sp.numbered_symbols("c"), order="canonical")
+    entries = tuple(e.xreplace(names) for e in (value if matrix else [value]))
+    return list(_printed(method, value.shape if matrix else None, entries))
+
+
+@functools.lru_cache(maxsize=512)
+def _printed(method: str, shape: tuple[int, int] | None, entries: tuple) -> tuple[str, ...]:
+    """The function of ``method`` computing ``entries`` (a matrix of ``shape``, or a scalar).
+
+    A pure function of its arguments, kept for the process: a class made from another
+    (``pendverify mutate``'s mutants) prints again only the methods whose expressions differ.
+    """
+    import sympy as sp
+
+    printer = numpy_printer()
+    replacements, reduced = sp.cse(list(entries), symbols=sp.numbered_symbols("c"), order="canonical")
     used = set().union(*(e.free_symbols for e in [*reduced, *(r for _, r in replacements)]))
     parameters = sorted((s for s in used if s.name[0] == "p"), key=lambda s: int(s.name[1:]))
     body = [f"{p.name} = P[{p.name[1:]}]" for p in parameters]
@@ -75,8 +89,8 @@ def _function(method: str, value, names: dict, printer) -> list[str]:
         body.append(f"{s.name} = {arrays[s.name[0]]}[:, {s.name[1:]}]")
     for symbol, expr in replacements:
         body.append(f"{symbol.name} = {printer.doprint(expr)}")
-    if matrix:
-        rows, cols = value.shape
+    if shape is not None:
+        rows, cols = shape
         body.append(f"out = numpy.empty((N, {rows}, {cols}))")
         for k, expr in enumerate(reduced):
             body.append(f"out[:, {k // cols}, {k % cols}] = {printer.doprint(expr)}")
@@ -84,7 +98,7 @@ def _function(method: str, value, names: dict, printer) -> list[str]:
         body.append("out = numpy.empty(N)")
         body.append(f"out[:] = {printer.doprint(reduced[0])}")
     body.append("return out")
-    return [f"def {method}(P, Q, V, U, W):", "    N = Q.shape[0]", *(f"    {line}" for line in body)]
+    return (f"def {method}(P, Q, V, U, W):", "    N = Q.shape[0]", *(f"    {line}" for line in body))
 
 
 def render(model_cls) -> str:
@@ -103,10 +117,10 @@ def render(model_cls) -> str:
     except PendverifyError as exc:
         sm, missing = None, dict.fromkeys(written, str(exc))
     if sm is not None:
-        names, printer = _renamed(sm), numpy_printer()
+        names = _renamed(sm)
         for method in written:
             try:
-                lines = _function(method, sm.evaluate(method, METHODS[method]), names, printer)
+                lines = _function(method, sm.evaluate(method, METHODS[method]), names)
             except PendverifyError as exc:
                 missing[method] = str(exc)
                 continue
