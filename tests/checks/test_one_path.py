@@ -1,14 +1,14 @@
 """One evaluation path: a state's figures do not depend on the batch it is judged in.
 
 Every check runs over a batch of states (``pendverify.checks.batch.CheckBatch``); one state
-is the batch of one.  For the two reference systems and two plug-in models, the states of a
-2000-state battery batch are judged again in a batch of 7 (in another order) and each alone:
-every state's relative error, relative tolerance and absolute error agree to a few ulps
-(``ULPS``: the generated NumPy code and Pinocchio's loops do the same operations on each
-state whatever the batch; the few ulps leave room for a vector math library whose last bit
-depends on a value's position in a SIMD register), and so do the verdicts.  A closed form
-SymPy cannot read runs in the model's own Python, the report names it, and a planted error
-in it is still caught.
+is the batch of one.  For the two reference systems and two plug-in models, the battery's
+states (2000 random ones and the special ones) are judged as one batch, then 7 of them in
+another order, then each alone: every state's relative error, relative tolerance and
+absolute error agree to a few ulps (``ULPS``: the generated NumPy code and Pinocchio's loops
+do the same operations on each state whatever the batch; the few ulps leave room for a
+vector math library whose last bit depends on a value's position in a SIMD register), and
+so do the verdicts.  A closed form SymPy cannot read runs in the model's own Python, the
+report names it, and a planted error in it is still caught.
 """
 
 from __future__ import annotations
