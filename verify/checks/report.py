@@ -110,7 +110,7 @@ class Report:
     notes: dict[str, list[str]] = field(default_factory=dict)
     sources: dict[str, str] = field(default_factory=dict)
     elapsed_s: float = 0.0
-    #: Known traps that explain a target's failures (``pendverify.checks.diagnose``), in words.
+    #: Known traps that explain a target's failures (``pendverify.diagnosis.diagnose``), in words.
     diagnoses: dict[str, list[str]] = field(default_factory=dict)
     #: What a user must know although the checks pass (``pendverify.checks.verdict``), per target.
     warnings: dict[str, list[str]] = field(default_factory=dict)

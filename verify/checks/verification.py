@@ -12,7 +12,7 @@ For each target (a closed-form model and a URDF in Pinocchio):
 4. the verdict rules of ``pendverify.checks.verdict`` run: a C with the right C·q̇ but
    not the Christoffel one is a warning, a URDF's Coulomb friction is a warning,
    ``strict`` turns warnings into failures;
-5. failures on trusted states are diagnosed (``pendverify.checks.diagnose``).
+5. failures on trusted states are diagnosed (``pendverify.diagnosis.diagnose``).
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ import numpy as np
 from pendverify.checks.applicability import derived_notes
 from pendverify.checks.batch import CheckBatch
 from pendverify.checks.catalogue import applicable_checks, run_checks, skipped_notes
-from pendverify.checks.diagnose import diagnose
+from pendverify.diagnosis.diagnose import diagnose
 from pendverify.checks.report import Report
 from pendverify.checks.result import CheckResult
 from pendverify.checks.sampling import sample_states

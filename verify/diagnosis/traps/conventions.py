@@ -19,7 +19,7 @@ import math
 import numpy as np
 
 from pendverify.checks.catalogue import applicable_checks, run_checks
-from pendverify.checks.traps.fit import DIAGNOSIS_SEED, EXACT_RESIDUAL, FIT_RESIDUAL, fmt
+from pendverify.diagnosis.traps.fit import DIAGNOSIS_SEED, EXACT_RESIDUAL, FIT_RESIDUAL, fmt
 from pendverify.robot.coordinates import CoordinateMap
 from pendverify.robot.system import PinocchioSystem
 

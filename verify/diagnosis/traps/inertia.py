@@ -7,7 +7,7 @@ inertia about the pivot from one about the centre of mass.  c_b = +1: the
 URDF's inertia is about the pivot; c_b = −1: the hand model adds m·r² to an
 inertia already about the pivot.  The fitted coefficients must be integers in
 {−1, 0, 1} within ``COEFF_TOL``, and the residual within ``FIT_RESIDUAL``
-(``pendverify.checks.traps.fit``).
+(``pendverify.diagnosis.traps.fit``).
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from pendverify.checks.traps.fit import FIT_RESIDUAL, fit_words
+from pendverify.diagnosis.traps.fit import FIT_RESIDUAL, fit_words
 from pendverify.robot.system import PinocchioSystem
 
 COEFF_TOL = 1e-3  # how close a fitted coefficient must be to an integer

@@ -16,7 +16,7 @@ import pytest
 
 from pendverify.analytic import CartDoublePendulum, DoublePendulum
 from pendverify.checks.catalogue import run_checks
-from pendverify.checks.diagnose import diagnose
+from pendverify.diagnosis.diagnose import diagnose
 from pendverify.checks.sampling import sample_states
 from pendverify.cli import main
 from pendverify.robot.coordinates import CoordinateMap

@@ -1,10 +1,10 @@
 """Name the known trap behind a failure, in words next to the numbers.
 
 When checks fail, each hypothesis (``HYPOTHESES``, one module each in
-``pendverify.checks.traps``) is tested against the model and the URDF, and the
+``pendverify.diagnosis.traps``) is tested against the model and the URDF, and the
 ones that explain the failure become a sentence in the report that says how well
 they fit: the *residual*, the part of the discrepancy the hypothesis leaves
-unexplained, relative to the whole (``pendverify.checks.traps.fit``: an exact fit at
+unexplained, relative to the whole (``pendverify.diagnosis.traps.fit``: an exact fit at
 rounding level, named with its residual up to 1e-3, not named beyond).
 
 Never a wrong diagnosis: a trap of these kinds changes M or H by a relative
@@ -15,23 +15,23 @@ check or diagnosis sees them.
 
 pivot inertia (``crba`` fails)
     the m·r² of an inertia about the pivot instead of the centre of mass, or
-    counted twice (``pendverify.checks.traps.inertia``).
+    counted twice (``pendverify.diagnosis.traps.inertia``).
 missing damping (``aba`` fails)
     friction missing from the hand q̈, of the wrong sign, or not declared in D
-    (``pendverify.checks.traps.damping``).
+    (``pendverify.diagnosis.traps.damping``).
 coordinate conventions (any check fails)
     absolute vs relative angles, degrees vs radians, a zero from the vertical or
-    from hanging (``pendverify.checks.traps.conventions``).
+    from hanging (``pendverify.diagnosis.traps.conventions``).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from pendverify.checks.traps.conventions import coordinate_conventions
-from pendverify.checks.traps.damping import missing_damping
-from pendverify.checks.traps.fit import diagnosis_states
-from pendverify.checks.traps.inertia import pivot_inertia
+from pendverify.diagnosis.traps.conventions import coordinate_conventions
+from pendverify.diagnosis.traps.damping import missing_damping
+from pendverify.diagnosis.traps.fit import diagnosis_states
+from pendverify.diagnosis.traps.inertia import pivot_inertia
 
 TRAP_MIN_ERROR = 1e-6  # smallest relative failure a convention or inertia trap can cause
 

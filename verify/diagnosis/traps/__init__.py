@@ -1,6 +1,6 @@
 """The known traps behind a failing check, each a hypothesis tested against the model and the URDF.
 
-``pendverify.checks.diagnose`` runs them and reports the ones that fit; each module here
+``pendverify.diagnosis.diagnose`` runs them and reports the ones that fit; each module here
 is one trap (``inertia``, ``damping``, ``conventions``), and ``fit`` holds the language
 and thresholds they share.
 """
