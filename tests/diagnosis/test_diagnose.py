@@ -16,9 +16,9 @@ import pytest
 
 from pendverify.analytic import CartDoublePendulum, DoublePendulum
 from pendverify.checks.catalogue import run_checks
-from pendverify.diagnosis.diagnose import diagnose
 from pendverify.checks.sampling import sample_states
 from pendverify.cli import main
+from pendverify.diagnosis.diagnose import diagnose
 from pendverify.robot.coordinates import CoordinateMap
 from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for

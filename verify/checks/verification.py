@@ -22,12 +22,12 @@ import numpy as np
 from pendverify.checks.applicability import derived_notes
 from pendverify.checks.batch import CheckBatch
 from pendverify.checks.catalogue import applicable_checks, run_checks, skipped_notes
-from pendverify.diagnosis.diagnose import diagnose
 from pendverify.checks.report import Report
 from pendverify.checks.result import CheckResult
 from pendverify.checks.sampling import sample_states
 from pendverify.checks.trust import REFUSE_REL, Verdicts, check_conditioning
 from pendverify.checks.verdict import FAIL, REFUSED, WARN, apply_strict, non_christoffel_c
+from pendverify.diagnosis.diagnose import diagnose
 from pendverify.errors import IllConditionedError
 from pendverify.progress import bar
 from pendverify.robot.geometry import MODEL_FORM_RTOL
