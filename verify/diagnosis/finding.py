@@ -1,0 +1,66 @@
+"""One finding of a diagnosis, as the report, the JSON document, the review page and JUnit carry it.
+
+A failing model's diagnosis is a list of ``Finding``; ``--json`` writes it under
+``diagnoses``, one list per model label, each finding an object (``as_dict``):
+
+==============  ===========================================================================
+field           meaning
+==============  ===========================================================================
+kind            ``entry`` (an entry that differs), ``pattern`` (the shape of its
+                difference over the states), ``repair`` (an edit of the model's own
+                expressions after which every check passes on every state), ``parameters``
+                (the hand model is this robot with other inertial parameters),
+                ``convention`` (a coordinate or inertia convention trap), ``structural``
+                (no inertial parameters explain the difference)
+quantity        ``M``, ``C``, ``Cqdot``, ``H``, ``V``, ``D``, ``B``, ``W``, ``Minv``, ``detM``,
+                ``qddot``, or null for a finding about the whole model
+index           the entry, 1-based as a derivation writes it (``[2, 2]`` for M's last entry
+                of a double pendulum, ``[1]`` for H's first, ``[]`` for a scalar or none)
+message         the finding in words, as the text report prints it
+==============  ===========================================================================
+
+A ``repair`` adds ``written`` and ``suggested`` (the entry before and after the edit, in
+SymPy syntax over the model's own names), ``suggested_source`` (the edit in the model's own
+notation: LaTeX for a LaTeX file, SymPy syntax for a text file, the Python expression for
+a class), ``location`` (file, key or method, and entry) and ``checks_pass`` (true only when
+every check was re-run on every state and passed).  A ``parameters`` finding adds
+``link``, ``parameter``, ``model_value`` and ``urdf_value``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+KINDS = ("entry", "pattern", "repair", "parameters", "convention", "structural")
+QUANTITIES = ("M", "C", "Cqdot", "H", "V", "D", "B", "W", "Minv", "detM", "qddot")
+
+
+@dataclass(frozen=True)
+class Finding:
+    """One thing a diagnosis found (module docstring)."""
+
+    kind: str
+    message: str
+    quantity: str | None = None
+    index: tuple[int, ...] = ()
+    #: the kind's own fields (``repair``: written, suggested, ...; ``parameters``: link, ...)
+    details: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        if self.kind not in KINDS:
+            raise ValueError(f"finding kind {self.kind!r}: must be one of {', '.join(KINDS)}")
+        if self.quantity is not None and self.quantity not in QUANTITIES:
+            raise ValueError(f"finding quantity {self.quantity!r}: must be one of {', '.join(QUANTITIES)}")
+
+    def as_dict(self) -> dict:
+        """The JSON object of ``diagnoses`` (module docstring)."""
+        return {
+            "kind": self.kind,
+            "quantity": self.quantity,
+            "index": list(self.index),
+            "message": self.message,
+            **self.details,
+        }
+
+    def __str__(self) -> str:
+        return self.message
