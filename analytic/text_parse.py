@@ -67,6 +67,8 @@ class TextModelSpec:
     equations: dict[str, object] = field(default_factory=dict)  # key → sp.Matrix or scalar
     derived: dict[str, str] = field(default_factory=dict)  # key → how it was computed from others
     notation: str = "sympy"
+    #: with notation = "latex": the file's [symbols] table, each LaTeX key with what it reads as
+    latex_symbols: dict[str, object] = field(default_factory=dict)
     urdf_joints: tuple[str, ...] = ()
     joint_transform: tuple | None = None
     joint_offset: tuple | None = None
@@ -229,6 +231,8 @@ def _read_equations(reader: Reader, spec: TextModelSpec, data: dict) -> None:
     if spec.notation == "latex":
         everything = {s.name: s for g in "qvuwp" for s in spec.symbols[g]} | FUNCTIONS | CONSTANTS
         latex = read_symbol_table(reader, data.get("symbols"), everything, parse_entry)
+        table = latex.table
+        spec.latex_symbols = {table.source[c]: value for c, value in table.entries.items()}
     for key, (shape, groups) in EQUATIONS.items():
         if key not in data:
             continue

@@ -56,6 +56,9 @@ class Measure:
     allowance: object = 0.0
     noted: object = False
     describe: Callable[[int], str] | None = None
+    #: the error of each entry (batch axis first) whose largest is ``error``, where the
+    #: quantity has entries (``pendverify.diagnosis.entries`` names those that differ)
+    entries: object = None
 
 
 class Terms:
@@ -158,7 +161,10 @@ class Terms:
     def a_hand(self):
         return self.batch.forms.value("acceleration")
 
-    def acceleration_pin(self, tau):
+    @cached_property
+    def a_pin(self):
+        """ABA at τ = B u + W w − D q̇: the friction and inputs as the hand model declares them."""
+        tau = mv(self.B, self.u) + mv(self.W, self.w_in) - mv(self.D, self.v)
         return self.batch.pin.acceleration(tau)
 
     @cached_property
@@ -219,27 +225,32 @@ def _at_least_one(x):
 
 # --- the measures ----------------------------------------------------------------------------
 def measure_crba(t):
-    w = t.w
-    return Measure(_max2(np.abs(scaled_matrix(t.M_pin - t.M_hand, w))), 1.0)
+    entries = np.abs(scaled_matrix(t.M_pin - t.M_hand, t.w))
+    return Measure(_max2(entries), 1.0, entries=entries)
 
 
 def measure_rnea(t):
     w = t.w
-    err = np.max(w * np.abs(t.bias_pin - t.bias_hand), axis=-1)
+    entries = w * np.abs(t.bias_pin - t.bias_hand)
     scale = (t.rate + t.d_rate) * total(np.abs(t.v / w)) + np.max(w * t.g_scale, axis=-1)
-    return Measure(err, scale, np.max(w * t.allowance, axis=-1))
+    return Measure(np.max(entries, axis=-1), scale, np.max(w * t.allowance, axis=-1), entries=entries)
 
 
 def measure_gravity(t):
     w = t.w
-    err = np.max(w * np.abs(t.H_pin - t.H_hand), axis=-1)
-    return Measure(err, np.max(w * t.g_scale, axis=-1), np.max(w * t.allowance, axis=-1))
+    entries = w * np.abs(t.H_pin - t.H_hand)
+    return Measure(
+        np.max(entries, axis=-1),
+        np.max(w * t.g_scale, axis=-1),
+        np.max(w * t.allowance, axis=-1),
+        entries=entries,
+    )
 
 
 def measure_coriolis(t):
     w = t.w
-    diff = t.C_pin - t.C_hand
-    return Measure(_max2(np.abs(scaled_matrix(diff, w))), _at_least_one(t.rate + t.d_rate))
+    entries = np.abs(scaled_matrix(t.C_pin - t.C_hand, w))
+    return Measure(_max2(entries), _at_least_one(t.rate + t.d_rate), entries=entries)
 
 
 def measure_skew(t):
@@ -268,20 +279,21 @@ def measure_minverse(t):
     Minv_norm = t.norm2(scaled_matrix(t.Minv_hand, sqrt_s))
     # δ(M⁻¹) = −M⁻¹ δM M⁻¹ with |δM̃| ~ ε‖M̃‖
     scale = Minv_norm * Minv_norm * t.norm2(scaled_matrix(t.M_hand, 1.0 / sqrt_s))
-    return Measure(_max2(np.abs(scaled_matrix(diff, sqrt_s))), scale)
+    entries = np.abs(scaled_matrix(diff, sqrt_s))
+    return Measure(_max2(entries), scale, entries=entries)
 
 
 def measure_aba(t):
     w = t.w
-    tau = mv(t.B, t.u) + mv(t.W, t.w_in) - mv(t.D, t.v)
-    a_pin = t.acceleration_pin(tau)
+    a_pin = t.a_pin
     a_hand = t.a_hand
     Minv_norm = t.norm2(scaled_matrix(t.Minv_hand, 1.0 / w))
     M_norm = t.norm2(scaled_matrix(t.M_hand, w))
     forces = force_scale_of(t.rate, t.v, w, t.g_scale, t.B, t.W, t.D, t.u, t.w_in)
     scale = Minv_norm * (forces + M_norm * np.max(np.abs(a_pin / w), axis=-1))
     allowance = Minv_norm * np.max(w * t.allowance, axis=-1)
-    return Measure(np.max(np.abs((a_pin - a_hand) / w), axis=-1), scale, allowance)
+    entries = np.abs((a_pin - a_hand) / w)
+    return Measure(np.max(entries, axis=-1), scale, allowance, entries=entries)
 
 
 def measure_energy(t):
@@ -317,7 +329,7 @@ def measure_damping(t):
             f"the hand model {D[i, j]:.6g}"
         )
 
-    return Measure(err, np.where(urdf > own, urdf, own), 0.0, err > 0, describe)
+    return Measure(err, np.where(urdf > own, urdf, own), 0.0, err > 0, describe, entries=diff)
 
 
 MEASURES: dict[str, Callable] = {

@@ -27,11 +27,11 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass
-from itertools import combinations
 
 import sympy as sp
 
 from pendverify.analytic.symbolic_reading import SymbolicModel, entries
+from pendverify.symbolic.edits import term_edits, trig_edits
 
 SCALE = sp.Rational(1001, 1000)
 OPERATORS = ("sign", "drop", "scale", "sin↔cos", "swap θ", "swap θ̇", "move")
@@ -60,55 +60,12 @@ def entry_label(method: str, value, index: int) -> str:
     return f"{method}[{r}]" if cols == 1 else f"{method}[{r},{c}]"
 
 
-def _walk(node, path=()) -> Iterator[tuple[sp.Basic, tuple[int, ...]]]:
-    yield node, path
-    if node.is_Atom:
-        return
-    for i, arg in enumerate(node.args):
-        yield from _walk(arg, (*path, i))
-
-
-def _replace(node, path, new):
-    if not path:
-        return new
-    args = list(node.args)
-    args[path[0]] = _replace(args[path[0]], path[1:], new)
-    return node.func(*args)
-
-
-def _sums(expr) -> Iterator[tuple[tuple[int, ...], list]]:
-    """(path, terms) of every sum in the tree; a non-sum entry counts as a sum of one term."""
-    if not expr.is_Add:
-        yield (), [expr]
-    for node, path in _walk(expr):
-        if node.is_Add:
-            yield path, list(node.args)
-
-
 def entry_mutants(expr, angles, rates) -> Iterator[tuple[str, str, sp.Expr]]:
-    """(operator, what, mutated entry) for one non-zero entry."""
-    for path, terms in _sums(expr):
-        for i, term in enumerate(terms):
-
-            def with_term(new, path=path, terms=terms, i=i):
-                rest = [*terms[:i], *([] if new is None else [new]), *terms[i + 1 :]]
-                return _replace(expr, path, sp.Add(*rest) if rest else sp.S.Zero)
-
-            yield "sign", f"{term} → {-term}", with_term(-term)
-            yield "drop", f"drop {term}", with_term(None)
-            yield "scale", f"{term} → (1 + 1e-3)·{term}", with_term(SCALE * term)
-            for a, b in combinations(rates, 2):
-                if term.has(a) or term.has(b):
-                    yield "swap θ̇", f"{a} ↔ {b} in {term}", with_term(term.xreplace({a: b, b: a}))
-    for node, path in _walk(expr):
-        if isinstance(node, (sp.sin, sp.cos)):
-            other = sp.cos if isinstance(node, sp.sin) else sp.sin
-            yield "sin↔cos", f"{node} → {other(*node.args)}", _replace(expr, path, other(*node.args))
-            arg = node.args[0]
-            for a, b in combinations(angles, 2):
-                if arg.has(a) or arg.has(b):
-                    swapped = node.func(arg.xreplace({a: b, b: a}))
-                    yield "swap θ", f"{a} ↔ {b} in {node}", _replace(expr, path, swapped)
+    """(operator, what, mutated entry) for one non-zero entry (``pendverify.symbolic.edits``)."""
+    for edit in term_edits(expr, rates, factors=(("scale", SCALE, "(1 + 1e-3)"),)):
+        yield edit.operator, edit.what, edit.expr
+    for edit in trig_edits(expr, angles):
+        yield edit.operator, edit.what, edit.expr
 
 
 def _divides(rate, term) -> bool:

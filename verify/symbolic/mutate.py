@@ -37,13 +37,13 @@ from __future__ import annotations
 import time
 
 import numpy as np
-import sympy as sp
 
 from pendverify.analytic.symbolic_reading import SymbolicModel, entries
 from pendverify.checks.catalogue import CHECKS, applicable_checks, run_check
 from pendverify.checks.sampling import sample_states
 from pendverify.errors import PendverifyError, UnknownNameError
 from pendverify.progress import bar
+from pendverify.symbolic.edited import edited_model
 from pendverify.symbolic.equivalence import coriolis_equivalence, differences, equivalence
 from pendverify.symbolic.mutants import Mutant, generate, is_coriolis_form
 from pendverify.symbolic.mutation_report import DETECTED, EQUIVALENT, SURVIVED, MutationReport, Outcome
@@ -67,30 +67,7 @@ DEFAULT_MUTATION_STATES = 40
 # --- numeric mutants ------------------------------------------------------------------------
 def numeric_model(model, sm: SymbolicModel, method: str, changes):
     """A model whose ``method`` returns the original value with ``changes`` written in."""
-    cls = type(model)
-    args = cls.closed_forms[method].args
-    symbols = sm.flat_arguments(args) + list(sm.parameters.values())
-    functions = [
-        (index, sp.lambdify(symbols, expr, modules="math", docstring_limit=0)) for index, _, expr in changes
-    ]
-    values = [getattr(model.params, name) for name in sm.parameters]
-    original = getattr(cls, method)
-    scalar = not isinstance(sm.closed_forms[method], sp.MatrixBase)
-
-    def mutated(self, *a):
-        flat = [float(x) for arg in a for x in np.ravel(arg)]
-        if scalar:
-            return float(functions[0][1](*flat, *values))
-        out = np.array(original(self, *a), dtype=float)
-        for index, f in functions:
-            out.flat[index] = f(*flat, *values)
-        return out
-
-    mutant = type(f"{cls.__name__}Mutant", (cls,), {method: mutated})(model.params)
-    if {"gravity_scale", "diagonal_scale"} - set(cls.hand_written()):
-        # derived tolerance scales stay the original's, as hand-written ones would
-        mutant.use_derived_scales(model.derived_scales())
-    return mutant
+    return edited_model(model, sm, {method: changes}, "Mutant", readable=False)
 
 
 def _failing(model, system, states, seed, order=None, stop: bool = False) -> list[str]:

@@ -65,8 +65,12 @@ def _function(method: str, value, names: dict) -> list[str]:
     """The lines of one generated function (a PrintMethodNotImplementedError if NumPy cannot)."""
     import sympy as sp
 
+    from pendverify.errors import PendverifyError
+
     matrix = isinstance(value, sp.MatrixBase)
     entries = tuple(e.xreplace(names) for e in (value if matrix else [value]))
+    if any(e.has(sp.zoo, sp.oo, -sp.oo, sp.nan) for e in entries):
+        raise PendverifyError("its expressions are infinite or NaN as SymPy reads them (a division by zero)")
     return list(_printed(method, value.shape if matrix else None, entries))
 
 

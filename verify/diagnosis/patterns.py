@@ -1,0 +1,173 @@
+"""The shape of a difference: hand − Pinocchio of one entry over the states, as a short formula.
+
+The difference d(s) of an entry over the judged states is fitted by a few functions of the
+basis its quantity allows:
+
+* M, H, V, D, det M: functions of q alone — 1, and sin and cos of each angle, of twice
+  each angle, and of the sums and differences of two and of three angles (the arguments
+  a closed form of a chain of revolute joints is built from; det M brings the doubled
+  angles through cos²);
+* C: those, and those times each rate q̇k (C is linear in q̇, and a friction inside C
+  is a constant);
+* C·q̇: those times each rate q̇k and each product q̇j·q̇k.
+
+M⁻¹ and q̈ are rational in the trigonometric functions and have no short basis; they are
+not fitted.  The fit is greedy (orthogonal matching pursuit: the basis function most
+correlated with what is left, then a least-squares fit on all chosen ones), at most
+``MAX_TERMS`` functions, and it stops when the relative residual ‖d − fit‖/‖d‖ is at
+most ``PATTERN_RESIDUAL``.  A difference made of k of the basis functions, sampled at more
+states than k, is recovered with a residual at rounding level: d is computed from values
+of size |hand| + |Pinocchio| with a rounding of a few ε of them, so the residual of an exact
+fit is a few ε·(|hand| + |Pinocchio|)/|d| — 1e-9 covers differences down to ~1e-6 of the
+entry's size (smaller ones are not fitted: the report gives the entry, not a shape).
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+
+import numpy as np
+import sympy as sp
+
+from pendverify.diagnosis.entries import EntryDifference
+from pendverify.diagnosis.finding import Finding
+
+MAX_TERMS = 6
+PATTERN_RESIDUAL = 1e-9
+#: a fitted coefficient below this fraction of the largest is rounding, not a term
+NEGLIGIBLE = 1e-9
+FITTED = ("M", "H", "V", "D", "detM", "C", "Cqdot")
+
+
+@dataclass(frozen=True)
+class Pattern:
+    """A fitted shape: ``terms`` as (coefficient, basis function's name), and the relative residual."""
+
+    terms: tuple[tuple[float, str], ...]
+    residual: float
+    #: each term's basis function as a SymPy expression over the model's names
+    functions: tuple = ()
+
+    def formula(self) -> str:
+        if not self.terms:
+            return "0"
+        out = ""
+        for c, name in self.terms:
+            sign = "−" if c < 0 else "+"
+            magnitude = f"{abs(c):.6g}" if name == "1" else f"{abs(c):.6g}·{name}"
+            out += f" {sign} {magnitude}" if out else (f"−{magnitude}" if c < 0 else magnitude)
+        return out
+
+    def kind(self) -> str:
+        if [n for _, n in self.terms] == ["1"]:
+            return "constant"
+        return f"{len(self.terms)} term{'s' if len(self.terms) > 1 else ''}"
+
+
+def _arguments(Q, angular, names):
+    """(name, values) of the trigonometric arguments of the basis."""
+    idx = [i for i, a in enumerate(angular) if a]
+    out = []
+    for i in idx:
+        out.append((names[i], Q[:, i]))
+    for i in idx:
+        out.append((f"2·{names[i]}", 2 * Q[:, i]))
+    for size in (2, 3):
+        for group in itertools.combinations(idx, size):
+            for signs in itertools.product((1, -1), repeat=size - 1):
+                values = Q[:, group[0]].copy()
+                text = names[group[0]]
+                for s, j in zip(signs, group[1:], strict=True):
+                    values = values + s * Q[:, j]
+                    text += f" {'+' if s > 0 else '−'} {names[j]}"
+                out.append((text, values))
+    return out
+
+
+def _symbol(name: str) -> sp.Symbol:
+    return sp.Symbol(name, real=True)  # as pendverify.analytic.symbolic_reading names them
+
+
+def position_basis(Q, angular, names) -> list[tuple[str, np.ndarray, sp.Expr]]:
+    """(name, values at the states Q, SymPy expression) of 1 and sin, cos of every argument."""
+    basis = [("1", np.ones(len(Q)), sp.S.One)]
+    for text, values in _arguments(Q, angular, names):
+        argument = sp.sympify(text.replace("·", "*").replace("−", "-"), locals={n: _symbol(n) for n in names})
+        basis.append((f"sin({text})", np.sin(values), sp.sin(argument)))
+        basis.append((f"cos({text})", np.cos(values), sp.cos(argument)))
+    return basis
+
+
+def basis_for(quantity: str, Q, V, angular, names) -> list[tuple[str, np.ndarray, sp.Expr]]:
+    """The basis a quantity's entries allow (module docstring), each function with its expression."""
+    position = position_basis(Q, angular, names)
+    if quantity in ("M", "H", "V", "D", "detM"):
+        return position
+    rates = [(f"d{n}", V[:, k], _symbol(f"d{n}")) for k, n in enumerate(names)]
+    linear = [
+        (r if p == "1" else f"{r}·{p}", rv * pv, rs * ps) for r, rv, rs in rates for p, pv, ps in position
+    ]
+    if quantity == "C":
+        return position + linear
+    products = []
+    for (a, av, a_s), (b, bv, b_s) in itertools.combinations_with_replacement(rates, 2):
+        product = f"{a}²" if a == b else f"{a}·{b}"
+        for p, pv, ps in position:
+            products.append((product if p == "1" else f"{product}·{p}", av * bv * pv, a_s * b_s * ps))
+    return linear + products
+
+
+def fit(d, basis) -> Pattern | None:
+    """The sparse fit of d by the basis (module docstring), or None when none is close enough."""
+    norm = float(np.linalg.norm(d))
+    if not np.isfinite(norm) or norm == 0:
+        return None
+    A = np.column_stack([b[1] for b in basis])
+    scale = np.linalg.norm(A, axis=0)
+    usable = scale > 0
+    unit = np.where(usable, A / np.where(usable, scale, 1.0), 0.0)
+    chosen: list[int] = []
+    residual, coeff = d.copy(), np.zeros(0)
+    for _ in range(min(MAX_TERMS, len(d) - 1)):
+        k = int(np.argmax(np.abs(unit.T @ residual)))
+        if k in chosen:
+            break
+        chosen.append(k)
+        coeff, *_ = np.linalg.lstsq(A[:, chosen], d, rcond=None)
+        residual = d - A[:, chosen] @ coeff
+        if np.linalg.norm(residual) <= PATTERN_RESIDUAL * norm:
+            break
+    relative = float(np.linalg.norm(residual) / norm)
+    if relative > PATTERN_RESIDUAL:
+        return None
+    largest = float(np.max(np.abs(coeff)))
+    kept = [(float(c), k) for c, k in sorted(zip(coeff, chosen, strict=True), key=lambda ck: ck[1])]
+    kept = [(c, k) for c, k in kept if abs(c) > NEGLIGIBLE * largest]
+    return Pattern(tuple((c, basis[k][0]) for c, k in kept), relative, tuple(basis[k][2] for _, k in kept))
+
+
+def entry_pattern(entry: EntryDifference, batch) -> Pattern | None:
+    """The shape of one entry's difference hand − Pinocchio over the judged states, if it has one."""
+    if entry.quantity not in FITTED:
+        return None
+    Q, V = batch.Q[entry.states], batch.V[entry.states]
+    model = batch.model
+    basis = basis_for(entry.quantity, Q, V, model.angular, model.coordinates)
+    with np.errstate(all="ignore"):
+        return fit(entry.hand - entry.pin, basis)
+
+
+def pattern_finding(entry: EntryDifference, pattern: Pattern, coordinates) -> Finding:
+    """The ``pattern`` finding: ``M[2,2]: hand − Pinocchio = 0.0416 (constant, residual 3e-16)``."""
+    label = entry.label(coordinates).split(" (")[0]
+    message = (
+        f"{label}: hand − Pinocchio = {pattern.formula()} ({pattern.kind()}, residual {pattern.residual:.1g})"
+    )
+    return Finding(
+        "pattern",
+        message,
+        entry.quantity,
+        tuple(i + 1 for i in entry.index),
+        {"terms": [[c, name] for c, name in pattern.terms], "residual": pattern.residual},
+    )

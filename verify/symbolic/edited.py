@@ -1,0 +1,72 @@
+"""A model with some entries of its closed forms replaced by other expressions.
+
+``edited_model(model, sm, edits)`` is an instance of a subclass of the model's class whose
+edited methods call the original and overwrite the edited entries (``edits``: {method:
+[(row-major index, original expression, new expression), ...]}); the other entries keep
+their original rounding, and methods that call an edited one see the edit, as they would in
+source code.  Numerically the new entries are lambdified onto ``math``; read by SymPy
+(``self.math`` is SymPy's, ``pendverify.analytic.symbolic_reading``) they are the new
+expressions themselves with the arguments substituted, so the generated NumPy code
+(``pendverify.numerics.codegen.vectorised``) and a second symbolic reading see the edited
+model.  ``pendverify mutate`` plants its mutants this way; a repair
+(``pendverify.diagnosis.repair``) is confirmed on the model edited this way.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import sympy as sp
+
+from pendverify.analytic.symbolic_reading import SYMBOLIC_MATH, SymbolicModel, to_sympy
+
+
+def _edited_method(cls, sm: SymbolicModel, method: str, changes, readable: bool):
+    args = cls.closed_forms[method].args
+    symbols = sm.flat_arguments(args) + list(sm.parameters.values())
+    functions = [
+        (index, sp.lambdify(symbols, expr, modules="math", docstring_limit=0)) for index, _, expr in changes
+    ]
+    original = getattr(cls, method)
+    scalar = not isinstance(sm.closed_forms[method], sp.MatrixBase)
+
+    def edited(self, *a):
+        flat = [x for arg in a for x in np.ravel(np.asarray(arg, dtype=object))]
+        values = [getattr(self.params, name) for name in sm.parameters]
+        if readable and self.math is SYMBOLIC_MATH:
+            mapping = dict(zip(symbols, [sp.sympify(x) for x in (*flat, *values)], strict=True))
+            if scalar:
+                return changes[0][2].xreplace(mapping)
+            shape = np.shape(original(self, *a))
+            out = np.array(to_sympy(original(self, *a)), dtype=object).reshape(shape)
+            for index, _, expr in changes:
+                out.flat[index] = expr.xreplace(mapping)
+            return out
+        flat = [float(x) for x in flat]
+        values = [float(v) for v in values]
+        if scalar:
+            return float(functions[0][1](*flat, *values))
+        out = np.array(original(self, *a), dtype=float)
+        for index, f in functions:
+            out.flat[index] = f(*flat, *values)
+        return out
+
+    edited.__name__ = method
+    return edited
+
+
+def edited_model(model, sm: SymbolicModel, edits: dict, name: str = "Edited", readable: bool = True):
+    """``model`` with the entries of ``edits`` ({method: changes}) replaced (module docstring).
+
+    ``readable=False``: SymPy cannot read the edited methods (they take floats only), so the
+    checks evaluate them with their own Python state by state instead of generating NumPy code
+    for each edited model (``pendverify mutate``'s hundreds of mutants: generating costs more
+    than it saves there)."""
+    cls = type(model)
+    namespace = {
+        method: _edited_method(cls, sm, method, changes, readable) for method, changes in edits.items()
+    }
+    edited = type(f"{cls.__name__}{name}", (cls,), namespace)(model.params)
+    if {"gravity_scale", "diagonal_scale"} - set(cls.hand_written()):
+        # derived tolerance scales stay the original's, as hand-written ones would
+        edited.use_derived_scales(model.derived_scales())
+    return edited
