@@ -203,6 +203,7 @@ def check(
     seed: int = DEFAULT_SEED,
     strict: bool = False,
     model_form_rtol: float = MODEL_FORM_RTOL,
+    explain: bool = True,
 ) -> CheckReport:
     """Compare Pinocchio on a URDF with a hand-derived closed form: ``pendverify check``.
 
@@ -227,7 +228,8 @@ def check(
     ``load_urdf`` take them (``urdf`` may also be ``erd:NAME``).  ``samples`` random states are
     drawn with ``seed`` (plus each model's special states); ``strict`` counts warnings as
     failures; ``model_form_rtol`` is the largest relative size of a URDF term the closed form
-    cannot express (``--model-form-rtol``).
+    cannot express (``--model-form-rtol``); ``explain=False`` skips the diagnosis of failing
+    models (``--no-explain``).
 
     Returns a ``CheckReport``: ``report["crba"]`` is one check's rows, ``print(report)`` the
     CLI's table.  A failing check is a result, not an exception (see
@@ -235,7 +237,7 @@ def check(
     """
     started = time.perf_counter()
     samples, seed = _count("samples", samples), _count("seed", seed)
-    strict, erd = _flag("strict", strict), _flag("erd", erd)
+    strict, erd, explain = _flag("strict", strict), _flag("erd", erd), _flag("explain", explain)
     if (
         isinstance(model_form_rtol, bool)
         or not isinstance(model_form_rtol, (int, float))
@@ -253,7 +255,12 @@ def check(
         urdf = _urdf_arg(urdf)
     selection = select_targets(model_cls, urdf, params, erd_urdfs=erd)
     report = build_report(
-        selection.targets, samples, seed, strict=strict, model_form_rtol=float(model_form_rtol)
+        selection.targets,
+        samples,
+        seed,
+        strict=strict,
+        model_form_rtol=float(model_form_rtol),
+        explain=explain,
     )
     report.skipped = selection.skipped
     report.elapsed_s = time.perf_counter() - started

@@ -139,10 +139,10 @@ def test_triple_pendulum_with_a_relative_angle_map_is_diagnosed(tmp_path, capsys
     assert _statuses(report)["crba"] == "fail"
     assert "absolute vs relative angles" in out
     (sentence,) = [
-        d
+        d["message"]
         for found in report["diagnoses"].values()
         for d in found
-        if d.startswith("absolute vs relative angles")
+        if d["message"].startswith("absolute vs relative angles")
     ]
     assert "the hand model's angles are absolute" in sentence
     assert "T → T·A = [[1.0, 0.0, 0.0], [-1.0, 1.0, 0.0], [0.0, -1.0, 1.0]]" in sentence

@@ -59,7 +59,8 @@ def test_urdf_inertia_about_the_pivot_is_named_in_the_report(tmp_path, capsys):
     )
     assert sentence in out
     report = json.loads(out_json.read_text())
-    assert "inertia given about the pivot" in report["diagnoses"]["double_pendulum:pivot"][0]
+    (trap,) = [d for d in report["diagnoses"]["double_pendulum:pivot"] if d["kind"] == "convention"]
+    assert "inertia given about the pivot" in trap["message"]
 
 
 class PivotCountedTwice(DoublePendulum):

@@ -4,8 +4,9 @@ One ``<testsuite>`` per model (target) and one ``<testcase>`` per check: ``class
 is the model, ``name`` the check.  A failed check carries a ``<failure>`` whose
 message is the table's row (error, tolerance, worst state) and whose text holds the
 check's notes; a refused check carries an ``<error>`` (not judged: neither pass nor
-fail); a warning passes and puts its sentence in ``<system-out>``.  Diagnoses go to
-the suite's ``<system-out>``.  The attribute counts (tests, failures, errors) are
+fail); a warning passes and puts its sentence in ``<system-out>``.  A failing case's
+text carries its notes and the model's diagnosis (``pendverify.diagnosis.explain``); notes
+and warnings go to the suite's ``<system-out>``.  The attribute counts (tests, failures, errors) are
 computed from the cases, so a CI system's totals equal the table's.  Text is escaped
 by ``xml.etree.ElementTree``; the file is UTF-8.
 """
@@ -22,11 +23,12 @@ def _row(r) -> str:
     return f"{r.check}: error {r.max_error:.3e}, tolerance {r.tolerance:.3e}, worst state {state}"
 
 
-def _case(r, seconds: float) -> ET.Element:
+def _case(r, seconds: float, diagnosis: list[str]) -> ET.Element:
     case = ET.Element("testcase", classname=r.model, name=r.check, time=f"{seconds:.3f}")
     notes = "\n".join(r.notes)
     if r.status == FAIL:
-        ET.SubElement(case, "failure", message=_row(r), type="verification failed").text = notes
+        text = "\n".join([*r.notes, *(f"diagnosis: {line}" for line in diagnosis)])
+        ET.SubElement(case, "failure", message=_row(r), type="verification failed").text = text
     elif r.status == REFUSED:
         ET.SubElement(case, "error", message=_row(r), type="refused by the trust rule").text = notes
     elif r.status == WARN:
@@ -51,12 +53,9 @@ def to_junit(report) -> str:
             skipped="0",
             time=f"{per_case * len(results):.3f}",
         )
-        suite.extend(_case(r, per_case) for r in results)
-        lines = [
-            *report.notes.get(model, []),
-            *report.warnings.get(model, []),
-            *report.diagnoses.get(model, []),
-        ]
+        diagnosis = [f.message for f in report.diagnoses.get(model, [])]
+        suite.extend(_case(r, per_case, diagnosis) for r in results)
+        lines = [*report.notes.get(model, []), *report.warnings.get(model, [])]
         if lines:
             ET.SubElement(suite, "system-out").text = "\n".join(lines)
     root.set("tests", str(len(report.results)))

@@ -110,14 +110,17 @@ class Report:
     notes: dict[str, list[str]] = field(default_factory=dict)
     sources: dict[str, str] = field(default_factory=dict)
     elapsed_s: float = 0.0
-    #: Known traps that explain a target's failures (``pendverify.diagnosis.diagnose``), in words.
-    diagnoses: dict[str, list[str]] = field(default_factory=dict)
+    #: What is wrong in a failing target and how to fix it (``pendverify.diagnosis.explain``):
+    #: ``pendverify.diagnosis.finding.Finding`` objects per model label.
+    diagnoses: dict[str, list] = field(default_factory=dict)
     #: What a user must know although the checks pass (``pendverify.checks.verdict``), per target.
     warnings: dict[str, list[str]] = field(default_factory=dict)
     #: --strict: warnings count as failures.
     strict: bool = False
     #: What was left out of the report and why, one sentence each (example-robot-data not installed).
     skipped: list[str] = field(default_factory=list)
+    #: diagnose failing models (``--no-explain`` turns it off)
+    explain: bool = True
 
     @property
     def status(self) -> str:
@@ -203,7 +206,7 @@ class Report:
             "strict": self.strict,
             "sources": self.sources,
             "notes": self.notes,
-            "diagnoses": self.diagnoses,
+            "diagnoses": {label: [f.as_dict() for f in found] for label, found in self.diagnoses.items()},
             "warnings": self.warnings,
             "skipped": self.skipped,
             "results": [r.as_dict() for r in self.results],
@@ -256,9 +259,9 @@ def trailing_lines(report: Report) -> list[str]:
     for r in report.failures():
         for note in r.notes:
             out.append(f"fail [{r.model} {r.check}]: {note}")
-    for model, sentences in report.diagnoses.items():
-        for sentence in sentences:
-            out.append(f"diagnosis [{model}]: {sentence}")
+    for model, findings in report.diagnoses.items():
+        for finding in findings:
+            out.append(f"diagnosis [{model}]: {finding.message}")
     judged = [r for r in report.results if r.largest_error == r.largest_error]  # not NaN
     if judged:
         top = max(judged, key=lambda r: r.largest_error)

@@ -12,7 +12,9 @@ For each target (a closed-form model and a URDF in Pinocchio):
 4. the verdict rules of ``pendverify.checks.verdict`` run: a C with the right C·q̇ but
    not the Christoffel one is a warning, a URDF's Coulomb friction is a warning,
    ``strict`` turns warnings into failures;
-5. failures on trusted states are diagnosed (``pendverify.diagnosis.diagnose``).
+5. failures on trusted states are diagnosed (``pendverify.diagnosis.explain``: the entries that
+   differ, the shape of each difference, the known traps and a confirmed repair), unless the
+   report says not to explain (``--no-explain``).
 """
 
 from __future__ import annotations
@@ -27,7 +29,7 @@ from pendverify.checks.result import CheckResult
 from pendverify.checks.sampling import sample_states
 from pendverify.checks.trust import REFUSE_REL, Verdicts, check_conditioning
 from pendverify.checks.verdict import FAIL, REFUSED, WARN, apply_strict, non_christoffel_c
-from pendverify.diagnosis.diagnose import diagnose
+from pendverify.diagnosis.explain import explain
 from pendverify.errors import IllConditionedError
 from pendverify.progress import bar
 from pendverify.robot.geometry import MODEL_FORM_RTOL
@@ -98,12 +100,12 @@ def _refuse(results: list[CheckResult], refused: list[str], total: int) -> None:
 
 def guarded_checks(
     label: str, model, system, states, seed: int
-) -> tuple[list[CheckResult], list[str], dict[str, str]]:
+) -> tuple[list[CheckResult], list[str], dict[str, str], CheckBatch]:
     """The checks that apply, on the states the trust rule accepts; checks refused where it refuses.
 
     The one way every caller (``check``, the certification battery) runs the checks on
     sampled states: (results, one sentence per refused state, {method: why it ran in the
-    model's own Python state by state} (``ClosedForms.per_state``)).
+    model's own Python state by state} (``ClosedForms.per_state``), the batch of the states judged).
     """
     batch = CheckBatch(model, system, states)
     kept, refused, _ = trusted(label, batch)
@@ -113,7 +115,7 @@ def guarded_checks(
     results = run_checks(label, model, system, batch.states, seed, names, batch)
     if refused:
         _refuse(results, refused, len(states))
-    return results, refused, batch.forms.per_state
+    return results, refused, batch.forms.per_state, batch
 
 
 def per_state_note(per_state: dict[str, str]) -> list[str]:
@@ -139,7 +141,7 @@ def verify_target(report: Report, target, samples: int, seed: int) -> None:
         + skipped_notes(target.model, target.system)
         + derived_notes(target.model)
     )
-    results, refused, per_state = guarded_checks(label, target.model, target.system, states, seed)
+    results, refused, per_state, batch = guarded_checks(label, target.model, target.system, states, seed)
     notes += per_state_note(per_state)
     kept = len(refused) < len(states)
     if refused:
@@ -159,8 +161,8 @@ def verify_target(report: Report, target, samples: int, seed: int) -> None:
     if report.strict:
         apply_strict(results)
     failing = [r for r in results if r.status == FAIL and r.check != "model-form"]
-    if failing and kept:
-        diagnoses = diagnose(target.model, target.system, failing)
+    if failing and kept and report.explain:
+        diagnoses = explain(batch, failing)
         if diagnoses:
             report.diagnoses[label] = diagnoses
     if notes:
@@ -171,10 +173,15 @@ def verify_target(report: Report, target, samples: int, seed: int) -> None:
 
 
 def build_report(
-    targets, samples: int, seed: int, strict: bool = False, model_form_rtol: float = MODEL_FORM_RTOL
+    targets,
+    samples: int,
+    seed: int,
+    strict: bool = False,
+    model_form_rtol: float = MODEL_FORM_RTOL,
+    explain: bool = True,
 ) -> Report:
     """Every applicable check on every target, judged and diagnosed: one Report."""
-    report = Report(seed=seed, states={}, results=[], strict=strict)
+    report = Report(seed=seed, states={}, results=[], strict=strict, explain=explain)
     with bar(len(targets), "check", "model") as progress:
         for target in targets:
             target.system.model_form_rtol = model_form_rtol

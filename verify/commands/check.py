@@ -61,6 +61,12 @@ def register(sub) -> None:
         help="warnings (a C that is not the Christoffel one, a URDF's Coulomb friction) count as failures",
     )
     p.add_argument(
+        "--no-explain",
+        dest="explain",
+        action="store_false",
+        help="do not diagnose a failing model (which entries differ, how, and a confirmed repair)",
+    )
+    p.add_argument(
         "--model-form-rtol",
         type=positive_float,
         default=None,
@@ -88,6 +94,7 @@ def run(args: argparse.Namespace) -> int:
         args.params,
         erd=args.erd,
         strict=args.strict,
+        explain=args.explain,
         **{key: value for key, value in given.items() if value is not None},
     )
     report.elapsed_s = time.perf_counter() - args.started

@@ -41,6 +41,11 @@ def _cqdot_errors(t, m):
     return t.w * np.abs((t.bias_pin - t.H_pin) - (t.bias_hand - t.H_hand))
 
 
+def _every_state(t, constant):
+    """A constant matrix (D) at every state of the batch."""
+    return np.broadcast_to(constant, (len(t.q), *np.shape(constant)))
+
+
 def _potential(t, which: str):
     return getattr(t, f"V_{which}") - getattr(t, f"V_{which}0")
 
@@ -54,7 +59,7 @@ COMPARED = (
     ),
     Compared("Minv", "minverse", lambda t: t.Minv_hand, lambda t: t.Minv_pin),
     Compared("qddot", "aba", lambda t: t.a_hand, lambda t: t.a_pin),
-    Compared("D", "damping", lambda t: t.D, lambda t: t.D_urdf),
+    Compared("D", "damping", lambda t: _every_state(t, t.D), lambda t: _every_state(t, t.D_urdf)),
     Compared("detM", "det", lambda t: t.det_hand, lambda t: t.det_pin, lambda t, m: np.abs(m.error)),
     Compared(
         "V",
@@ -102,8 +107,6 @@ def differing_entries(batch, failing: set[str]) -> list[EntryDifference]:
             errors = np.asarray(compared.errors(terms, measure), dtype=float)
             hand = np.asarray(compared.hand(terms), dtype=float)
             pin = np.asarray(compared.pin(terms), dtype=float)
-        if errors.ndim == 0 or errors.shape[0] != n:  # a constant quantity (D): the same at every state
-            errors, hand, pin = (np.broadcast_to(x, (n, *np.shape(x))) for x in (errors, hand, pin))
         judged = evidence.judged
         if judged.size == 0:
             continue

@@ -65,6 +65,7 @@ def edited_model(model, sm: SymbolicModel, edits: dict, name: str = "Edited", re
     namespace = {
         method: _edited_method(cls, sm, method, changes, readable) for method, changes in edits.items()
     }
+    namespace["__module__"] = cls.__module__  # messages name the model's own file
     edited = type(f"{cls.__name__}{name}", (cls,), namespace)(model.params)
     if {"gravity_scale", "diagonal_scale"} - set(cls.hand_written()):
         # derived tolerance scales stay the original's, as hand-written ones would

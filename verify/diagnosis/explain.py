@@ -1,0 +1,47 @@
+"""A failing model's diagnosis: what is wrong and how to fix it, as a list of ``Finding``.
+
+In order:
+
+1. the entries that differ, each with the shape of its difference over the states
+   (``pendverify.diagnosis.entries``, ``pendverify.diagnosis.patterns``);
+2. the known traps (``pendverify.diagnosis.diagnose``: coordinate conventions, an inertia
+   about the pivot, friction missing from q̈);
+3. the repair, a single edit (or a pair) of the model's own expressions confirmed by every
+   check on every state, or a sentence saying none was found (``pendverify.diagnosis.repair``).
+
+Only a model with a failing check on trusted states is diagnosed (the caller decides);
+the repair search is bounded by ``deadline_s``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from pendverify.diagnosis.diagnose import diagnose
+from pendverify.diagnosis.entries import differing_entries, entry_finding
+from pendverify.diagnosis.finding import Finding
+from pendverify.diagnosis.patterns import entry_pattern, pattern_finding
+from pendverify.diagnosis.repair import search_repair
+
+#: the repair search's bound: a 3-degree-of-freedom model's search takes well under it
+REPAIR_DEADLINE_S = 10.0
+
+
+def explain(batch, results, deadline_s: float = REPAIR_DEADLINE_S) -> list[Finding]:
+    """The diagnosis of a model whose checks ``results`` on ``batch`` fail (module docstring)."""
+    failing = {r.check for r in results if not r.passed}
+    findings: list[Finding] = []
+    with np.errstate(all="ignore"):
+        for entry in differing_entries(batch, failing):
+            findings.append(entry_finding(entry, batch))
+            pattern = entry_pattern(entry, batch)
+            if pattern is not None:
+                findings.append(pattern_finding(entry, pattern, batch.model.coordinates))
+    for trap in diagnose(batch.model, batch.system, results):
+        findings.append(trap if isinstance(trap, Finding) else Finding("convention", trap))
+    repairs, why_not = search_repair(batch, deadline_s)
+    findings += repairs
+    if why_not:  # said as a repair that is not one: checks_pass false, nothing suggested
+        details = {"written": None, "suggested": None, "suggested_source": None, "location": None}
+        findings.append(Finding("repair", why_not, details={**details, "checks_pass": False}))
+    return findings

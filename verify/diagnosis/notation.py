@@ -1,0 +1,82 @@
+"""An expression in the model's own notation, and where an entry sits in the model's source.
+
+* a LaTeX model file (``notation = "latex"``): LaTeX with the file's own symbols — each
+  model name printed as the first key of the file's ``[symbols]`` table that reads as it
+  (``\\theta_1`` for theta1), and each shorthand of the table (``\\delta`` = I2 + m2*r2**2)
+  put back where its expression stands (SymPy's ``subs``, which also finds 2·I2 + 2·m2·r2²
+  as 2·δ); the location is the file and the equation's key;
+* a text model file in SymPy syntax: SymPy's own printing over the file's names;
+* a Python class: the same printing, which is a Python expression over the class's names;
+  the location is the source file and ``Class.method``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import sympy as sp
+
+from pendverify.analytic.source_file import where
+
+#: method → the key of a text model file that gives it
+TEXT_KEYS = {
+    "mass_matrix": "M",
+    "coriolis_matrix": "C",
+    "coriolis_force": "Cqdot",
+    "gravity": "H",
+    "potential_energy": "V",
+    "damping_matrix": "D",
+    "input_matrix": "B",
+    "disturbance_matrix": "W",
+    "det_mass_matrix": "det_M",
+    "inverse_mass_matrix": "M_inv",
+    "acceleration": "qddot",
+}
+
+
+@dataclass
+class Notation:
+    """How the model writes its expressions (module docstring)."""
+
+    kind: str  # "latex", "sympy" or "python"
+    source: str
+    class_name: str
+    derived: dict = field(default_factory=dict)  # text file: key → how it was computed from others
+    names: dict = field(default_factory=dict)  # LaTeX: symbol → its LaTeX
+    shorthands: list = field(default_factory=list)  # LaTeX: (expression, its symbol), largest first
+
+    @classmethod
+    def of(cls, model_cls) -> Notation:
+        spec = getattr(model_cls, "text_spec", None)
+        if spec is None:
+            return cls("python", where(model_cls), model_cls.__name__)
+        notation = cls(spec.notation, str(spec.path), model_cls.__name__, dict(spec.derived))
+        for key, value in spec.latex_symbols.items():
+            value = sp.sympify(value)
+            if isinstance(value, sp.Symbol):
+                notation.names.setdefault(value, key)
+            elif value.free_symbols:
+                stand_in = sp.Symbol(f"shorthand{len(notation.shorthands)}")
+                notation.names[stand_in] = key
+                notation.shorthands.append((value, stand_in))
+        notation.shorthands.sort(key=lambda pair: -sp.count_ops(pair[0]))
+        return notation
+
+    def render(self, expr) -> str:
+        """The expression as the model's source would write it."""
+        if self.kind != "latex":
+            return str(expr)
+        forms = []
+        for form in (expr, sp.factor_terms(expr)):  # 2·I2 + 2·m2·r2² is 2·δ once factored
+            for value, stand_in in self.shorthands:
+                form = form.subs(value, stand_in)
+            forms.append(form)
+        return sp.latex(min(forms, key=sp.count_ops), symbol_names=self.names)
+
+    def location(self, method: str, label: str) -> str:
+        """Where the entry sits: the file, the key (or Class.method) and the entry."""
+        if self.kind == "python":
+            return f"{self.source}, {self.class_name}.{method}, entry {label}"
+        key = TEXT_KEYS.get(method, method)
+        how = f" (derived: {self.derived[key]})" if key in self.derived else ""
+        return f"{self.source}, key {key}{how}, entry {label}"
