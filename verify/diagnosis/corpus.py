@@ -1,0 +1,229 @@
+"""A corpus of planted single-edit errors, and how well the diagnosis names and repairs them.
+
+For every model file the worked examples ship (``pendverify.worked_examples``: the Python
+class, and the same model as LaTeX or text where there is one) and every non-zero entry of
+its written closed forms, one error per operator (``OPERATORS``) is planted where the
+operator applies — the first place in the entry's tree where it changes the entry — with
+``pendverify.symbolic.edited.edited_model``.  A planted model that passes every check is
+*not detected* and left out (an equivalent edit, or a gap ``pendverify mutate`` reports).
+For each detected one the diagnosis (``pendverify.diagnosis.explain``) is run and scored:
+
+named
+    an ``entry`` finding names the planted entry (for a Coriolis-type matrix, which is not
+    unique, its row of C·q̇; for a form beyond the interface, any entry of what it feeds);
+repaired
+    a confirmed ``repair`` finding (every check passes on every state);
+restored
+    the repair gives back the entries as they were, or ones proved equal to them
+    (``pendverify.symbolic.zero_test``): the planted edit or an equivalent one.
+
+The untouched models are diagnosed too: they must pass, with no finding at all.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import random
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import sympy as sp
+
+from pendverify.analytic.symbolic_reading import SymbolicModel, entries
+from pendverify.analytic.text_expression import read_expression
+from pendverify.analytic.text_parse import CONSTANTS, FUNCTIONS
+from pendverify.checks.batch import CheckBatch
+from pendverify.checks.catalogue import applicable_checks, run_checks
+from pendverify.checks.sampling import sample_states
+from pendverify.diagnosis.explain import explain
+from pendverify.diagnosis.repair import QUANTITY
+from pendverify.symbolic.edited import edited_model
+from pendverify.symbolic.edits import parameter_edits, term_edits, trig_edits, walk
+from pendverify.symbolic.zero_test import is_zero
+
+OPERATORS = (
+    "sign",
+    "drop",
+    "duplicate",
+    "factor 2",
+    "factor ½",
+    "sin↔cos",
+    "swap θ",
+    "swap θ̇",
+    "parameter",
+    "offset",
+    "pivot",
+)
+CORPUS_SEED = 24
+CORPUS_SAMPLES = 12  # random states per planted model, besides the special ones
+
+
+@dataclass(frozen=True)
+class Plant:
+    """One planted error: ``new`` for entry ``index`` (row-major) of ``method``."""
+
+    method: str
+    index: int
+    operator: str
+    original: sp.Expr
+    new: sp.Expr
+    what: str
+
+
+def _pivot(expr, kinds: dict) -> sp.Expr | None:
+    """The entry with one more m·r² (an inertia about the pivot where the centre of mass is meant)."""
+    for node, _ in walk(expr):
+        if node.is_Mul:
+            mass = [s for s in node.free_symbols if kinds.get(s) == "mass"]
+            length = [s for s in node.free_symbols if kinds.get(s) in ("length", "offset") and node.has(s**2)]
+            if mass and length:
+                return expr + mass[0] * length[0] ** 2
+    return None
+
+
+def entry_plants(method: str, index: int, expr, sm: SymbolicModel, kinds: dict) -> list[Plant]:
+    """One planted error per operator that applies to this entry (module docstring)."""
+    angles, rates = sm.angles, sm.symbols["v"]
+    found: dict[str, tuple] = {}
+    factors = (("duplicate", sp.Integer(2), "2"),)
+    for edit in itertools.chain(term_edits(expr, rates, factors), trig_edits(expr, angles, offsets=True)):
+        if edit.operator in ("scale",):
+            continue
+        if edit.operator == "offset" and edit.new.args and edit.new.args[0] - edit.old.args[0] != sp.pi / 2:
+            continue
+        if edit.operator not in found and edit.expr != expr:
+            found[edit.operator] = (edit.expr, edit.what)
+    for edit in parameter_edits(expr, kinds):
+        if edit.expr != expr:
+            found.setdefault("parameter", (edit.expr, edit.what))
+            break
+    found["factor 2"] = (2 * expr, f"{expr} → 2·({expr})")
+    found["factor ½"] = (expr / 2, f"{expr} → ({expr})/2")
+    if method == "mass_matrix":
+        pivot = _pivot(expr, kinds)
+        if pivot is not None:
+            found["pivot"] = (pivot, f"{expr} → {pivot}")
+    return [Plant(method, index, op, expr, *found[op]) for op in OPERATORS if op in found]
+
+
+def plants(sm: SymbolicModel) -> list[Plant]:
+    """Every planted error of the corpus for one model."""
+    kinds = {sm.parameters[name]: kind for name, kind in _kinds(sm).items()}
+    out = []
+    for method, value in sm.closed_forms.items():
+        for index, expr in enumerate(entries(value)):
+            if expr != 0:
+                out += entry_plants(method, index, expr, sm, kinds)
+    return out
+
+
+def _kinds(sm) -> dict:
+    return {f.name: f.metadata.get("kind", "") for f in dataclasses.fields(sm.cls.params_type)}
+
+
+@dataclass
+class Score:
+    """What the diagnosis did with one planted error."""
+
+    plant: Plant
+    detected: bool = False
+    named: bool = False
+    repaired: bool = False
+    restored: bool = False
+    seconds: float = 0.0
+    message: str = ""
+
+
+@dataclass
+class ModelScores:
+    """One model file's corpus: every planted error scored, and whether the untouched model is clean."""
+
+    label: str
+    scores: list[Score] = field(default_factory=list)
+    clean: bool = True
+
+    def count(self, what: str) -> int:
+        return sum(getattr(s, what) for s in self.scores)
+
+
+def _named(plant: Plant, findings, forms) -> bool:
+    value = forms[plant.method]
+    quantity = QUANTITY.get(plant.method)
+    named = [(f.quantity, f.index) for f in findings if f.kind == "entry"]
+    if quantity is None:
+        return bool(named)
+    if isinstance(value, sp.MatrixBase):
+        r, c = divmod(plant.index, value.shape[1])
+        index = (r + 1,) if value.shape[1] == 1 else (r + 1, c + 1)
+    else:
+        index = ()
+    if quantity == "C":  # C is not unique: its row of C·q̇ is what differs
+        return (quantity, index) in named or ("Cqdot", (index[0],)) in named
+    return (quantity, index) in named
+
+
+def _restored(findings, plant: Plant, sm: SymbolicModel) -> bool:
+    """Whether a confirmed repair of the planted entry gives back the original (or an equal) entry."""
+    names = {s.name: s for group in sm.symbols.values() for s in group}
+    names |= {p.name: p for p in sm.parameters.values()} | FUNCTIONS | CONSTANTS
+    for f in findings:
+        if f.kind == "repair" and f.details.get("checks_pass") and f.details["written"] == str(plant.new):
+            suggested = read_expression(f.details["suggested"], names)
+            if is_zero(suggested - plant.original, sm.angles):
+                return True
+    return False
+
+
+def score_model(
+    label: str, model, system, chosen=None, deadline_s: float = 10.0, progress=None
+) -> ModelScores:
+    """The corpus of one model (``chosen``: a subset of its plants), each planted error scored."""
+    cls = type(model)
+    sm = SymbolicModel.of(cls)
+    forms = sm.closed_forms
+    states = sample_states(model, CORPUS_SAMPLES, CORPUS_SEED)
+    out = ModelScores(label)
+    batch = CheckBatch(model, system, states)
+    results = run_checks(label, model, system, states, CORPUS_SEED, applicable_checks(model, system), batch)
+    out.clean = all(r.passed for r in results)
+    for plant in plants(sm) if chosen is None else chosen:
+        score = Score(plant)
+        planted = edited_model(
+            model, sm, {plant.method: [(plant.index, plant.original, plant.new)]}, "Planted"
+        )
+        start = time.perf_counter()
+        with np.errstate(all="ignore"):
+            batch = CheckBatch(planted, system, states)
+            try:
+                results = run_checks(
+                    label, planted, system, states, CORPUS_SEED, applicable_checks(planted, system), batch
+                )
+            except (ArithmeticError, ValueError, np.linalg.LinAlgError):
+                results = None
+        if results is not None and not all(r.passed for r in results):
+            score.detected = True
+            findings = explain(batch, results, deadline_s)
+            score.named = _named(plant, findings, forms)
+            score.repaired = any(f.kind == "repair" and f.details.get("checks_pass") for f in findings)
+            score.restored = _restored(findings, plant, sm)
+            score.message = next((f.message for f in findings if f.kind == "repair"), "")
+        score.seconds = time.perf_counter() - start
+        out.scores.append(score)
+        if progress is not None:
+            progress.update(1)
+    return out
+
+
+def sample_plants(sm: SymbolicModel, per_operator: int, seed: int = CORPUS_SEED) -> list[Plant]:
+    """Up to ``per_operator`` planted errors of each operator, drawn with ``seed``."""
+    rng = random.Random(seed)
+    by_operator: dict[str, list[Plant]] = {}
+    for plant in plants(sm):
+        by_operator.setdefault(plant.operator, []).append(plant)
+    chosen = []
+    for operator in OPERATORS:
+        group = by_operator.get(operator, [])
+        chosen += rng.sample(group, min(per_operator, len(group)))
+    return chosen
