@@ -57,9 +57,11 @@ A hypothesis whose direction lies in the null space (its data-space image within
 tolerance of zero) says nothing and is skipped.  Single hypotheses are tried first, then
 pairs; the unknowns are solved by Gauss–Newton from the linear fit (exact for the linear
 ones), and an explanation is accepted only when Y·(π_urdf + Δπ(x)) reproduces the hand
-model's rows within ``tolerance``.  Among the accepted, the fewest hypotheses, then the
-fewest unknowns win; when several remain the equations cannot tell them apart and every
-one is reported, saying so and naming the combinations the equations fix.  An explanation
+model's rows within ``tolerance``; a solved value's rounding (a finding's ``rounding``) is
+‖row of J⁺‖·``tolerance``, J the image of ∂Δπ/∂x at the solution.  Among the accepted,
+the fewest hypotheses, then the fewest unknowns win; when several remain the equations
+cannot tell them apart and every one is reported, saying so and naming the combinations the
+equations fix.  An explanation
 without unknowns (an inertia about the pivot) predicts the difference rather than fitting it,
 so it is preferred to a one-unknown one that also fits (any change of I_xx fits what m·r² on
 I_xx does).  When no one or two hypotheses fit, the combinations that differ beyond their
@@ -83,6 +85,7 @@ from functools import cached_property
 import numpy as np
 import pinocchio as pin
 
+from pendverify.analytic.interface import BiasOnlyModel
 from pendverify.checks.scaling import mv, total
 from pendverify.checks.trust import EPS
 from pendverify.diagnosis.finding import Finding
@@ -147,10 +150,11 @@ class Rows:
 
 
 def _hand_coriolis_force(batch) -> np.ndarray:
+    """The hand model's C·q̇ as its bias reads it (``pendverify.checks.closed_forms``)."""
     forms = batch.forms
-    if batch.model.has_coriolis_matrix:
-        return mv(forms.value("coriolis_matrix"), batch.V)
-    return forms.value("coriolis_force")
+    if isinstance(batch.model, BiasOnlyModel):
+        return forms.value("coriolis_force")
+    return mv(forms.value("coriolis_matrix"), batch.V)
 
 
 def stacked_rows(batch) -> Rows:
@@ -420,6 +424,8 @@ class Explanation:
     hypotheses: tuple[Hypothesis, ...]
     values: tuple[float, ...]  # one per hypothesis (0 for one without an unknown)
     residual: float
+    #: each value's rounding: ‖row of J⁺‖·tolerance, J the image of ∂Δπ/∂x (0 without an unknown)
+    roundings: tuple[float, ...]
 
     @property
     def unknowns(self) -> int:
@@ -448,7 +454,7 @@ def _directions(hypotheses, x, P):
 def _solve(implied: ImpliedParameters, hypotheses) -> Explanation | None:
     """The hypotheses' unknowns by Gauss–Newton from the linear fit; None when they are not identifiable."""
     phi, target, P = implied.phi, implied.target, implied.phi.shape[1]
-    x = np.zeros(len(hypotheses))
+    x, rounding = np.zeros(len(hypotheses)), np.zeros(len(hypotheses))
     free = np.array([h.unknowns > 0 for h in hypotheses])
     if free.any():
         D = _directions(hypotheses, x, P)
@@ -467,9 +473,12 @@ def _solve(implied: ImpliedParameters, hypotheses) -> Explanation | None:
             x[free] += step
             if np.all(np.abs(step) <= 4 * EPS * np.abs(x[free])):
                 break
+        # δx = J⁺ δz with ‖δz‖ within the tolerance: each unknown's rounding
+        J = phi @ _directions(hypotheses, x, P)
+        rounding[free] = np.linalg.norm(np.linalg.pinv(J), axis=1) * implied.tolerance
     misfit = np.linalg.norm(phi @ _delta(hypotheses, x, P) - target)
     residual = float(np.hypot(misfit, implied.residual))
-    return Explanation(tuple(hypotheses), tuple(float(v) for v in x), residual)
+    return Explanation(tuple(hypotheses), tuple(map(float, x)), residual, tuple(map(float, rounding)))
 
 
 def explanations(implied: ImpliedParameters, model: pin.Model) -> list[Explanation]:
@@ -566,22 +575,25 @@ def _findings(found: list[Explanation], implied: ImpliedParameters, model: pin.M
     out = []
     for explanation in found:
         changes = [
-            (h, *_values(h, x, model))
-            for h, x in zip(explanation.hypotheses, explanation.values, strict=True)
+            (h, *_values(h, x, model), rounding)
+            for h, x, rounding in zip(
+                explanation.hypotheses, explanation.values, explanation.roundings, strict=True
+            )
         ]
-        phrases = [_phrase(h, ours, theirs, model.inertias[h.joint + 1]) for h, ours, theirs in changes]
+        phrases = [_phrase(h, ours, theirs, model.inertias[h.joint + 1]) for h, ours, theirs, _ in changes]
         sentence = "your equations are this URDF with " + " and ".join(phrases)
         if len(found) > 1:
             sentence += (
                 f" — one of {len(found)} explanations your M, C·q̇ and H cannot tell apart: they fix "
                 f"only {_combinations(implied)} (I about each joint's origin)"
             )
-        for h, ours, theirs in changes:
+        for h, ours, theirs, rounding in changes:
             details = {
                 "link": h.link,
                 "parameter": h.parameter,
                 "model_value": _listed(ours),
                 "urdf_value": _listed(theirs),
+                "rounding": rounding,
                 "residual": explanation.residual,
             }
             if h.parameter in ("first moment", "centre of mass"):
@@ -608,6 +620,7 @@ def _combinations_finding(implied: ImpliedParameters) -> Finding:
             "combinations": [c.name for c in differ],
             "model_value": [c.model_value for c in differ],
             "urdf_value": [c.urdf_value for c in differ],
+            "rounding": [c.rounding for c in differ],
             "residual": implied.residual,
         },
     )
