@@ -37,7 +37,7 @@ from ..conftest import SEED, default_params
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 STATES = 40
 EPS = float(np.finfo(float).eps)
-TIME_LIMIT = 1.0  # s, the brief's bound for a 3-dof model
+TIME_LIMIT = 1.0  # s: the diagnosis of a 3-dof model is bounded by a second
 
 
 # --- the models and their systems ------------------------------------------------------------
@@ -328,6 +328,34 @@ def test_an_inertia_that_is_not_the_pivot_s_is_one_component():
     d = finding.details
     assert (d["link"], d["parameter"], d["component"]) == ("link2", "inertia about the centre of mass", "xx")
     assert _close(d["model_value"], params.I2 + 0.01, d["rounding"])
+
+
+def test_a_first_moment_with_the_inertia_about_the_joint_kept_is_named():
+    """r2 changed in β and H only: I2 + m2·r2² (the inertia about joint 2) kept, so m·c_y alone moves."""
+    cls, params, system = _builtin("double_pendulum")
+    r2 = 0.25
+    hand = params.replace(r2=r2, I2=params.I2 + params.m2 * (params.r2**2 - r2**2))
+    (finding,) = identify_parameters(_batch(cls(hand), system))
+    d = finding.details
+    assert (d["link"], d["parameter"], d["axis"]) == ("link2", "first moment", "y")
+    assert _close(d["model_value"], params.m2 * r2, d["rounding"])
+    assert _close(d["urdf_value"], params.m2 * params.r2)
+    assert "(its centre of mass at y = 0.25 m, with its inertia about the joint kept?)" in finding.message
+
+
+def test_a_urdf_inertia_about_the_pivot_is_named():
+    """The other sign: the URDF's <inertia> of link1 is about the pivot, the hand model's about the centre."""
+    cls, params, _ = _builtin("double_pendulum")
+    pivot = params.I1 + params.m1 * params.r1**2
+    system = PinocchioSystem.for_params(params.replace(I1=pivot))
+    model = cls(params)
+    batch = _batch(model, system)
+    assert _failing(model, system, batch)
+    (finding,) = identify_parameters(batch)
+    d = finding.details
+    assert (d["link"], d["parameter"]) == ("link1", "inertia about the pivot")
+    assert "link1's inertia about the centre of mass where the URDF has it about the pivot" in finding.message
+    assert _close(d["model_value"][0][0], params.I1) and _close(d["urdf_value"][0][0], pivot)
 
 
 def test_the_identifiable_combinations_of_a_planar_chain():
