@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 
 from pendverify.checks.result import CheckResult
 from pendverify.checks.verdict import FAIL, LABELS, PASS, REFUSED, WARN, worst
+from pendverify.diagnosis.finding import text_lines
 from pendverify.display import REPR_LIMIT, html_lines, html_table, listed
 from pendverify.jsonio import to_json, versions
 
@@ -260,8 +261,8 @@ def trailing_lines(report: Report) -> list[str]:
         for note in r.notes:
             out.append(f"fail [{r.model} {r.check}]: {note}")
     for model, findings in report.diagnoses.items():
-        for finding in findings:
-            out.append(f"diagnosis [{model}]: {finding.message}")
+        for line in text_lines(findings):
+            out.append(f"diagnosis [{model}]: {line}")
     judged = [r for r in report.results if r.largest_error == r.largest_error]  # not NaN
     if judged:
         top = max(judged, key=lambda r: r.largest_error)

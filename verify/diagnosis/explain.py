@@ -6,7 +6,10 @@ In order:
    (``pendverify.diagnosis.entries``, ``pendverify.diagnosis.patterns``);
 2. the known traps (``pendverify.diagnosis.diagnose``: coordinate conventions, an inertia
    about the pivot, friction missing from q̈);
-3. the repair, a single edit (or a pair) of the model's own expressions confirmed by every
+3. the inertial parameters the model implies: whether it is this robot's dynamics with other
+   masses, centres of mass or inertias, and which; or that no mass distribution explains it
+   (``pendverify.diagnosis.parameters``);
+4. the repair, a single edit (or a pair) of the model's own expressions confirmed by every
    check on every state, or a sentence saying none was found (``pendverify.diagnosis.repair``).
 
 Only a model with a failing check on trusted states is diagnosed (the caller decides);
@@ -20,6 +23,7 @@ import numpy as np
 from pendverify.diagnosis.diagnose import diagnose
 from pendverify.diagnosis.entries import differing_entries, entry_finding
 from pendverify.diagnosis.finding import Finding
+from pendverify.diagnosis.parameters import identify_parameters
 from pendverify.diagnosis.patterns import entry_pattern, pattern_finding
 from pendverify.diagnosis.repair import search_repair
 
@@ -39,6 +43,7 @@ def explain(batch, results, deadline_s: float = REPAIR_DEADLINE_S) -> list[Findi
                 findings.append(pattern_finding(entry, pattern, batch.model.coordinates))
     for trap in diagnose(batch.model, batch.system, results):
         findings.append(trap if isinstance(trap, Finding) else Finding("convention", trap))
+    findings += identify_parameters(batch)
     repairs, why_not = search_repair(batch, deadline_s)
     findings += repairs
     if why_not:  # said as a repair that is not one: checks_pass false, nothing suggested

@@ -64,3 +64,22 @@ class Finding:
 
     def __str__(self) -> str:
         return self.message
+
+
+#: entries the text report names one by one; the rest are counted (all are in ``--json``)
+TEXT_ENTRIES = 6
+
+
+def text_lines(findings: list[Finding]) -> list[str]:
+    """The diagnosis as the text report prints it, short: each entry with the shape of its
+    difference on one line (the first ``TEXT_ENTRIES``, the rest counted), then the other findings."""
+    listed = [f for f in findings if f.kind == "entry"]
+    shapes = {(f.quantity, f.index): f for f in findings if f.kind == "pattern"}
+    lines = []
+    for entry in listed[:TEXT_ENTRIES]:
+        shape = shapes.get((entry.quantity, entry.index))
+        lines.append(entry.message + (f"; {shape.message.split(': ', 1)[1]}" if shape else ""))
+    if len(listed) > TEXT_ENTRIES:
+        rest = [f.message.split(":", 1)[0].split(" (", 1)[0] for f in listed[TEXT_ENTRIES:]]
+        lines.append(f"{len(rest)} more entries differ ({', '.join(rest)}): all of them are in --json")
+    return lines + [f.message for f in findings if f.kind not in ("entry", "pattern")]

@@ -239,26 +239,25 @@ def find_slots(batch, sm: SymbolicModel) -> list[Slot]:
             X = current.reshape(len(batch), shape[0], cols)
             residual = (X @ batch.V[:, :, None])[..., 0] - target
         target = target.reshape(len(batch), -1)
+        # an entry is judged against the size of its whole quantity: an exact zero where
+        # Pinocchio rounds to 1e-17 is not a difference
+        size = float(np.max(np.abs(target), initial=0.0)) + float(np.max(np.abs(current), initial=0.0))
         for index, expr in enumerate(flat):
             values = current[:, index]
             if row:
                 r, c = divmod(index, shape[1])
                 rate = batch.V[:, c]
-                scale = float(np.max(np.abs(target[:, r]))) + float(np.max(np.abs(X[:, r] * batch.V)))
+                scale = float(np.max(np.abs(target))) + float(np.max(np.abs(X * batch.V[:, None, :])))
                 slot = Slot(method, index, _label(method, value, index), expr, form.args, values, None,
                             (residual[:, r], rate), scale=scale or 1.0)  # fmt: skip
-                if (
-                    np.max(np.abs(residual[:, r])) > SCREEN_RTOL * slot.scale
-                    and np.any(rate != 0)
-                    and expr != 0
-                ):
+                if np.max(np.abs(residual[:, r])) > SCREEN_RTOL * slot.scale and np.any(rate != 0):
                     slots.append(slot)
                 continue
             goal = target[:, index]
             diff = values - goal
             if centred:
                 diff = diff - np.mean(diff)
-            scale = float(np.max(np.abs(goal))) + float(np.max(np.abs(values))) or 1.0
+            scale = size or 1.0
             if np.max(np.abs(diff)) > SCREEN_RTOL * scale or not np.all(np.isfinite(values)):
                 slots.append(Slot(method, index, _label(method, value, index), expr, form.args, values, goal,
                                   None, centred, scale))  # fmt: skip
@@ -323,16 +322,47 @@ def _coefficient_edits(slot: Slot, evaluate) -> list[Edit]:
     return out
 
 
-def _monomials(sm: SymbolicModel, params: dict) -> list[tuple[float, sp.Expr]]:
-    """(value, expression) of every product of at most ``DEGREE`` parameters, with simple fractions."""
-    symbols = list(sm.parameters.values())
+#: the kinds of parameter an added term of each quantity may hold (its units): friction only in
+#: D, gravity only in H and V
+KINDS_OF = {
+    "D": {"damping"},
+    "H": {"mass", "length", "offset", "gravity", "inertia", ""},
+    "V": {"mass", "length", "offset", "gravity", "inertia", ""},
+}
+OTHER_KINDS = {"mass", "length", "offset", "inertia", ""}
+
+
+def _monomials(sm: SymbolicModel, params: dict, quantity: str) -> list[tuple[float, sp.Expr]]:
+    """(value, expression) of the parameter products an added term may hold: first those the
+    model's own terms hold (the parameter part of each term of its written forms), then every
+    product of at most ``DEGREE`` parameters of the kinds the quantity allows (``KINDS_OF``)."""
+    kinds = {p.name: k for p, k in zip(sm.parameters.values(), _kind_list(sm), strict=True)}
+    allowed = KINDS_OF.get(quantity, OTHER_KINDS)
+    symbols = [s for s in sm.parameters.values() if kinds[s.name] in allowed]
+    own: dict = {}
+    for value in sm.closed_forms.values():
+        for expr in entries(value):
+            for _, terms in sums(expr):
+                for term in terms:
+                    factor = sp.Mul(*[f for f in sp.Mul.make_args(term) if f.free_symbols <= set(symbols)])
+                    factor = factor.as_coeff_Mul()[1]
+                    if factor.free_symbols:
+                        own[factor] = None
+    generic = [
+        sp.Mul(*combo)
+        for degree in range(1, DEGREE + 1)
+        for combo in itertools.combinations_with_replacement(symbols, degree)
+    ]
     out = []
-    for degree in range(1, DEGREE + 1):
-        for combo in itertools.combinations_with_replacement(symbols, degree):
-            value = float(np.prod([params[s.name] for s in combo]))
-            if value != 0:
-                out.append((value, sp.Mul(*combo)))
+    for expr in [*own, *generic]:
+        value = float(expr.xreplace({sm.parameters[p]: v for p, v in params.items()}))
+        if value != 0 and np.isfinite(value):
+            out.append((value, expr))
     return out
+
+
+def _kind_list(sm) -> list[str]:
+    return [f.metadata.get("kind", "") for f in dataclasses.fields(sm.cls.params_type)]
 
 
 FRACTIONS = tuple(
@@ -347,10 +377,15 @@ def _matched(coefficient: float, monomials) -> sp.Expr | None:
     """coefficient as ± a simple fraction times a product of parameters, or as a sum of two such
     (factors ±1, ±2, ±½), the simplest such; None when none equals it to 1e-9."""
     close = 1e-9 * abs(coefficient)
-    for value, expr in monomials:
-        ratio = Fraction(abs(coefficient) / value).limit_denominator(12)
-        if ratio in FRACTIONS and abs(float(ratio) * value - abs(coefficient)) <= close:
-            return sp.sign(coefficient) * sp.Rational(ratio.numerator, ratio.denominator) * expr
+    for whole in (True, False):  # a product as it stands before one with a fraction
+        for value, expr in monomials:
+            ratio = Fraction(abs(coefficient) / value).limit_denominator(12)
+            if (
+                (ratio == 1) is whole
+                and ratio in FRACTIONS
+                and abs(float(ratio) * value - abs(coefficient)) <= close
+            ):
+                return sp.sign(coefficient) * sp.Rational(ratio.numerator, ratio.denominator) * expr
     values = np.array([v for v, _ in monomials])
     order = np.argsort(values)
     ordered = values[order]
@@ -365,13 +400,20 @@ def _matched(coefficient: float, monomials) -> sp.Expr | None:
 
 
 def _added_term_edits(slot: Slot, batch, monomials) -> list[Edit]:
-    """The entry's difference fitted and written as parameters times basis functions (module docstring)."""
-    if slot.row is not None or QUANTITY.get(slot.method) not in ("M", "H", "V", "D", "detM", "Cqdot"):
+    """The entry's difference fitted and written as parameters times basis functions (module
+    docstring).  For a Coriolis row the entry's share q̇j·Δ of the row's residual is fitted, with
+    Δ in the basis of C."""
+    quantity = QUANTITY.get(slot.method, "C" if slot.row is not None else None)
+    if quantity not in ("M", "H", "V", "D", "detM", "Cqdot", "C"):
         return []
-    rows = np.arange(len(slot.values))
     model = batch.model
-    basis = basis_for(QUANTITY[slot.method], batch.Q[rows], batch.V[rows], model.angular, model.coordinates)
-    diff = slot.target - slot.values
+    basis = basis_for(quantity, batch.Q, batch.V, model.angular, model.coordinates)
+    if slot.row is None:
+        diff = slot.target - slot.values
+    else:
+        residual, rate = slot.row
+        basis = [(name, values * rate, expr) for name, values, expr in basis]
+        diff = -residual
     pattern = fit(diff, basis)
     if pattern is None:
         return []
@@ -505,10 +547,13 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
     slots = find_slots(screen, sm)
     if not slots:
         return [], "no single entry of the written closed forms disagrees with Pinocchio: no repair searched"
-    monomials = _monomials(sm, params)
     pool = sum_pool(sm)
+    monomials: dict[str, list] = {}
     for slot in slots:
-        _screen(slot, screen, sm, evaluate, monomials, pool, deadline)
+        quantity = QUANTITY.get(slot.method, "")
+        if quantity not in monomials:
+            monomials[quantity] = _monomials(sm, params, quantity)
+        _screen(slot, screen, sm, evaluate, monomials[quantity], pool, deadline)
     notation = Notation.of(type(batch.model))
     tried = 0
     for _, changes, edit, slot in _candidates(slots):

@@ -120,15 +120,18 @@ def trig_edits(expr, angles, offsets: bool = False) -> Iterator[Edit]:
 
 
 def parameter_edits(expr, kinds: dict) -> Iterator[Edit]:
-    """One parameter replaced by another of the same kind inside one additive term."""
-    for path, terms in sums(expr):
-        for i, term in enumerate(terms):
-            for p in sorted(term.free_symbols & set(kinds), key=str):
-                for other in sorted(kinds, key=str):
-                    if other != p and kinds[other] == kinds[p]:
-                        new = term.xreplace({p: other})
-                        edited = with_term(expr, path, terms, i, new)
-                        yield Edit("parameter", term, new, edited, f"{p} → {other} in {term}")
+    """One occurrence of a parameter replaced by another of the same kind (in p² one factor: p·p')."""
+    for node, path in walk(expr):
+        if node in kinds:
+            p, replaced = node, lambda other: other
+        elif node.is_Pow and node.base in kinds and node.exp.is_Integer and node.exp > 1:
+            p, replaced = node.base, lambda other, node=node: node.base ** (node.exp - 1) * other
+        else:
+            continue
+        for other in sorted(kinds, key=str):
+            if other != p and kinds[other] == kinds[p]:
+                new = replaced(other)
+                yield Edit("parameter", node, new, replace_at(expr, path, new), f"{node} → {new}")
 
 
 def structural_edits(expr, angles, rates, kinds: dict) -> Iterator[Edit]:
