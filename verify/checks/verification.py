@@ -160,9 +160,9 @@ def verify_target(report: Report, target, samples: int, seed: int) -> None:
         apply_strict(results)
     failing = [r for r in results if r.status == FAIL and r.check != "model-form"]
     if failing and kept:
-        diagnoses = diagnose(target.model, target.system, failing)
-        if diagnoses:
-            report.diagnoses[label] = diagnoses
+        findings = diagnose(target.model, target.system, failing)
+        if findings:
+            report.diagnoses[label] = [f.message for f in findings]
     if notes:
         report.notes[label] = notes
     if warnings:
