@@ -32,8 +32,12 @@ read as degrees, and 1 for a change between absolute and relative angles);
 ``candidates`` lists each distinct map once, in that order, under its simplest
 description, after the declared map itself (no trap).
 
-For n coordinates, a of them angles, that is at most 2ⁿ·(1 + 2·(2ⁿ⁺¹ − 1))·2·4ᵃ maps
-before duplicates go (with θ0 = 0): 4 864 for the triple pendulum.
+For n coordinates, a of them angles, that is (5·2ⁿ − 2)·2·4ᵃ maps before duplicates go
+(with θ0 = 0; 2ⁿ flips, and the 2ⁿ + 2ⁿ − 1 distinct orders of each of A and A⁻¹ with them,
+each with and without degrees, times the shifts): 4 864 for the triple pendulum.  The work
+grows as 8ⁿ, so a larger model flips, and shifts, at most ``touched`` coordinates at a time
+(besides all of them at once, flipped or shifted alike), the largest number that keeps the
+count within ``MAX_CANDIDATES``.
 """
 
 from __future__ import annotations
@@ -57,6 +61,12 @@ DEG = math.pi / 180
 #: decimals two maps must agree to, entry by entry, to be one map (a map's entries are O(1)-O(100)
 #: sums of a few products of exact small integers, π/180 and multiples of π/2: rounding ~1e-14)
 SAME_MAP_DECIMALS = 9
+#: the most candidates enumerated for up to three coordinates: enumerating and screening one costs
+#: ~45 µs (measured: 21 888 candidates of a triple pendulum with two non-zero offsets in 0.95 s, one
+#: core), so 40 000 keep a search under ~2 s.  Every combination fits unless all three offsets are
+#: non-zero (then at most two flipped or shifted at a time: 30 400).  A candidate's cost grows about
+#: as n (one more body to fit, larger matrices): beyond three coordinates the budget is 3/n of it.
+MAX_CANDIDATES = 40_000
 
 
 @dataclass(frozen=True)
@@ -118,12 +128,41 @@ def difference_matrix(model) -> np.ndarray:
     return A
 
 
-def _subsets(items) -> list[tuple[int, ...]]:
+def _subsets(items, most: int) -> list[tuple[int, ...]]:
+    """The subsets of at most ``most`` items, and all of them."""
     items = list(items)
-    return [c for r in range(len(items) + 1) for c in itertools.combinations(items, r)]
+    out = [c for r in range(min(most, len(items)) + 1) for c in itertools.combinations(items, r)]
+    return out if len(items) <= most else [*out, tuple(items)]
 
 
-def _linear_parts(model):
+def _shift_grid(angular: np.ndarray, most: int) -> np.ndarray:
+    """Quarter turns k per coordinate: on at most ``most`` angles, or the same on all of them."""
+    idx = list(np.flatnonzero(angular))
+    rows = []
+    for subset in _subsets(idx, most):
+        if len(subset) > most:  # all of them, turned alike
+            rows += [[k if i in subset else 0 for i in range(len(angular))] for k in (1, 2, 3)]
+            continue
+        for ks in itertools.product((1, 2, 3), repeat=len(subset)):
+            k = dict(zip(subset, ks, strict=True))
+            rows.append([k.get(i, 0) for i in range(len(angular))])
+    return np.array(rows, dtype=int)
+
+
+def _most_touched(model, readings: int, sides: int) -> int:
+    """The largest number of coordinates flipped or shifted at a time that keeps the count in budget."""
+    n, angular = model.nv, np.array(model.angular, dtype=bool)
+    budget = MAX_CANDIDATES * min(1.0, 3 / n)
+    relative = 2 if angular.sum() >= 2 else 0
+    for most in range(n, 0, -1):
+        flips = len(_subsets(range(n), most))
+        linear = (flips + relative * (2 * flips - 1)) * (2 if angular.any() else 1)
+        if linear * len(_shift_grid(angular, most)) * readings * sides <= budget:
+            return most
+    return 1
+
+
+def _linear_parts(model, most: int):
     """(flips, flip_first, relative, angles_in_degrees, X) for every linear part X."""
     n, angular = model.nv, np.array(model.angular, dtype=bool)
     R = {0: np.eye(n)}
@@ -131,7 +170,7 @@ def _linear_parts(model):
         A = difference_matrix(model)
         R.update({1: A, -1: np.linalg.inv(A)})
     D = np.diag(np.where(angular, DEG, 1.0))
-    for flips in _subsets(range(n)):
+    for flips in _subsets(range(n), most):
         S = np.diag([-1.0 if i in flips else 1.0 for i in range(n)])
         for relative, Rm in R.items():
             for flip_first in (False, True) if relative and flips else (False,):
@@ -165,11 +204,12 @@ def candidates(model, T, theta0, revolute) -> list[Candidate]:
     """
     T, theta0 = np.asarray(T, float), np.asarray(theta0, float)
     angular = np.array(model.angular, dtype=bool)
-    grid = np.array(list(itertools.product(*[range(4) if a else (0,) for a in angular])))
-    s = np.array(SHIFTS)[grid]  # (G, n)
     readings = _offset_readings(model, theta0)
+    most = _most_touched(model, len(readings), 2 if np.any(theta0) else 1)
+    grid = _shift_grid(angular, most)
+    s = np.array(SHIFTS)[grid]  # (G, n)
     found = []
-    for flips, flip_first, relative, degrees, X in _linear_parts(model):
+    for flips, flip_first, relative, degrees, X in _linear_parts(model, most):
         X_inv = np.linalg.inv(X)
         for read in readings if not degrees else [()]:
             theta0v = theta0.copy()

@@ -30,8 +30,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from pendverify.checks.batch import CheckBatch
-from pendverify.diagnosis.traps.inertia import COEFF_TOL, parallel_axis_terms
+from pendverify.diagnosis.traps.inertia import COEFF_TOL, parallel_axis_systems
 from pendverify.robot.coordinates import CoordinateMap
+
+#: candidates evaluated at once: their arrays, (CHUNK, K, n², nb) for the fit, stay within a few MB
+CHUNK = 2048
 
 
 @dataclass(frozen=True)
@@ -61,43 +64,58 @@ def _integers(coefficients: np.ndarray) -> np.ndarray:
     return np.where(ok[:, None], rounded, 0.0)
 
 
-def screen(model, system, candidates, states) -> Screen | None:
-    """Each candidate's residual and pivot fit at ``states`` (module docstring); None where the hand
-    model's M or H is not finite there (nothing to compare)."""
-    n = model.nv
-    hand = CheckBatch(model, system, states).terms
-    if not (np.all(np.isfinite(hand.M_hand)) and np.all(np.isfinite(hand.H_hand))):
-        return None
-    theta, w = hand.q, hand.w  # (K, n)
-    ww = w[:, :, None] * w[:, None, :]
-    g_scale = np.max(w * hand.g_scale, axis=-1)  # (K,)
-    # a model without gravity (scale 0): H compared in scaled units as they are
-    g_scale = np.where(g_scale > 0, g_scale, 1.0)
+@dataclass(frozen=True)
+class _Hand:
+    """The hand model at the screen's states: θ (K, n), M and H, the weights w w and gravity scales."""
 
-    T = np.array([c.T for c in candidates])  # (C, n, n)
-    theta0 = np.array([c.theta0 for c in candidates])  # (C, n)
-    q = ((theta[None] - theta0[:, None]) @ np.swapaxes(T, -1, -2)).reshape(-1, n)  # q = T'(θ − θ0')
-    joint = system.with_map(CoordinateMap(np.eye(n), np.zeros(n), system.cmap.joint_nq))
+    theta: np.ndarray
+    M: np.ndarray
+    H: np.ndarray
+    w: np.ndarray
+    ww: np.ndarray
+    g_scale: np.ndarray
+
+
+def _errors(hand: _Hand, joint, shifts, T, theta0):
+    """(error of M without the fit, error of M with it, error of H, the fit's c) of candidates (T, θ0')."""
+    C, (K, n) = len(T), hand.theta.shape
+    q = ((hand.theta[None] - theta0[:, None]) @ np.swapaxes(T, -1, -2)).reshape(-1, n)  # q = T'(θ − θ0')
     pin = joint.at(q)
-    C, K = len(candidates), len(states)
     M = _congruence(T, pin.mass_matrix().reshape(C, K, n, n))
     H = (np.swapaxes(T, -1, -2)[:, None] @ pin.gravity().reshape(C, K, n, 1))[..., 0]
+    dM = ((M - hand.M) * hand.ww).reshape(C, K * n * n)  # scaled
+    eH = np.max(np.max(hand.w * np.abs(H - hand.H), axis=-1) / hand.g_scale, axis=-1)
+    if not shifts:
+        return np.max(np.abs(dM), axis=-1), np.max(np.abs(dM), axis=-1), eH, np.zeros((C, 0))
+    terms = [_congruence(T, only.at(q).mass_matrix().reshape(C, K, n, n)) * hand.ww for _, only in shifts]
+    A = np.stack(terms, axis=-1).reshape(C, K * n * n, len(shifts))  # (C, K n², nb)
+    coefficients = _integers((np.linalg.pinv(A) @ dM[..., None])[..., 0])
+    left = dM - (A @ coefficients[..., None])[..., 0]
+    return np.max(np.abs(dM), axis=-1), np.max(np.abs(left), axis=-1), eH, coefficients
 
-    dM = (M - hand.M_hand) * ww  # (C, K, n, n), scaled
-    eH = np.max(np.max(w * np.abs(H - hand.H_hand), axis=-1) / g_scale, axis=-1)  # (C,)
-    links, Kq = parallel_axis_terms(joint, q)
-    if links:
-        Kc = np.stack([_congruence(T, k.reshape(C, K, n, n)) * ww for k in Kq], axis=-1)
-        A = Kc.reshape(C, K * n * n, len(links))  # (C, K n², nb)
-        b = dM.reshape(C, K * n * n, 1)
-        coefficients = _integers((np.linalg.pinv(A) @ b)[..., 0])
-        left = b[..., 0] - (A @ coefficients[..., None])[..., 0]
-    else:
-        coefficients = np.zeros((C, 0))
-        left = dM.reshape(C, -1)
-    eM = np.max(np.abs(left), axis=-1)
-    error = np.maximum(eM, eH)
-    before = float(max(np.max(np.abs(dM[0])), eH[0]))
+
+def screen(model, system, candidates, states) -> Screen | None:
+    """Each candidate's residual and pivot fit at ``states`` (module docstring); None where the hand
+    model's M or H is not finite there (nothing to compare).  The candidates go through in chunks of
+    ``CHUNK``, which bounds the memory the batched fit takes."""
+    n = model.nv
+    terms = CheckBatch(model, system, states).terms
+    if not (np.all(np.isfinite(terms.M_hand)) and np.all(np.isfinite(terms.H_hand))):
+        return None
+    w = terms.w  # (K, n)
+    g_scale = np.max(w * terms.g_scale, axis=-1)  # (K,)
+    # a model without gravity (scale 0): H compared in scaled units as they are
+    g_scale = np.where(g_scale > 0, g_scale, 1.0)
+    hand = _Hand(terms.q, terms.M_hand, terms.H_hand, w, w[:, :, None] * w[:, None, :], g_scale)
+    joint = system.with_map(CoordinateMap(np.eye(n), np.zeros(n), system.cmap.joint_nq))
+    shifts = parallel_axis_systems(joint)
+    T = np.array([c.T for c in candidates])  # (C, n, n)
+    theta0 = np.array([c.theta0 for c in candidates])  # (C, n)
+    parts = [
+        _errors(hand, joint, shifts, T[i : i + CHUNK], theta0[i : i + CHUNK]) for i in range(0, len(T), CHUNK)
+    ]
+    bare, fitted, eH, coefficients = (np.concatenate(x) for x in zip(*parts, strict=True))
+    before = float(max(bare[0], eH[0]))
     with np.errstate(divide="ignore", invalid="ignore"):
-        residual = error / before
-    return Screen(residual, coefficients, links, before)
+        residual = np.maximum(fitted, eH) / before
+    return Screen(residual, coefficients, [name for name, _ in shifts], before)
