@@ -11,9 +11,11 @@ from __future__ import annotations
 import importlib.util
 import json
 import math
+import re
 import sys
 import time
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -27,9 +29,11 @@ from pendverify.diagnosis.traps.convention_maps import (
     ABSOLUTE_RELATIVE,
     DEGREES,
     HALF,
+    MAX_CANDIDATES,
     PIVOT,
     QUARTER,
     SIGN,
+    candidates,
 )
 from pendverify.diagnosis.traps.conventions import coordinate_conventions
 from pendverify.diagnosis.traps.fit import EXACT_RESIDUAL, diagnosis_states
@@ -155,6 +159,22 @@ def test_a_map_trap_with_an_inertia_about_the_pivot_is_named_with_both():
     assert [f.details["traps"] for f in diagnose(model, system, results)] == [[ABSOLUTE_RELATIVE, PIVOT]]
 
 
+def test_a_joint_fit_that_leaves_a_small_difference_says_so():
+    # as above, with the URDF's inertia 1e-5 larger than I_com + m·r²: the two traps explain all but that
+    model, right = _setup("triple_pendulum", lambda p: p.replace(I3=(p.I3 + p.m3 * p.r3**2) * (1 + 1e-5)))
+    finding = _finding(model, _planted(right, np.eye(3), (0, 0, 0)))
+    assert set(finding.details["traps"]) == {ABSOLUTE_RELATIVE, PIVOT}
+    match = re.search(
+        r"all but ([0-9.e+-]+) of the discrepancy goes; a smaller difference remains as well$",
+        finding.message,
+    )
+    assert match, finding.message
+    # the 1e-5 of I3 + m3 r3² against the whole discrepancy, M's of order one: between 1e-7 and 1e-4
+    residual = float(match.group(1))
+    assert 1e-7 < residual < 1e-4
+    assert residual == pytest.approx(finding.details["residual"], rel=0.05)  # printed to two digits
+
+
 # --- one trap, named as before ------------------------------------------------------------------------
 def test_one_trap_keeps_its_sentence():
     model, right = _setup("triple_pendulum")
@@ -238,6 +258,22 @@ def test_an_inertia_about_the_pivot_alone_is_left_to_the_inertia_trap():
     (finding,) = diagnose(model, system, results)
     assert finding.quantity == "M" and finding.kind == "convention"
     assert finding.message.startswith("M_urdf − M_hand is exactly the parallel-axis term m·r² of link3")
+
+
+# --- bounded work --------------------------------------------------------------------------------------
+@pytest.mark.parametrize("n", [3, 4, 5, 6, 7])
+def test_the_candidates_stay_within_the_budget_and_keep_every_single_trap(n):
+    model = SimpleNamespace(nv=n, angular=(True,) * n)
+    found = candidates(model, np.eye(n), np.zeros(n), [True] * n)
+    assert len(found) <= MAX_CANDIDATES * min(1.0, 3 / n)
+    flips = {c.flips for c in found if c.traps == (SIGN,)}
+    shifts = {c.shifts for c in found if c.traps == (QUARTER,)}
+    for i in range(n):
+        assert (i,) in flips
+        assert tuple(1 if j == i else 0 for j in range(n)) in shifts
+    if n <= 3:  # every combination: each non-empty set of flips, each pattern of k ∈ {0, 1, 3} but none
+        assert len(flips) == 2**n - 1
+        assert len(shifts) == 3**n - 1
 
 
 # --- how long the search takes -------------------------------------------------------------------------
