@@ -118,7 +118,7 @@ def pivot_clause(links: dict[str, int], mr2: dict[str, float]) -> str:
     return f"{PIVOT}: " + " and ".join(parts)
 
 
-def single(model, c: Candidate, T, theta0) -> str:
+def single(model, c: Candidate, theta0) -> str:
     """The sentence of one trap alone (its words as they have always been), before the fit."""
     (trap,) = c.traps
     angular = np.array(model.angular, dtype=bool)
@@ -156,9 +156,11 @@ def single(model, c: Candidate, T, theta0) -> str:
         phrase = _shift_phrase(model, c.shifts)
         sentence = f"{_zero_clause(model, c, trap == HALF)}; with θ0 shifted by {phrase} {PASSES}"
     states_theta0 = trap in (QUARTER, HALF) or (trap == DEGREES and not c.angles_in_degrees)
-    if not states_theta0 and not np.array_equal(c.theta0, theta0):
-        sentence += f" (θ0 → {fmt(c.theta0)})"
-    return sentence
+    if states_theta0 or np.array_equal(c.theta0, theta0):
+        return sentence
+    if f", {PASSES}" in sentence:
+        return sentence.replace(f", {PASSES}", f" and θ0 → {fmt(c.theta0)}, {PASSES}")
+    return sentence.replace(f" {PASSES}", f", with θ0 → {fmt(c.theta0)}, {PASSES}")
 
 
 def clauses(model, c: Candidate, theta0, links: dict[str, int], mr2: dict[str, float]) -> list[str]:

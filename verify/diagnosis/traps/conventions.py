@@ -93,10 +93,10 @@ def _mr2(system) -> dict[str, float]:
 
 
 def _sentence(model, system, c: Candidate, links, residual, passes, alternatives) -> str:
-    T, theta0 = system.cmap.T, system.cmap.theta0
+    theta0 = system.cmap.theta0
     mr2 = _mr2(system) if links or any(al for _, al in alternatives) else {}
     if len(_traps(c, links)) == 1:
-        sentence = words.single(model, c, T, theta0)
+        sentence = words.single(model, c, theta0)
     else:
         sentence = words.joint(model, c, theta0, links, mr2)
     sentence = words.with_fit(sentence, residual, passes)
