@@ -13,8 +13,8 @@ The hand model's M and H are evaluated once, at the same states.
 
 The pivot-inertia trap is fitted after the map change, as ``inertia.pivot_inertia`` fits it
 without one: M' − M_hand ≈ Σ_b c_b K'_b by least squares over the scaled entries, batched
-over the candidates (``numpy.linalg.pinv``), with c rounded to {−1, 0, 1}; a candidate whose
-coefficients are not all within ``inertia.COEFF_TOL`` of such integers gets c = 0.
+over the candidates (``numpy.linalg.pinv``), with c rounded to {−1, 0, 1} (``inertia.integer_coefficients``:
+c = 0 where the coefficients are not all within ``inertia.COEFF_TOL`` of such integers).
 
 A candidate's error is the one the ``crba`` and ``gravity`` checks measure
 (``pendverify.checks.quantities``), the larger of the two over the states: the largest
@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pendverify.checks.batch import CheckBatch
-from pendverify.diagnosis.traps.inertia import COEFF_TOL, parallel_axis_systems
+from pendverify.diagnosis.traps.inertia import integer_coefficients, parallel_axis_systems
 from pendverify.robot.coordinates import CoordinateMap
 
 #: candidates evaluated at once: their arrays, (CHUNK, K, n², nb) for the fit, stay within a few MB
@@ -55,13 +55,6 @@ def _congruence(T, A):
     """Tᵀ A T for each candidate's T (C, n, n) and its states' A (C, K, n, n)."""
     Tc = T[:, None]
     return np.swapaxes(Tc, -1, -2) @ A @ Tc
-
-
-def _integers(coefficients: np.ndarray) -> np.ndarray:
-    """Each row rounded to integers in {−1, 0, 1}, or zero where one entry is not within COEFF_TOL."""
-    rounded = np.round(coefficients)
-    ok = np.all((np.abs(coefficients - rounded) <= COEFF_TOL) & (np.abs(rounded) <= 1), axis=-1)
-    return np.where(ok[:, None], rounded, 0.0)
 
 
 @dataclass(frozen=True)
@@ -89,7 +82,7 @@ def _errors(hand: _Hand, joint, shifts, T, theta0):
         return np.max(np.abs(dM), axis=-1), np.max(np.abs(dM), axis=-1), eH, np.zeros((C, 0))
     terms = [_congruence(T, only.at(q).mass_matrix().reshape(C, K, n, n)) * hand.ww for _, only in shifts]
     A = np.stack(terms, axis=-1).reshape(C, K * n * n, len(shifts))  # (C, K n², nb)
-    coefficients = _integers((np.linalg.pinv(A) @ dM[..., None])[..., 0])
+    coefficients = integer_coefficients((np.linalg.pinv(A) @ dM[..., None])[..., 0])
     left = dM - (A @ coefficients[..., None])[..., 0]
     return np.max(np.abs(dM), axis=-1), np.max(np.abs(left), axis=-1), eH, coefficients
 

@@ -95,12 +95,12 @@ def corrected_system(system: PinocchioSystem, coefficients: dict[str, float], cm
     return _with_model(system, model, cmap)
 
 
-def integer_coefficients(coefficients: np.ndarray) -> np.ndarray | None:
-    """The fitted c_b as integers in {−1, 0, 1} (last axis), or None where one is not within ``COEFF_TOL``."""
+def integer_coefficients(coefficients: np.ndarray) -> np.ndarray:
+    """Fitted c_b (rows, last axis) rounded to integers in {−1, 0, 1}; a row with an entry not within
+    ``COEFF_TOL`` of one becomes zero (no pivot trap)."""
     rounded = np.round(coefficients)
-    if np.any(np.abs(coefficients - rounded) > COEFF_TOL) or np.any(np.abs(rounded) > 1):
-        return None
-    return rounded
+    ok = np.all((np.abs(coefficients - rounded) <= COEFF_TOL) & (np.abs(rounded) <= 1), axis=-1)
+    return np.where(ok[..., None], rounded, 0.0)
 
 
 def pivot_inertia(model, system, failing, states) -> Finding | None:
@@ -116,7 +116,7 @@ def pivot_inertia(model, system, failing, states) -> Finding | None:
         return None
     coeff, *_ = np.linalg.lstsq(A, b, rcond=None)
     rounded = integer_coefficients(coeff)
-    if rounded is None or not np.any(rounded):
+    if not np.any(rounded):
         return None
     residual = float(np.linalg.norm(A @ rounded - b) / np.linalg.norm(b))
     if residual > FIT_RESIDUAL:
