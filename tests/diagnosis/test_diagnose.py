@@ -31,7 +31,7 @@ REPO = Path(__file__).resolve().parents[2]
 def _diagnoses(model, system, planted: bool = True):
     results = run_checks("planted", model, system, sample_states(model, 30, SEED), SEED)
     assert all(r.passed for r in results) is not planted, "a planted error must fail, the seed pass"
-    return diagnose(model, system, results)
+    return [finding.message for finding in diagnose(model, system, results)]
 
 
 def _dp_system(params):

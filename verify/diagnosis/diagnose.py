@@ -2,8 +2,8 @@
 
 When checks fail, each hypothesis (``HYPOTHESES``, one module each in
 ``pendverify.diagnosis.traps``) is tested against the model and the URDF, and the
-ones that explain the failure become a sentence in the report that says how well
-they fit: the *residual*, the part of the discrepancy the hypothesis leaves
+ones that explain the failure become a ``Finding`` (``pendverify.diagnosis.finding``)
+whose message says how well they fit: the *residual*, the part of the discrepancy the hypothesis leaves
 unexplained, relative to the whole (``pendverify.diagnosis.traps.fit``: an exact fit at
 rounding level, named with its residual up to 1e-3, not named beyond).
 
@@ -19,15 +19,18 @@ pivot inertia (``crba`` fails)
 missing damping (``aba`` fails)
     friction missing from the hand q̈, of the wrong sign, or not declared in D
     (``pendverify.diagnosis.traps.damping``).
-coordinate conventions (any check fails)
-    absolute vs relative angles, degrees vs radians, a zero from the vertical or
-    from hanging (``pendverify.diagnosis.traps.conventions``).
+coordinate conventions (``crba`` or ``gravity`` fails)
+    an axis sign flip, absolute vs relative angles, degrees vs radians, a zero from
+    the vertical or from hanging, and an inertia about the pivot with them, searched
+    jointly: two at once are named as well as one
+    (``pendverify.diagnosis.traps.conventions``).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from pendverify.diagnosis.finding import Finding
 from pendverify.diagnosis.traps.conventions import coordinate_conventions
 from pendverify.diagnosis.traps.damping import missing_damping
 from pendverify.diagnosis.traps.fit import diagnosis_states
@@ -43,8 +46,8 @@ def _largest_failure(results) -> float:
 HYPOTHESES = (pivot_inertia, missing_damping, coordinate_conventions)
 
 
-def diagnose(model, system, results) -> list[str]:
-    """One sentence per known trap that explains the failing checks, with how well it fits."""
+def diagnose(model, system, results) -> list[Finding]:
+    """One finding per known trap that explains the failing checks; its message says how well it fits."""
     failing = {r.check for r in results if not r.passed}
     if not failing:
         return []
@@ -54,7 +57,7 @@ def diagnose(model, system, results) -> list[str]:
     out = []
     with np.errstate(all="ignore"):
         for hypothesis in hypotheses:
-            sentence = hypothesis(model, system, failing, states)
-            if sentence:
-                out.append(sentence)
+            finding = hypothesis(model, system, failing, states)
+            if finding is not None:
+                out.append(finding)
     return out

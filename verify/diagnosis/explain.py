@@ -41,8 +41,7 @@ def explain(batch, results, deadline_s: float = REPAIR_DEADLINE_S) -> list[Findi
             pattern = entry_pattern(entry, batch)
             if pattern is not None:
                 findings.append(pattern_finding(entry, pattern, batch.model.coordinates))
-    for trap in diagnose(batch.model, batch.system, results):
-        findings.append(trap if isinstance(trap, Finding) else Finding("convention", trap))
+    findings += diagnose(batch.model, batch.system, results)
     findings += identify_parameters(batch)
     repairs, why_not = search_repair(batch, deadline_s)
     findings += repairs

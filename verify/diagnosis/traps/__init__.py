@@ -2,5 +2,7 @@
 
 ``pendverify.diagnosis.diagnose`` runs them and reports the ones that fit; each module here
 is one trap (``inertia``, ``damping``, ``conventions``), and ``fit`` holds the language
-and thresholds they share.
+and thresholds they share.  The convention search has three helpers: the maps the traps
+lead to (``convention_maps``), their vectorised screen (``convention_screen``) and their
+sentences (``convention_words``).
 """

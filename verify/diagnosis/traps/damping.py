@@ -11,10 +11,18 @@ from __future__ import annotations
 
 import numpy as np
 
+from pendverify.diagnosis.finding import Finding
+
 FIT_RTOL = 1e-6  # relative residual of the damping fit that counts as exact
 
 
-def missing_damping(model, system, failing, states) -> str | None:
+def missing_damping(model, system, failing, states) -> Finding | None:
+    sentence = _damping_sentence(model, system, failing, states)
+    return None if sentence is None else Finding(kind="pattern", message=sentence, quantity="qddot")
+
+
+def _damping_sentence(model, system, failing, states) -> str | None:
+    """The fit of M·(q̈_hand − q̈_pin) by X·q̇ in words (module docstring), or None."""
     if "aba" not in failing:
         return None
     moving = [s for s in states if np.any(s.v != 0)]

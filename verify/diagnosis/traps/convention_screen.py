@@ -1,0 +1,114 @@
+"""Screen every candidate map at once: Pinocchio's M and H through it against the hand model's.
+
+At a handful of states θ_s, each candidate map (T', θ0')
+(``pendverify.diagnosis.traps.convention_maps``) puts Pinocchio at q = T'(θ_s − θ0').  One
+batch in joint coordinates (``PinocchioSystem.at`` under the identity map) evaluates M_q, H_q
+and the bodies' parallel-axis terms K_q (``pendverify.diagnosis.traps.inertia``) at every
+such q, and the congruences of ``pendverify.robot.coordinates`` bring them to the hand's
+coordinates:
+
+    M' = T'ᵀ M_q T',   H' = T'ᵀ H_q,   K'_b = T'ᵀ K_q,b T'.
+
+The hand model's M and H are evaluated once, at the same states.
+
+The pivot-inertia trap is fitted after the map change, as ``inertia.pivot_inertia`` fits it
+without one: M' − M_hand ≈ Σ_b c_b K'_b by least squares over the scaled entries, batched
+over the candidates (``numpy.linalg.pinv``), with c rounded to {−1, 0, 1} (``inertia.integer_coefficients``:
+c = 0 where the coefficients are not all within ``inertia.COEFF_TOL`` of such integers).
+
+A candidate's error is the one the ``crba`` and ``gravity`` checks measure
+(``pendverify.checks.quantities``), the larger of the two over the states: the largest
+entry of (M' − Σ_b c_b K'_b − M_hand)·(w wᵀ), w = S^{-½} the scaled coordinates' weights,
+and max_i w_i |H'_i − H_hand,i| over max_i w_i·(gravity scale)_i.  Its residual is that
+error over the declared map's (the first candidate, without a fit).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from pendverify.checks.batch import CheckBatch
+from pendverify.diagnosis.traps.inertia import integer_coefficients, parallel_axis_systems
+from pendverify.robot.coordinates import CoordinateMap
+
+#: candidates evaluated at once: their arrays, (CHUNK, K, n², nb) for the fit, stay within a few MB
+CHUNK = 2048
+
+
+@dataclass(frozen=True)
+class Screen:
+    """The screen's verdict on each candidate, in the candidates' order."""
+
+    #: error over the declared map's (C,)
+    residual: np.ndarray
+    #: the fitted pivot coefficients c_b in {−1, 0, 1} (C, nb)
+    coefficients: np.ndarray
+    #: the links whose bodies carry a parallel-axis term, in the coefficients' order
+    links: list[str]
+    #: the declared map's error (the denominator of ``residual``)
+    before: float
+
+
+def _congruence(T, A):
+    """Tᵀ A T for each candidate's T (C, n, n) and its states' A (C, K, n, n)."""
+    Tc = T[:, None]
+    return np.swapaxes(Tc, -1, -2) @ A @ Tc
+
+
+@dataclass(frozen=True)
+class _Hand:
+    """The hand model at the screen's states: θ (K, n), M and H, the weights w w and gravity scales."""
+
+    theta: np.ndarray
+    M: np.ndarray
+    H: np.ndarray
+    w: np.ndarray
+    ww: np.ndarray
+    g_scale: np.ndarray
+
+
+def _errors(hand: _Hand, joint, shifts, T, theta0):
+    """(error of M without the fit, error of M with it, error of H, the fit's c) of candidates (T, θ0')."""
+    C, (K, n) = len(T), hand.theta.shape
+    q = ((hand.theta[None] - theta0[:, None]) @ np.swapaxes(T, -1, -2)).reshape(-1, n)  # q = T'(θ − θ0')
+    pin = joint.at(q)
+    M = _congruence(T, pin.mass_matrix().reshape(C, K, n, n))
+    H = (np.swapaxes(T, -1, -2)[:, None] @ pin.gravity().reshape(C, K, n, 1))[..., 0]
+    dM = ((M - hand.M) * hand.ww).reshape(C, K * n * n)  # scaled
+    eH = np.max(np.max(hand.w * np.abs(H - hand.H), axis=-1) / hand.g_scale, axis=-1)
+    if not shifts:
+        return np.max(np.abs(dM), axis=-1), np.max(np.abs(dM), axis=-1), eH, np.zeros((C, 0))
+    terms = [_congruence(T, only.at(q).mass_matrix().reshape(C, K, n, n)) * hand.ww for _, only in shifts]
+    A = np.stack(terms, axis=-1).reshape(C, K * n * n, len(shifts))  # (C, K n², nb)
+    coefficients = integer_coefficients((np.linalg.pinv(A) @ dM[..., None])[..., 0])
+    left = dM - (A @ coefficients[..., None])[..., 0]
+    return np.max(np.abs(dM), axis=-1), np.max(np.abs(left), axis=-1), eH, coefficients
+
+
+def screen(model, system, candidates, states) -> Screen | None:
+    """Each candidate's residual and pivot fit at ``states`` (module docstring); None where the hand
+    model's M or H is not finite there (nothing to compare).  The candidates go through in chunks of
+    ``CHUNK``, which bounds the memory the batched fit takes."""
+    n = model.nv
+    terms = CheckBatch(model, system, states).terms
+    if not (np.all(np.isfinite(terms.M_hand)) and np.all(np.isfinite(terms.H_hand))):
+        return None
+    w = terms.w  # (K, n)
+    g_scale = np.max(w * terms.g_scale, axis=-1)  # (K,)
+    # a model without gravity (scale 0): H compared in scaled units as they are
+    g_scale = np.where(g_scale > 0, g_scale, 1.0)
+    hand = _Hand(terms.q, terms.M_hand, terms.H_hand, w, w[:, :, None] * w[:, None, :], g_scale)
+    joint = system.with_map(CoordinateMap(np.eye(n), np.zeros(n), system.cmap.joint_nq))
+    shifts = parallel_axis_systems(joint)
+    T = np.array([c.T for c in candidates])  # (C, n, n)
+    theta0 = np.array([c.theta0 for c in candidates])  # (C, n)
+    parts = [
+        _errors(hand, joint, shifts, T[i : i + CHUNK], theta0[i : i + CHUNK]) for i in range(0, len(T), CHUNK)
+    ]
+    bare, fitted, eH, coefficients = (np.concatenate(x) for x in zip(*parts, strict=True))
+    before = float(max(bare[0], eH[0]))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        residual = np.maximum(fitted, eH) / before
+    return Screen(residual, coefficients, [name for name, _ in shifts], before)
