@@ -551,6 +551,17 @@ def bench_certify(
     return measure(params, settings, repeats), settings, repeats
 
 
+def bench_explain(quick: bool = False):
+    """The diagnosis on the corpus of planted errors in every shipped model: ``pendverify bench explain``.
+
+    ``quick``: a seeded sample of up to 2 planted errors per operator and model instead of all.
+    Returns ``pendverify.bench.explain.ExplainBench`` (its scores per model file).
+    """
+    from pendverify.bench.explain import run_explain_bench
+
+    return run_explain_bench(_flag("quick", quick))
+
+
 # --- certificates ----------------------------------------------------------------------------------
 def certify_set(
     output: str | Path,

@@ -1,6 +1,8 @@
 """``pendverify bench accuracy [--scene SCENE.toml] [--quick] [-o DIR]``: the work–precision benchmark;
 ``pendverify bench certify [--quick] [--json PATH]``: the certification battery's cost
-(``pendverify.bench.certify``).
+(``pendverify.bench.certify``);
+``pendverify bench explain [--quick]``: how well the diagnosis names and repairs planted errors,
+and its cost (``pendverify.bench.explain``).
 
 Without ``--scene``, the two reference systems' problems (``pendverify.bench.seed_problems``); with it, a
 user's scene, any model (``pendverify.bench.problems.scene_problems`` says which problems
@@ -77,6 +79,16 @@ def register(sub) -> None:
         help="a parameter set to measure (repeat for more; default: each built-in model's own set)",
     )
     c.set_defaults(func=run_certify)
+    e = add_command(
+        what,
+        "explain",
+        "the diagnosis on a corpus of planted errors in every shipped model: named, repaired, time",
+        ["pendverify bench explain --quick", "pendverify bench explain"],
+    )
+    e.add_argument(
+        "--quick", action="store_true", help="a seeded sample: up to 2 planted errors per operator and model"
+    )
+    e.set_defaults(func=run_explain)
 
 
 def limit_blas() -> tuple[object, str]:
@@ -127,6 +139,19 @@ def run(args: argparse.Namespace) -> int:
             f"target ≤ {target}: {'met' if met else 'NOT met'}"
         )
     print(f"written: {out}/work_precision.png, .csv, .md")
+    return 0
+
+
+def run_explain(args: argparse.Namespace) -> int:
+    """``bench explain``: the corpus of planted errors, diagnosed, on one core."""
+    guard, _ = limit_blas()
+    with guard:
+        from pendverify import api
+        from pendverify.bench.explain import table
+
+        text = table(api.bench_explain(args.quick))
+    lines = text.splitlines()
+    print("\n".join(lines[-2:]) if args.quiet else text)
     return 0
 
 

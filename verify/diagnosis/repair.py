@@ -23,7 +23,10 @@
 3. **Confirmed.** A candidate becomes a repair only when the edited model
    (``pendverify.symbolic.edited``) passes every applicable check on every state of the
    report's batch; candidates are confirmed simplest first, at most ``CONFIRMATIONS`` of
-   them, within the time bound.
+   them, within the time bound.  Once one is confirmed, other edits of the same entries are
+   confirmed too (up to ``ALTERNATIVES``) and shown as alternatives: with the given parameter
+   values two edits can give the same numbers (m = 2·m2 makes m2 → m the same as a factor 2),
+   and the checks cannot tell which one the derivation meant.
 
 Screening tolerance: a right entry and Pinocchio's value differ by rounding, a few ε of the
 terms' size times the cancellation; ``SCREEN_RTOL`` = 1e-7 of the entry's size leaves a
@@ -55,6 +58,9 @@ SCREEN_RTOL = 1e-7
 DENOMINATOR = 12
 DEGREE = 3
 CONFIRMATIONS = 12
+#: confirmed edits of the same entries shown besides the first: parameter values can make two
+#: edits give the same numbers (a parameter worth twice another, a 3·I = m·r²)
+ALTERNATIVES = 2
 MAX_PAIRS = 40
 QUANTITY = {
     "mass_matrix": "M",
@@ -332,7 +338,7 @@ KINDS_OF = {
 OTHER_KINDS = {"mass", "length", "offset", "inertia", ""}
 
 
-def _monomials(sm: SymbolicModel, params: dict, quantity: str) -> list[tuple[float, sp.Expr]]:
+def _monomials(sm: SymbolicModel, params: dict, quantity: str) -> tuple[list, list]:
     """(value, expression) of the parameter products an added term may hold: first those the
     model's own terms hold (the parameter part of each term of its written forms), then every
     product of at most ``DEGREE`` parameters of the kinds the quantity allows (``KINDS_OF``)."""
@@ -353,11 +359,13 @@ def _monomials(sm: SymbolicModel, params: dict, quantity: str) -> list[tuple[flo
         for degree in range(1, DEGREE + 1)
         for combo in itertools.combinations_with_replacement(symbols, degree)
     ]
-    out = []
-    for expr in [*own, *generic]:
-        value = float(expr.xreplace({sm.parameters[p]: v for p, v in params.items()}))
-        if value != 0 and np.isfinite(value):
-            out.append((value, expr))
+    values = {sm.parameters[p]: v for p, v in params.items()}
+    out: tuple[list, list] = ([], [])
+    for group, exprs in zip(out, (list(own), generic), strict=True):
+        for expr in exprs:
+            value = float(expr.xreplace(values))
+            if value != 0 and np.isfinite(value):
+                group.append((value, expr))
     return out
 
 
@@ -421,7 +429,8 @@ def _added_term_edits(slot: Slot, batch, monomials) -> list[Edit]:
     for (c, name), function in zip(pattern.terms, pattern.functions, strict=True):
         if slot.centred and name == "1":  # V is compared up to a constant
             continue
-        monomial = _matched(c, monomials)
+        own, generic = monomials  # the model's own products alone first, then with every other
+        monomial = _matched(c, own) or _matched(c, own + generic)
         if monomial is None:
             return []
         added.append(monomial * function)
@@ -478,14 +487,17 @@ def _fields(sm):
     return dataclasses.fields(sm.cls.params_type)
 
 
+#: the order candidates are confirmed in, simplest first: a factor 2 or ½ comes after the edits
+#: that change a symbol, so that a parameter swapped for one worth twice as much (mc = 2·mp) is
+#: put back as the swap, not as a factor
 RANK = {
     "sign": 0,
-    "scale": 1,
     "drop": 1,
     "swap θ": 2,
     "swap θ̇": 2,
+    "parameter": 2,
     "sin↔cos": 3,
-    "parameter": 4,
+    "scale": 4,
     "offset": 5,
     "add": 6,
 }
@@ -555,13 +567,22 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
             monomials[quantity] = _monomials(sm, params, quantity)
         _screen(slot, screen, sm, evaluate, monomials[quantity], pool, deadline)
     notation = Notation.of(type(batch.model))
-    tried = 0
+    tried, found, seen = 0, [], set()
     for _, changes, edit, slot in _candidates(slots):
-        if time.perf_counter() > deadline or tried >= CONFIRMATIONS:
+        if time.perf_counter() > deadline or tried >= CONFIRMATIONS or len(found) > ALTERNATIVES:
             break
+        key = tuple(sorted((m, i, str(new)) for (m, i), (_, new) in changes.items()))
+        if key in seen or (found and set(changes) != set(found[0][0])):
+            continue  # the same edit again, or (once one is found) an edit of other entries
+        seen.add(key)
         tried += 1
         if _confirmed(batch, sm, changes):
-            return _findings(changes, edit, slot, forms, notation), ""
+            found.append((changes, edit, slot))
+    if found:
+        findings = _findings(*found[0], forms, notation)
+        for changes, edit, slot in found[1:]:
+            findings += _findings(changes, edit, slot, forms, notation, alternative=True)
+        return findings, ""
     where = ", ".join(s.label for s in slots[:6]) + (f" and {len(slots) - 6} more" if len(slots) > 6 else "")
     bound = " (the search stopped at its time bound)" if time.perf_counter() > deadline else ""
     return [], (
@@ -570,7 +591,8 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
     )
 
 
-def _findings(changes: dict, edit: Edit, slot: Slot, forms: dict, notation) -> list[Finding]:
+def _findings(changes: dict, edit: Edit, slot: Slot, forms: dict, notation, alternative: bool = False):
+    """The ``repair`` findings of one confirmed edit (one per entry it changes)."""
     out = []
     for (method, index), (old, new) in changes.items():
         label = _label(method, forms[method], index)
@@ -582,6 +604,10 @@ def _findings(changes: dict, edit: Edit, slot: Slot, forms: dict, notation) -> l
             else f"{notation.render(edit.old)} → {notation.render(edit.new)} in {label}"
         )
         message = f"{label}: {shown} makes every check pass on every state ({location})"
+        if alternative:
+            message = (
+                f"or, equally: {message} (with these parameter values the checks cannot tell the two apart)"
+            )
         quantity = QUANTITY.get(method)
         value = forms[method]
         if isinstance(value, sp.MatrixBase):
