@@ -102,6 +102,23 @@ def check_matrix(report) -> str:
     return _boxed(f"<table><tr><th>check \\ model</th>{head}</tr>\n{rows}\n</table>")
 
 
+def diagnosis_block(report) -> str:
+    """What is wrong in each failing model and how to fix it, under the check matrix: the
+    diagnosis's findings (``pendverify.diagnosis.explain``), the repair first."""
+    order = {"repair": 0, "parameters": 1, "convention": 2, "structural": 3, "entry": 4, "pattern": 5}
+    out = []
+    for model, findings in report.diagnoses.items():
+        items = "".join(
+            f'<li class="{_e(f.kind)}"><strong>{_e(f.kind)}</strong> {_e(f.message)}</li>'
+            for f in sorted(findings, key=lambda f: order[f.kind])
+        )
+        out.append(
+            f'<div class="diagnosis"><p class="fail">what is wrong in {_e(model)}, and how to fix it:</p>'
+            f"<ul>{items}</ul></div>\n"
+        )
+    return "".join(out)
+
+
 def check_table(report) -> str:
     """The verification table of ``pendverify check`` (a ``pendverify.checks.report.Report``).
 
@@ -122,6 +139,7 @@ def check_table(report) -> str:
     total = sum(report.states.values())
     return (
         check_matrix(report)
+        + diagnosis_block(report)
         + f'<p class="meta">{len(report.results)} checks on {len(report.states)} model(s), {total} states '
         f"(seed {report.seed}); each cell: largest error / tolerance, relative, in diagonally scaled "
         "coordinates: tolerance = K·ε·(1 + |θ|max)·cond(T)² (+ model-form allowance).</p>\n"

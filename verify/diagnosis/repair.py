@@ -568,9 +568,11 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
         _screen(slot, screen, sm, evaluate, monomials[quantity], pool, deadline)
     notation = Notation.of(type(batch.model))
     tried, found, seen = 0, [], set()
-    for _, changes, edit, slot in _candidates(slots):
+    for rank, changes, edit, slot in _candidates(slots):
         if time.perf_counter() > deadline or tried >= CONFIRMATIONS or len(found) > ALTERNATIVES:
             break
+        if found and rank > RANK["scale"]:
+            break  # an alternative is a simple edit, not a shift or a fitted term that happens to fit
         key = tuple(sorted((m, i, str(new)) for (m, i), (_, new) in changes.items()))
         if key in seen or (found and set(changes) != set(found[0][0])):
             continue  # the same edit again, or (once one is found) an edit of other entries

@@ -34,7 +34,7 @@ def _damping_sentence(model, system, failing, states) -> str | None:
         diff = model.acceleration(s.q, s.v, s.u, s.w) - system.acceleration(s.q, s.v, tau)
         target.append(model.mass_matrix(s.q) @ diff)
         rows.append(s.v)
-    V, R = np.array(rows), np.array(target)
+    V, R = np.array(rows, dtype=float), np.array(target, dtype=float)  # a model may return object arrays
     X, *_ = np.linalg.lstsq(V, R, rcond=None)  # R ≈ V Xᵀ: r = X q̇
     X = X.T
     if np.linalg.norm(V @ X.T - R) > FIT_RTOL * np.linalg.norm(R) or np.max(np.abs(X)) == 0:
