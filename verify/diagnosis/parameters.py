@@ -273,17 +273,25 @@ class ImpliedParameters:
     def unexplained(self) -> list[str]:
         """An irreducible set of entries whose rows, left out, let parameters reproduce the rest.
 
-        Entries (M[i,j] with M[j,i], C·q̇[i], H[i]) are put back one by one, the best-fitted
-        first (smallest largest |residual| of the fit to all rows), and stay out only when
-        the rows kept with them no longer ``fits``: no single entry of the set can be put back.
+        Entries (M[i,j] with M[j,i], C·q̇[i], H[i]) are put back one by one and stay out only
+        when the rows kept with them no longer ``fits``: no single entry of the set can be put
+        back.  The set starts from the entries that differ from the URDF's own (left out, the
+        rest is the URDF's, which fits), the worst first put back last, so that the entries named
+        are ones that differ; when every entry differs, from all of them, the best-fitted first.
         """
         labels = np.array([_entry(label) for label in self.rows.labels])
         Y, b = self._unit_columns, self.rows.b
-        x, *_ = np.linalg.lstsq(Y, b, rcond=None)
-        r = np.abs(b - Y @ x)
-        entries = sorted(dict.fromkeys(labels), key=lambda e: float(np.max(r[labels == e])))
-        out = set(entries)
-        for entry in entries:
+        scaled = self.urdf[self.norms > 0] * self.norms[self.norms > 0]
+        off = np.abs(b - Y @ scaled)  # each row's difference from the URDF's own parameters
+        differing = [e for e in dict.fromkeys(labels) if np.max(off[labels == e]) > K * EPS]
+        if len(differing) == len(set(labels)):
+            x, *_ = np.linalg.lstsq(Y, b, rcond=None)
+            r = np.abs(b - Y @ x)
+            differing = sorted(differing, key=lambda e: float(np.max(r[labels == e])))
+        else:
+            differing = sorted(differing, key=lambda e: float(np.max(off[labels == e])))
+        out = set(differing)
+        for entry in differing:
             if self.fits(~np.isin(labels, list(out - {entry}))):
                 out.discard(entry)
         return [e for e in dict.fromkeys(labels) if e in out]
