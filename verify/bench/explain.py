@@ -39,14 +39,16 @@ class ExplainBench:
 
 def shipped_targets():
     """(label, model, system, degrees of freedom) of every model file the worked examples ship."""
-    from pendverify.api import load_model, load_params, load_urdf
+    from pendverify.analytic.plugin import load_model_class
+    from pendverify.robot.system import PinocchioSystem
+    from pendverify.targets import parameter_values
     from pendverify.worked_examples import EXAMPLES
 
     for example in EXAMPLES:
         for file in example.models:
-            cls = load_model(file.source)
-            params = load_params(cls, example.params.source)
-            system = load_urdf(cls, example.urdf.source, getattr(params, "g", None))
+            cls = load_model_class(str(file.source))
+            params = parameter_values(cls, example.params.source)
+            system = PinocchioSystem.for_model(cls, example.urdf.source, getattr(params, "g", None))
             yield f"{example.name}, {file.role}", cls(params), system, example.dof
 
 

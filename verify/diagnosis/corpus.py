@@ -38,7 +38,7 @@ from pendverify.checks.batch import CheckBatch
 from pendverify.checks.catalogue import applicable_checks, run_checks
 from pendverify.checks.sampling import sample_states
 from pendverify.diagnosis.explain import explain
-from pendverify.diagnosis.repair import QUANTITY
+from pendverify.diagnosis.slots import QUANTITY
 from pendverify.symbolic.edited import edited_model
 from pendverify.symbolic.edits import parameter_edits, term_edits, trig_edits, walk
 from pendverify.symbolic.zero_test import is_zero

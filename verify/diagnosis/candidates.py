@@ -1,0 +1,298 @@
+"""What could repair a slot: the edits tried on one entry, screened at the screening states.
+
+Per slot (``pendverify.diagnosis.slots``), the edits of ``pendverify.symbolic.edits`` (the
+inverses of ``pendverify mutate``'s operators) are evaluated at the screening states,
+vectorised over them, and those that make the slot agree are kept (``screen``).  Three kinds
+are found from the numbers rather than enumerated blindly:
+
+* a coefficient k on one term (t → k·t), fitted by least squares over the states where the
+  entry is affine in it and kept when k is one of ``COEFFICIENTS`` — this undoes a sign
+  (k = −1), a duplicated term or a factor 2 (k = ½), a factor ½ (k = 2), a term that should
+  not be there (k = 0) and ``pendverify mutate``'s 1e-3 scale;
+* an added term: the entry's difference fitted by the basis of
+  ``pendverify.diagnosis.patterns``, each coefficient matched to a simple fraction times a
+  product of at most ``DEGREE`` parameters of the kinds the quantity allows (the model's own
+  products first) — this undoes a dropped term and an inertia about the pivot (± m·r²);
+* a restored term: a sum completed by the one term it lacks, as the same sum stands elsewhere
+  in the model (a term dropped inside det M or M⁻¹).
+
+``candidates`` orders what passed the screen for confirmation, simplest first (``RANK``): each
+edit alone, then the same edit wherever the same expression stands in other slots (a shared
+sub-expression in code, a shorthand in a LaTeX file), then pairs of two slots' edits.
+``pairs_within`` tries two edits of one entry, for models of up to three degrees of freedom.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import time
+from fractions import Fraction
+
+import numpy as np
+import sympy as sp
+
+from pendverify.analytic.symbolic_reading import SymbolicModel, entries
+from pendverify.diagnosis.patterns import basis_for, fit
+from pendverify.diagnosis.slots import QUANTITY, SCREEN_RTOL, Slot
+from pendverify.symbolic.edits import Edit, replace_at, structural_edits, sums, walk, with_term
+
+DEGREE = 3
+MAX_PAIRS = 40
+
+#: the coefficients a one-term edit may put right: a sign, a dropped term, a factor 2 or ½
+#: (a duplicated term), and the inverse of ``pendverify mutate``'s 1e-3 scale
+COEFFICIENTS = (Fraction(-1), Fraction(0), Fraction(2), Fraction(1, 2), Fraction(1000, 1001))
+
+
+def _nice(k: float) -> Fraction | None:
+    """k as one of ``COEFFICIENTS`` when it is one to rounding."""
+    if not np.isfinite(k):
+        return None
+    return next((c for c in COEFFICIENTS if abs(float(c) - k) <= 1e-9 * max(1.0, abs(k))), None)
+
+
+def _affine(expr, path) -> bool:
+    """Whether the entry is affine in the coefficient of the term at ``path`` (only sums and
+    products above it)."""
+    node = expr
+    for i in path:
+        if not (node.is_Add or node.is_Mul):
+            return False
+        node = node.args[i]
+    return True
+
+
+def _coefficient_edits(slot: Slot, evaluate) -> list[Edit]:
+    """t → k·t for one term: k solved for by least squares where the entry is affine in it,
+    each of ``COEFFICIENTS`` tried where it is not (inside a power or a function)."""
+    out = []
+    if slot.row is None:
+        goal = slot.target
+    else:  # the entry value that zeroes the row's residual, where its rate is not zero
+        with np.errstate(all="ignore"):
+            goal = slot.values - slot.row[0] / np.where(slot.row[1] != 0, slot.row[1], np.nan)
+    places = [((), [slot.expr], 0, True)]
+    places += [(p, t, i, False) for p, t in sums(slot.expr) for i in range(len(t))]
+    for path, terms, i, whole in places:
+        term = terms[i]
+        if whole or _affine(slot.expr, path):
+            without = sp.S.Zero if whole else with_term(slot.expr, path, terms, i, None)
+            base = evaluate(without, slot.symbols)
+            part = slot.values - base
+            target = goal - base
+            if slot.centred:
+                part, target = part - np.mean(part), target - np.mean(target)
+            ok = np.isfinite(target) & np.isfinite(part)
+            denominator = float(np.dot(part[ok], part[ok]))
+            k = _nice(float(np.dot(part[ok], target[ok]) / denominator)) if denominator > 0 else None
+            tried = [k] if k is not None else []
+        else:
+            tried = list(COEFFICIENTS)
+        for k in tried:
+            factor = sp.Rational(k.numerator, k.denominator)
+            new = factor * term
+            expr = new if whole else with_term(slot.expr, path, terms, i, new)
+            operator = {0: "drop", -1: "sign"}.get(k, "scale")
+            out.append(Edit(operator, term, new, expr, f"{term} → {new}"))
+    return out
+
+
+#: the kinds of parameter an added term of each quantity may hold (its units): friction only in
+#: D, gravity only in H and V
+KINDS_OF = {
+    "D": {"damping"},
+    "H": {"mass", "length", "offset", "gravity", "inertia", ""},
+    "V": {"mass", "length", "offset", "gravity", "inertia", ""},
+}
+OTHER_KINDS = {"mass", "length", "offset", "inertia", ""}
+
+
+def monomials_for(sm: SymbolicModel, params: dict, quantity: str) -> tuple[list, list]:
+    """(value, expression) of the parameter products an added term may hold: first those the
+    model's own terms hold (the parameter part of each term of its written forms), then every
+    product of at most ``DEGREE`` parameters of the kinds the quantity allows (``KINDS_OF``)."""
+    kinds = {p.name: k for p, k in zip(sm.parameters.values(), _kind_list(sm), strict=True)}
+    allowed = KINDS_OF.get(quantity, OTHER_KINDS)
+    symbols = [s for s in sm.parameters.values() if kinds[s.name] in allowed]
+    own: dict = {}
+    for value in sm.closed_forms.values():
+        for expr in entries(value):
+            for _, terms in sums(expr):
+                for term in terms:
+                    factor = sp.Mul(*[f for f in sp.Mul.make_args(term) if f.free_symbols <= set(symbols)])
+                    factor = factor.as_coeff_Mul()[1]
+                    if factor.free_symbols:
+                        own[factor] = None
+    generic = [
+        sp.Mul(*combo)
+        for degree in range(1, DEGREE + 1)
+        for combo in itertools.combinations_with_replacement(symbols, degree)
+    ]
+    values = {sm.parameters[p]: v for p, v in params.items()}
+    out: tuple[list, list] = ([], [])
+    for group, exprs in zip(out, (list(own), generic), strict=True):
+        for expr in exprs:
+            value = float(expr.xreplace(values))
+            if value != 0 and np.isfinite(value):
+                group.append((value, expr))
+    return out
+
+
+def _kind_list(sm) -> list[str]:
+    return [f.metadata.get("kind", "") for f in dataclasses.fields(sm.cls.params_type)]
+
+
+FRACTIONS = tuple(
+    Fraction(a, b) for b in (1, 2, 3, 4, 6, 12) for a in range(1, 5) if Fraction(a, b).denominator == b
+)
+
+
+PAIR_FACTORS = (1, -1, 2, -2, sp.Rational(1, 2), -sp.Rational(1, 2))
+
+
+def _matched(coefficient: float, monomials) -> sp.Expr | None:
+    """coefficient as ± a simple fraction times a product of parameters, or as a sum of two such
+    (factors ±1, ±2, ±½), the simplest such; None when none equals it to 1e-9."""
+    close = 1e-9 * abs(coefficient)
+    for whole in (True, False):  # a product as it stands before one with a fraction
+        for value, expr in monomials:
+            ratio = Fraction(abs(coefficient) / value).limit_denominator(12)
+            if (
+                (ratio == 1) is whole
+                and ratio in FRACTIONS
+                and abs(float(ratio) * value - abs(coefficient)) <= close
+            ):
+                return sp.sign(coefficient) * sp.Rational(ratio.numerator, ratio.denominator) * expr
+    values = np.array([v for v, _ in monomials])
+    order = np.argsort(values)
+    ordered = values[order]
+    for f1, f2 in itertools.product(PAIR_FACTORS, repeat=2):
+        rest = (coefficient - float(f1) * values) / float(f2)  # what the second monomial must be
+        at = np.clip(np.searchsorted(ordered, rest), 1, len(ordered) - 1)
+        for k in np.flatnonzero(np.minimum(abs(ordered[at] - rest), abs(ordered[at - 1] - rest)) <= close):
+            j = order[at[k]] if abs(ordered[at[k]] - rest[k]) <= close else order[at[k] - 1]
+            if j != k:
+                return f1 * monomials[k][1] + f2 * monomials[j][1]
+    return None
+
+
+def _added_term_edits(slot: Slot, batch, monomials) -> list[Edit]:
+    """The entry's difference fitted and written as parameters times basis functions (module
+    docstring).  For a Coriolis row the entry's share q̇j·Δ of the row's residual is fitted, with
+    Δ in the basis of C."""
+    quantity = QUANTITY.get(slot.method, "C" if slot.row is not None else None)
+    if quantity not in ("M", "H", "V", "D", "detM", "Cqdot", "C"):
+        return []
+    model = batch.model
+    basis = basis_for(quantity, batch.Q, batch.V, model.angular, model.coordinates)
+    if slot.row is None:
+        diff = slot.target - slot.values
+    else:
+        residual, rate = slot.row
+        basis = [(name, values * rate, expr) for name, values, expr in basis]
+        diff = -residual
+    pattern = fit(diff, basis)
+    if pattern is None:
+        return []
+    added = []
+    for (c, name), function in zip(pattern.terms, pattern.functions, strict=True):
+        if slot.centred and name == "1":  # V is compared up to a constant
+            continue
+        own, generic = monomials  # the model's own products alone first, then with every other
+        monomial = _matched(c, own) or _matched(c, own + generic)
+        if monomial is None:
+            return []
+        added.append(monomial * function)
+    term = sp.Add(*added)
+    return [Edit("add", sp.S.Zero, term, slot.expr + term, f"add {term}")]
+
+
+def sum_pool(sm: SymbolicModel) -> list[frozenset]:
+    """The sums written anywhere in the model's closed forms, each as the set of its terms."""
+    pool = set()
+    for value in sm.closed_forms.values():
+        for expr in entries(value):
+            pool |= {frozenset(node.args) for node, _ in walk(expr) if node.is_Add}
+    return sorted(pool, key=len)
+
+
+def _restored_term_edits(slot: Slot, pool) -> list[Edit]:
+    """A sum (or a lone term) completed by the one term it lacks, as the same sum stands elsewhere
+    in the model: the inverse of a term dropped inside a factor (det M, M⁻¹)."""
+    out = []
+    for node, path in walk(slot.expr):
+        terms = frozenset(node.args) if node.is_Add else frozenset([node])
+        if node.is_Number:
+            continue
+        for other in pool:
+            if len(other) == len(terms) + 1 and terms < other:
+                new = sp.Add(*other)
+                added = next(iter(other - terms))
+                out.append(
+                    Edit("drop", node, new, replace_at(slot.expr, path, new), f"add {added} to {node}")
+                )
+    return out
+
+
+def screen_slot(slot: Slot, batch, sm, evaluate, monomials, pool, deadline: float) -> None:
+    kinds = {sm.parameters[f.name]: f.metadata.get("kind", "") for f in _fields(sm)}
+    edits = _coefficient_edits(slot, evaluate) + _added_term_edits(slot, batch, monomials)
+    edits += _restored_term_edits(slot, pool)
+    edits += list(structural_edits(slot.expr, sm.angles, sm.symbols["v"], kinds))
+    seen = set()
+    allowed = set(sm.flat_arguments(slot.symbols)) | set(sm.parameters.values())
+    for edit in edits:
+        if time.perf_counter() > deadline:
+            return
+        if edit.expr in seen or edit.expr == slot.expr or not edit.expr.free_symbols <= allowed:
+            continue
+        seen.add(edit.expr)
+        values = evaluate(edit.expr, slot.symbols)
+        if np.all(np.isfinite(values)) and slot.mismatch(values) <= SCREEN_RTOL:
+            slot.matches.append(edit)
+
+
+def _fields(sm):
+    return dataclasses.fields(sm.cls.params_type)
+
+
+#: the order candidates are confirmed in, simplest first: a factor 2 or ½ comes after the edits
+#: that change a symbol, so that a parameter swapped for one worth twice as much (mc = 2·mp) is
+#: put back as the swap, not as a factor
+RANK = {
+    "sign": 0,
+    "drop": 1,
+    "swap θ": 2,
+    "swap θ̇": 2,
+    "parameter": 2,
+    "sin↔cos": 3,
+    "scale": 4,
+    "offset": 5,
+    "add": 6,
+}
+
+
+def candidates(slots: list[Slot]) -> list[tuple[int, dict, Edit, Slot]]:
+    """(rank, {(method, index): (old, new)}, the edit shown, its slot), simplest first."""
+    out = []
+    for slot in slots:
+        for edit in slot.matches:
+            local = {(slot.method, slot.index): (slot.expr, edit.expr)}
+            out.append((RANK.get(edit.operator, 9), local, edit, slot))
+            shared = dict(local)
+            for other in (
+                s for s in slots if s is not slot
+            ):  # the same edit where the same expression stands
+                if other.expr == slot.expr:
+                    shared[(other.method, other.index)] = (other.expr, edit.expr)
+                elif not edit.old.is_Atom and other.expr.has(edit.old):
+                    shared[(other.method, other.index)] = (other.expr, other.expr.subs(edit.old, edit.new))
+            if len(shared) > 1:
+                out.append((10 + RANK.get(edit.operator, 9), shared, edit, slot))
+    if len(slots) == 2 and not any(len(c) == 2 for _, c, _, _ in out):
+        a, b = slots
+        for ea, eb in itertools.islice(itertools.product(a.matches, b.matches), MAX_PAIRS):
+            changes = {(a.method, a.index): (a.expr, ea.expr), (b.method, b.index): (b.expr, eb.expr)}
+            out.append((20 + RANK.get(ea.operator, 9) + RANK.get(eb.operator, 9), changes, ea, a))
+    return sorted(out, key=lambda c: c[0])

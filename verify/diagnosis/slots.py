@@ -1,0 +1,224 @@
+"""Where a repair is needed: the entries of the written closed forms that disagree with Pinocchio.
+
+The model's written closed forms are read as SymPy expressions
+(``pendverify.analytic.symbolic_reading``) and each entry is evaluated at the screening states
+(the first ``SCREEN_STATES`` judged states, special ones first; ``evaluator``, vectorised over
+them) next to what it must equal there according to Pinocchio (``targets``): M, H, det M,
+M⁻¹, q̈, C·q̇ directly; V up to a constant (both centred); D the URDF's where it declares
+damping; a Coriolis-type matrix (C, or C + D) through its rows' product with q̇, since C
+itself is not unique; a form beyond the interface through what it ``equals``.  An entry whose
+values differ by more than ``SCREEN_RTOL`` of its quantity's size is a *slot* to repair.
+
+Screening tolerance: a right entry and Pinocchio's value differ by rounding, a few ε of the
+terms' size times the cancellation; ``SCREEN_RTOL`` = 1e-7 of the quantity's size leaves a
+margin of 1e8 ε for that and is still far below any edit (a 1e-3 scale changes a term by
+1e-3 of itself).  It only selects candidates: the checks decide (``pendverify.diagnosis.repair``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import sympy as sp
+
+from pendverify.analytic.symbolic_reading import SymbolicModel, entries
+
+SCREEN_STATES = 24
+SCREEN_RTOL = 1e-7
+QUANTITY = {
+    "mass_matrix": "M",
+    "coriolis_matrix": "C",
+    "coriolis_force": "Cqdot",
+    "gravity": "H",
+    "potential_energy": "V",
+    "damping_matrix": "D",
+    "det_mass_matrix": "detM",
+    "inverse_mass_matrix": "Minv",
+    "acceleration": "qddot",
+}
+
+
+@dataclass
+class Slot:
+    """One entry of a written closed form that disagrees with what Pinocchio says it must be."""
+
+    method: str
+    index: int  # row-major into the method's value
+    label: str
+    expr: sp.Expr
+    symbols: list
+    values: np.ndarray  # the entry at the screening states
+    target: np.ndarray | None  # what it must be (None: a Coriolis row, see ``row``)
+    #: a Coriolis-type row: (the row's residual (X − X_pin)·q̇ at the states, q̇_j)
+    row: tuple | None = None
+    centred: bool = False  # V: compared up to a constant
+    scale: float = 1.0
+    matches: list = field(default_factory=list)
+
+    def mismatch(self, candidate: np.ndarray) -> float:
+        if self.row is not None:
+            residual, rate = self.row
+            return float(np.max(np.abs(residual + (candidate - self.values) * rate))) / self.scale
+        diff = candidate - self.target
+        if self.centred:
+            diff = diff - np.mean(diff)
+        return float(np.max(np.abs(diff))) / self.scale
+
+
+def evaluator(sm: SymbolicModel, arrays: dict, params: list):
+    """f(expr, args) → the expression's values at the screening states (vectorised)."""
+    n = len(arrays["q"])
+
+    def evaluate(expr, args: str) -> np.ndarray:
+        symbols = sm.flat_arguments(args) + list(sm.parameters.values())
+        columns = [arrays[a][:, k] for a in args for k in range(arrays[a].shape[1])]
+        with np.errstate(all="ignore"):
+            value = sp.lambdify(symbols, expr, modules="numpy", docstring_limit=0)(*columns, *params)
+        return np.broadcast_to(np.asarray(value, dtype=float), (n,))
+
+    return evaluate
+
+
+class _Matrix:
+    """A 2-D array whose ``*`` is the matrix product, as ``equals`` strings write it (SymPy's)."""
+
+    def __init__(self, a):
+        self.a = np.asarray(a, dtype=float)
+
+    @staticmethod
+    def _of(x):
+        return x.a if isinstance(x, _Matrix) else x
+
+    def __mul__(self, other):
+        o = self._of(other)
+        return _Matrix(self.a @ o if np.ndim(o) == 2 else self.a * o)
+
+    def __rmul__(self, other):
+        return _Matrix(other * self.a)
+
+    def __add__(self, other):
+        return _Matrix(self.a + self._of(other))
+
+    __radd__ = __add__
+
+    def __sub__(self, other):
+        return _Matrix(self.a - self._of(other))
+
+    def __rsub__(self, other):
+        return _Matrix(self._of(other) - self.a)
+
+    def __neg__(self):
+        return _Matrix(-self.a)
+
+
+def _equals_targets(form, terms, k: int, D, B, W):
+    """What a form beyond the interface equals at state k, from Pinocchio's M, C, H."""
+
+    def column(x):
+        return _Matrix(np.reshape(x, (-1, 1)))
+
+    namespace = {
+        "M": _Matrix(terms.M_pin[k]),
+        "C": _Matrix(terms.C_pin[k]),
+        "H": column(terms.H_pin[k]),
+        "D": _Matrix(D),
+        "B": _Matrix(np.reshape(B, (len(terms.q[k]), -1))),
+        "W": _Matrix(np.reshape(W, (len(terms.q[k]), -1))),
+        "q": column(terms.q[k]),
+        "v": column(terms.v[k]),
+        "u": column(terms.u[k]),
+        "w": column(terms.w_in[k]),
+    }
+    value = eval(form.equals, {"__builtins__": {}}, namespace)  # the model class's own declaration
+    return np.asarray(value.a if isinstance(value, _Matrix) else value, dtype=float)
+
+
+def _targets(batch, method: str, form, shape) -> tuple[np.ndarray | None, bool, bool]:
+    """(what the method must be at each screening state, whether it is a Coriolis row form,
+    whether it is compared up to a constant), or (None, …) when Pinocchio does not say."""
+    t = batch.terms
+    n = len(batch)
+    system = batch.system
+    D = t.D_urdf if np.any(system.urdf_damping()) else t.D
+    fixed = {
+        "mass_matrix": lambda: t.M_pin,
+        "gravity": lambda: t.H_pin,
+        "potential_energy": lambda: t.V_pin,
+        "det_mass_matrix": lambda: t.det_pin,
+        "inverse_mass_matrix": lambda: t.Minv_pin,
+        "acceleration": lambda: t.a_pin,
+        "coriolis_force": lambda: t.bias_pin - t.H_pin,
+        "coriolis_matrix": lambda: t.bias_pin - t.H_pin,
+        "damping_matrix": lambda: np.broadcast_to(t.D_urdf, (n, *np.shape(t.D_urdf))),
+    }
+    if method == "damping_matrix" and not np.any(system.urdf_damping()):
+        return None, False, False
+    if method in fixed:
+        return (
+            np.asarray(fixed[method](), dtype=float),
+            method == "coriolis_matrix",
+            method == "potential_energy",
+        )
+    if not form.equals:
+        return None, False, False
+    values = np.array([_equals_targets(form, t, k, D, t.B, t.W) for k in range(n)])
+    row = form.args == "qv" and "C" in form.equals and len(shape) == 2 and shape[0] == shape[1]
+    if row:  # the rows' product with q̇
+        values = (values @ t.v[:, :, None])[..., 0]
+    return values.reshape((n, -1) if not row else (n, shape[0])), row, False
+
+
+def entry_label(method: str, value, index: int) -> str:
+    name = QUANTITY.get(method, method)
+    if not isinstance(value, sp.MatrixBase):
+        return name
+    r, c = divmod(index, value.shape[1])
+    return f"{name}[{r + 1}]" if value.shape[1] == 1 else f"{name}[{r + 1},{c + 1}]"
+
+
+def find_slots(batch, sm: SymbolicModel) -> list[Slot]:
+    """Every entry of a written closed form that disagrees with Pinocchio at the screening states."""
+    model = batch.model
+    params = [float(getattr(model.params, p)) for p in sm.parameters]
+    arrays = {"q": batch.Q, "v": batch.V, "u": batch.U, "w": batch.W}
+    evaluate = evaluator(sm, arrays, params)
+    forms = type(model).closed_forms
+    slots = []
+    for method, value in sm.closed_forms.items():
+        form = forms[method]
+        shape = value.shape if isinstance(value, sp.MatrixBase) else ()
+        with np.errstate(all="ignore"):
+            target, row, centred = _targets(batch, method, form, shape)
+        if target is None:
+            continue
+        flat = entries(value)
+        current = np.stack([evaluate(e, form.args) for e in flat], axis=-1) if flat else None
+        if row:
+            cols = shape[1]
+            X = current.reshape(len(batch), shape[0], cols)
+            residual = (X @ batch.V[:, :, None])[..., 0] - target
+        target = target.reshape(len(batch), -1)
+        # an entry is judged against the size of its whole quantity: an exact zero where
+        # Pinocchio rounds to 1e-17 is not a difference
+        size = float(np.max(np.abs(target), initial=0.0)) + float(np.max(np.abs(current), initial=0.0))
+        for index, expr in enumerate(flat):
+            values = current[:, index]
+            if row:
+                r, c = divmod(index, shape[1])
+                rate = batch.V[:, c]
+                scale = float(np.max(np.abs(target))) + float(np.max(np.abs(X * batch.V[:, None, :])))
+                slot = Slot(method, index, entry_label(method, value, index), expr, form.args, values, None,
+                            (residual[:, r], rate), scale=scale or 1.0)  # fmt: skip
+                if np.max(np.abs(residual[:, r])) > SCREEN_RTOL * slot.scale and np.any(rate != 0):
+                    slots.append(slot)
+                continue
+            goal = target[:, index]
+            diff = values - goal
+            if centred:
+                diff = diff - np.mean(diff)
+            scale = size or 1.0
+            if np.max(np.abs(diff)) > SCREEN_RTOL * scale or not np.all(np.isfinite(values)):
+                label = entry_label(method, value, index)
+                slots.append(Slot(method, index, label, expr, form.args, values, goal, None, centred, scale))
+    return slots
