@@ -177,7 +177,38 @@ def _matched(coefficient: float, monomials) -> sp.Expr | None:
     return None
 
 
-def _added_term_edits(slot: Slot, batch, monomials) -> list[Edit]:
+#: the physical dimension (kg, m, s) of each kind of parameter whose unit is fixed
+DIMENSIONS = {"mass": (1, 0, 0), "length": (0, 1, 0), "offset": (0, 1, 0), "inertia": (1, 2, 0)}
+DIMENSIONS["gravity"] = (0, 1, -2)
+
+
+def _dimension(expr, kinds: dict) -> tuple | None:
+    """The dimension of a product of parameters, or None when a factor's kind has no fixed unit."""
+    total = np.zeros(3)
+    for factor in sp.Mul.make_args(expr):
+        if factor.is_Number:
+            continue
+        base, exponent = factor.as_base_exp()
+        if kinds.get(base) not in DIMENSIONS or not exponent.is_Number:
+            return None
+        total += float(exponent) * np.array(DIMENSIONS[kinds[base]])
+    return tuple(total)
+
+
+def _entry_dimensions(expr, kinds: dict) -> set:
+    """The dimensions of the parameter parts of an entry's terms (an added term must have one)."""
+    out = set()
+    for term in sp.Add.make_args(sp.expand(expr)):
+        factor = sp.Mul(
+            *[f for f in sp.Mul.make_args(term) if f.free_symbols and f.free_symbols <= set(kinds)]
+        )
+        dimension = _dimension(factor, kinds)
+        if dimension is not None and factor != 1:
+            out.add(dimension)
+    return out
+
+
+def _added_term_edits(slot: Slot, batch, monomials, kinds: dict) -> list[Edit]:
     """The entry's difference fitted and written as parameters times basis functions (module
     docstring).  For a Coriolis row the entry's share q̇j·Δ of the row's residual is fitted, with
     Δ in the basis of C."""
@@ -195,6 +226,11 @@ def _added_term_edits(slot: Slot, batch, monomials) -> list[Edit]:
     pattern = fit(diff, basis)
     if pattern is None:
         return []
+    dimensions = _entry_dimensions(slot.expr, kinds)
+    if dimensions:  # an added term has the dimension of the entry's own terms
+        monomials = tuple(
+            [(v, e) for v, e in group if _dimension(e, kinds) in dimensions] for group in monomials
+        )
     added = []
     for (c, name), function in zip(pattern.terms, pattern.functions, strict=True):
         if slot.centred and name == "1":  # V is compared up to a constant
@@ -235,11 +271,12 @@ def _restored_term_edits(slot: Slot, pool) -> list[Edit]:
     return out
 
 
-def screen_slot(slot: Slot, batch, sm, evaluate, monomials, pool, deadline: float) -> None:
-    kinds = {sm.parameters[f.name]: f.metadata.get("kind", "") for f in _fields(sm)}
-    edits = _coefficient_edits(slot, evaluate) + _added_term_edits(slot, batch, monomials)
-    edits += _restored_term_edits(slot, pool)
-    edits += list(structural_edits(slot.expr, sm.angles, sm.symbols["v"], kinds))
+def _kinds(sm) -> dict:
+    return {sm.parameters[f.name]: f.metadata.get("kind", "") for f in _fields(sm)}
+
+
+def _evaluated(slot: Slot, edits, sm, evaluate, deadline: float):
+    """(edit, its values at the screening states, the slot's mismatch with them) of each new edit."""
     seen = set()
     allowed = set(sm.flat_arguments(slot.symbols)) | set(sm.parameters.values())
     for edit in edits:
@@ -249,8 +286,57 @@ def screen_slot(slot: Slot, batch, sm, evaluate, monomials, pool, deadline: floa
             continue
         seen.add(edit.expr)
         values = evaluate(edit.expr, slot.symbols)
-        if np.all(np.isfinite(values)) and slot.mismatch(values) <= SCREEN_RTOL:
-            slot.matches.append(edit)
+        if np.all(np.isfinite(values)):
+            yield edit, values, slot.mismatch(values)
+
+
+def screen_slot(slot: Slot, batch, sm, evaluate, monomials, pool, deadline: float) -> None:
+    """The edits of one slot that make it agree at the screening states, in ``slot.matches``."""
+    edits = _coefficient_edits(slot, evaluate) + _added_term_edits(slot, batch, monomials, _kinds(sm))
+    edits += _restored_term_edits(slot, pool)
+    edits += list(structural_edits(slot.expr, sm.angles, sm.symbols["v"], _kinds(sm)))
+    slot.matches += [
+        e for e, _, mismatch in _evaluated(slot, edits, sm, evaluate, deadline) if mismatch <= SCREEN_RTOL
+    ]
+
+
+#: first edits of an entry a pair starts from: those that bring it closest to agreeing
+FIRST_EDITS = 15
+
+
+def _enumerated(slot: Slot, sm, pool) -> list[Edit]:
+    """The edits of an entry that need no fit: a sign, a drop, a factor 2 or ½ on each term, the
+    structural edits and the restored terms (a pair's two edits are each of these, or the
+    second a solved coefficient: never an added term, which would fit anything)."""
+    out = []
+    for path, terms in sums(slot.expr):
+        for i, term in enumerate(terms):
+            for k in COEFFICIENTS[:4]:
+                new = sp.Rational(k.numerator, k.denominator) * term
+                out.append(
+                    Edit("scale", term, new, with_term(slot.expr, path, terms, i, new), f"{term} → {new}")
+                )
+    out += list(structural_edits(slot.expr, sm.angles, sm.symbols["v"], _kinds(sm)))
+    return out + _restored_term_edits(slot, pool)
+
+
+def pairs_within(slot: Slot, sm, evaluate, pool, deadline: float) -> list[Edit]:
+    """Two edits of one entry that together make it agree: each of the ``FIRST_EDITS`` first
+    edits that bring it closest, followed by every second edit (module docstring)."""
+    before = slot.mismatch(slot.values)
+    evaluated = _evaluated(slot, _enumerated(slot, sm, pool), sm, evaluate, deadline)
+    closer = [(m, i, e, v) for i, (e, v, m) in enumerate(evaluated) if m < before]
+    firsts = sorted(closer, key=lambda x: (x[0], x[1]))[:FIRST_EDITS]
+    out = []
+    for _, _, first, values in firsts:
+        inner = dataclasses.replace(slot, expr=first.expr, values=values, matches=[])
+        seconds = _coefficient_edits(inner, evaluate) + _enumerated(inner, sm, pool)
+        for second, _, mismatch in _evaluated(inner, seconds, sm, evaluate, deadline):
+            if mismatch <= SCREEN_RTOL and second.expr != slot.expr:
+                out.append(
+                    Edit("pair", slot.expr, second.expr, second.expr, f"{first.what}, then {second.what}")
+                )
+    return out
 
 
 def _fields(sm):
@@ -270,6 +356,7 @@ RANK = {
     "scale": 4,
     "offset": 5,
     "add": 6,
+    "pair": 30,
 }
 
 

@@ -27,7 +27,14 @@ import sympy as sp
 
 from pendverify.analytic.symbolic_reading import SymbolicModel
 from pendverify.checks.catalogue import applicable_checks, run_checks
-from pendverify.diagnosis.candidates import RANK, candidates, monomials_for, screen_slot, sum_pool
+from pendverify.diagnosis.candidates import (
+    RANK,
+    candidates,
+    monomials_for,
+    pairs_within,
+    screen_slot,
+    sum_pool,
+)
 from pendverify.diagnosis.finding import Finding
 from pendverify.diagnosis.notation import Notation
 from pendverify.diagnosis.slots import QUANTITY, SCREEN_STATES, Slot, entry_label, evaluator, find_slots
@@ -35,6 +42,8 @@ from pendverify.symbolic.edited import edited_model
 from pendverify.symbolic.edits import Edit
 
 CONFIRMATIONS = 12
+#: pairs of edits of one entry are tried for models of up to this many degrees of freedom
+PAIRS_UP_TO_DOF = 3
 #: confirmed edits of the same entries shown besides the first: parameter values can make two
 #: edits give the same numbers (a parameter worth twice another, a 3·I = m·r²)
 ALTERNATIVES = 2
@@ -79,11 +88,38 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
             monomials[quantity] = monomials_for(sm, params, quantity)
         screen_slot(slot, screening, sm, evaluate, monomials[quantity], pool, deadline)
     notation = Notation.of(type(batch.model))
+    found, tried = _confirm(batch, sm, candidates(slots), deadline)
+    pairs = not found and batch.model.nv <= PAIRS_UP_TO_DOF and len(slots) <= 2
+    if pairs:  # two edits of one entry
+        within = [
+            (RANK["pair"], {(slot.method, slot.index): (slot.expr, edit.expr)}, edit, slot)
+            for slot in slots
+            for edit in pairs_within(slot, sm, evaluate, pool, deadline)
+        ]
+        found, more = _confirm(batch, sm, within, deadline)
+        tried += more
+    if found:
+        findings = _findings(*found[0], forms, notation)
+        for changes, edit, slot in found[1:]:
+            findings += _findings(changes, edit, slot, forms, notation, alternative=True)
+        return findings, ""
+    where = ", ".join(s.label for s in slots[:6]) + (f" and {len(slots) - 6} more" if len(slots) > 6 else "")
+    bound = " (the search stopped at its time bound)" if time.perf_counter() > deadline else ""
+    also = " nor two edits of one entry," if pairs else ""
+    return [], (
+        f"no repair: no single edit of {where} (nor one edit of each, for two entries,{also}) makes every "
+        f"check pass; {tried} candidate(s) tried against every check{bound}"
+    )
+
+
+def _confirm(batch, sm, ordered, deadline: float) -> tuple[list, int]:
+    """The candidates (in order) that every check confirms: the first, then alternatives of the
+    same entries (module docstring); and how many were tried."""
     tried, found, seen = 0, [], set()
-    for rank, changes, edit, slot in candidates(slots):
+    for rank, changes, edit, slot in ordered:
         if time.perf_counter() > deadline or tried >= CONFIRMATIONS or len(found) > ALTERNATIVES:
             break
-        if found and rank > RANK["scale"]:
+        if found and rank > RANK["scale"] and rank != RANK["pair"]:
             break  # an alternative is a simple edit, not a shift or a fitted term that happens to fit
         key = tuple(sorted((m, i, str(new)) for (m, i), (_, new) in changes.items()))
         if key in seen or (found and set(changes) != set(found[0][0])):
@@ -92,17 +128,7 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
         tried += 1
         if _confirmed(batch, sm, changes):
             found.append((changes, edit, slot))
-    if found:
-        findings = _findings(*found[0], forms, notation)
-        for changes, edit, slot in found[1:]:
-            findings += _findings(changes, edit, slot, forms, notation, alternative=True)
-        return findings, ""
-    where = ", ".join(s.label for s in slots[:6]) + (f" and {len(slots) - 6} more" if len(slots) > 6 else "")
-    bound = " (the search stopped at its time bound)" if time.perf_counter() > deadline else ""
-    return [], (
-        f"no repair: no single edit of {where} (nor a pair, for two entries) makes every check pass; "
-        f"{tried} candidate(s) tried against every check{bound}"
-    )
+    return found, tried
 
 
 def _findings(changes: dict, edit: Edit, slot: Slot, forms: dict, notation, alternative: bool = False):
@@ -117,6 +143,8 @@ def _findings(changes: dict, edit: Edit, slot: Slot, forms: dict, notation, alte
             if len(written) + len(suggested) <= 160
             else f"{notation.render(edit.old)} → {notation.render(edit.new)} in {label}"
         )
+        if edit.operator == "pair":
+            shown += f" (two edits: {edit.what})"
         message = f"{label}: {shown} makes every check pass on every state ({location})"
         if alternative:
             message = (
