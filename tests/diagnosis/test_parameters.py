@@ -29,7 +29,8 @@ from pendverify.analytic.plugin import load_model_class, plugin_parameters
 from pendverify.checks.batch import CheckBatch
 from pendverify.checks.catalogue import run_checks
 from pendverify.checks.sampling import sample_states
-from pendverify.diagnosis.parameters import identify_parameters, implied_parameters
+from pendverify.diagnosis.implied import implied_parameters
+from pendverify.diagnosis.parameters import identify_parameters
 from pendverify.robot.system import PinocchioSystem
 
 from ..conftest import SEED, default_params
@@ -37,7 +38,6 @@ from ..conftest import SEED, default_params
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 STATES = 40
 EPS = float(np.finfo(float).eps)
-TIME_LIMIT = 1.0  # s: the diagnosis of a 3-dof model is bounded by a second
 
 
 # --- the models and their systems ------------------------------------------------------------
@@ -375,8 +375,9 @@ def test_the_identifiable_combinations_of_a_planar_chain():
 
 
 # --- bounded ---------------------------------------------------------------------------------------
-def test_a_three_dof_model_takes_less_than_a_second():
-    """Two changes of the triple pendulum: every single and every pair of hypotheses is tried."""
+def test_two_changes_of_a_three_dof_model_are_both_named():
+    """Two changes of the triple pendulum: every single and every pair of hypotheses is tried.
+    The time is printed (``-s``), not asserted: tests never assert wall times."""
     cls, params, system = _example("triple_pendulum")
     model = cls(params.replace(m1=1.0, r2=0.2))
     batch = _batch(model, system)
@@ -389,5 +390,4 @@ def test_a_three_dof_model_takes_less_than_a_second():
         ("link1", "mass"),
         ("link2", "centre of mass"),
     ]
-    assert elapsed < TIME_LIMIT
     assert math.isfinite(findings[0].details["residual"])
