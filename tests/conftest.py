@@ -11,7 +11,9 @@ cache for repeated runs).  Tests that need an empty cache of their own make one.
 
 from __future__ import annotations
 
+import importlib.util
 import os
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -84,3 +86,17 @@ def assert_close(actual, expected, rtol, context=""):
     assert np.all(np.isfinite(actual)), f"non-finite result {context}"
     err = np.max(np.abs(actual - expected) / np.maximum(1.0, np.abs(expected)))
     assert err <= rtol, f"error {err:.3g} > {rtol:.3g} {context}"
+
+
+def example_module(stem: str):
+    """The module of the shipped example ``examples/<stem>.py``, imported under a private name."""
+    name = f"_pendverify_example_{stem}"
+    path = Path(__file__).resolve().parents[1] / "examples" / f"{stem}.py"
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module  # dataclasses look their module up while the file runs
+    try:
+        spec.loader.exec_module(module)
+    finally:
+        del sys.modules[name]
+    return module

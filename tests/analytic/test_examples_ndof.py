@@ -12,15 +12,15 @@ with a relative-angle map — must fail the check that looks at them.
 
 from __future__ import annotations
 
-import importlib.util
 import json
-import sys
 from pathlib import Path
 
 import pytest
 
 from pendverify.analytic.params import load_parameter_file
 from pendverify.cli import main
+
+from ..conftest import example_module
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 STEMS = ("triple_pendulum", "furuta_pendulum")
@@ -150,16 +150,6 @@ def test_triple_pendulum_with_a_relative_angle_map_is_diagnosed(tmp_path, capsys
 
 
 # --- the committed URDFs ------------------------------------------------------------------------
-def _example_module(stem: str):
-    name = f"_pendverify_example_{stem}"
-    spec = importlib.util.spec_from_file_location(name, EXAMPLES / f"{stem}.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module  # dataclasses look their module up while the file runs
-    try:
-        spec.loader.exec_module(module)
-    finally:
-        del sys.modules[name]
-    return module
 
 
 @pytest.mark.parametrize(
@@ -170,7 +160,7 @@ def _example_module(stem: str):
     ],
 )
 def test_committed_urdfs_match_their_generators(stem, model_class, generator):
-    module = _example_module(stem)
+    module = example_module(stem)
     cls = getattr(module, model_class)
     _, _, params = load_parameter_file(EXAMPLES / f"{stem}.toml", {cls.name: cls.params_type})
     assert (EXAMPLES / f"{stem}.urdf").read_text() == getattr(module, generator)(params), (

@@ -8,11 +8,9 @@ takes about the centres of mass) must make every check pass on states it has not
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import math
 import re
-import sys
 import time
 from pathlib import Path
 from types import SimpleNamespace
@@ -42,7 +40,7 @@ from pendverify.robot.coordinates import CoordinateMap
 from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
 
-from ..conftest import SEED, default_params
+from ..conftest import SEED, default_params, example_module
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 CLASSES = {
@@ -54,25 +52,13 @@ CLASSES = {
 A2 = np.array([[1.0, 0.0], [-1.0, 1.0]])
 
 
-def _module(stem: str):
-    name = f"_pendverify_example_{stem}"
-    spec = importlib.util.spec_from_file_location(name, EXAMPLES / f"{stem}.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module  # dataclasses look their module up while the file runs
-    try:
-        spec.loader.exec_module(module)
-    finally:
-        del sys.modules[name]
-    return module
-
-
 def _setup(stem: str, urdf_params=None):
     """(model, its system) of a shipped model; ``urdf_params`` (params → params) alters its URDF."""
     if stem == "double_pendulum":
         params = default_params(stem)
         urdf = urdf_for(urdf_params(params) if urdf_params else params)
         return DoublePendulum(params), PinocchioSystem.for_model(DoublePendulum, urdf, params.g)
-    module = _module(stem)
+    module = example_module(stem)
     cls = getattr(module, CLASSES[stem])
     _, _, params = load_parameter_file(EXAMPLES / f"{stem}.toml", {cls.name: cls.params_type})
     urdf = str(EXAMPLES / f"{stem}.urdf")

@@ -17,21 +17,10 @@ from dataclasses import dataclass, field
 import sympy as sp
 
 from pendverify.analytic.source_file import where
+from pendverify.analytic.text_model import METHODS
 
 #: method → the key of a text model file that gives it
-TEXT_KEYS = {
-    "mass_matrix": "M",
-    "coriolis_matrix": "C",
-    "coriolis_force": "Cqdot",
-    "gravity": "H",
-    "potential_energy": "V",
-    "damping_matrix": "D",
-    "input_matrix": "B",
-    "disturbance_matrix": "W",
-    "det_mass_matrix": "det_M",
-    "inverse_mass_matrix": "M_inv",
-    "acceleration": "qddot",
-}
+TEXT_KEYS = {method: key for key, (method, _) in METHODS.items()}
 
 
 @dataclass
