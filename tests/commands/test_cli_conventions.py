@@ -382,6 +382,7 @@ COMMAND_IMPORTS = {
     "pendverify.bench.report",
     "pendverify.bench.plot",
     "pendverify.bench.certify_report",
+    "pendverify.bench.explain_report",
     "pendverify.bench.timing",  # cpu_model, for the report's machine
 }
 #: the certify helper routes commands/certify.py through api (certify_set, recheck) separately

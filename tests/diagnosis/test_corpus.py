@@ -11,7 +11,8 @@ search or a parameter identification run on it anyway must find nothing.
 
 from __future__ import annotations
 
-from pendverify.bench.explain import run_explain_bench, shipped_targets, table
+from pendverify.bench.explain import run_explain_bench, shipped_targets
+from pendverify.bench.explain_report import table
 from pendverify.checks.batch import CheckBatch
 from pendverify.checks.sampling import sample_states
 from pendverify.diagnosis.corpus import CORPUS_SAMPLES, CORPUS_SEED

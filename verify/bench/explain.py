@@ -13,8 +13,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numpy as np
-
 from pendverify.diagnosis.corpus import CORPUS_SEED, ModelScores, plants, sample_plants, score_model
 
 QUICK_PER_OPERATOR = 2
@@ -68,59 +66,3 @@ def run_explain_bench(quick: bool = False) -> ExplainBench:
             out.models.append(score_model(label, model, system, chosen[label], progress=progress))
             out.dof[label] = dof
     return out
-
-
-def _rate(part: int, whole: int) -> str:
-    return f"{part}/{whole} ({100 * part / whole:.1f} %)" if whole else "–"
-
-
-def table(bench: ExplainBench) -> str:
-    """The figures as text: one row per model file, the totals, the time against the bound."""
-    header = (
-        "model file",
-        "dof",
-        "planted",
-        "detected",
-        "named",
-        "repaired",
-        "restored",
-        "clean",
-        "mean s",
-        "max s",
-    )
-    rows = []
-    for m in bench.models:
-        seconds = [s.seconds for s in m.scores if s.detected] or [0.0]
-        detected = m.count("detected")
-        rows.append(
-            (
-                m.label,
-                str(bench.dof[m.label]),
-                str(len(m.scores)),
-                str(detected),
-                _rate(m.count("named"), detected),
-                _rate(m.count("repaired"), detected),
-                _rate(m.count("restored"), detected),
-                "yes" if m.clean else "NO",
-                f"{np.mean(seconds):.2f}",
-                f"{max(seconds):.2f}",
-            )
-        )
-    widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(header)]
-    lines = ["  ".join(h.ljust(w) for h, w in zip(header, widths, strict=True))]
-    lines.append("-" * len(lines[0]))
-    lines += ["  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True)).rstrip() for r in rows]
-    t = bench.totals()
-    slowest = max((s.seconds for m in bench.models for s in m.scores if s.detected), default=0.0)
-    lines += [
-        "",
-        f"{'a seeded sample' if bench.quick else 'every'} planted error ({t['planted']}), "
-        f"{t['detected']} detected by the checks: entry named {_rate(t['named'], t['detected'])}, "
-        f"repaired {_rate(t['repaired'], t['detected'])}, the planted edit or an equivalent one "
-        f"{_rate(t['restored'], t['detected'])} (target ≥ 90 %: "
-        f"{'met' if t['detected'] and t['restored'] >= 0.9 * t['detected'] else 'NOT met'})",
-        f"untouched models clean: {sum(m.clean for m in bench.models)}/{len(bench.models)}; "
-        f"largest diagnosis {slowest:.2f} s (bound {BOUND_S:g} s for up to 3 degrees of freedom: "
-        f"{'met' if slowest <= BOUND_S else 'NOT met'})",
-    ]
-    return "\n".join(lines)

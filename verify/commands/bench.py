@@ -147,7 +147,7 @@ def run_explain(args: argparse.Namespace) -> int:
     guard, _ = limit_blas()
     with guard:
         from pendverify import api
-        from pendverify.bench.explain import table
+        from pendverify.bench.explain_report import table
 
         text = table(api.bench_explain(args.quick))
     lines = text.splitlines()
