@@ -40,15 +40,17 @@ def explain(batch, results, deadline_s: float = REPAIR_DEADLINE_S) -> list[Findi
     start = time.perf_counter()
     failing = {r.check for r in results if not r.passed}
     findings: list[Finding] = []
+    # quantities of any size reach here (a damping of 1e300 is valid input): overflow in a fit
+    # makes that fit fail, it is not an error
     with np.errstate(all="ignore"):
         for entry in differing_entries(batch, failing):
             findings.append(entry_finding(entry, batch))
             pattern = entry_pattern(entry, batch)
             if pattern is not None:
                 findings.append(pattern_finding(entry, pattern, batch.model.coordinates))
-    findings += diagnose(batch.model, batch.system, results)
-    findings += identify_parameters(batch)
-    repairs, why_not = search_repair(batch, max(0.0, deadline_s - (time.perf_counter() - start)))
+        findings += diagnose(batch.model, batch.system, results)
+        findings += identify_parameters(batch)
+        repairs, why_not = search_repair(batch, max(0.0, deadline_s - (time.perf_counter() - start)))
     findings += repairs
     if why_not:  # said as a repair that is not one: checks_pass false, nothing suggested
         details = {"written": None, "suggested": None, "suggested_source": None, "location": None}
