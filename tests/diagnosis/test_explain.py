@@ -9,6 +9,8 @@ what the report says; the seeds are the project's (``SEED``) and the CLI's defau
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -194,3 +196,14 @@ def test_two_edits_in_one_entry_are_found_when_no_single_edit_is_enough(tmp_path
     (repair,) = [f for f in next(iter(report["diagnoses"].values())) if f["kind"] == "repair"]
     assert repair["checks_pass"] is True and "(two edits: " in repair["message"]
     assert repair["suggested"] == "I1 + I2 + 2*l1*m2*r2*cos(theta2) + m1*r1**2 + m2*(l1**2 + r2**2)"
+
+
+def test_the_diagnosis_is_loaded_only_when_a_model_fails():
+    """Importing the check path does not load SymPy or the searches: a passing run starts as fast
+    as before the diagnosis existed (they are imported when a model fails)."""
+    code = (
+        "import sys, pendverify.cli, pendverify.checks.verification; "
+        "print(sorted(m for m in ('sympy', 'pendverify.diagnosis.explain') if m in sys.modules))"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert done.stdout.strip() == "[]"

@@ -29,7 +29,6 @@ from pendverify.checks.result import CheckResult
 from pendverify.checks.sampling import sample_states
 from pendverify.checks.trust import REFUSE_REL, Verdicts, check_conditioning
 from pendverify.checks.verdict import FAIL, REFUSED, WARN, apply_strict, non_christoffel_c
-from pendverify.diagnosis.explain import explain
 from pendverify.errors import IllConditionedError
 from pendverify.progress import bar
 from pendverify.robot.geometry import MODEL_FORM_RTOL
@@ -162,6 +161,9 @@ def verify_target(report: Report, target, samples: int, seed: int) -> None:
         apply_strict(results)
     failing = [r for r in results if r.status == FAIL and r.check != "model-form"]
     if failing and kept and report.explain:
+        # SymPy and the searches are loaded only when a model fails (a passing run starts faster)
+        from pendverify.diagnosis.explain import explain
+
         diagnoses = explain(batch, failing)
         if diagnoses:
             report.diagnoses[label] = diagnoses
