@@ -81,12 +81,14 @@ __all__ = [
     "animation_html",
     "bench_accuracy",
     "bench_certify",
+    "bench_explain",
     "certify_set",
     "check",
     "check_animation_length",
     "compare_symbolic",
     "copy_example",
     "generate_keys",
+    "implied_parameters",
     "load_model",
     "load_params",
     "load_scene",
@@ -265,6 +267,35 @@ def check(
     report.skipped = selection.skipped
     report.elapsed_s = time.perf_counter() - started
     return CheckReport.from_report(report)
+
+
+def implied_parameters(
+    model: ModelLike,
+    urdf: UrdfLike,
+    params: ParamsLike,
+    *,
+    samples: int = DEFAULT_RANDOM_STATES,
+    seed: int = DEFAULT_SEED,
+):
+    """Which inertial parameters of the URDF's tree does the hand model assume?
+
+    The hand model's M, C·q̇ and H at ``samples`` random states (drawn with ``seed``) are fitted
+    by Pinocchio's joint torque regressor (``pendverify.diagnosis.implied``).  Returns an
+    ``ImpliedParameters``: ``exact`` (some inertial parameters reproduce the equations to
+    rounding), ``agrees`` (the URDF's own do), ``combinations`` (each identifiable combination
+    with the model's and the URDF's value and its rounding) and ``unexplained`` (the entries
+    no parameters reproduce, when not ``exact``).  Bad input raises ``PendverifyError``.
+    """
+    from pendverify.checks.batch import CheckBatch
+    from pendverify.checks.sampling import sample_states
+    from pendverify.diagnosis.implied import implied_parameters as fit
+
+    cls = load_model(model)
+    parameter_set = load_params(cls, params)
+    system = load_urdf(cls, urdf, getattr(parameter_set, "g", None))
+    hand = cls(parameter_set)
+    states = sample_states(hand, _count("samples", samples), _count("seed", seed))
+    return fit(CheckBatch(hand, system, states))
 
 
 # --- simulate and draw -----------------------------------------------------------------------------

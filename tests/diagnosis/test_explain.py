@@ -27,6 +27,7 @@ from pendverify.diagnosis.finding import KINDS, QUANTITIES
 from pendverify.diagnosis.parameters import identify_parameters
 from pendverify.diagnosis.repair import search_repair
 from pendverify.robot.system import PinocchioSystem
+from pendverify.robot.writer import urdf_for
 from pendverify.testing import assert_verified
 from pendverify.viz.review import diagnosis_block
 
@@ -207,3 +208,18 @@ def test_the_diagnosis_is_loaded_only_when_a_model_fails():
     )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert done.stdout.strip() == "[]"
+
+
+def test_which_inertial_parameters_a_model_assumes(tmp_path):
+    """``api.implied_parameters``: the reference model against a URDF whose link 2 weighs half as
+    much again is this robot with other parameters (exact), not the URDF's own (agrees false),
+    and every combination that differs involves link 2; against its own URDF, all agree."""
+    params = default_params("double_pendulum")
+    heavy = tmp_path / "heavy.urdf"
+    heavy.write_text(urdf_for(params.replace(m2=1.5 * params.m2)))
+    implied = api.implied_parameters("double_pendulum", heavy, DP_PARAMS, samples=20)
+    assert implied.exact and not implied.agrees
+    differing = [c.name for c in implied.combinations if c.differs]
+    assert differing and all("link2" in name for name in differing), differing
+    own = api.implied_parameters("double_pendulum", DP_URDF, DP_PARAMS, samples=20)
+    assert own.exact and own.agrees and not any(c.differs for c in own.combinations)
