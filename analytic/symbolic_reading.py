@@ -101,6 +101,12 @@ class SymbolicModel:
         model.math = SYMBOLIC_MATH
         return cls(model_cls, model, symbols, parameters)
 
+    @cached_property
+    def kinds(self) -> dict[sp.Symbol, str]:
+        """{parameter symbol: its kind} (``mass``, ``length``, ...) as the parameter set declares it."""
+        fields = dataclasses.fields(self.cls.params_type)
+        return {self.parameters[f.name]: f.metadata.get("kind", "") for f in fields}
+
     @property
     def angles(self) -> tuple[sp.Symbol, ...]:
         return tuple(s for s, a in zip(self.symbols["q"], self.cls.angular, strict=True) if a)

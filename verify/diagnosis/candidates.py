@@ -2,7 +2,7 @@
 
 Per slot (``pendverify.diagnosis.slots``), the edits of ``pendverify.symbolic.edits`` (the
 inverses of ``pendverify mutate``'s operators) are evaluated at the screening states,
-vectorised over them, and those that make the slot agree are kept (``screen``).  Three kinds
+vectorised over them, and those that make the slot agree are kept (``screen_slot``).  Three kinds
 are found from the numbers rather than enumerated blindly:
 
 * a coefficient k on one term (t → k·t), fitted by least squares over the states where the
@@ -112,9 +112,9 @@ def monomials_for(sm: SymbolicModel, params: dict, quantity: str) -> tuple[list,
     """(value, expression) of the parameter products an added term may hold: first those the
     model's own terms hold (the parameter part of each term of its written forms), then every
     product of at most ``DEGREE`` parameters of the kinds the quantity allows (``KINDS_OF``)."""
-    kinds = {p.name: k for p, k in zip(sm.parameters.values(), _kind_list(sm), strict=True)}
+    kinds = sm.kinds
     allowed = KINDS_OF.get(quantity, OTHER_KINDS)
-    symbols = [s for s in sm.parameters.values() if kinds[s.name] in allowed]
+    symbols = [s for s in sm.parameters.values() if kinds[s] in allowed]
     own: dict = {}
     for value in sm.closed_forms.values():
         for expr in entries(value):
@@ -137,10 +137,6 @@ def monomials_for(sm: SymbolicModel, params: dict, quantity: str) -> tuple[list,
             if value != 0 and np.isfinite(value):
                 group.append((value, expr))
     return out
-
-
-def _kind_list(sm) -> list[str]:
-    return [f.metadata.get("kind", "") for f in dataclasses.fields(sm.cls.params_type)]
 
 
 FRACTIONS = tuple(
@@ -271,10 +267,6 @@ def _restored_term_edits(slot: Slot, pool) -> list[Edit]:
     return out
 
 
-def _kinds(sm) -> dict:
-    return {sm.parameters[f.name]: f.metadata.get("kind", "") for f in _fields(sm)}
-
-
 def _evaluated(slot: Slot, edits, sm, evaluate, deadline: float):
     """(edit, its values at the screening states, the slot's mismatch with them) of each new edit."""
     seen = set()
@@ -292,9 +284,9 @@ def _evaluated(slot: Slot, edits, sm, evaluate, deadline: float):
 
 def screen_slot(slot: Slot, batch, sm, evaluate, monomials, pool, deadline: float) -> None:
     """The edits of one slot that make it agree at the screening states, in ``slot.matches``."""
-    edits = _coefficient_edits(slot, evaluate) + _added_term_edits(slot, batch, monomials, _kinds(sm))
+    edits = _coefficient_edits(slot, evaluate) + _added_term_edits(slot, batch, monomials, sm.kinds)
     edits += _restored_term_edits(slot, pool)
-    edits += list(structural_edits(slot.expr, sm.angles, sm.symbols["v"], _kinds(sm)))
+    edits += list(structural_edits(slot.expr, sm.angles, sm.symbols["v"], sm.kinds))
     slot.matches += [
         e for e, _, mismatch in _evaluated(slot, edits, sm, evaluate, deadline) if mismatch <= SCREEN_RTOL
     ]
@@ -316,7 +308,7 @@ def _enumerated(slot: Slot, sm, pool) -> list[Edit]:
                 out.append(
                     Edit("scale", term, new, with_term(slot.expr, path, terms, i, new), f"{term} → {new}")
                 )
-    out += list(structural_edits(slot.expr, sm.angles, sm.symbols["v"], _kinds(sm)))
+    out += list(structural_edits(slot.expr, sm.angles, sm.symbols["v"], sm.kinds))
     return out + _restored_term_edits(slot, pool)
 
 
@@ -337,10 +329,6 @@ def pairs_within(slot: Slot, sm, evaluate, pool, deadline: float) -> list[Edit]:
                     Edit("pair", slot.expr, second.expr, second.expr, f"{first.what}, then {second.what}")
                 )
     return out
-
-
-def _fields(sm):
-    return dataclasses.fields(sm.cls.params_type)
 
 
 #: the order candidates are confirmed in, simplest first: a factor 2 or ½ comes after the edits

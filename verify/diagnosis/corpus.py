@@ -22,7 +22,6 @@ The untouched models are diagnosed too: they must pass, with no finding at all.
 
 from __future__ import annotations
 
-import dataclasses
 import itertools
 import random
 import time
@@ -110,17 +109,13 @@ def entry_plants(method: str, index: int, expr, sm: SymbolicModel, kinds: dict) 
 
 def plants(sm: SymbolicModel) -> list[Plant]:
     """Every planted error of the corpus for one model."""
-    kinds = {sm.parameters[name]: kind for name, kind in _kinds(sm).items()}
+    kinds = sm.kinds
     out = []
     for method, value in sm.closed_forms.items():
         for index, expr in enumerate(entries(value)):
             if expr != 0:
                 out += entry_plants(method, index, expr, sm, kinds)
     return out
-
-
-def _kinds(sm) -> dict:
-    return {f.name: f.metadata.get("kind", "") for f in dataclasses.fields(sm.cls.params_type)}
 
 
 @dataclass
