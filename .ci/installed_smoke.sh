@@ -70,6 +70,9 @@ step pendverify keygen -o keys
 step pendverify example double_pendulum reference
 step pendverify certify reference/double_pendulum.toml -o certs --key keys/pendverify-signing.key.pem
 step pendverify recheck certs/double_pendulum.cert.json --trust keys/pendverify-signing.pub.pem
+# a typo in the LaTeX model (2\delta for \delta in M's last entry): the diagnosis repairs it
+sed 's/& \\delta \\end{bmatrix}/\& 2\\delta \\end{bmatrix}/g' reference/double_pendulum_latex.toml >typo.toml
+step python -c 'import sys, pendverify; r = pendverify.check("typo.toml", "reference/double_pendulum.urdf", "reference/double_pendulum.toml"); sys.exit(r.passed or not any(f.kind == "repair" and f.details["checks_pass"] for fs in r.diagnoses.values() for f in fs))'
 step python -c 'import pendverify, sys; sys.exit(not pendverify.certify_set("api-certs", "reference/double_pendulum.toml", samples=200).certified)'
 
 sed 's/^count = 200$/count = 20/' "$sweep_200" >sweep_20.toml
