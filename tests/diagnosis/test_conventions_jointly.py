@@ -274,3 +274,15 @@ def test_search_time_for_the_triple_pendulum():
     elapsed = time.perf_counter() - start
     print(f"\njoint convention search, triple pendulum (3 dof), two traps: {elapsed:.3f} s")
     assert finding is not None
+
+
+def test_a_pivot_correction_that_leaves_no_physical_inertia_is_not_an_explanation():
+    """Taking m·r² off link 1 of the reference double pendulum, whose I1 = 0.0208 kg·m² is less
+    than m1·r1² = 0.0625 kg·m², leaves an inertia no body has: the correction is refused (None),
+    not passed on to Pinocchio (which raised); taking it off an inertia about the pivot works."""
+    params = default_params("double_pendulum")
+    system = PinocchioSystem.for_params(params)
+    assert params.I1 < params.m1 * params.r1**2
+    assert corrected_system(system, {"link1 (joint joint1)": 1.0}) is None
+    pivot = params.replace(I1=params.I1 + params.m1 * params.r1**2)
+    assert corrected_system(PinocchioSystem.for_params(pivot), {"link1 (joint joint1)": 1.0}) is not None

@@ -82,7 +82,10 @@ def _traps(c: Candidate, links) -> list[str]:
 def _confirm(model, system, c: Candidate, links, states, before) -> tuple[float, bool]:
     """(residual, whether every check passes) with the URDF seen through candidate ``c``."""
     cmap = CoordinateMap(c.T, c.theta0, system.cmap.joint_nq)
-    after, passes = _discrepancy(model, corrected_system(system, links, cmap), states)
+    corrected = corrected_system(system, links, cmap)
+    if corrected is None:  # the correction leaves a body no physical inertia: not an explanation
+        return np.inf, False
+    after, passes = _discrepancy(model, corrected, states)
     return after / before, passes
 
 

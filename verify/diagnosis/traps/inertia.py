@@ -84,14 +84,19 @@ def parallel_axis_terms(system: PinocchioSystem, theta) -> tuple[list[str], np.n
 
 
 def corrected_system(system: PinocchioSystem, coefficients: dict[str, float], cmap=None):
-    """``system`` with c_b·(m (|c|² 𝟙 − c cᵀ)) taken off each named body's inertia (and map ``cmap``)."""
+    """``system`` with c_b·(m (|c|² 𝟙 − c cᵀ)) taken off each named body's inertia (and map ``cmap``),
+    or None when that leaves a body an inertia no body has (Pinocchio refuses one that is not
+    positive): the correction is then not a physical explanation."""
     model = system.model.copy()
     for j in range(1, model.njoints):
         c = coefficients.get(_link_name(model, j), 0.0)
         if c:
             inertia = model.inertias[j]
             rotational = np.asarray(inertia.inertia) - c * _shift(inertia)
-            model.inertias[j] = pin.Inertia(inertia.mass, np.asarray(inertia.lever), rotational)
+            try:
+                model.inertias[j] = pin.Inertia(inertia.mass, np.asarray(inertia.lever), rotational)
+            except RuntimeError:  # "The 3d inertia should be positive"
+                return None
     return _with_model(system, model, cmap)
 
 
