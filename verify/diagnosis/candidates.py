@@ -25,6 +25,7 @@ sub-expression in code, a shorthand in a LaTeX file), then pairs of two slots' e
 from __future__ import annotations
 
 import dataclasses
+import functools
 import itertools
 import time
 from fractions import Fraction
@@ -124,18 +125,25 @@ def monomials_for(sm: SymbolicModel, params: dict, quantity: str) -> tuple[list,
                     factor = factor.as_coeff_Mul()[1]
                     if factor.free_symbols:
                         own[factor] = None
-    generic = [
-        sp.Mul(*combo)
-        for degree in range(1, DEGREE + 1)
-        for combo in itertools.combinations_with_replacement(symbols, degree)
-    ]
     values = {sm.parameters[p]: v for p, v in params.items()}
-    out: tuple[list, list] = ([], [])
-    for group, exprs in zip(out, (list(own), generic), strict=True):
-        for expr in exprs:
-            value = float(expr.xreplace(values))
+    mine = []
+    for expr in own:
+        value = float(expr.xreplace(values))
+        if value != 0 and np.isfinite(value):
+            mine.append((value, expr))
+    return mine, _products(tuple(symbols), tuple(values[s] for s in symbols))
+
+
+@functools.lru_cache(maxsize=256)
+def _products(symbols: tuple, values: tuple) -> list:
+    """(value, expression) of every product of at most ``DEGREE`` of ``symbols`` (with repetition),
+    kept for the process: the same parameter set meets every planted error of a model."""
+    out = []
+    for degree in range(1, DEGREE + 1):
+        for combo in itertools.combinations_with_replacement(range(len(symbols)), degree):
+            value = float(np.prod([values[i] for i in combo]))
             if value != 0 and np.isfinite(value):
-                group.append((value, expr))
+                out.append((value, sp.Mul(*[symbols[i] for i in combo])))
     return out
 
 

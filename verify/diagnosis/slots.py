@@ -17,6 +17,7 @@ margin of 1e8 ε for that and is still far below any edit (a 1e-3 scale changes 
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -66,15 +67,22 @@ class Slot:
         return float(np.max(np.abs(diff))) / self.scale
 
 
+@functools.lru_cache(maxsize=8192)
+def compiled(symbols: tuple, expr):
+    """``expr`` as a NumPy function of ``symbols``, kept for the process: a repair search meets the
+    same entries and edits again (each planted error of ``bench explain`` has the others' entries)."""
+    return sp.lambdify(symbols, expr, modules="numpy", docstring_limit=0)
+
+
 def evaluator(sm: SymbolicModel, arrays: dict, params: list):
     """f(expr, args) → the expression's values at the screening states (vectorised)."""
     n = len(arrays["q"])
 
     def evaluate(expr, args: str) -> np.ndarray:
-        symbols = sm.flat_arguments(args) + list(sm.parameters.values())
+        symbols = tuple(sm.flat_arguments(args) + list(sm.parameters.values()))
         columns = [arrays[a][:, k] for a in args for k in range(arrays[a].shape[1])]
         with np.errstate(all="ignore"):
-            value = sp.lambdify(symbols, expr, modules="numpy", docstring_limit=0)(*columns, *params)
+            value = compiled(symbols, expr)(*columns, *params)
         return np.broadcast_to(np.asarray(value, dtype=float), (n,))
 
     return evaluate
