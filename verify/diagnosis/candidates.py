@@ -24,6 +24,7 @@ sub-expression in code, a shorthand in a LaTeX file), then pairs of two slots' e
 
 from __future__ import annotations
 
+import collections
 import dataclasses
 import functools
 import itertools
@@ -285,15 +286,54 @@ def _evaluated(slot: Slot, edits, sm, evaluate, deadline: float):
         if edit.expr in seen or edit.expr == slot.expr or not edit.expr.free_symbols <= allowed:
             continue
         seen.add(edit.expr)
-        values = evaluate(edit.expr, slot.symbols)
+        values = _edited_values(slot, edit.expr, evaluate)
         if np.all(np.isfinite(values)):
             yield edit, values, slot.mismatch(values)
+
+
+#: an edit that changes at most this many of a sum's terms is evaluated through those terms
+CHANGED_TERMS = 4
+
+
+def _edited_values(slot: Slot, expr, evaluate) -> np.ndarray:
+    """The edited entry at the screening states.  When it differs from the entry in a few of its
+    top-level terms, as most edits do, the entry's values less the terms taken out plus the terms
+    put in: a long entry (the triple pendulum's det M) is not compiled again for each edit, and
+    its terms are met again by other edits.  Otherwise the whole edited entry."""
+    before = collections.Counter(sp.Add.make_args(slot.expr))
+    after = collections.Counter(sp.Add.make_args(expr))
+    removed, added = before - after, after - before
+    if slot.expr.is_Add and sum(removed.values()) + sum(added.values()) <= CHANGED_TERMS:
+        values = np.array(slot.values, dtype=float)
+        for term, count in removed.items():
+            values = values - count * evaluate(term, slot.symbols)
+        for term, count in added.items():
+            values = values + count * evaluate(term, slot.symbols)
+        return values
+    return evaluate(expr, slot.symbols)
+
+
+def _constant_edits(slot: Slot, monomials) -> list[Edit]:
+    """A constant entry (of B, W, D) written as the value its slot must take, when that value is a
+    simple fraction or a fraction times a product of parameters of the quantity's kinds."""
+    if slot.symbols or slot.target is None:
+        return []
+    value = float(np.mean(slot.target))
+    fraction = Fraction(value).limit_denominator(12)
+    if abs(float(fraction) - value) <= 1e-9 * max(1.0, abs(value)):
+        new = sp.Rational(fraction.numerator, fraction.denominator)
+    else:
+        own, generic = monomials
+        new = _matched(value, own) or _matched(value, own + generic)
+    if new is None or new == slot.expr:
+        return []
+    return [Edit("constant", slot.expr, new, new, f"{slot.expr} → {new}")]
 
 
 def screen_slot(slot: Slot, batch, sm, evaluate, monomials, pool, deadline: float) -> None:
     """The edits of one slot that make it agree at the screening states, in ``slot.matches``."""
     edits = _coefficient_edits(slot, evaluate) + _added_term_edits(slot, batch, monomials, sm.kinds)
-    edits += _restored_term_edits(slot, pool)
+    edits += _restored_term_edits(slot, pool) + _constant_edits(slot, monomials)
     edits += list(structural_edits(slot.expr, sm.angles, sm.symbols["v"], sm.kinds))
     slot.matches += [
         e for e, _, mismatch in _evaluated(slot, edits, sm, evaluate, deadline) if mismatch <= SCREEN_RTOL
@@ -348,6 +388,7 @@ RANK = {
     "swap θ": 2,
     "swap θ̇": 2,
     "parameter": 2,
+    "constant": 2,
     "sin↔cos": 3,
     "scale": 4,
     "offset": 5,
@@ -356,26 +397,30 @@ RANK = {
 }
 
 
-def candidates(slots: list[Slot]) -> list[tuple[int, dict, Edit, Slot]]:
-    """(rank, {(method, index): (old, new)}, the edit shown, its slot), simplest first."""
+def candidates(slots: list[Slot], among: list[Slot]) -> list[tuple[int, dict, Edit, Slot]]:
+    """(rank, {(method, index): (old, new)}, the edit shown, its slot) of the edits that passed the
+    screen in the slots ``among``, simplest first: each alone, then the same edit wherever the
+    same expression stands in the other ``slots``."""
     out = []
-    for slot in slots:
+    for slot in among:
         for edit in slot.matches:
             local = {(slot.method, slot.index): (slot.expr, edit.expr)}
             out.append((RANK.get(edit.operator, 9), local, edit, slot))
             shared = dict(local)
-            for other in (
-                s for s in slots if s is not slot
-            ):  # the same edit where the same expression stands
+            for other in (s for s in slots if s is not slot):
                 if other.expr == slot.expr:
                     shared[(other.method, other.index)] = (other.expr, edit.expr)
                 elif not edit.old.is_Atom and other.expr.has(edit.old):
                     shared[(other.method, other.index)] = (other.expr, other.expr.subs(edit.old, edit.new))
             if len(shared) > 1:
                 out.append((10 + RANK.get(edit.operator, 9), shared, edit, slot))
-    if len(slots) == 2 and not any(len(c) == 2 for _, c, _, _ in out):
-        a, b = slots
-        for ea, eb in itertools.islice(itertools.product(a.matches, b.matches), MAX_PAIRS):
-            changes = {(a.method, a.index): (a.expr, ea.expr), (b.method, b.index): (b.expr, eb.expr)}
-            out.append((20 + RANK.get(ea.operator, 9) + RANK.get(eb.operator, 9), changes, ea, a))
+    return sorted(out, key=lambda c: c[0])
+
+
+def slot_pairs(a: Slot, b: Slot) -> list[tuple[int, dict, Edit, Slot]]:
+    """One edit of each of two slots, each of which passed its own screen (at most ``MAX_PAIRS``)."""
+    out = []
+    for ea, eb in itertools.islice(itertools.product(a.matches, b.matches), MAX_PAIRS):
+        changes = {(a.method, a.index): (a.expr, ea.expr), (b.method, b.index): (b.expr, eb.expr)}
+        out.append((20 + RANK.get(ea.operator, 9) + RANK.get(eb.operator, 9), changes, ea, a))
     return sorted(out, key=lambda c: c[0])

@@ -8,10 +8,12 @@
 3. **Confirmed**: a candidate becomes a repair only when the edited model
    (``pendverify.symbolic.edited``) passes every applicable check on every state of the
    report's batch; candidates are confirmed simplest first, at most ``CONFIRMATIONS`` of
-   them, within the time bound.  Once one is confirmed, other simple edits of the same entries
-   are confirmed too (up to ``ALTERNATIVES``) and shown as alternatives: with the given
-   parameter values two edits can give the same numbers (m = 2·m2 makes m2 → m the same as a
-   factor 2), and the checks cannot tell which one the derivation meant.  When no single edit
+   them, within the time bound.  Once one is confirmed, the next simple edits (of
+   this entry or another, ``ALTERNATIVE_TRIES`` of them) are confirmed too and the ones that
+   pass are shown as alternatives (up to ``ALTERNATIVES``): with the given parameter values two
+   edits can give the same numbers (m = 2·m2 makes m2 → m the same as a factor 2), and an error
+   in B shows as well in a hand-written q̈ that uses it; the checks cannot tell which one the
+   derivation meant.  When no single edit
    passes, pairs of edits of one entry are tried for models of up to three degrees of freedom.
 
 The repair is printed in the model's own notation, where it sits
@@ -33,6 +35,7 @@ from pendverify.diagnosis.candidates import (
     monomials_for,
     pairs_within,
     screen_slot,
+    slot_pairs,
     sum_pool,
 )
 from pendverify.diagnosis.finding import Finding
@@ -47,6 +50,11 @@ PAIRS_UP_TO_DOF = 3
 #: confirmed edits of the same entries shown besides the first: parameter values can make two
 #: edits give the same numbers (a parameter worth twice another, a 3·I = m·r²)
 ALTERNATIVES = 2
+#: candidates confirmed after the first repair, looking for alternatives (of this entry or
+#: another: an error in B shows as well in a q̈ that uses B, and either edit passes)
+ALTERNATIVE_TRIES = 4
+#: how long the search for alternatives goes on after the first repair
+ALTERNATIVE_SECONDS = 2.0
 
 
 def _confirmed(batch, sm, changes: dict) -> bool:
@@ -64,7 +72,12 @@ def _confirmed(batch, sm, changes: dict) -> bool:
 
 
 def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
-    """The confirmed repair of a failing model as findings, and what the search did, in words."""
+    """The confirmed repair of a failing model as findings, and what the search did, in words.
+
+    The slots are screened shortest first, and each one's candidates are confirmed before the
+    next is screened, so that a long entry (an M⁻¹ written with det M inside) does not use the
+    time a short one needed.  Once a repair is found, the other slots are screened for
+    alternatives for at most ``ALTERNATIVE_SECONDS``."""
     start = time.perf_counter()
     deadline = start + deadline_s
     try:
@@ -81,26 +94,31 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
     if not slots:
         return [], "no single entry of the written closed forms disagrees with Pinocchio: no repair searched"
     pool = sum_pool(sm)
-    monomials: dict[str, list] = {}
-    for slot in slots:
+    monomials: dict[str, tuple] = {}
+    confirm = _Confirmation(batch, sm, deadline)
+    screened = []
+    for slot in sorted(slots, key=lambda s: sp.count_ops(s.expr)):
+        if time.perf_counter() > min(deadline, confirm.alternatives_until):
+            break
         quantity = QUANTITY.get(slot.method, "")
         if quantity not in monomials:
             monomials[quantity] = monomials_for(sm, params, quantity)
         screen_slot(slot, screening, sm, evaluate, monomials[quantity], pool, deadline)
-    notation = Notation.of(type(batch.model))
-    found, tried = _confirm(batch, sm, candidates(slots), deadline)
-    pairs = not found and batch.model.nv <= PAIRS_UP_TO_DOF and len(slots) <= 2
+        screened.append(slot)
+        confirm.run(candidates(slots, [slot]))
+    if not confirm.found and len(slots) == 2 and len(screened) == 2:  # one edit of each entry
+        confirm.run(slot_pairs(*slots))
+    pairs = not confirm.found and batch.model.nv <= PAIRS_UP_TO_DOF and len(slots) <= 2
     if pairs:  # two edits of one entry
-        within = [
+        confirm.run(
             (RANK["pair"], {(slot.method, slot.index): (slot.expr, edit.expr)}, edit, slot)
             for slot in slots
             for edit in pairs_within(slot, sm, evaluate, pool, deadline)
-        ]
-        found, more = _confirm(batch, sm, within, deadline)
-        tried += more
-    if found:
-        findings = _findings(*found[0], forms, notation)
-        for changes, edit, slot in found[1:]:
+        )
+    notation = Notation.of(type(batch.model))
+    if confirm.found:
+        findings = _findings(*confirm.found[0], forms, notation)
+        for changes, edit, slot in confirm.found[1:]:
             findings += _findings(changes, edit, slot, forms, notation, alternative=True)
         return findings, ""
     where = ", ".join(s.label for s in slots[:6]) + (f" and {len(slots) - 6} more" if len(slots) > 6 else "")
@@ -108,27 +126,43 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
     also = " nor two edits of one entry," if pairs else ""
     return [], (
         f"no repair: no single edit of {where} (nor one edit of each, for two entries,{also}) makes every "
-        f"check pass; {tried} candidate(s) tried against every check{bound}"
+        f"check pass; {confirm.tried} candidate(s) tried against every check{bound}"
     )
 
 
-def _confirm(batch, sm, ordered, deadline: float) -> tuple[list, int]:
-    """The candidates (in order) that every check confirms: the first, then alternatives of the
-    same entries (module docstring); and how many were tried."""
-    tried, found, seen = 0, [], set()
-    for rank, changes, edit, slot in ordered:
-        if time.perf_counter() > deadline or tried >= CONFIRMATIONS or len(found) > ALTERNATIVES:
-            break
-        if found and rank > RANK["scale"] and rank != RANK["pair"]:
-            break  # an alternative is a simple edit, not a shift or a fitted term that happens to fit
-        key = tuple(sorted((m, i, str(new)) for (m, i), (_, new) in changes.items()))
-        if key in seen or (found and set(changes) != set(found[0][0])):
-            continue  # the same edit again, or (once one is found) an edit of other entries
-        seen.add(key)
-        tried += 1
-        if _confirmed(batch, sm, changes):
-            found.append((changes, edit, slot))
-    return found, tried
+class _Confirmation:
+    """The candidates every check confirms, in the order they come: the first, then alternatives
+    (module docstring); how many were tried; when the search for alternatives ends."""
+
+    def __init__(self, batch, sm, deadline: float):
+        self.batch, self.sm, self.deadline = batch, sm, deadline
+        self.found: list = []
+        self.tried, self.tried_at_first, self.longest = 0, 0, 0.0
+        self.seen: set = set()
+        self.alternatives_until = float("inf")
+
+    def run(self, ordered) -> None:
+        for rank, changes, edit, slot in ordered:
+            # a confirmation is not started unless the longest one so far still fits in the bound
+            late = time.perf_counter() + self.longest > min(self.deadline, self.alternatives_until)
+            if late or self.tried >= CONFIRMATIONS or len(self.found) > ALTERNATIVES:
+                return
+            if self.found and (rank > RANK["scale"] and rank != RANK["pair"]):
+                return  # an alternative is a simple edit, not a shift or a fitted term that happens to fit
+            key = tuple(sorted((m, i, str(new)) for (m, i), (_, new) in changes.items()))
+            if key in self.seen:
+                continue  # the same edit again
+            if self.found and self.tried - self.tried_at_first >= ALTERNATIVE_TRIES:
+                return
+            self.seen.add(key)
+            self.tried += 1
+            started = time.perf_counter()
+            if _confirmed(self.batch, self.sm, changes):
+                self.found.append((changes, edit, slot))
+                if len(self.found) == 1:
+                    self.tried_at_first = self.tried
+                    self.alternatives_until = time.perf_counter() + ALTERNATIVE_SECONDS
+            self.longest = max(self.longest, time.perf_counter() - started)
 
 
 def _findings(changes: dict, edit: Edit, slot: Slot, forms: dict, notation, alternative: bool = False):

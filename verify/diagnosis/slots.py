@@ -9,6 +9,13 @@ damping; a Coriolis-type matrix (C, or C + D) through its rows' product with q̇
 itself is not unique; a form beyond the interface through what it ``equals``.  An entry whose
 values differ by more than ``SCREEN_RTOL`` of its quantity's size is a *slot* to repair.
 
+B, W (and D where the URDF declares no damping) have no counterpart in Pinocchio; what they
+must be follows from the hand model's own q̈: M_pin·q̈_hand + bias_pin = B u + W w − D q̇ at
+every state, a linear regression of the left side on (u, w, −q̇) (``_force_matrices``).  When
+it is exact (relative residual within ``SCREEN_RTOL``: everything else the hand model says is
+Pinocchio's) its matrices are B's, W's and D's targets, so that an error in B is found in B
+and not only where q̈ uses it.
+
 Screening tolerance: a right entry and Pinocchio's value differ by rounding, a few ε of the
 terms' size times the cancellation; ``SCREEN_RTOL`` = 1e-7 of the quantity's size leaves a
 margin of 1e8 ε for that and is still far below any edit (a 1e-3 scale changes a term by
@@ -142,6 +149,28 @@ def _equals_targets(form, terms, k: int, D, B, W):
     return np.asarray(value.a if isinstance(value, _Matrix) else value, dtype=float)
 
 
+def _force_matrices(batch) -> dict[str, np.ndarray] | None:
+    """{method: B, W, D} fitted from M_pin·q̈_hand + bias_pin = B u + W w − D q̇ (module docstring),
+    or None when no constant matrices reproduce it (something else is wrong too)."""
+    t = batch.terms
+    nu, nw = batch.U.shape[1], batch.W.shape[1]
+    with np.errstate(all="ignore"):
+        force = (t.M_pin @ t.a_hand[:, :, None])[..., 0] + t.bias_pin
+    X = np.concatenate([batch.U, batch.W, -batch.V], axis=1)
+    if not np.all(np.isfinite(force)) or np.linalg.matrix_rank(X) < X.shape[1]:
+        return None
+    solution, *_ = np.linalg.lstsq(X, force, rcond=None)
+    residual = float(np.max(np.abs(X @ solution - force), initial=0.0))
+    if residual > SCREEN_RTOL * (float(np.max(np.abs(force), initial=0.0)) or 1.0):
+        return None
+    matrices = solution.T  # n × (nu + nw + n)
+    return {
+        "input_matrix": matrices[:, :nu],
+        "disturbance_matrix": matrices[:, nu : nu + nw],
+        "damping_matrix": matrices[:, nu + nw :],
+    }
+
+
 def _targets(batch, method: str, form, shape) -> tuple[np.ndarray | None, bool, bool]:
     """(what the method must be at each screening state, whether it is a Coriolis row form,
     whether it is compared up to a constant), or (None, …) when Pinocchio does not say."""
@@ -160,8 +189,14 @@ def _targets(batch, method: str, form, shape) -> tuple[np.ndarray | None, bool, 
         "coriolis_matrix": lambda: t.bias_pin - t.H_pin,
         "damping_matrix": lambda: np.broadcast_to(t.D_urdf, (n, *np.shape(t.D_urdf))),
     }
-    if method == "damping_matrix" and not np.any(system.urdf_damping()):
-        return None, False, False
+    forces = _force_matrices(batch)
+    if method in ("input_matrix", "disturbance_matrix") or (
+        method == "damping_matrix" and not np.any(system.urdf_damping())
+    ):
+        if forces is None or method not in forces:
+            return None, False, False
+        value = forces[method]
+        return np.broadcast_to(value, (n, *value.shape)), False, False
     if method in fixed:
         return (
             np.asarray(fixed[method](), dtype=float),

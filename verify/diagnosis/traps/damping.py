@@ -35,6 +35,8 @@ def _damping_sentence(model, system, failing, states) -> str | None:
         target.append(model.mass_matrix(s.q) @ diff)
         rows.append(s.v)
     V, R = np.array(rows, dtype=float), np.array(target, dtype=float)  # a model may return object arrays
+    if not np.all(np.isfinite(R)):
+        return None  # a q̈ not finite at a state is no damping trap (and LAPACK would refuse it)
     X, *_ = np.linalg.lstsq(V, R, rcond=None)  # R ≈ V Xᵀ: r = X q̇
     X = X.T
     if np.linalg.norm(V @ X.T - R) > FIT_RTOL * np.linalg.norm(R) or np.max(np.abs(X)) == 0:

@@ -117,8 +117,8 @@ def pivot_inertia(model, system, failing, states) -> Finding | None:
         return None
     A = K.reshape(len(names), -1).T
     b = (batch.terms.M_pin - batch.terms.M_hand).ravel()
-    if not np.linalg.norm(b) > 0:
-        return None
+    if not np.linalg.norm(b) > 0 or not np.all(np.isfinite(b)):
+        return None  # (a hand M not finite at a state is no inertia trap; LAPACK would refuse it)
     coeff, *_ = np.linalg.lstsq(A, b, rcond=None)
     rounded = integer_coefficients(coeff)
     if not np.any(rounded):
