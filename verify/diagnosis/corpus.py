@@ -145,12 +145,12 @@ class ModelScores:
 
 def _named(plant: Plant, findings, forms) -> bool:
     """Whether an ``entry`` finding names the planted entry (module docstring).  A form beyond the
-    interface, and D where no check compares it alone (a URDF without damping: only q̈ shows
-    it), count as named when any entry is."""
+    interface, B and W (no check compares them with Pinocchio) and D where no check compares it
+    alone (a URDF without damping) show only in what they feed (q̈): named when any entry is."""
     value = forms[plant.method]
     quantity = QUANTITY.get(plant.method)
     named = [(f.quantity, f.index) for f in findings if f.kind == "entry"]
-    if quantity is None or (quantity == "D" and all(q != "D" for q, _ in named)):
+    if quantity in (None, "B", "W") or (quantity == "D" and all(q != "D" for q, _ in named)):
         return bool(named)
     if isinstance(value, sp.MatrixBase):
         r, c = divmod(plant.index, value.shape[1])

@@ -33,7 +33,8 @@ import sympy as sp
 from pendverify.analytic.symbolic_reading import SymbolicModel, entries
 
 SCREEN_STATES = 24
-SCREEN_RTOL = 1e-7
+SCREEN_RTOL = 1e-7  # (module docstring)
+#: each interface method's quantity, as ``diagnoses`` in the JSON report names it
 QUANTITY = {
     "mass_matrix": "M",
     "coriolis_matrix": "C",
@@ -41,6 +42,8 @@ QUANTITY = {
     "gravity": "H",
     "potential_energy": "V",
     "damping_matrix": "D",
+    "input_matrix": "B",
+    "disturbance_matrix": "W",
     "det_mass_matrix": "detM",
     "inverse_mass_matrix": "Minv",
     "acceleration": "qddot",
