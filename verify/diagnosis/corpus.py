@@ -15,7 +15,9 @@ repaired
     a confirmed ``repair`` finding (every check passes on every state);
 restored
     the repair gives back the entries as they were, or ones proved equal to them
-    (``pendverify.symbolic.zero_test``): the planted edit or an equivalent one.
+    (``pendverify.symbolic.zero_test``): the planted edit or an equivalent one;
+seconds
+    how long the diagnosis took (``explain``, after the checks, as ``check`` runs it).
 
 The untouched models are diagnosed too: they must pass, with no finding at all.
 """
@@ -191,7 +193,6 @@ def score_model(
         planted = edited_model(
             model, sm, {plant.method: [(plant.index, plant.original, plant.new)]}, "Planted"
         )
-        start = time.perf_counter()
         with np.errstate(all="ignore"):
             batch = CheckBatch(planted, system, states)
             try:
@@ -202,12 +203,13 @@ def score_model(
                 results = None
         if results is not None and not all(r.passed for r in results):
             score.detected = True
+            start = time.perf_counter()  # the diagnosis alone, as check runs it after the checks
             findings = explain(batch, results, deadline_s)
+            score.seconds = time.perf_counter() - start
             score.named = _named(plant, findings, forms)
             score.repaired = any(f.kind == "repair" and f.details.get("checks_pass") for f in findings)
             score.restored = _restored(findings, plant, sm)
             score.message = next((f.message for f in findings if f.kind == "repair"), "")
-        score.seconds = time.perf_counter() - start
         out.scores.append(score)
         if progress is not None:
             progress.update(1)

@@ -33,6 +33,9 @@ from pendverify.diagnosis.repair import search_repair
 
 #: the repair search's bound: a 3-degree-of-freedom model's search takes well under it
 REPAIR_DEADLINE_S = 10.0
+#: kept from the repair search's share for what it does after its last step (its findings, in
+#: the model's notation) and for the step it is in when the time is up (one screening evaluation)
+FINISHING_S = 0.5
 
 
 def explain(batch, results, deadline_s: float = REPAIR_DEADLINE_S) -> list[Finding]:
@@ -50,7 +53,8 @@ def explain(batch, results, deadline_s: float = REPAIR_DEADLINE_S) -> list[Findi
                 findings.append(pattern_finding(entry, pattern, batch.model.coordinates))
         findings += diagnose(batch.model, batch.system, results)
         findings += identify_parameters(batch)
-        repairs, why_not = search_repair(batch, max(0.0, deadline_s - (time.perf_counter() - start)))
+        left = deadline_s - (time.perf_counter() - start) - FINISHING_S
+        repairs, why_not = search_repair(batch, max(0.0, left))
     findings += repairs
     if why_not:  # said as a repair that is not one: checks_pass false, nothing suggested
         details = {"written": None, "suggested": None, "suggested_source": None, "location": None}
