@@ -19,7 +19,7 @@ restored
 seconds
     how long the diagnosis took (``explain``, after the checks, as ``check`` runs it).
 
-The untouched models are diagnosed too: they must pass, with no finding at all.
+The untouched models must pass every check (``ModelScores.clean``), so get no diagnosis.
 """
 
 from __future__ import annotations
