@@ -72,3 +72,17 @@ def test_a_matrix_holding_nan_is_never_given_to_eigvalsh():
 def test_a_singular_symmetric_matrix_has_an_infinite_condition_number():
     assert conds2(np.zeros((2, 2)) + np.array([[1.0, 1.0], [1.0, 1.0]])) > 1e15
     assert conds2(np.diag([1.0, 0.0])) == np.inf
+
+
+def test_a_matrix_that_is_not_finite_is_never_given_to_lapack(capfd):
+    """LAPACK prints "On entry to DLASCL parameter number 4 had an illegal value" on standard
+    error for an SVD of a matrix holding a NaN or an infinity: such a matrix gets what the SVD
+    gives it (a LinAlgError from ``norms2``, NaN from ``conds2``) without it, in a batch too, and
+    the finite ones their SVD figures."""
+    batch = np.array([[[1.0, 2.0], [3.0, np.nan]], [[np.inf, 0.0], [0.0, 1.0]], [[1.0, 2.0], [0.0, 1.0]]])
+    conds = conds2(batch)
+    assert np.isnan(conds[:2]).all() and conds[2] == np.linalg.cond(batch[2])
+    with pytest.raises(np.linalg.LinAlgError):
+        norms2(batch)  # the NaN one
+    assert np.isnan(norms2(batch[1])) and norms2(batch[2]) == np.linalg.norm(batch[2], 2)
+    assert "illegal value" not in capfd.readouterr().err
