@@ -47,8 +47,8 @@ from pendverify.symbolic.edits import Edit
 CONFIRMATIONS = 12
 #: pairs of edits of one entry are tried for models of up to this many degrees of freedom
 PAIRS_UP_TO_DOF = 3
-#: confirmed edits of the same entries shown besides the first: parameter values can make two
-#: edits give the same numbers (a parameter worth twice another, a 3·I = m·r²)
+#: confirmed edits shown besides the first: parameter values can make two edits give the same
+#: numbers (a parameter worth twice another, a 3·I = m·r²)
 ALTERNATIVES = 2
 #: candidates confirmed after the first repair, looking for alternatives (of this entry or
 #: another: an error in B shows as well in a q̈ that uses B, and either edit passes)
@@ -58,6 +58,7 @@ ALTERNATIVE_SECONDS = 2.0
 
 
 def _confirmed(batch, sm, changes: dict) -> bool:
+    """Whether the model with ``changes`` passes every applicable check on every state of ``batch``."""
     edits: dict[str, list] = {}
     for (method, index), (old, new) in changes.items():
         edits.setdefault(method, []).append((index, old, new))
