@@ -31,7 +31,8 @@ from pendverify.diagnosis.parameters import identify_parameters
 from pendverify.diagnosis.patterns import entry_pattern, pattern_finding
 from pendverify.diagnosis.repair import search_repair
 
-#: the repair search's bound: a 3-degree-of-freedom model's search takes well under it
+#: the whole diagnosis's bound, 10 s for up to 3 degrees of freedom on a 2-core machine; most
+#: take well under a second, a hard case reaches it (``pendverify bench explain`` measures both)
 REPAIR_DEADLINE_S = 10.0
 #: kept from the repair search's share for what it does after its last step (its findings, in
 #: the model's notation) and for the step it is in when the time is up (one screening evaluation)
