@@ -53,6 +53,7 @@ if TYPE_CHECKING:
     from pendverify.bench.run import Results
     from pendverify.certify.battery import BatterySettings
     from pendverify.certify.issue import Issued, Rechecked
+    from pendverify.robot.summary import RobotSummary
     from pendverify.simulation.scene import Scene
     from pendverify.simulation.simulate import Run
     from pendverify.stress.catalogue import StressReport
@@ -95,6 +96,7 @@ __all__ = [
     "load_urdf",
     "mutate",
     "read_model",
+    "read_robot",
     "recheck",
     "review",
     "review_scenes",
@@ -504,6 +506,15 @@ def read_model(model: ModelLike) -> ModelReading:
         for method, form in cls.written_closed_forms().items()
     ]
     return ModelReading(cls, tuple(sm.parameters), equations)
+
+
+def read_robot(description: str | Path) -> RobotSummary:
+    """A robot description as Pinocchio will use it, each number with where it came from:
+    ``pendverify show --robot`` (``pendverify.robot.summary``)."""
+    from pendverify.robot.description import load_description
+    from pendverify.robot.summary import robot_summary
+
+    return robot_summary(load_description(_urdf_arg(description)))
 
 
 # --- stress and benchmarks -------------------------------------------------------------------------
