@@ -149,7 +149,8 @@ def _split_f(reader: Reader, spec: TextModelSpec) -> None:
     eq["H"], eq["Cqdot"] = H, Cqdot
     if any(x != 0 for x in D):
         eq["D"] = D
-    spec.derived.update({k: f"from f: {how}" for k, how in _F_PARTS.items() if k in eq})
+    source = "the equations' f" if "f" in spec.derived else "f"
+    spec.derived.update({k: f"from {source}: {how}" for k, how in _F_PARTS.items() if k in eq})
 
 
 def _integrated(reader: Reader, H, q):
