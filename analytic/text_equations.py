@@ -29,9 +29,9 @@ import sympy as sp
 from pendverify.analytic.latex_parse import LatexError
 from pendverify.display import shortened
 
-#: how M and f were obtained (``spec.derived``, printed by ``pendverify show``)
+#: how M, and where f, came from (``spec.derived``, printed by ``pendverify show``)
 DERIVED_M = "from the equations: the coefficients of the accelerations, ∂(lhs − rhs)/∂q̈"
-DERIVED_F = "from the equations: −(lhs − rhs) at q̈ = 0"
+DERIVED_F = "the equations' f"  # f = −(lhs − rhs) at q̈ = 0; the parts say "from the equations' f: …"
 
 _ALIGN = re.compile(r"\\(begin|end)\{(align|aligned|eqnarray|equation|gather|gathered|split)\*?\}")
 _ENV = re.compile(r"\\(begin|end)\{[^{}]*\}")

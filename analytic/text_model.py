@@ -149,7 +149,7 @@ def _split_f(reader: Reader, spec: TextModelSpec) -> None:
     eq["H"], eq["Cqdot"] = H, Cqdot
     if any(x != 0 for x in D):
         eq["D"] = D
-    source = "the equations' f" if "f" in spec.derived else "f"
+    source = spec.derived.pop("f", "f")  # where f came from: "f", "the equations' f", …
     spec.derived.update({k: f"from {source}: {how}" for k, how in _F_PARTS.items() if k in eq})
 
 
@@ -217,11 +217,17 @@ def _energies(self, q, v, u, w) -> Energies:
     )
 
 
-def build_model_class(spec: TextModelSpec) -> type[ClosedFormModel]:
-    """The ``ClosedFormModel`` (or ``BiasOnlyModel``) subclass of a parsed text model."""
+def build_model_class(spec: TextModelSpec, module: types.ModuleType | None = None) -> type[ClosedFormModel]:
+    """The ``ClosedFormModel`` (or ``BiasOnlyModel``) subclass of a parsed text model.
+
+    ``module``: the module the class is to live in (a Python model file's own); None: a stand-in
+    module naming ``spec.path`` (a text file, or the object a model was made from).
+    """
     class_name = "".join(part.capitalize() for part in spec.name.split("_")) or "TextModel"
-    module = types.ModuleType(module_name(spec.path))
-    setattr(module, TEXT_FILE, str(spec.path))
+    if module is None:
+        module = types.ModuleType(module_name(spec.path))
+        setattr(module, TEXT_FILE, str(spec.path))
+        sys.modules[module.__name__] = module
     fields = [
         (p, float, dataclasses.field(metadata={"kind": kind, "unit": unit, "doc": f"{p} in [{unit}]"}))
         for p, (kind, unit) in spec.parameters.items()
@@ -250,7 +256,6 @@ def build_model_class(spec: TextModelSpec) -> type[ClosedFormModel]:
     for c in (cls, params_type):
         c.__module__ = module.__name__
         setattr(module, c.__name__, c)
-    sys.modules[module.__name__] = module
     return cls
 
 

@@ -47,6 +47,9 @@ TOP_KEYS = (
     "M", "C", "C_plus_D", "Cqdot", "H", "V", "D", "B", "W", "f", "det_M", "M_inv", "qddot",
     "equations",
 )  # fmt: skip
+#: the keys of a declaration without equations (a Python model file's ``DECLARATION``, the API's
+#: ``declaration``): the equations come from elsewhere (``pendverify.analytic.mechanics_model``)
+DECLARATION_KEYS = ("name", "coordinates", "inputs", "disturbances", "parameters", "urdf")
 NOTATIONS = ("sympy", "latex")
 #: each equation: (shape as a string of dimension names, the argument groups it may use)
 EQUATIONS = {
@@ -156,14 +159,22 @@ def parse_equation(reader: Reader, key: str, value, rows: int, cols: int | None,
 def read_text_model(path: str | Path) -> TextModelSpec:
     """Parse and check a text model file (module docstring)."""
     path = Path(path)
-    reader = Reader(path)
     try:
         data = read_toml(path)
     except PendverifyError as exc:
         raise PendverifyError(str(exc)) from None
+    return read_text_document(path, data)
+
+
+def read_text_document(path: Path, data: dict, top_keys: tuple[str, ...] = TOP_KEYS) -> TextModelSpec:
+    """A text model's document (its TOML as a dict; ``path`` names it in messages), read and checked.
+
+    ``top_keys``: the keys it may hold (a declaration without equations allows fewer).
+    """
+    reader = Reader(path)
     for key in data:
-        if key not in TOP_KEYS:
-            close = difflib.get_close_matches(key, TOP_KEYS, n=3)
+        if key not in top_keys:
+            close = difflib.get_close_matches(key, top_keys, n=3)
             reader.fail(key, f"unknown key{'; did you mean ' + ', '.join(close) + '?' if close else ''}")
     notation = data.get("notation", "sympy")
     if notation not in NOTATIONS:
