@@ -140,6 +140,8 @@ class ClosedFormModel(metaclass=ModelClass):
     geometry_reader: ClassVar[str] = ""
     #: False for models that give only the force C·q̇ (``BiasOnlyModel``).
     has_coriolis_matrix: ClassVar[bool] = True
+    #: False for models that give q̈ alone (``AccelerationOnlyModel``).
+    has_mass_matrix: ClassVar[bool] = True
     #: The motion ``pendverify certify`` simulates; None: derived from the model's scales.
     battery_motion: ClassVar[BatteryMotion | None] = None
 
@@ -337,5 +339,49 @@ class BiasOnlyModel(ClosedFormModel):
         return self.coriolis_force(q, v) + self.gravity(q)
 
 
+class AccelerationOnlyModel(ClosedFormModel):
+    """A model given only by its accelerations q̈ = f(q, q̇, u, w), with B (and D, W) declared.
+
+    It writes ``acceleration`` and, with inputs, ``input_matrix`` B: the generalised force of
+    each input, which Pinocchio's ABA needs (τ = B u + W w − D q̇).  Its inputs do not determine
+    M (fewer inputs than coordinates: ∂q̈/∂u = M⁻¹B is not square), so it has no M, C, H or V:
+    only ``aba`` (and ``damping``) run, and the report says why the others do not.  The sizes
+    of the terms that its tolerance is judged against (the inertia scale, ‖M‖, ‖M⁻¹‖ and the
+    gravity scale) are then the URDF's (``pendverify.checks.batch``): the robot the model is
+    compared with, whose M the model's q̈ implies if it is right.
+    """
+
+    has_mass_matrix: ClassVar[bool] = False
+    has_coriolis_matrix: ClassVar[bool] = False
+    closed_forms: ClassVar[dict[str, ClosedForm]] = {
+        "acceleration": ClosedForm(INTERFACE["acceleration"].args, "M**-1*(B*u + W*w - D*v - C*v - H)")
+    }
+
+    @abstractmethod
+    def acceleration(self, q, v, u, w):
+        """q̈(q, q̇, u, w), the model's own closed form."""
+
+    def _none(self, what: str):
+        raise NotImplementedError(f"{self.name} gives q̈ alone, no {what}")
+
+    def mass_matrix(self, q):
+        self._none("M")
+
+    def coriolis_matrix(self, q, v):
+        self._none("C")
+
+    def coriolis_force(self, q, v):
+        self._none("C·q̇")
+
+    def gravity(self, q):
+        self._none("H")
+
+    def potential_energy(self, q):
+        self._none("V")
+
+    def bias(self, q, v):
+        self._none("C·q̇ + H")
+
+
 #: the classes whose methods are the interface's own defaults, not a model's
-_INTERFACE_CLASSES = (ClosedFormModel, BiasOnlyModel)
+_INTERFACE_CLASSES = (ClosedFormModel, BiasOnlyModel, AccelerationOnlyModel)

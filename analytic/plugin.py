@@ -176,6 +176,13 @@ def load_model_class(path: str | Path) -> type[ClosedFormModel]:
         and obj.__module__ == module.__name__
     ]
     if not found:
+        # deferred on purpose: SymPy's mechanics loads only for a model file that declares one
+        from pendverify.analytic.mechanics_model import model_file_declaration
+
+        declared = model_file_declaration(module, path)
+        if declared is not None:
+            validate_model_class(declared, path)
+            return declared
         raise PendverifyError(
             f"{path}: defines no subclass of pendverify.analytic.ClosedFormModel "
             "(see examples/cart_pole.py for a complete model file)"

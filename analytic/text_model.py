@@ -28,7 +28,7 @@ import numpy as np
 import sympy as sp
 
 from pendverify.analytic.forms import Energies
-from pendverify.analytic.interface import BiasOnlyModel, ClosedFormModel
+from pendverify.analytic.interface import AccelerationOnlyModel, BiasOnlyModel, ClosedFormModel
 from pendverify.analytic.module_names import module_name
 from pendverify.analytic.parameter_set import ParameterSet
 from pendverify.analytic.source_file import TEXT_FILE
@@ -59,6 +59,9 @@ def _is_zero(expr) -> bool:
 def complete_equations(reader: Reader, spec: TextModelSpec) -> None:
     """Check the set of equations and derive what is given in another form (module docstring)."""
     eq = spec.equations
+    if "M" not in eq and "qddot" in eq:
+        if not _mass_from_acceleration(reader, spec):
+            return  # q̈ alone, inputs that do not span the coordinates: an AccelerationOnlyModel
     if "M" not in eq:
         reader.fail("M", "missing: the mass matrix, a list of rows of expressions")
     if "f" in eq:
@@ -105,6 +108,50 @@ _F_PARTS = {
 }
 
 
+def _cancelled(matrix):
+    return matrix.applyfunc(lambda x: sp.cancel(sp.together(x)))
+
+
+def _mass_from_acceleration(reader: Reader, spec: TextModelSpec) -> bool:
+    """q̈ alone (no M): M = B (∂q̈/∂u)⁻¹ and f = M q̈ where B is square and invertible; else False.
+
+    q̈ = M⁻¹(B u + …) is required affine in u with ∂q̈/∂u = M⁻¹B free of u.  With as many
+    inputs as coordinates and B invertible, M = B (M⁻¹B)⁻¹ exactly, f = M q̈(q, q̇, u, w), and
+    f goes the one way every f goes (``_split_f``); the hand-written q̈ stays q̈, checked by aba.
+    The declared D and W must be the ones q̈ implies.  With fewer inputs M is not determined:
+    the model is an ``AccelerationOnlyModel`` (D, W as declared, zero by default).
+    """
+    eq, sym = spec.equations, spec.symbols
+    if "H" in eq or "V" in eq or "C" in eq or "Cqdot" in eq or "C_plus_D" in eq or "f" in eq:
+        reader.fail("qddot", "without M, give q̈ alone (with B, D, W): not H, V, C, Cqdot or f")
+    if spec.inputs and "B" not in eq:
+        reader.fail("B", f"missing: the model declares inputs {', '.join(spec.inputs)}; q̈ alone needs B too")
+    a = eq["qddot"]
+    if not spec.inputs:
+        return False
+    G = a.jacobian(list(sym["u"]))
+    if G.free_symbols & set(sym["u"]):
+        reader.fail("qddot", "is not affine in the inputs (∂q̈/∂u depends on u)")
+    B = eq["B"]
+    if B.rows != B.cols or B.det() == 0:
+        return False
+    M = _cancelled(B * G.inv())
+    declared = {k: eq.pop(k) for k in ("B", "D", "W") if k in eq}
+    eq["M"], eq["f"] = M, _cancelled(M * a)
+    qddot = eq.pop("qddot")
+    spec.derived["f"] = "q̈'s M·q̈"
+    _split_f(reader, spec)
+    eq["qddot"] = qddot
+    spec.derived["M"] = "from q̈: B (∂q̈/∂u)⁻¹"
+    n = len(spec.coordinates)
+    zero = {"D": sp.zeros(n, n), "W": sp.zeros(n, len(spec.disturbances))}
+    for key, value in declared.items():
+        implied = eq.get(key, zero.get(key))
+        if not all(_is_zero(x) for x in implied - value):
+            reader.fail(key, f"q̈ implies {key} = {shortened(str(implied.tolist()), 60)}, not the one given")
+    return True
+
+
 def _split_f(reader: Reader, spec: TextModelSpec) -> None:
     """M q̈ = f(q, q̇, u, w) split into H, Cqdot, D, B, W (module docstring); each part is checked."""
     eq, sym = spec.equations, spec.symbols
@@ -149,7 +196,8 @@ def _split_f(reader: Reader, spec: TextModelSpec) -> None:
     eq["H"], eq["Cqdot"] = H, Cqdot
     if any(x != 0 for x in D):
         eq["D"] = D
-    spec.derived.update({k: f"from f: {how}" for k, how in _F_PARTS.items() if k in eq})
+    source = spec.derived.pop("f", "f")  # where f came from: "f", "the equations' f", …
+    spec.derived.update({k: f"from {source}: {how}" for k, how in _F_PARTS.items() if k in eq})
 
 
 def _integrated(reader: Reader, H, q):
@@ -216,11 +264,17 @@ def _energies(self, q, v, u, w) -> Energies:
     )
 
 
-def build_model_class(spec: TextModelSpec) -> type[ClosedFormModel]:
-    """The ``ClosedFormModel`` (or ``BiasOnlyModel``) subclass of a parsed text model."""
+def build_model_class(spec: TextModelSpec, module: types.ModuleType | None = None) -> type[ClosedFormModel]:
+    """The ``ClosedFormModel`` (or ``BiasOnlyModel``) subclass of a parsed text model.
+
+    ``module``: the module the class is to live in (a Python model file's own); None: a stand-in
+    module naming ``spec.path`` (a text file, or the object a model was made from).
+    """
     class_name = "".join(part.capitalize() for part in spec.name.split("_")) or "TextModel"
-    module = types.ModuleType(module_name(spec.path))
-    setattr(module, TEXT_FILE, str(spec.path))
+    if module is None:
+        module = types.ModuleType(module_name(spec.path))
+        setattr(module, TEXT_FILE, str(spec.path))
+        sys.modules[module.__name__] = module
     fields = [
         (p, float, dataclasses.field(metadata={"kind": kind, "unit": unit, "doc": f"{p} in [{unit}]"}))
         for p, (kind, unit) in spec.parameters.items()
@@ -244,12 +298,17 @@ def build_model_class(spec: TextModelSpec) -> type[ClosedFormModel]:
     for key, (method, args) in METHODS.items():
         if key in spec.equations:
             namespace[method] = _method(key, args, spec)
-    base = BiasOnlyModel if "Cqdot" in spec.equations else ClosedFormModel
+    if "M" not in spec.equations:  # q̈ alone, M not determined (``_mass_from_acceleration``)
+        base = AccelerationOnlyModel
+        del namespace["energies"]
+    elif "Cqdot" in spec.equations:
+        base = BiasOnlyModel
+    else:
+        base = ClosedFormModel
     cls = type(class_name, (base,), namespace)
     for c in (cls, params_type):
         c.__module__ = module.__name__
         setattr(module, c.__name__, c)
-    sys.modules[module.__name__] = module
     return cls
 
 

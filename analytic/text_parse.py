@@ -8,8 +8,10 @@ A text model declares ``name``; ``[coordinates]`` (in order, each ``"angle"`` or
 some derivations print it; needs ``D``) or ``Cqdot`` (the vector C·q̇), ``H``
 (vector) and/or ``V`` (scalar; a missing H is ∂V/∂q, a missing V is integrated
 from H), optional ``D``, ``B``, ``W``, ``det_M``, ``M_inv``, ``qddot`` — or, instead
-of C, H, D, B and W, ``f``, the right-hand side of M q̈ = f(q, q̇, u, w) — with the
-rates named ``d<coordinate>``; and ``[urdf]`` (``joints``, ``transform``,
+of C, H, D, B and W, ``f``, the right-hand side of M q̈ = f(q, q̇, u, w) — or, instead of
+all of them, ``equations``, the equations of motion whole (``lhs = rhs``, one per
+coordinate, ``pendverify.analytic.text_equations``) — with the rates named
+``d<coordinate>`` and the accelerations ``dd<coordinate>``; and ``[urdf]`` (``joints``, ``transform``,
 ``offset``).  With ``notation = "latex"`` the equations are LaTeX and a
 ``[symbols]`` table maps the document's symbols (``pendverify.analytic.text_model_latex``).
 
@@ -33,6 +35,7 @@ import sympy as sp
 
 from pendverify.analytic.parameter_set import KIND_RULES
 from pendverify.analytic.params import read_toml
+from pendverify.analytic.text_equations import latex_side, read_equations, split_equations
 from pendverify.analytic.text_expression import FUNCTIONS, ExpressionError, fragment, read_expression
 from pendverify.analytic.text_model_latex import parse_latex_equation, read_symbol_table
 from pendverify.display import shortened
@@ -42,13 +45,17 @@ CONSTANTS = {"pi": sp.pi}
 TOP_KEYS = (
     "name", "notation", "coordinates", "inputs", "disturbances", "parameters", "symbols", "urdf",
     "M", "C", "C_plus_D", "Cqdot", "H", "V", "D", "B", "W", "f", "det_M", "M_inv", "qddot",
+    "equations",
 )  # fmt: skip
+#: the keys of a declaration without equations (a Python model file's ``DECLARATION``, the API's
+#: ``declaration``): the equations come from elsewhere (``pendverify.analytic.mechanics_model``)
+DECLARATION_KEYS = ("name", "coordinates", "inputs", "disturbances", "parameters", "urdf")
 NOTATIONS = ("sympy", "latex")
 #: each equation: (shape as a string of dimension names, the argument groups it may use)
 EQUATIONS = {
     "M": ("nn", "q"), "C": ("nn", "qv"), "C_plus_D": ("nn", "qv"), "Cqdot": ("n", "qv"), "H": ("n", "q"),
     "V": ("", "q"), "D": ("nn", ""), "B": ("nu", ""), "W": ("nw", ""), "f": ("n", "qvuw"),
-    "det_M": ("", "q"), "M_inv": ("nn", "q"), "qddot": ("n", "qvuw"),
+    "det_M": ("", "q"), "M_inv": ("nn", "q"), "qddot": ("n", "qvuw"), "equations": ("e", "qvuwa"),
 }  # fmt: skip
 
 
@@ -152,14 +159,22 @@ def parse_equation(reader: Reader, key: str, value, rows: int, cols: int | None,
 def read_text_model(path: str | Path) -> TextModelSpec:
     """Parse and check a text model file (module docstring)."""
     path = Path(path)
-    reader = Reader(path)
     try:
         data = read_toml(path)
     except PendverifyError as exc:
         raise PendverifyError(str(exc)) from None
+    return read_text_document(path, data)
+
+
+def read_text_document(path: Path, data: dict, top_keys: tuple[str, ...] = TOP_KEYS) -> TextModelSpec:
+    """A text model's document (its TOML as a dict; ``path`` names it in messages), read and checked.
+
+    ``top_keys``: the keys it may hold (a declaration without equations allows fewer).
+    """
+    reader = Reader(path)
     for key in data:
-        if key not in TOP_KEYS:
-            close = difflib.get_close_matches(key, TOP_KEYS, n=3)
+        if key not in top_keys:
+            close = difflib.get_close_matches(key, top_keys, n=3)
             reader.fail(key, f"unknown key{'; did you mean ' + ', '.join(close) + '?' if close else ''}")
     notation = data.get("notation", "sympy")
     if notation not in NOTATIONS:
@@ -197,14 +212,19 @@ def read_text_model(path: str | Path) -> TextModelSpec:
             reader.fail(f"parameters.{p}.unit", "must be a string")
         parameters[p] = (decl["kind"], unit)
     rates = tuple(f"d{c}" for c in coords)
-    all_names = [*coords, *rates, *inputs, *disturbances, *parameters]
+    accelerations = tuple(f"dd{c}" for c in coords)
+    all_names = [*coords, *rates, *accelerations, *inputs, *disturbances, *parameters]
     twice = sorted({n for n in all_names if all_names.count(n) > 1})
     if twice:
-        reader.fail("coordinates", f"name(s) {', '.join(twice)} used twice among coordinates, d<coordinate> "
-                                   "rates, inputs, disturbances and parameters")  # fmt: skip
+        reader.fail(
+            "coordinates",
+            f"name(s) {', '.join(twice)} used twice among coordinates, d<coordinate> rates, "
+            "dd<coordinate> accelerations, inputs, disturbances and parameters",
+        )
     symbols = {
         "q": tuple(sp.Symbol(c, real=True) for c in coords),
         "v": tuple(sp.Symbol(r, real=True) for r in rates),
+        "a": tuple(sp.Symbol(a, real=True) for a in accelerations),
         "u": tuple(sp.Symbol(n, real=True) for n in inputs),
         "w": tuple(sp.Symbol(n, real=True) for n in disturbances),
         "p": tuple(
@@ -229,7 +249,7 @@ def _read_equations(reader: Reader, spec: TextModelSpec, data: dict) -> None:
     dims = {"n": n, "u": len(spec.inputs), "w": len(spec.disturbances)}
     latex = None
     if spec.notation == "latex":
-        everything = {s.name: s for g in "qvuwp" for s in spec.symbols[g]} | FUNCTIONS | CONSTANTS
+        everything = {s.name: s for g in "qvuwap" for s in spec.symbols[g]} | FUNCTIONS | CONSTANTS
         latex = read_symbol_table(reader, data.get("symbols"), everything, parse_entry)
         table = latex.table
         spec.latex_symbols = {table.source[c]: value for c, value in table.entries.items()}
@@ -237,12 +257,32 @@ def _read_equations(reader: Reader, spec: TextModelSpec, data: dict) -> None:
         if key not in data:
             continue
         allowed = {s.name: s for g in groups + "p" for s in spec.symbols[g]} | FUNCTIONS | CONSTANTS
+        if shape == "e":
+            _read_whole_equations(reader, spec, data, key, allowed, latex)
+            continue
         rows = n if shape else 0
         cols = dims[shape[1]] if len(shape) == 2 else None
         if latex is not None:
             spec.equations[key] = parse_latex_equation(reader, latex, key, data[key], rows, cols, allowed)
         else:
             spec.equations[key] = parse_equation(reader, key, data[key], rows, cols, allowed)
+
+
+def _read_whole_equations(reader: Reader, spec: TextModelSpec, data: dict, key: str, allowed, latex) -> None:
+    """The ``equations`` key: M and f of M q̈ = f (``pendverify.analytic.text_equations``)."""
+    given = [k for k in ("M", "f", "C", "C_plus_D", "Cqdot", "H", "D", "B", "W", "qddot") if k in data]
+    if given:
+        reader.fail(
+            key, f"give the equations or their parts, not both (the file also gives {', '.join(given)})"
+        )
+    if latex is not None:
+        side = latex_side(reader, latex)
+    else:
+
+        def side(k, text, names):
+            return parse_entry(reader, k, text.strip(), names)
+
+    split_equations(reader, spec, key, read_equations(reader, spec, key, data[key], allowed, side))
 
 
 def _read_urdf(reader: Reader, spec: TextModelSpec, urdf) -> None:

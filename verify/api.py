@@ -109,14 +109,36 @@ __all__ = [
 
 
 # --- loading ----------------------------------------------------------------------------------------
-def load_model(source: ModelLike) -> type[ClosedFormModel]:
+def load_model(
+    source: ModelLike | Any, declaration: Mapping[str, Any] | None = None
+) -> type[ClosedFormModel]:
     """A closed-form model class.
 
     ``source`` is a built-in model's name (``"double_pendulum"``, ``"cart_double_pendulum"``), the
-    path of a model file (``.py``, exactly one ``ClosedFormModel`` subclass: what ``--analytic``
-    takes) or a ``ClosedFormModel`` subclass, which is validated as a model file's class is and
-    returned as is.
+    path of a model file (``.py``, exactly one ``ClosedFormModel`` subclass, or a ``METHOD`` and
+    its ``DECLARATION``; ``.toml``, a text model: what ``--analytic`` takes), a ``ClosedFormModel``
+    subclass, which is validated as a model file's class is and returned as is, or a
+    ``sympy.physics.mechanics`` derivation — a ``LagrangesMethod``, a ``KanesMethod`` or a
+    ``(mass_matrix, forcing)`` pair — with its ``declaration``: the coordinates' kinds, the
+    parameters' kinds, the inputs and the URDF map, as a text model file declares them
+    (``pendverify.analytic.mechanics_model``).
     """
+    if declaration is not None or _is_mechanics(source):
+        from pendverify.analytic.mechanics_model import is_mechanics, mechanics_model
+
+        if not is_mechanics(source):
+            raise PendverifyError(
+                "a declaration goes with a LagrangesMethod, a KanesMethod or a (mass_matrix, forcing) "
+                f"pair; got a {type(source).__name__}"
+            )
+        if declaration is None:
+            raise PendverifyError(
+                f"a {type(source).__name__} needs a declaration: its coordinates' and parameters' kinds, "
+                "inputs and urdf joints (see pendverify.analytic.mechanics_model)"
+            )
+        cls = mechanics_model(source, declaration)
+        validate_model_class(cls, "<declaration>")
+        return cls
     if isinstance(source, type):
         if not issubclass(source, ClosedFormModel) or source is ClosedFormModel:
             raise PendverifyError(
@@ -145,6 +167,12 @@ def load_model(source: ModelLike) -> type[ClosedFormModel]:
         "a model is a built-in name, a model file (.py) or a ClosedFormModel subclass; "
         f"got a {type(source).__name__}"
     )
+
+
+def _is_mechanics(source) -> bool:
+    """Whether ``source`` looks like a SymPy mechanics derivation (without importing SymPy for others)."""
+    module = type(source).__module__
+    return module.startswith("sympy") or (isinstance(source, tuple) and len(source) == 2)
 
 
 def load_params(model_cls: ModelLike, source: ParamsLike) -> ParameterSet:
@@ -208,6 +236,7 @@ def check(
     strict: bool = False,
     model_form_rtol: float = MODEL_FORM_RTOL,
     explain: bool = True,
+    declaration: Mapping[str, Any] | None = None,
 ) -> CheckReport:
     """Compare Pinocchio on a URDF with a hand-derived closed form: ``pendverify check``.
 
@@ -233,7 +262,8 @@ def check(
     drawn with ``seed`` (plus each model's special states); ``strict`` counts warnings as
     failures; ``model_form_rtol`` is the largest relative size of a URDF term the closed form
     cannot express (``--model-form-rtol``); ``explain=False`` skips the diagnosis of failing
-    models (``--no-explain``).
+    models (``--no-explain``).  ``declaration`` goes with a ``sympy.physics.mechanics`` model
+    (``load_model``): ``check(model=lagranges_method, urdf=..., params=..., declaration={...})``.
 
     Returns a ``CheckReport``: ``report["crba"]`` is one check's rows, ``print(report)`` the
     CLI's table.  A failing check is a result, not an exception (see
@@ -254,7 +284,7 @@ def check(
                 f"{model}: names example-robot-data's URDF; give it as model or as urdf, not both"
             )
         model, urdf = None, model
-    model_cls = None if model is None else load_model(model)
+    model_cls = None if model is None else load_model(model, declaration)
     if urdf is not None and not erd_data.is_erd_spec(urdf):
         urdf = _urdf_arg(urdf)
     selection = select_targets(model_cls, urdf, params, erd_urdfs=erd)

@@ -14,6 +14,25 @@ from __future__ import annotations
 from pendverify.analytic.forms import INTERFACE, STATES, TOLERANCE
 
 
+def needs_mass_matrix(model, system) -> str:
+    """A ``requires``: the check compares M or what is built with it, which q̈ alone may not give."""
+    if model.has_mass_matrix:
+        return ""
+    return (
+        f"not run: {_class(model).__name__} gives q̈ alone and its inputs do not span the coordinates "
+        "(∂q̈/∂u = M⁻¹B is not square), so M, C·q̇, H and V are not determined; q̈ is checked by aba"
+    )
+
+
+def needs_mass_matrix_and(requires):
+    """A ``requires``: ``needs_mass_matrix``, then ``requires``."""
+
+    def both(model, system) -> str:
+        return needs_mass_matrix(model, system) or requires(model, system)
+
+    return both
+
+
 def needs_matrix_c(model, system) -> str:
     if model.has_coriolis_matrix:
         return ""
@@ -52,6 +71,12 @@ def derived_notes(model) -> list[str]:
     """
     written = set(_class(model).hand_written())
     notes = []
+    if not model.has_mass_matrix:
+        notes.append(
+            "aba: q̈ is the model's own; the model gives no M, so the sizes its tolerance is judged "
+            "against (inertia scale, ‖M‖, ‖M⁻¹‖, gravity scale) are the URDF's"
+        )
+        return notes
     if "acceleration" not in written:
         notes.append(
             "aba: q̈ is derived from the model's M, C, H, D, B, W, not hand-written: aba checks M and "

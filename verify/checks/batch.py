@@ -82,6 +82,12 @@ class CheckBatch:
     @cached_property
     def forms(self) -> ClosedForms:
         forms = ClosedForms(self.model, self.Q, self.V, self.U, self.W, self.python_only)
+        if not self.model.has_mass_matrix:
+            # q̈ alone: the sizes the tolerances are judged against are the URDF's (its M, |M_ii|, and
+            # its gravity bound), not a closed form's (``AccelerationOnlyModel``)
+            M = self.pin.mass_matrix()
+            forms.replace({"mass_matrix": M, "diagonal_scale": np.abs(np.diagonal(M, axis1=-2, axis2=-1))})
+            forms.replace_constant("gravity_scale", urdf_gravity_scale(self.model, self.system))
         forms.replace(self.replaced)
         return forms
 
@@ -114,6 +120,31 @@ class CheckBatch:
         diag = np.diagonal(own.crba_upper(), axis1=-2, axis2=-1)
         S = self.forms.value("diagonal_scale")
         return term_amplification_batch(self.system, configurations(self.system.cmap, self.Q), diag, S)
+
+
+#: the grid points per angle on which ``urdf_gravity_scale`` takes the largest |H_i|
+GRAVITY_GRID = 8
+
+
+def urdf_gravity_scale(model, system) -> np.ndarray:
+    """max |H_i(q)| of the URDF over a grid of configurations: the gravity scale of a model without H.
+
+    Angles on GRAVITY_GRID points over [−π, π) each (positions at zero: gravity of a prismatic
+    joint's subtree does not depend on its position); H_i is a sum of sinusoids of the angles, so
+    the grid's largest value is at least cos(π/GRAVITY_GRID) ≈ 0.92 of the largest over all q for
+    one sinusoid: the size of the gravity terms, as the Σ|terms| of a closed form's H is.
+    """
+    angular = np.array(model.angular)
+    points = np.linspace(-np.pi, np.pi, GRAVITY_GRID, endpoint=False)
+    k = int(np.count_nonzero(angular))
+    if k > 4:  # a grid too large: the same number of seeded random configurations instead
+        grid = np.random.default_rng(0).uniform(-np.pi, np.pi, (GRAVITY_GRID**4, k))
+    else:
+        grid = np.stack(np.meshgrid(*[points] * k, indexing="ij"), axis=-1).reshape(-1, k)
+    Q = np.zeros((len(grid), model.nv))
+    Q[:, angular] = grid
+    H = system.at(Q, np.zeros_like(Q)).gravity()
+    return np.max(np.abs(H), axis=0)
 
 
 def state_at(model, q, v=None) -> State:

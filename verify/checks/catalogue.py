@@ -38,7 +38,13 @@ share, ``pendverify.checks.judge.collect`` forms the tolerance above as arrays a
 from __future__ import annotations
 
 from pendverify.checks import quantities
-from pendverify.checks.applicability import hand_written, needs_matrix_c, needs_urdf_damping
+from pendverify.checks.applicability import (
+    hand_written,
+    needs_mass_matrix,
+    needs_mass_matrix_and,
+    needs_matrix_c,
+    needs_urdf_damping,
+)
 from pendverify.checks.batch import CheckBatch
 from pendverify.checks.judge import collect, conclude
 from pendverify.checks.result import Check, CheckResult
@@ -55,25 +61,39 @@ __all__ = [
 
 
 CHECKS: tuple[Check, ...] = (
-    Check("crba", "crba (symmetrised)", "M(q)", 8, quantities.measure_crba),
-    Check("rnea", "rnea(q, q̇, 0)", "C(q,q̇)·q̇ + H(q), friction removed", 16, quantities.measure_rnea),
-    Check("gravity", "computeGeneralizedGravity", "H(q)", 16, quantities.measure_gravity),
+    Check("crba", "crba (symmetrised)", "M(q)", 8, quantities.measure_crba, needs_mass_matrix),
+    Check(
+        "rnea",
+        "rnea(q, q̇, 0)",
+        "C(q,q̇)·q̇ + H(q), friction removed",
+        16,
+        quantities.measure_rnea,
+        needs_mass_matrix,
+    ),
+    Check("gravity", "computeGeneralizedGravity", "H(q)", 16, quantities.measure_gravity, needs_mass_matrix),
     Check(
         "coriolis",
         "computeCoriolisMatrix",
         "C(q,q̇) without friction",
         16,
         quantities.measure_coriolis,
-        needs_matrix_c,
+        needs_mass_matrix_and(needs_matrix_c),
     ),
-    Check("skew", "Ṁ (RNEA derivatives) − 2C", "skew-symmetric", 16, quantities.measure_skew, needs_matrix_c),
+    Check(
+        "skew",
+        "Ṁ (RNEA derivatives) − 2C",
+        "skew-symmetric",
+        16,
+        quantities.measure_skew,
+        needs_mass_matrix_and(needs_matrix_c),
+    ),
     Check(
         "det",
         "det(crba) by LU",
         "closed-form det M(q) > 0",
         16,
         quantities.measure_det,
-        hand_written("det_mass_matrix"),
+        needs_mass_matrix_and(hand_written("det_mass_matrix")),
     ),
     Check(
         "minverse",
@@ -81,10 +101,17 @@ CHECKS: tuple[Check, ...] = (
         "M(q)⁻¹ (closed form)",
         16,
         quantities.measure_minverse,
-        hand_written("inverse_mass_matrix"),
+        needs_mass_matrix_and(hand_written("inverse_mass_matrix")),
     ),
     Check("aba", "aba(q, q̇, Bu + Ww − Dq̇)", "closed-form q̈ (f + g·u, M⁻¹f)", 16, quantities.measure_aba),
-    Check("energy", "kinetic + potential energy", "½q̇ᵀMq̇, V(q) − V(0)", 16, quantities.measure_energy),
+    Check(
+        "energy",
+        "kinetic + potential energy",
+        "½q̇ᵀMq̇, V(q) − V(0)",
+        16,
+        quantities.measure_energy,
+        needs_mass_matrix,
+    ),
     # Tᵀ·diag(b)·T: each entry a sum of at most n products of exact decimals' roundings
     Check(
         "damping",

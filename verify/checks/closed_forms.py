@@ -70,6 +70,10 @@ class ClosedForms:
         for name, value in values.items():
             self._values[name] = np.asarray(value, dtype=float)
 
+    def replace_constant(self, name: str, value) -> None:
+        """Method ``name`` (called without arguments) is ``value`` (computed elsewhere)."""
+        self._constants[(name,)] = value
+
     # --- how ----------------------------------------------------------------------------
     def _evaluate(self, name: str) -> np.ndarray:
         if name in self.written:

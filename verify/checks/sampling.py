@@ -3,7 +3,8 @@
 Random states draw angles uniformly in ±ANGLE_RANGE rad (so that angle wrapping
 is exercised), positions in ±POSITION_RANGE m, rates in ±RATE_RANGE (rad/s or
 m/s), and inputs and disturbances as generalized forces of up to ±ACCEL_RANGE
-times the coordinate's inertia scale (N·m or N).  Each of the model's named
+times the coordinate's inertia scale (N·m or N) — for a model given by q̈ alone, which has
+no inertia scale, the force whose q̈ at rest is at most ±ACCEL_RANGE.  Each of the model's named
 special configurations (all zero, upright, folded, θ1 = θ2, ...) is visited at
 rest and with one random velocity and forcing.  Everything is reproducible from
 the seed, which each report records.
@@ -45,9 +46,23 @@ class State:
         }
 
 
-def _force_scales(model: ClosedFormModel, columns: np.ndarray) -> np.ndarray:
+def _force_scales(model: ClosedFormModel, columns: np.ndarray, group: str) -> np.ndarray:
+    if not model.has_mass_matrix:  # q̈ alone: the force giving an acceleration of ACCEL_RANGE at rest
+        return np.array(
+            [ACCEL_RANGE / _acceleration_per_unit(model, group, k) for k in range(columns.shape[1])]
+        )
     inertia = model.diagonal_scale(np.zeros(model.nv))
     return ACCEL_RANGE * np.array([np.max(np.abs(col) * inertia) for col in columns.T])
+
+
+def _acceleration_per_unit(model: ClosedFormModel, group: str, k: int) -> float:
+    """max |Δq̈| for a unit of input (``group`` "u") or disturbance ("w") k at the zero state."""
+    zero = np.zeros(model.nv)
+    u, w = np.zeros(len(model.inputs)), np.zeros(len(model.disturbances))
+    rest = np.asarray(model.acceleration(zero, zero, u, w), dtype=float)
+    (u if group == "u" else w)[k] = 1.0
+    push = np.asarray(model.acceleration(zero, zero, u, w), dtype=float) - rest
+    return float(np.max(np.abs(push))) or 1.0
 
 
 def sample_states(model: ClosedFormModel, n_random: int = DEFAULT_RANDOM_STATES, seed: int = DEFAULT_SEED):
@@ -62,8 +77,8 @@ def sample_states(model: ClosedFormModel, n_random: int = DEFAULT_RANDOM_STATES,
     nv = model.nv
     angular = np.array(model.angular)
     q_range = np.where(angular, ANGLE_RANGE, POSITION_RANGE)
-    u_scale = _force_scales(model, model.input_matrix())
-    w_scale = _force_scales(model, model.disturbance_matrix())
+    u_scale = _force_scales(model, model.input_matrix(), "u")
+    w_scale = _force_scales(model, model.disturbance_matrix(), "w")
     nu, nw = u_scale.size, w_scale.size
     special = {name: np.asarray(q, dtype=float) for name, q in model.special_states().items()}
     moving = np.concatenate([np.full(nv, RATE_RANGE), np.ones(nu + nw)])  # q̇, u, w of a moving state
