@@ -219,3 +219,40 @@ def test_what_changes_m_or_the_bias_and_cannot_be_carried_is_refused(old, new, e
     assert old in text
     with pytest.raises(UrdfShapeError, match=expected.replace("(", r"\(")):
         load_description(text.replace(old, new, 1))
+
+
+INERTIAL = '<inertial pos="0 0.25 0" mass="1" diaginertia="0.02 0.01 0.02"/>'
+
+
+def arm(body: str, head: str = "") -> str:
+    return f'<mujoco model="arm">{head}<worldbody>{body}</worldbody></mujoco>'
+
+
+def test_default_classes_childclass_and_degrees_are_mujocos():
+    text = arm(
+        f'<body name="b" childclass="c" euler="90 0 0"><joint name="j" axis="1 0 0"/>{INERTIAL}'
+        f'<body name="e" pos="0 0.5 0"><joint name="k" class="d" axis="1 0 0"/>{INERTIAL}</body></body>',
+        head='<default><joint damping="0.7" frictionloss="0.01"/>'
+        '<default class="c"><joint damping="0.2"/></default>'
+        '<default class="d"><joint armature="0.05"/></default></default>',
+    )
+    loaded = load_description(text)
+    assert loaded.facts.joint_dynamics["j"].damping == 0.2 and loaded.facts.joint_dynamics["k"].damping == 0.7
+    assert loaded.model.armature.tolist() == [0.0, 0.05] and loaded.model.friction.tolist() == [0.01, 0.01]
+    assert np.allclose(
+        loaded.model.jointPlacements[1].rotation, [[1, 0, 0], [0, 0, -1], [0, 1, 0]], atol=1e-15
+    )
+    assert loaded.origins["j.damping"] == "from default class 'c'"
+    assert loaded.origins["k.armature"] == "from default class 'd'"
+
+
+def test_an_unnamed_joint_gets_a_name_and_a_ref_is_the_pose_as_written():
+    import pinocchio as pin
+
+    loaded = load_description(
+        arm(f'<body name="b"><joint axis="1 0 0" ref="30" damping="0.1"/>{INERTIAL}</body>')
+    )
+    assert loaded.model.names[1] == "bJoint_0"
+    data = loaded.model.createData()
+    pin.forwardKinematics(loaded.model, data, np.zeros(1))  # q = qpos − ref: the pose as written
+    assert np.allclose(data.oMi[1].rotation, np.eye(3), atol=1e-15)
