@@ -100,7 +100,7 @@ class VisualSystem:
         system = PinocchioSystem.for_model(model_cls, urdf, g)
         loaded = system.urdf  # the verified text: a xacro file's is the URDF it expanded to
         if loaded.format == "mjcf":
-            visual_model = mjcf_visuals(system.model, loaded.text)
+            visual_model = mjcf_visuals(system.model, loaded.text, loaded.source)
         else:
             visual_model = _urdf_visuals(system.model, loaded.text)
         return cls(system, visual_model, visual_model.createData(), loaded.text)

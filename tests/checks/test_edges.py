@@ -218,7 +218,7 @@ def test_a_rounding_size_offset_is_allowed_and_reported(tmp_path, capsys):
     )
     assert status == 0, out
     row = _results(report)["model-form"]
-    assert row["status"] == "pass" and 1e-6 < row["max_error"] < 1e-5
+    assert row["status"] == "warn" and 1e-6 < row["max_error"] < 1e-5  # allowed for: pass (warn)
     assert "within the model-form threshold 0.0001" in out
 
 

@@ -100,6 +100,11 @@ class Terms:
         return self.batch.system.allowance
 
     @cached_property
+    def energy_allowance(self):
+        """|ΔV(θ) − ΔV(0)| a model-form term may cause, per state (``PinocchioSystem.energy_allowance``)."""
+        return self.batch.system.energy_allowance(self.q)
+
+    @cached_property
     def D_urdf(self):
         system = self.batch.system
         return system.cmap.matrix_to_model(np.diag(system.urdf_damping()))
@@ -304,7 +309,7 @@ def measure_energy(t):
     dv_hand = t.V_hand - t.V_hand0
     kinetic_scale = 0.5 * total((t.v / w) ** 2) * t.norm2(scaled_matrix(t.M_hand, w))
     potential_scale = float(np.max(t.g_scale))
-    allowance = 2 * float(np.sum(t.allowance))  # |ΔV| ≤ m g |offset| at both ends
+    allowance = t.energy_allowance
     return Measure(kinetic + np.abs(dv_pin - dv_hand), kinetic_scale + potential_scale, allowance)
 
 

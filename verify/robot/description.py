@@ -8,15 +8,17 @@ format (``FORMATS``) is decided before anything is read into Pinocchio:
   defaults (``pendverify.robot.xacro_expand``), then read as URDF; errors name the xacro file.
 * **URDF** — root ``<robot>``: read strictly (``pendverify.robot.strict``), then by Pinocchio's
   URDF reader (``pendverify.robot.urdfdom``).
-* **MJCF** — root ``<mujoco>``: read strictly (``pendverify.robot.mjcf_strict``), then by
-  Pinocchio's MJCF reader (``pendverify.robot.mjcf``).
+* **MJCF** — root ``<mujoco>``: its numbers read strictly, compiled by MuJoCo, copied into
+  Pinocchio and cross-checked against MuJoCo (``pendverify.robot.mjcf``); its text is the file's
+  with includes in place.
 * **SDFormat** — root ``<sdf>``: Pinocchio's SDFormat reader if this build has one, else
   refused (``pendverify.robot.sdf``).
 
 Whatever the format, the model's fixed base is then moved to the origin (``anchor_base``)
 and the result is one ``LoadedDescription``: the model, the facts Pinocchio does not keep
 (joint damping and friction as written, an MJCF's gravity), the text that was read (for
-xacro: the URDF it expanded to) and notes.
+xacro: the URDF it expanded to), notes, and for an MJCF where each number came from
+(``origins``).
 """
 
 from __future__ import annotations
@@ -65,6 +67,9 @@ class LoadedDescription:
     format: str = "urdf"
     #: what reading the file noticed (defaults applied, armature, ...)
     reading_notes: list[str] = field(default_factory=list)
+    #: "<body or joint name>.<quantity>" (and "gravity") → where the number came from
+    #: (``pendverify.robot.mjcf_origins``); filled for MJCF only, empty for other formats
+    origins: dict[str, str] = field(default_factory=dict)
 
     def notes(self) -> list[str]:
         out = [f"Pinocchio's {READERS[self.format]} parser logged: {line}" for line in self.log]
@@ -120,7 +125,7 @@ def load_description(description: str | Path, source: str | None = None) -> Load
         text, source = str(description), source or TEXT_SOURCE
     fmt = description_format(text, path, source)
     notes: list[str] = []
-    root_offset = 0.0
+    origins: dict[str, str] = {}
     if fmt == "xacro":
         text, log = expand_xacro(text, path, source)
         try:
@@ -139,12 +144,12 @@ def load_description(description: str | Path, source: str | None = None) -> Load
                 f"extension elements urdfdom ignores, so the model leaves them out: {shortened(listed, 300)}"
             )
     elif fmt == "mjcf":
-        model, reading, log = build_mjcf_model(text, source)
-        facts, notes, root_offset = reading.facts, reading.notes, reading.root_offset
+        model, reading, log = build_mjcf_model(text, source, path)
+        facts, notes, origins, text = reading.facts, reading.notes, reading.origins, reading.text
     else:
         model, facts, log = build_sdf_model(text, source)
-    offset = max(anchor_base(model), root_offset)
-    return LoadedDescription(model, source, text, facts, offset, log, fmt, notes)
+    offset = anchor_base(model)
+    return LoadedDescription(model, source, text, facts, offset, log, fmt, notes, origins)
 
 
 def urdf_text(description: str | Path, purpose: str, source: str | None = None) -> str:

@@ -56,6 +56,13 @@ class ModelForm:
     what: str
     relative: float
     allowance: np.ndarray
+    #: the quantity ``relative`` is measured against
+    enters: str = "H1"
+    #: what a term beyond the threshold means
+    outside: str = "the URDF lies outside the closed form's family"
+    #: whether the term's potential grows with the coordinates (|ΔV| is then bounded by the
+    #: integral of ``allowance``, not by it at each end)
+    potential_grows: bool = False
 
     def within(self, rtol: float) -> bool:
         return self.relative <= rtol
@@ -66,10 +73,26 @@ class ModelForm:
             verdict = f"within the model-form threshold {rtol:g}: the checks allow for it"
         else:
             verdict = (
-                f"above the model-form threshold {rtol:g} (--model-form-rtol): the URDF lies outside "
-                "the closed form's family, and no allowance is made"
+                f"above the model-form threshold {rtol:g} (--model-form-rtol): {self.outside}, "
+                "and no allowance is made"
             )
-        return f"{self.what}; that is {self.relative:.3g} of H1, {verdict}"
+        return f"{self.what}; that is {self.relative:.3g} of {self.enters}, {verdict}"
+
+
+def combined(forms: list[ModelForm | None]) -> ModelForm | None:
+    """Several terms the closed form cannot express as one: their sizes and allowances add (each
+    bounds its own |ΔH|, and |ΔH| of a sum is at most the sum)."""
+    present = [f for f in forms if f is not None]
+    if len(present) <= 1:
+        return present[0] if present else None
+    return ModelForm(
+        "; ".join(f"{f.what} ({f.relative:.3g} of {f.enters})" for f in present),
+        float(sum(f.relative for f in present)),
+        np.sum([f.allowance for f in present], axis=0),
+        enters="H",
+        outside="; ".join(f.outside for f in present),
+        potential_grows=any(f.potential_grows for f in present),
+    )
 
 
 GeometryReader = Callable[[pin.Model, str, "float | None"], UrdfGeometry]

@@ -1,58 +1,127 @@
-"""Pinocchio's MJCF reader run on text the strict MJCF reader accepted, its output captured.
+"""An MJCF read as MuJoCo means it: compiled by MuJoCo, copied into Pinocchio, cross-checked.
 
-``build_mjcf_model`` reads the text strictly (``pendverify.robot.mjcf_strict``), writes that
-same text to a temporary file (Pinocchio's Python bindings read MJCF from a file only; the
-kinematic model needs no mesh, so the file's folder does not matter) and runs
-``pinocchio.buildModelFromMJCF`` on it with file descriptors 1 and 2 captured.  Then it
-checks that Pinocchio built what the strict reader read: the same joints in the same order,
-and for each the same damping, armature and friction loss (MuJoCo's reading of the default
-classes); any difference is refused rather than verified.
+``build_mjcf_model`` runs, in order:
+
+1. the strict reading of the file's numbers, includes expanded (``pendverify.robot.mjcf_rules``,
+   ``pendverify.robot.mjcf_origins.expand_includes``): MuJoCo's own parser is lenient;
+2. MuJoCo's compiler (``pendverify.robot.mjcf_compile``): includes, default classes,
+   ``childclass``, frames, angle units, ``inertiafromgeom``, ``fusestatic``; a compile error is one
+   line; what changes M or the bias and cannot be carried over is refused, the rest noted;
+3. the Pinocchio model built from the compiled ``MjModel`` at full double precision
+   (``pendverify.robot.mjcf_pinocchio``);
+4. the cross-check of M and the bias forces between MuJoCo and that model on seeded states
+   (``pendverify.robot.mjcf_crosscheck``), refusing with the difference;
+5. the facts (joint damping and friction loss as MuJoCo resolved them, the file's gravity
+   vector) and where each number came from (``pendverify.robot.mjcf_origins``).
+
+``mjcf_visuals`` draws MuJoCo's compiled geoms (boxes, spheres, capsules, cylinders,
+ellipsoids; planes and meshes are left out) on the model's body frames.
 """
 
 from __future__ import annotations
 
-import os
-import tempfile
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
+from pathlib import Path
 
+import mujoco
 import numpy as np
 import pinocchio as pin
 
-from pendverify.errors import UrdfShapeError
-from pendverify.robot.mjcf_strict import MjcfReading, read_mjcf_strictly
-from pendverify.robot.urdfdom import build_from_file, capture_output
+from pendverify.robot.mjcf_compile import carried_over, compile_mjcf
+from pendverify.robot.mjcf_crosscheck import cross_check
+from pendverify.robot.mjcf_origins import DEFAULT, expand_includes, origins
+from pendverify.robot.mjcf_pinocchio import body_name, build_pinocchio, joint_name, pose
+from pendverify.robot.mjcf_rules import Numbers, check_numbers
+from pendverify.robot.strict import DescriptionFacts, JointDynamics
+from pendverify.robot.xml_reading import parse_xml
 
 
-def build_mjcf_model(text: str, source: str) -> tuple[pin.Model, MjcfReading, list[str]]:
-    """(model, strict reading, Pinocchio's printed lines) of an MJCF document; errors name ``source``."""
-    reading = read_mjcf_strictly(text, source)
-    model, log = build_from_file(pin.buildModelFromMJCF, text, "model.xml", source, "MJCF")
-    _same_as_read(model, reading, source)
-    return model, reading, log
+@dataclass
+class MjcfReading:
+    """What reading an MJCF found besides the Pinocchio model."""
+
+    facts: DescriptionFacts
+    notes: list[str] = field(default_factory=list)
+    #: "<body or joint>.<quantity>" (and "gravity") → where the number came from
+    origins: dict[str, str] = field(default_factory=dict)
+    #: the file's text with its includes in place (what a certificate bundles)
+    text: str = ""
 
 
-def mjcf_visuals(model: pin.Model, text: str) -> pin.GeometryModel:
-    """The visual geometry of an MJCF document (read already by ``build_mjcf_model``) for ``model``."""
-    with tempfile.TemporaryDirectory(prefix="pendverify-mjcf-") as folder:
-        path = os.path.join(folder, "model.xml")
-        with open(path, "w", encoding="utf-8") as handle:
-            handle.write(text)
-        with capture_output((1, 2)):
-            return pin.buildGeomFromMJCF(model, path, pin.GeometryType.VISUAL)
+def build_mjcf_model(
+    text: str, source: str, path: Path | None = None
+) -> tuple[pin.Model, MjcfReading, list[str]]:
+    """(model, reading, log) of an MJCF document (the file at ``path``, whose text is ``text``)."""
+    root = parse_xml(text, source)
+    has_includes = root.find(".//include") is not None
+    expand_includes(root, None if path is None else path.parent, source)
+    expanded = ET.tostring(root, encoding="unicode") if has_includes and path is not None else text
+    check_numbers(root, Numbers(source))
+    mj = compile_mjcf(text, None if path is None else str(path), source, has_includes)
+    note = carried_over(mj, source)
+    model, joints = build_pinocchio(mj)
+    cross_check(mj, model, joints, source)
+    names = [joint_name(mj, j) for j in joints]
+    bodies = [body_name(mj, b) for b in range(1, mj.nbody)]
+    provenance = origins(root, bodies, [joint_name(mj, j) for j in range(mj.njnt)])
 
+    def given(name: str, quantity: str, value) -> float | None:
+        """``value``, or None where the file (and its classes) leave it at MuJoCo's default."""
+        return None if provenance.get(f"{name}.{quantity}") == DEFAULT and value == 0 else float(value)
 
-def _same_as_read(model: pin.Model, reading: MjcfReading, source: str) -> None:
-    built = [model.names[j] for j in range(1, model.njoints)]
-    if built != reading.joints:
-        raise UrdfShapeError(
-            source,
-            f"Pinocchio's MJCF reader built the joints {built}, the file declares {reading.joints}; refused",
-        )
-    for j, name in enumerate(built, start=1):
-        v = model.joints[j].idx_v
-        pinocchio = (float(model.damping[v]), float(model.armature[v]), float(model.friction[v]))
-        if not np.array_equal(pinocchio, reading.dynamics[name]):
-            raise UrdfShapeError(
-                source,
-                f"joint {name!r}: Pinocchio's MJCF reader gives (damping, armature, frictionloss) = "
-                f"{pinocchio}, MuJoCo's reading of the file {reading.dynamics[name]}; refused",
+    dynamics, types = {}, {}
+    for k, j in enumerate(joints):
+        dof = int(mj.jnt_dofadr[j])
+        damping = given(names[k], "damping", mj.dof_damping[dof])
+        friction = given(names[k], "frictionloss", mj.dof_frictionloss[dof])
+        if damping is not None or friction is not None:
+            dynamics[names[k]] = JointDynamics(damping, friction)
+        types[names[k]] = "hinge" if model.joints[k + 1].shortname().startswith("JointModelR") else "slide"
+    gravity = tuple(float(x) for x in mj.opt.gravity)
+    facts = DescriptionFacts(dynamics, types, -gravity[2] + 0.0, gravity)
+    notes = [note] if note else []
+    for k, j in enumerate(joints):
+        armature = float(mj.dof_armature[int(mj.jnt_dofadr[j])])
+        if armature:
+            notes.append(
+                f"joint {names[k]!r} has armature {armature:g}: it is on M's diagonal (MuJoCo's, Pinocchio's)"
             )
+        if mj.qpos0[mj.jnt_qposadr[j]] != 0:
+            notes.append(
+                f"joint {names[k]!r} has ref = {mj.qpos0[mj.jnt_qposadr[j]]:g}: its q is MuJoCo's qpos − ref"
+            )
+    return model, MjcfReading(facts, notes, provenance, expanded), []
+
+
+def mjcf_visuals(model: pin.Model, text: str, source: str) -> pin.GeometryModel:
+    """MuJoCo's compiled geoms of an MJCF (read already by ``build_mjcf_model``: ``text`` is its
+    text with includes in place, ``source`` its file if it is one) as Pinocchio visuals, each on
+    its body's frame of ``model``."""
+    import coal
+
+    path = Path(source)
+    mj = compile_mjcf(text, str(path) if path.is_file() else None, source, False)
+    shapes = {
+        int(mujoco.mjtGeom.mjGEOM_SPHERE): lambda s: coal.Sphere(s[0]),
+        int(mujoco.mjtGeom.mjGEOM_CAPSULE): lambda s: coal.Capsule(s[0], 2 * s[1]),
+        int(mujoco.mjtGeom.mjGEOM_CYLINDER): lambda s: coal.Cylinder(s[0], 2 * s[1]),
+        int(mujoco.mjtGeom.mjGEOM_BOX): lambda s: coal.Box(*(2 * np.asarray(s))),
+        int(mujoco.mjtGeom.mjGEOM_ELLIPSOID): lambda s: coal.Ellipsoid(*np.asarray(s)),
+    }
+    visuals = pin.GeometryModel()
+    for g in range(mj.ngeom):
+        make = shapes.get(int(mj.geom_type[g]))
+        if make is None:
+            continue
+        b = int(mj.geom_bodyid[g])
+        if b == 0:
+            joint, placement = 0, pose(mj.geom_quat[g], mj.geom_pos[g])
+        else:
+            frame = model.frames[model.getFrameId(body_name(mj, b), pin.FrameType.BODY)]
+            joint, placement = frame.parentJoint, frame.placement * pose(mj.geom_quat[g], mj.geom_pos[g])
+        name = mujoco.mj_id2name(mj, mujoco.mjtObj.mjOBJ_GEOM, g) or f"geom{g}"
+        obj = pin.GeometryObject(name, joint, placement, make(np.array(mj.geom_size[g], dtype=float)))
+        obj.meshColor = np.array(mj.geom_rgba[g], dtype=float)
+        visuals.addGeometryObject(obj)
+    return visuals

@@ -1,28 +1,27 @@
-"""The numbers of an MJCF (MuJoCo XML) file, and its default classes, read strictly.
+"""The numbers of an MJCF (MuJoCo XML) file read strictly, before MuJoCo's compiler reads them.
 
-Used by ``pendverify.robot.mjcf_strict``.  Conventions:
+MuJoCo's parser is lenient: it reads ``damping="0.1x"`` as 0.1 and a short vector's missing
+numbers as defaults, without a word.  ``check_numbers`` reads every numeric attribute this
+module knows (``VECTORS``, ``SCALARS``) wherever its element stands (bodies, default classes,
+included files) and refuses with one line naming the file, the element, the attribute, the
+value and the rule:
 
 * One number: the whole attribute is a plain finite decimal literal, without surrounding
-  whitespace (``pendverify.robot.urdf_numbers``, the URDF reader's rule).  Pinocchio's MJCF
-  reader turns ``nan``, ``1.0x`` or ``1e400`` into a refusal only for a body's mass; elsewhere
-  (damping, inertia, positions) it reads them as 0 or garbage without a word.
-* A vector: its numbers separated by XML whitespace (MuJoCo's and Pinocchio's stream reading),
-  exactly as many as the attribute holds (``VECTORS``; Pinocchio reads a short vector's
-  missing numbers from uninitialised memory and ignores extra ones).
+  whitespace (``pendverify.robot.urdf_numbers``, the URDF reader's rule).
+* A vector: its numbers separated by XML whitespace, exactly as many as the attribute holds
+  (``VECTORS``).
 * Signs: masses, inertias, damping, armature, friction loss, joint margin, geom sizes,
   mass and density are ≥ 0 (``NON_NEGATIVE``).
-* Default classes: the top-level ``<default>`` is MuJoCo's class ``main``; nested ones must
-  be named.  A joint's attributes are resolved as MuJoCo does (its ``class``, else the
-  nearest ``childclass`` of its bodies, else ``main``, each with its ancestors) and as
-  Pinocchio's reader does (``main``, then the body's childclass, then the joint's class);
-  where the two disagree the file is refused naming the joint and the attribute.
+
+What the numbers mean (default classes, frames, angle units, inertia from geoms) is MuJoCo's
+compiler's to answer (``pendverify.robot.mjcf_compile``).
 """
 
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import NoReturn
 
 from pendverify.errors import UrdfShapeError
@@ -57,27 +56,6 @@ NON_NEGATIVE: dict[str, tuple[str, ...]] = {
     "site": ("size",),
     "compiler": ("boundmass", "boundinertia"),
     "option": ("density", "viscosity"),
-}
-#: joint attributes whose resolved value must be the same for MuJoCo and for Pinocchio
-JOINT_RESOLVED = (
-    "type",
-    "axis",
-    "damping",
-    "armature",
-    "frictionloss",
-    "stiffness",
-    "springref",
-    "springdamper",
-    "range",
-    "limited",
-    "actuatorfrcrange",
-    "margin",
-)
-#: joint attributes a default class may not set: Pinocchio's reader takes ``pos`` from the
-#: joint element only, and converts a class's ``ref`` before it knows the joint's type
-NOT_IN_DEFAULTS = {
-    "pos": "Pinocchio's MJCF reader takes a joint's pos from the joint element only, MuJoCo from its class",
-    "ref": "Pinocchio's MJCF reader converts a class's ref before it knows the joint's type",
 }
 
 
@@ -123,85 +101,25 @@ class Numbers:
         return parse_pieces(raw, pieces, fail)
 
 
-@dataclass
-class DefaultClass:
-    name: str
-    parent: str | None
-    joint: dict[str, str] = field(default_factory=dict)
+#: elements that name what a message is about
+OWNERS = ("body", "joint", "geom", "site")
 
 
-def read_defaults(root: ET.Element, numbers: Numbers) -> dict[str, DefaultClass]:
-    """{class name: class} of the file's ``<default>`` tree (``main`` for the top level)."""
-    classes: dict[str, DefaultClass] = {}
-    tops = root.findall("default")
-    if not tops:
-        return classes
+def check_numbers(root: ET.Element, numbers: Numbers) -> None:
+    """Every numeric attribute below ``root`` (an MJCF with its includes expanded), checked."""
 
-    def visit(element: ET.Element, parent: str | None) -> None:
-        name = element.get("class")
-        if parent is None and name not in (None, "main"):
-            numbers.fail(
-                "<default>", f" class = {quoted(name)}: the top-level default class is MuJoCo's 'main'"
-            )
-        if parent is not None and name is None:
-            numbers.fail(f"default class {parent!r}", ": a nested <default> needs a class name")
-        name = name or "main"
-        if name in classes:
-            numbers.fail(f"default class {quoted(name)}", ": defined twice")
-        place = f"default class {quoted(name)}"
-        cls = classes[name] = DefaultClass(name, parent)
-        for tag in ("joint", "geom", "site"):
-            found = element.findall(tag)
-            if len(found) > 1:
-                numbers.fail(place, f": has {len(found)} <{tag}> elements; Pinocchio's reader uses the first")
-            for child in found:
-                numbers.element(child, f"{place} <{tag}>")
-        for child in element.findall("joint"):
-            for attr, why in NOT_IN_DEFAULTS.items():
-                if attr in child.attrib:
-                    numbers.fail(
-                        f"{place} <joint>",
-                        f" {attr} = {quoted(child.attrib[attr])}: not in a default class ({why})",
-                    )
-            cls.joint = dict(child.attrib)
-        for child in element.findall("default"):
-            visit(child, name)
+    def visit(element: ET.Element, owner: str) -> None:
+        for child in element:
+            if not isinstance(child.tag, str):
+                continue
+            name = child.get("name") if child.tag in OWNERS else None
+            if child.tag == "default":
+                place = f"default class {quoted(child.get('class', 'main'))}"
+            elif name is not None:
+                place = f"{child.tag} {quoted(name)}"
+            else:
+                place = f"{owner} <{child.tag}>".lstrip()
+            numbers.element(child, place)
+            visit(child, place)
 
-    visit(tops[0], None)
-    return classes
-
-
-def chain(classes: dict[str, DefaultClass], name: str | None) -> dict[str, str]:
-    """A class's joint attributes with its ancestors' (nearer ones win); {} for None."""
-    if name is None or name not in classes:
-        return {}
-    cls = classes[name]
-    return {**chain(classes, cls.parent), **cls.joint}
-
-
-def resolve_joint(
-    joint: ET.Element, childclass: str | None, classes: dict[str, DefaultClass], place: str, numbers: Numbers
-) -> tuple[dict[str, str], str | None]:
-    """(the joint's attributes with its defaults, the class MuJoCo takes them from); refused where
-    MuJoCo's and Pinocchio's readings differ."""
-    own = joint.get("class")
-    for name in (own, childclass):
-        if name is not None and name not in classes:
-            numbers.fail(place, f": class {quoted(name)} is not defined by any <default>")
-    effective = own or childclass or ("main" if "main" in classes else None)
-    mujoco = {**chain(classes, effective), **joint.attrib}
-    pinocchio = {
-        **chain(classes, "main"),
-        **chain(classes, childclass),
-        **chain(classes, own),
-        **joint.attrib,
-    }
-    for attr in JOINT_RESOLVED:
-        if mujoco.get(attr) != pinocchio.get(attr):
-            numbers.fail(
-                place,
-                f": {attr} resolves to {quoted(mujoco.get(attr))} for MuJoCo (class {effective!r}) but to "
-                f"{quoted(pinocchio.get(attr))} for Pinocchio's reader (which also applies childclass "
-                f"{childclass!r}); give the joint its {attr} explicitly",
-            )
-    return mujoco, effective
+    visit(root, "")

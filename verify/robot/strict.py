@@ -137,13 +137,16 @@ class DescriptionFacts:
     ``joint_dynamics``: joint name → its damping and Coulomb friction as written (a URDF's
     ``<dynamics>``, an MJCF joint's ``damping``/``frictionloss``), for every joint that has one.
     ``joint_types``: joint name → its type as written (``revolute``, ``hinge``, ...), for every joint.
-    ``gravity``: g [m/s²] the description itself sets (an MJCF's ``<option gravity>``, MuJoCo's
-    default 9.81 when absent); None for a format that sets none (URDF).
+    ``gravity``: g [m/s²] the description itself sets along −z (an MJCF's ``<option gravity>``:
+    minus its z component; MuJoCo's default 9.81 when absent); None for a format that sets none
+    (URDF).  ``gravity_vector``: the whole vector [m/s²] the description sets (its part not along
+    −z is the tilt ``pendverify.robot.gravity_tilt`` measures); None for a format that sets none.
     """
 
     joint_dynamics: dict[str, JointDynamics]
     joint_types: dict[str, str]
     gravity: float | None = None
+    gravity_vector: tuple[float, float, float] | None = None
 
 
 #: The facts of a URDF (the name the URDF reader has always used).

@@ -21,7 +21,8 @@ from pendverify.display import listed, shortened
 from pendverify.robot import seed_geometry  # noqa: F401  (registers the reference systems' readers)
 from pendverify.robot.batch import PinocchioBatch, finite_rows
 from pendverify.robot.coordinates import CoordinateMap
-from pendverify.robot.geometry import MODEL_FORM_RTOL, UrdfGeometry, reader
+from pendverify.robot.geometry import MODEL_FORM_RTOL, ModelForm, UrdfGeometry, combined, reader
+from pendverify.robot.gravity_tilt import tilt_form
 from pendverify.robot.joint_map import declared_geometry
 from pendverify.robot.seed_geometry import DEFAULT_G
 from pendverify.robot.urdf import LoadedUrdf, load_urdf
@@ -53,12 +54,16 @@ class PinocchioSystem:
         source: str,
         urdf: LoadedUrdf | None = None,
         model_form_rtol: float = MODEL_FORM_RTOL,
+        gravity_vector=None,
     ):
         self.model = model
-        self.model.gravity.linear = np.array([0.0, 0.0, -g])
+        self.model.gravity.linear = np.array([0.0, 0.0, -g] if gravity_vector is None else gravity_vector)
         self.data = model.createData()
         self.cmap = geometry.cmap
         self.geometry = geometry
+        #: the description's gravity tilted off −z, a term the closed form's scalar g cannot express
+        #: (``pendverify.robot.gravity_tilt``); None when Pinocchio's gravity is along −z
+        self.tilt = None if gravity_vector is None else tilt_form(model, geometry.cmap, gravity_vector)
         self.source = source
         self.urdf = urdf
         #: the model-form threshold (``MODEL_FORM_RTOL``; ``check --model-form-rtol``)
@@ -107,9 +112,13 @@ class PinocchioSystem:
                 f"the description's own gravity is g = {own:g} m/s²; "
                 f"it is evaluated with the closed form's g = {g:g}"
             )
+        vector = loaded.facts.gravity_vector
+        if g is not None and g != own:
+            vector = None  # the closed form's g along −z replaces the file's gravity
         g = own if g is None else g
         geometry = geometry_for(model_cls, loaded.model, loaded.source, g)
-        return cls(loaded.model, geometry, DEFAULT_G if g is None else g, loaded.source, loaded)
+        g = DEFAULT_G if g is None else g
+        return cls(loaded.model, geometry, g, loaded.source, loaded, gravity_vector=vector)
 
     @classmethod
     def for_params(cls, params, source: str | None = None):
@@ -128,26 +137,54 @@ class PinocchioSystem:
         The model-form bound while the term is within ``model_form_rtol``; beyond it,
         nothing: the URDF is outside the family and the checks say so by failing.
         """
-        form = self.geometry.model_form
+        form = self.model_form
         if form is not None and form.within(self.model_form_rtol):
             return form.allowance.copy()
         return np.zeros(self.model.nv)
+
+    def energy_allowance(self, theta) -> np.ndarray:
+        """|ΔV(θ) − ΔV(0)| per state θ (N, n) a model-form term within the threshold may cause.
+
+        A bounded term (an off-line centre of mass: |ΔV| ≤ its allowance at each end) gives
+        2·Σ a; a term whose potential grows with the coordinates (a gravity tilt along a slide)
+        is the integral of ΔH from 0 to θ, at most Σ a_i |θ_i| on the straight path.
+        """
+        a = self.allowance
+        out = np.full(len(theta), 2 * float(np.sum(a)))
+        form = self.model_form
+        if form is not None and form.potential_grows and np.any(a):
+            out = out + np.abs(np.asarray(theta, dtype=float)) @ a
+        return out
 
     @property
     def notes(self) -> list[str]:
         """What reading the URDF noticed: parser messages, the base's offset, the map, the model form."""
         out = self.urdf.notes() if self.urdf is not None else []
         out += self.geometry.notes
-        form = self.geometry.model_form
+        form = self.model_form
         if form is not None and form.within(self.model_form_rtol):  # beyond it, a failing row says so
             out.append(form.sentence(self.model_form_rtol))
         return out
 
+    @property
+    def model_form(self) -> ModelForm | None:
+        """What of the description the closed form cannot express: the geometry reader's term and
+        the gravity's tilt, as one (``pendverify.robot.geometry.combined``)."""
+        return combined([self.geometry.model_form, self.tilt])
+
     def with_map(self, cmap: CoordinateMap) -> PinocchioSystem:
         """The same URDF seen through another coordinate map (for testing hypotheses)."""
         geometry = dataclasses.replace(self.geometry, cmap=cmap)
-        g = -float(self.model.gravity.linear[2])
-        return PinocchioSystem(self.model.copy(), geometry, g, self.source, self.urdf, self.model_form_rtol)
+        gravity = self.model.gravity.linear.copy()
+        return PinocchioSystem(
+            self.model.copy(),
+            geometry,
+            -float(gravity[2]),
+            self.source,
+            self.urdf,
+            self.model_form_rtol,
+            gravity_vector=None if self.tilt is None else gravity,
+        )
 
     def urdf_damping(self) -> np.ndarray | None:
         """The joints' <dynamics damping> (joint coordinates, Pinocchio's order), or None if no joint has one.
