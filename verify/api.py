@@ -98,6 +98,7 @@ __all__ = [
     "recheck",
     "review",
     "review_scenes",
+    "ros_packages",
     "simulate",
     "stress",
     "trajectory",
@@ -174,6 +175,24 @@ def load_urdf(model_cls: ModelLike, urdf: UrdfLike, g: float | None = None) -> P
     if g is not None:
         g = check_value(OPTIONS_SOURCE, "g", g, "gravity")
     return PinocchioSystem.for_model(cls, _urdf_arg(urdf), g)
+
+
+def ros_packages(*folders: str | Path):
+    """Inside ``with pendverify.ros_packages(DIR, ...):`` the folders hold ROS packages for
+    ``$(find PKG)`` in xacro and ``package://PKG/...`` meshes (``--package-path DIR`` on the
+    command line).
+
+    Every function that takes a URDF reads it there: the folders are searched (each is a
+    package or holds packages below it) before ``ROS_PACKAGE_PATH`` and
+    ``AMENT_PREFIX_PATH/share`` (``pendverify.robot.packages``).  A folder that does not exist
+    raises ``PendverifyError``; an unknown package, one line naming it and the folders searched.
+    """
+    from pendverify.robot.packages import package_path
+
+    for folder in folders:
+        if not isinstance(folder, (str, Path)):
+            raise PendverifyError(f"a package folder is a path; got a {type(folder).__name__}")
+    return package_path(folders)
 
 
 # --- check -----------------------------------------------------------------------------------------

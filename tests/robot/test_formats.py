@@ -166,14 +166,17 @@ def xacro_doc(body: str) -> str:
     )
 
 
-def test_xacro_find_needs_ros_and_is_refused(tmp_path):
+def test_xacro_find_of_a_package_not_found_is_refused_naming_it(tmp_path, monkeypatch):
+    """Packages are found without ROS (tests/robot/test_ros_packages.py); an unknown one is one line."""
+    monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)
+    monkeypatch.delenv("AMENT_PREFIX_PATH", raising=False)
     path = tmp_path / "arm.urdf.xacro"
     path.write_text(xacro_doc('<xacro:include filename="$(find arm_description)/urdf/arm.xacro"/>'))
     with pytest.raises(UrdfShapeError) as info:
         load_description(path)
     message = str(info.value)
-    assert message.startswith(f"{path}: xacro cannot expand it: it uses $(find PKG)")
-    assert "give the URDF" in message
+    assert message.startswith(f"{path}: xacro cannot expand it: ROS package 'arm_description' not found")
+    assert "--package-path DIR" in message
 
 
 def test_xacro_arguments_take_their_defaults_and_includes_resolve_beside_the_file(tmp_path):
