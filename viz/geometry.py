@@ -102,7 +102,9 @@ class VisualSystem:
         """
         system = PinocchioSystem.for_model(model_cls, urdf, g)
         loaded = system.urdf  # the verified text: a xacro file's is the URDF it expanded to
-        if loaded.format == "mjcf":
+        if loaded.visual_model is not None:  # given with a Pinocchio model
+            visual_model = loaded.visual_model.copy()
+        elif loaded.format == "mjcf":
             visual_model = mjcf_visuals(system.model, loaded.text)
         else:
             visual_model = _urdf_visuals(system.model, loaded.text, loaded.source)
