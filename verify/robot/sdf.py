@@ -52,6 +52,8 @@ NON_NEGATIVE = (
     "size",
     "spring_stiffness",
 )
+#: SDFormat's booleans (a link's ``<gravity>`` is one)
+BOOLEANS = ("true", "false", "1", "0")
 INERTIA = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 
 
@@ -109,6 +111,8 @@ def _check(element: ET.Element, place: str, source: str) -> None:
         return
     raw = (element.text or "").strip()
     pieces = raw.split()
+    if tag == "gravity" and len(pieces) == 1 and pieces[0] in BOOLEANS:
+        return  # a link's <gravity> switch, not a world's gravity vector
     if len(pieces) not in NUMBERS[tag]:
         need = " or ".join(str(c) for c in NUMBERS[tag])
         found = len(pieces)
