@@ -25,6 +25,7 @@ _LAZY = {
     "load_urdf": "pendverify.api",
     "simulate": "pendverify.api",
     "certify_set": "pendverify.api",
+    "ros_packages": "pendverify.api",
     "CheckReport": "pendverify.checks.report",
     "CheckRows": "pendverify.checks.report",
     "Run": "pendverify.simulation.simulate",
@@ -44,11 +45,20 @@ __all__ = [
     "load_model",
     "load_params",
     "load_urdf",
+    "ros_packages",
     "simulate",
 ]
 
 if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
-    from pendverify.api import certify_set, check, load_model, load_params, load_urdf, simulate
+    from pendverify.api import (
+        certify_set,
+        check,
+        load_model,
+        load_params,
+        load_urdf,
+        ros_packages,
+        simulate,
+    )
     from pendverify.checks.report import CheckReport, CheckRows
     from pendverify.errors import PendverifyError
     from pendverify.simulation.simulate import Run

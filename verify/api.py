@@ -36,6 +36,8 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
+import pinocchio as pin
+
 from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
 from pendverify.analytic.parameter_set import check_value
 from pendverify.analytic.plugin import load_model_class, validate_model_class
@@ -44,7 +46,9 @@ from pendverify.checks.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
 from pendverify.checks.verification import build_report
 from pendverify.errors import InputError, PendverifyError, UnknownNameError
 from pendverify.robot import erd as erd_data
+from pendverify.robot.description import LoadedDescription
 from pendverify.robot.geometry import MODEL_FORM_RTOL
+from pendverify.robot.pinocchio_model import PinocchioRobot, describe_model, is_pinocchio_object
 from pendverify.robot.system import PinocchioSystem
 from pendverify.targets import is_builtin, parameter_values, select_targets
 
@@ -67,8 +71,10 @@ if TYPE_CHECKING:
 ModelLike = str | Path | type[ClosedFormModel]
 #: Parameters: a TOML parameter file, the flat mapping of parameter values, or a parameter set.
 ParamsLike = str | Path | Mapping[str, float] | ParameterSet
-#: A URDF: a file path or the XML text itself.
-UrdfLike = str | Path
+#: A URDF: a file path, the XML text itself, or a robot given as a Pinocchio object: a
+#: ``pinocchio.Model``, a ``pinocchio.RobotWrapper`` or a ``PinocchioRobot`` (a model with its
+#: visual model and URDF text), read by ``pendverify.robot.pinocchio_model``.
+UrdfLike = str | Path | pin.Model | pin.RobotWrapper | PinocchioRobot
 
 #: ``source`` of the errors about the arguments of these functions.
 OPTIONS_SOURCE = "<pendverify API arguments>"
@@ -78,6 +84,7 @@ __all__ = [
     "ModelLike",
     "ModelReading",
     "ParamsLike",
+    "PinocchioRobot",
     "UrdfLike",
     "animation_html",
     "bench_accuracy",
@@ -100,6 +107,7 @@ __all__ = [
     "recheck",
     "review",
     "review_scenes",
+    "ros_packages",
     "simulate",
     "stress",
     "trajectory",
@@ -193,7 +201,8 @@ def load_params(model_cls: ModelLike, source: ParamsLike) -> ParameterSet:
 
 
 def load_urdf(model_cls: ModelLike, urdf: UrdfLike, g: float | None = None) -> PinocchioSystem:
-    """A URDF (file path or XML text) loaded in Pinocchio and seen in ``model_cls``'s coordinates.
+    """A URDF (file path or XML text; or a ``pinocchio.Model``, ``RobotWrapper`` or
+    ``PinocchioRobot``, copied) loaded in Pinocchio and seen in ``model_cls``'s coordinates.
 
     The URDF is read strictly and its base anchored at the origin; the coordinate map is the
     one the model reads off the geometry (built-in models) or declares (``urdf_joints``,
@@ -206,10 +215,34 @@ def load_urdf(model_cls: ModelLike, urdf: UrdfLike, g: float | None = None) -> P
     return PinocchioSystem.for_model(cls, _urdf_arg(urdf), g)
 
 
+def ros_packages(*folders: str | Path):
+    """Inside ``with pendverify.ros_packages(DIR, ...):`` the folders hold ROS packages for
+    ``$(find PKG)`` in xacro and ``package://PKG/...`` meshes (``--package-path DIR`` on the
+    command line).
+
+    Every function that takes a URDF reads it there: the folders are searched (each is a
+    package or holds packages below it) before ``ROS_PACKAGE_PATH`` and
+    ``AMENT_PREFIX_PATH/share`` (``pendverify.robot.packages``).  A folder that does not exist
+    raises ``PendverifyError``; an unknown package, one line naming it and the folders searched.
+    """
+    from pendverify.robot.packages import package_path
+
+    for folder in folders:
+        if not isinstance(folder, (str, Path)):
+            raise PendverifyError(f"a package folder is a path; got a {type(folder).__name__}")
+    return package_path(folders)
+
+
 # --- check -----------------------------------------------------------------------------------------
-def _urdf_arg(urdf: UrdfLike) -> str:
+def _urdf_arg(urdf: UrdfLike) -> str | LoadedDescription:
+    """A URDF argument as the readers take it: a path or text as a string, a Pinocchio object read."""
+    if is_pinocchio_object(urdf):
+        return describe_model(urdf)
     if not isinstance(urdf, (str, Path)):
-        raise PendverifyError(f"a URDF is a file path or its XML text; got a {type(urdf).__name__}")
+        raise PendverifyError(
+            "a URDF is a file path, its XML text, a pinocchio.Model or a RobotWrapper; "
+            f"got a {type(urdf).__name__}"
+        )
     return str(urdf)
 
 
@@ -639,7 +672,7 @@ def certify_set(
     output: str | Path,
     params: str | Path | None = None,
     *,
-    urdf: str | Path | None = None,
+    urdf: UrdfLike | None = None,
     model: str | None = None,
     urdf_params: str | Path | None = None,
     analytic: str | Path | None = None,
@@ -654,6 +687,9 @@ def certify_set(
     ``erd:NAME``) with ``urdf_params`` (the set it must match) or a built-in ``model``
     whose parameters are read off the URDF; or a model file ``analytic`` with its
     ``urdf`` and ``urdf_params`` (the certificate then embeds the file's text).
+    A ``urdf`` given as a Pinocchio object is certified with the URDF text it came with
+    (``PinocchioRobot(model, urdf_text=...)``), which must build that very model; without
+    one it is refused (a certificate embeds its URDF).
     ``key``: an Ed25519 private key file (``pendverify keygen``) that signs it.
     Returns the issued result (``items``, ``certified``, ``certificate``, ``path``).
     (Not ``certify``: that name is the ``pendverify.certify`` sub-package.)
@@ -669,7 +705,7 @@ def certify_set(
         settings = dataclasses.replace(settings, seed=_count("seed", seed))
     target = certification_input(
         None if params is None else str(params),
-        None if urdf is None else str(urdf),
+        None if urdf is None else _urdf_arg(urdf),
         model,
         None if urdf_params is None else str(urdf_params),
         None if analytic is None else str(analytic),

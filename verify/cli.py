@@ -145,10 +145,19 @@ def _main(argv: list[str] | None) -> int:
         contextlib.redirect_stdout(sys.stderr) if args.json == STDOUT else contextlib.nullcontext()
     )
     try:
-        with text_to_stderr:
+        with text_to_stderr, _ros_packages(getattr(args, "package_path", None)):
             return args.func(args)
     except BaseException as exc:  # the contract: every outcome is an exit status and one line
         return _fail(exc, args.debug)
+
+
+def _ros_packages(folders: list[str] | None):
+    """The ``--package-path`` folders as the setting of the command's run (``pendverify.ros_packages``)."""
+    if not folders:
+        return contextlib.nullcontext()
+    from pendverify.api import ros_packages
+
+    return ros_packages(*folders)
 
 
 def _fail(exc: BaseException, debug: bool) -> int:

@@ -31,7 +31,7 @@ from pendverify.analytic.plugin import check_model_outputs, load_model_class, pl
 from pendverify.analytic.source_file import where
 from pendverify.errors import ParameterError, PendverifyError, UnknownNameError
 from pendverify.robot import erd
-from pendverify.robot.description import description_stem, is_description_text
+from pendverify.robot.description import LoadedDescription, description_stem, is_description_text
 from pendverify.robot.seed_geometry import DEFAULT_G
 from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
@@ -131,7 +131,8 @@ def model_target(
 ) -> Target:
     """A model class, a URDF and (unless the URDF fixes them) its parameters: built-in or plug-in.
 
-    ``urdf`` is a description's file path (URDF, xacro, MJCF) or the XML text itself.  The target
+    ``urdf`` is a description's file path (URDF, xacro, MJCF), the XML text itself or a description
+    already read (a Pinocchio model's, ``pendverify.robot.pinocchio_model``).  The target
     is labelled ``{model}:{name}``; ``name`` defaults to the file's stem without its format's
     suffixes (``arm.urdf.xacro`` → ``arm``), or ``urdf-text`` for text.
     """
@@ -157,8 +158,15 @@ def model_target(
         raise PendverifyError(f"{cls.name}: building the model failed: {type(exc).__name__}: {exc}") from None
     check_model_outputs(model)
     if name is None:
-        name = "urdf-text" if is_description_text(urdf) else description_stem(urdf)
+        name = _description_name(urdf)
     return Target(f"{cls.name}:{name}", model, system, system.source, notes)
+
+
+def _description_name(urdf) -> str:
+    """A target's name from its description: the file's stem, ``urdf-text``, or a Pinocchio model's name."""
+    if isinstance(urdf, LoadedDescription):
+        return urdf.model.name or "pinocchio-model"
+    return "urdf-text" if is_description_text(urdf) else description_stem(urdf)
 
 
 def params_target(

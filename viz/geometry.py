@@ -3,7 +3,8 @@
 The geometry on screen is the geometry that was verified: the URDF text comes
 from ``pendverify.robot.writer.urdf_for`` (the same writer the checks and the
 simulator use), or is the URDF a scene names (a model file's, ``VisualSystem.for_model``);
-Pinocchio parses its ``<visual>`` elements into a visual
+Pinocchio parses its ``<visual>`` elements (a mesh's ``package://PKG/...`` file found in its ROS
+package, ``pendverify.robot.packages``) into a visual
 ``GeometryModel``, and ``pinocchio.visualize.MeshcatVisualizer`` turns every
 ``GeometryObject`` (box, cylinder, sphere, with the URDF material colour) into a
 meshcat object at ``<root>/visuals/<geometry name>``.  Poses come from
@@ -29,6 +30,7 @@ import pinocchio as pin
 
 from pendverify.analytic import ParameterSet
 from pendverify.robot.mjcf import mjcf_visuals
+from pendverify.robot.packages import resolve_package_uris
 from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
 
@@ -67,7 +69,8 @@ def colour_links_without_material(visual_model: pin.GeometryModel) -> None:
         obj.meshColor = np.array(LINK_COLOURS[k % len(LINK_COLOURS)])
 
 
-def _urdf_visuals(model: pin.Model, urdf: str) -> pin.GeometryModel:
+def _urdf_visuals(model: pin.Model, urdf: str, source: str = "<URDF>") -> pin.GeometryModel:
+    urdf = resolve_package_uris(urdf, source)  # package://PKG/... meshes: files in their package
     visual_model = pin.buildGeomFromUrdfString(model, urdf, pin.GeometryType.VISUAL)
     colour_links_without_material(visual_model)
     return visual_model
@@ -99,10 +102,12 @@ class VisualSystem:
         """
         system = PinocchioSystem.for_model(model_cls, urdf, g)
         loaded = system.urdf  # the verified text: a xacro file's is the URDF it expanded to
-        if loaded.format == "mjcf":
+        if loaded.visual_model is not None:  # given with a Pinocchio model
+            visual_model = loaded.visual_model.copy()
+        elif loaded.format == "mjcf":
             visual_model = mjcf_visuals(system.model, loaded.text, loaded.source)
         else:
-            visual_model = _urdf_visuals(system.model, loaded.text)
+            visual_model = _urdf_visuals(system.model, loaded.text, loaded.source)
         return cls(system, visual_model, visual_model.createData(), loaded.text)
 
     @property

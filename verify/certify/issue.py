@@ -36,8 +36,9 @@ from pendverify.certify.simulations import recorded_engines
 from pendverify.certify.sweep_task import SetResult
 from pendverify.display import listed, shortened
 from pendverify.errors import CertificateError, ParameterError, PendverifyError
-from pendverify.robot.description import load_description
+from pendverify.robot.description import LoadedDescription, load_description
 from pendverify.robot.erd import resolve_urdf
+from pendverify.robot.pinocchio_model import certified_text
 from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
 from pendverify.targets import PARAMS_HINT
@@ -67,8 +68,7 @@ def certification_input(
             raise PendverifyError(f"{analytic}: give a model file or a built-in model name, not both")
         return _plugin_input(analytic, urdf, urdf_params or params_file)
     if urdf:
-        path, name = _urdf_and_name(urdf)
-        text = load_description(path).text  # a xacro file's: the URDF it expands to
+        path, name, text = _urdf_input(urdf)
         if urdf_params:
             model_name, _, params = load_parameter_file(urdf_params)
             if model and model != model_name:
@@ -110,8 +110,19 @@ def _plugin_input(model_file: str, urdf: str | None, params_file: str | None) ->
             None,
             "certify needs a gravity parameter g: its runs set gravity by it",
         )
+    _, name, text = _urdf_input(urdf)
+    return CertificationInput(name, source, params, text)
+
+
+def _urdf_input(urdf: str | LoadedDescription) -> tuple[str, str, str]:
+    """(where it came from, bundle name, URDF text) of a URDF argument: a path, ``erd:NAME``, or a
+    model given as a Pinocchio object (its name names the bundle; ``certified_text``)."""
+    if isinstance(urdf, LoadedDescription):
+        name = urdf.model.name
+        check_name(name, urdf.source, "model name (it names the bundle)")
+        return urdf.source, name, certified_text(urdf)
     path, name = _urdf_and_name(urdf)
-    return CertificationInput(name, source, params, load_description(path).text)
+    return str(path), name, load_description(path).text  # a xacro file's: the URDF it expands to
 
 
 def _urdf_and_name(urdf: str):

@@ -197,6 +197,18 @@ def add_analytic_option(parser, what: str) -> None:
     )
 
 
+def add_package_path_option(parser) -> None:
+    """``--package-path DIR`` (repeatable): folders holding ROS packages, for ``$(find PKG)`` and
+    ``package://PKG/...`` (``pendverify.robot.packages``); the CLI enters them around the command."""
+    parser.add_argument(
+        "--package-path",
+        action="append",
+        metavar="DIR",
+        help="a folder holding ROS packages (or one package), searched for $(find PKG) and package://PKG/... "
+        "before ROS_PACKAGE_PATH and AMENT_PREFIX_PATH; repeatable (default: none)",
+    )
+
+
 def refuse_together(first: str, second: str, rule: str):
     """Refuse two options given together (exit status 2), naming both and the rule."""
     from pendverify.errors import OptionConflictError

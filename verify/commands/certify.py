@@ -10,6 +10,7 @@ from pendverify.certify.sweep_limits import DEFAULT_MAX_SETS, WORKER_TIMEOUT_S
 from pendverify.commands import (
     add_analytic_option,
     add_command,
+    add_package_path_option,
     positive_float,
     positive_int,
     refuse_together,
@@ -78,6 +79,7 @@ def register(sub) -> None:
         "--key",
         help="sign the certificate(s) with this Ed25519 private key (pendverify keygen) (default: unsigned)",
     )
+    add_package_path_option(p)
     p.set_defaults(func=run_certify)
 
     r = add_command(

@@ -7,6 +7,7 @@ import time
 
 from pendverify.commands import (
     add_command,
+    add_package_path_option,
     add_sampling_options,
     builtin_models,
     positive_float,
@@ -74,6 +75,7 @@ def register(sub) -> None:
         help="largest relative size of a URDF term the closed form cannot express, e.g. a centre of "
         "mass off the reference system's joint line (default: 1e-4)",
     )
+    add_package_path_option(p)
     p.set_defaults(func=run)
 
 

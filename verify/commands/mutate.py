@@ -6,6 +6,7 @@ import argparse
 
 from pendverify.commands import (
     add_command,
+    add_package_path_option,
     add_sampling_options,
     builtin_models,
     write_json_report,
@@ -42,6 +43,7 @@ def register(sub) -> None:
         metavar="NAME",
         help="mutate only this closed form (e.g. mass_matrix); repeatable (default: every closed form)",
     )
+    add_package_path_option(p)
     p.set_defaults(func=run)
 
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import argparse
 
-from pendverify.commands import add_analytic_option, add_command
+from pendverify.commands import add_analytic_option, add_command, add_package_path_option
 
 
 def register(sub) -> None:
@@ -45,6 +45,7 @@ def register(sub) -> None:
         help="the URDF (or xacro, MJCF) ABA integrates and the animation draws (default: the scene's urdf, "
         "or the project's URDF of the parameter set)",
     )
+    add_package_path_option(p)
     p.set_defaults(func=run)
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 
-from pendverify.commands import add_command, write_json_report
+from pendverify.commands import add_command, add_package_path_option, write_json_report
 
 
 def register(sub) -> None:
@@ -34,6 +34,7 @@ def register(sub) -> None:
         "or the project's URDF of the parameter set)",
     )
     p.add_argument("--html", help="also write a self-contained HTML animation (as `pendverify render`)")
+    add_package_path_option(p)
     p.set_defaults(func=run)
 
 

@@ -15,6 +15,7 @@ import time
 from pendverify.commands import (
     add_analytic_option,
     add_command,
+    add_package_path_option,
     add_sampling_options,
     write_json_report,
 )
@@ -44,6 +45,7 @@ def register(sub) -> None:
     add_analytic_option(p, "run hard cases derived from its parameters' kinds; needs --urdf, --params")
     p.add_argument("--urdf", help="with --analytic: the model's URDF or xacro file")
     p.add_argument("--params", help="with --analytic: its parameter file (TOML)")
+    add_package_path_option(p)
     p.set_defaults(func=run)
 
 

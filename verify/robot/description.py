@@ -44,8 +44,9 @@ FORMATS = {"urdf": "robot", "xacro": "robot", "mjcf": "mujoco", "sdf": "sdf"}
 SUFFIXES = (".urdf.xacro", ".mjcf.xml", ".xacro", ".urdf", ".mjcf", ".sdf", ".xml")
 #: ``source`` of a description given as XML text rather than a file
 TEXT_SOURCE = "<urdf text>"
-#: format → what its reader is called in messages
-READERS = {"urdf": "URDF", "xacro": "URDF", "mjcf": "MJCF", "sdf": "SDFormat"}
+#: format → what its reader is called in messages ("pinocchio": a model given as an object,
+#: ``pendverify.robot.pinocchio_model``)
+READERS = {"urdf": "URDF", "xacro": "URDF", "mjcf": "MJCF", "sdf": "SDFormat", "pinocchio": "Pinocchio"}
 #: format → the suffix of a file that holds its verified text (xacro: the URDF it expanded to)
 FILE_SUFFIXES = {"urdf": ".urdf", "xacro": ".urdf", "mjcf": ".mjcf.xml", "sdf": ".sdf"}
 
@@ -63,13 +64,15 @@ class LoadedDescription:
     base_offset: float = 0.0
     #: what the readers (urdfdom, Pinocchio's MJCF reader, xacro) logged
     log: list[str] = field(default_factory=list)
-    #: "urdf", "xacro", "mjcf" or "sdf"
+    #: "urdf", "xacro", "mjcf", "sdf" or "pinocchio"
     format: str = "urdf"
     #: what reading the file noticed (defaults applied, armature, ...)
     reading_notes: list[str] = field(default_factory=list)
     #: "<body or joint name>.<quantity>" (and "gravity") → where the number came from
     #: (``pendverify.robot.mjcf_origins``); filled for MJCF only, empty for other formats
     origins: dict[str, str] = field(default_factory=dict)
+    #: the visual geometry given with a Pinocchio model (None: built from ``text`` when drawn)
+    visual_model: pin.GeometryModel | None = None
 
     def notes(self) -> list[str]:
         out = [f"Pinocchio's {READERS[self.format]} parser logged: {line}" for line in self.log]

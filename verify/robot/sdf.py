@@ -1,17 +1,20 @@
-"""SDFormat (``<sdf>``) descriptions: read by Pinocchio's SDFormat reader when this build has one.
+"""SDFormat (``<sdf>``) descriptions: read strictly, then by Drake (``pendverify.robot.sdf_drake``).
 
 Conventions:
 
-* Without SDFormat support in Pinocchio (``pinocchio.WITH_SDFORMAT`` is False, as in the
-  build this project is tested with) an SDF file is refused with one line saying so.
-* With it, the file is read strictly first: every number held by an element pendverify
-  knows (``NUMBERS``: poses, masses, inertias, axes, dynamics, limits, sizes, gravity) is a
-  plain finite decimal, or as many such numbers as the element holds, separated by XML
-  whitespace (surrounding whitespace in element text is allowed: SDF is pretty-printed);
-  masses, damping, friction and sizes are ≥ 0; each inertia tensor is valid
+* The file is read strictly first: every number held by an element pendverify knows
+  (``NUMBERS``: poses, masses, inertias, axes, dynamics, limits, sizes, gravity) is a plain
+  finite decimal, or as many such numbers as the element holds, separated by XML whitespace
+  (surrounding whitespace in element text is allowed: SDF is pretty-printed); masses, damping,
+  friction and sizes are ≥ 0; each inertia tensor is valid
   (``pendverify.robot.inertia_rounding``); a joint spring (``spring_stiffness``) is refused.
-  Then ``pinocchio.buildModelsFromSdf`` builds the model; a model with constraints (a closed
-  chain) is refused.  A joint's ``<axis><dynamics>`` damping and friction are its facts.
+  Drake's parser is lenient where this reader is not.
+* Then Drake's SDFormat parser (the optional extra ``pendverify[sdf]``; without it, one line
+  naming the extra) builds a ``MultibodyPlant`` that is handed to Pinocchio and cross-checked
+  against Drake's own M and bias (``pendverify.robot.sdf_drake``).  Pinocchio's own SDFormat
+  reader is not used: the PyPI wheel has none.
+* A joint's ``<axis><dynamics>`` damping and friction are its facts; an SDF sets no gravity
+  pendverify reads (a model file has no ``<world>``): the closed form's g is used.
 """
 
 from __future__ import annotations
@@ -22,9 +25,9 @@ import pinocchio as pin
 
 from pendverify.errors import UrdfShapeError
 from pendverify.robot.inertia_rounding import check_inertia_tensor
+from pendverify.robot.sdf_drake import build_from_drake, import_drake
 from pendverify.robot.strict import DescriptionFacts, JointDynamics
 from pendverify.robot.urdf_numbers import NOT_A_NUMBER, parse_number, quoted, why_not
-from pendverify.robot.urdfdom import build_from_file
 from pendverify.robot.xml_reading import parse_xml
 
 #: element tag → how many numbers its text holds
@@ -49,24 +52,16 @@ NON_NEGATIVE = (
     "size",
     "spring_stiffness",
 )
+#: SDFormat's booleans (a link's ``<gravity>`` is one)
+BOOLEANS = ("true", "false", "1", "0")
 INERTIA = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
-
-NO_SDFORMAT = (
-    "an SDFormat description (<sdf>), but this Pinocchio build has no SDFormat support "
-    "(pinocchio.WITH_SDFORMAT is False): use a Pinocchio built with SDFormat, "
-    "or describe the robot as URDF, xacro or MJCF"
-)
 
 
 def build_sdf_model(text: str, source: str) -> tuple[pin.Model, DescriptionFacts, list[str]]:
-    """(model, facts, log) of an SDF document; refused without SDFormat support (see the module docstring)."""
-    if not getattr(pin, "WITH_SDFORMAT", False):
-        raise UrdfShapeError(source, NO_SDFORMAT)
+    """(model, facts, Drake's log) of an SDF document (see the module docstring)."""
+    import_drake(source)  # without the extra: one line, before anything else is said
     facts = read_sdf_strictly(text, source)
-    built, log = build_from_file(pin.buildModelsFromSdf, text, "model.sdf", source, "SDFormat")
-    model, constraints = (built[0], built[1]) if isinstance(built, tuple) else (built, [])
-    if len(constraints):
-        raise UrdfShapeError(source, f"has {len(constraints)} constraint(s) (a closed chain); refused")
+    model, log = build_from_drake(text, source)
     return model, facts, log
 
 
@@ -116,6 +111,8 @@ def _check(element: ET.Element, place: str, source: str) -> None:
         return
     raw = (element.text or "").strip()
     pieces = raw.split()
+    if tag == "gravity" and len(pieces) == 1 and pieces[0] in BOOLEANS:
+        return  # a link's <gravity> switch, not a world's gravity vector
     if len(pieces) not in NUMBERS[tag]:
         need = " or ".join(str(c) for c in NUMBERS[tag])
         found = len(pieces)

@@ -7,8 +7,14 @@ Conventions:
   no ``name:=value`` mappings: every ``xacro:arg`` takes the default the file gives it (an
   argument without a default is xacro's own error).  Includes are resolved relative to the
   file (relative to the working directory for XML text given directly).
-* ``$(find PKG)`` needs ROS's package index (``ament_index_python``); without it the file is
-  refused with a one-line error saying so (expand it in a ROS environment and give the URDF).
+* ``$(find PKG)`` is package PKG's folder as ``pendverify.robot.packages.find_package`` finds it
+  (``--package-path``, ``ROS_PACKAGE_PATH``, ``AMENT_PREFIX_PATH``), not ROS's package index; an
+  include's ``package://PKG/...`` file name is resolved the same way.  xacro's seams for this are
+  two module-level functions it looks up at each call: ``xacro.substitution_args._eval_find``
+  (what ``$(find)`` evaluates to) and ``xacro.abs_filename_spec`` (an include's file name made
+  absolute).  They are replaced for the duration of one expansion, under the lock that already
+  serialises expansions, and restored afterwards; an unknown package is one line naming it and
+  the folders searched.
 * Whatever xacro prints (its warnings) is captured and handed back as log lines.
 * Every xacro error is one ``UrdfShapeError`` naming the xacro file (and the included file the
   error arose in), never a traceback.
@@ -26,6 +32,7 @@ from pathlib import Path
 
 from pendverify.display import shortened
 from pendverify.errors import UrdfShapeError
+from pendverify.robot.packages import PACKAGE_SCHEME, resolve_uri
 from pendverify.robot.xml_reading import parse_xml
 
 #: namespace URIs that mark an element or attribute as xacro's (ElementTree spells them {uri}tag)
@@ -60,9 +67,20 @@ def expand_xacro(text: str, path: Path | None, source: str) -> tuple[str, list[s
         import xacro
     except ImportError:  # pragma: no cover - a dependency of pendverify
         raise UrdfShapeError(source, "a xacro file, but the 'xacro' package is not installed") from None
+    from xacro import substitution_args
+
     printed = io.StringIO()
     with _LOCK:
+        xacro_find, xacro_filename = substitution_args._eval_find, xacro.abs_filename_spec
+
+        def find(name: str) -> str:
+            return resolve_uri(f"{PACKAGE_SCHEME}{name}", source).rstrip("/")
+
+        def filename(spec: str) -> str:
+            return resolve_uri(spec, source) if spec.startswith(PACKAGE_SCHEME) else xacro_filename(spec)
+
         try:
+            substitution_args._eval_find, xacro.abs_filename_spec = find, filename
             with contextlib.redirect_stdout(printed), contextlib.redirect_stderr(printed):
                 xacro.init_stacks(None if path is None else str(path))
                 xacro.all_includes = []
@@ -70,8 +88,11 @@ def expand_xacro(text: str, path: Path | None, source: str) -> tuple[str, list[s
                 xacro.process_doc(doc)
         except Exception as exc:  # xacro's errors, including the evaluation of ${...} expressions
             where = _included_file(xacro, path)
-            raise UrdfShapeError(source, f"xacro cannot expand it{where}: {_reason(exc)}") from None
+            package = _package_error(exc)  # a package not found: its own sentence, whole
+            reason = _reason(exc) if package is None else package.problem
+            raise UrdfShapeError(source, f"xacro cannot expand it{where}: {reason}") from None
         finally:
+            substitution_args._eval_find, xacro.abs_filename_spec = xacro_find, xacro_filename
             xacro.init_stacks(None)
     origin = "XML text" if path is None else Path(path).name
     doc.insertBefore(
@@ -90,11 +111,16 @@ def _included_file(xacro, path: Path | None) -> str:
     return ""
 
 
+def _package_error(exc: BaseException | None) -> UrdfShapeError | None:
+    """The ``UrdfShapeError`` of an unknown package that xacro wrapped (in ``XacroException.exc``)."""
+    seen = 0
+    while exc is not None and seen < 20:
+        if isinstance(exc, UrdfShapeError):
+            return exc
+        exc, seen = getattr(exc, "exc", None) or exc.__cause__ or exc.__context__, seen + 1
+    return None
+
+
 def _reason(exc: Exception) -> str:
     message = " ".join(str(exc).split()) or type(exc).__name__
-    if "ament_index_python" in message:
-        return (
-            "it uses $(find PKG), which needs ROS's package index (ament_index_python), not installed here: "
-            "expand it in a ROS environment (xacro FILE > FILE.urdf) and give the URDF"
-        )
     return shortened(message, REASON_WIDTH)

@@ -114,7 +114,7 @@ class Run:
             "scene_file": s.source,
             "model": s.model,
             **({"model_file": s.model_file} if s.model_file else {}),
-            **({"urdf": self.dynamics.urdf} if self.dynamics.urdf else {}),
+            **({"urdf": _urdf_name(self.dynamics.urdf)} if self.dynamics.urdf else {}),
             "parameters": s.params.as_dict(),
             "parameters_source": s.params_source,
             "engine": self.engine,
@@ -156,6 +156,11 @@ class Run:
         data = np.column_stack([self.t, self.q, self.v, self.u, self.w, self.energy])
         lines = [",".join(cols)] + [",".join(repr(float(x)) for x in row) for row in data]
         return "\n".join(lines) + "\n"
+
+
+def _urdf_name(urdf) -> str:
+    """The metadata's ``urdf``: a path or text as given; for a Pinocchio object, its source."""
+    return urdf if isinstance(urdf, str) else urdf.source
 
 
 def _breakpoints(scene: Scene) -> list[float]:
