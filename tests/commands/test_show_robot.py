@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 from pendverify import api
 from pendverify.cli import main
 
@@ -64,3 +66,18 @@ def test_a_missing_robot_file_is_one_line(tmp_path, capsys):
     assert main(["show", "--robot", str(tmp_path / "nope.urdf")]) == 2
     err = capsys.readouterr().err
     assert "nope.urdf" in err and "file not found" in err and "Traceback" not in err
+
+
+def test_an_mjcfs_numbers_say_what_mujoco_made_of_them(capsys):
+    """gymnasium's double pendulum on a cart: inertias from geoms, damping from the default
+    class, and its gravity vector as written (1e-5 along x)."""
+    gymnasium = pytest.importorskip("gymnasium")
+    path = Path(gymnasium.__file__).parent / "envs" / "mujoco" / "assets" / "inverted_double_pendulum.xml"
+    assert main(["show", "--robot", str(path)]) == 0
+    out = capsys.readouterr().out
+    table = rows(out)
+    assert "(MJCF)" in out.splitlines()[0]
+    assert "gravity: 1e-05 0 -9.81 m/s² (written in the file)" in out
+    assert table[("hinge", "mass")].endswith("computed by MuJoCo from geoms")
+    assert table[("hinge", "damping")].endswith("from default class 'main'")
+    assert table[("hinge2", "frame")].split()[1:4] == ["0", "0", "0.6"]

@@ -256,3 +256,57 @@ def test_an_unnamed_joint_gets_a_name_and_a_ref_is_the_pose_as_written():
     data = loaded.model.createData()
     pin.forwardKinematics(loaded.model, data, np.zeros(1))  # q = qpos − ref: the pose as written
     assert np.allclose(data.oMi[1].rotation, np.eye(3), atol=1e-15)
+
+
+def _model_file(folder: Path, model: type) -> Path:
+    """A model file holding the hand model (certify embeds a model file's text)."""
+    path = folder / f"{model.name}.py"
+    path.write_text(
+        f"from tests.robot.mjcf_hand_models import {model.__name__} as HandModel\n\n\n"
+        f"class {model.__name__}File(HandModel):\n    pass\n"
+    )
+    return path
+
+
+def _params_file(folder: Path, model: type, values: dict[str, float]) -> Path:
+    path = folder / f"{model.name}.toml"
+    lines = [f'model = "{model.name}"', f'name = "{model.name}"', "", "[parameters]"]
+    lines += [f"{key} = {float(value)!r}" for key, value in values.items()]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_a_shipped_mujoco_file_is_drawn_with_its_geoms_on_each_moving_body(case):
+    from pendverify.viz.geometry import VisualSystem
+
+    path, model, _, _ = CASES[case]
+    visuals = VisualSystem.for_model(model, str(path))
+    drawn = {o.parentJoint for o in visuals.objects}
+    assert set(range(1, visuals.system.model.njoints)) <= drawn, f"{case}: joints drawn {drawn}"
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_a_shipped_mujoco_file_is_certified_and_rechecked(tmp_path, case):
+    """certify bundles the MJCF with its includes in place, and recheck reads that bundle back."""
+    path, model, params, mass = CASES[case]
+    model_file = _model_file(tmp_path, model)
+    issued = api.certify_set(
+        tmp_path / "out",
+        urdf=path,
+        urdf_params=_params_file(tmp_path, model, params()),
+        analytic=model_file,
+        samples=20,
+    )
+    assert issued.certified, f"{case}: {[(i.name, i.status) for i in issued.items]}"
+    assert api.recheck(issued.path, run_embedded_code=True).passed
+    wrong = params()
+    wrong[mass] *= 1.01
+    refused = api.certify_set(
+        tmp_path / "wrong",
+        urdf=path,
+        urdf_params=_params_file(tmp_path, model, wrong),
+        analytic=model_file,
+        samples=20,
+    )
+    assert not refused.certified

@@ -87,17 +87,22 @@ def carried_over(mj: mujoco.MjModel, source: str) -> str:
     return _not_carried_note(mj)
 
 
+def _count(n: int, noun: str) -> str:
+    """ "1 geom", "5 geoms": a count with its noun."""
+    return f"{n} {noun}{'s' if n != 1 else ''}"
+
+
 def _not_carried_note(mj: mujoco.MjModel) -> str:
     parts = []
     limited = [joint_name(mj, j) for j in range(mj.njnt) if mj.jnt_limited[j]]
     if limited:
         parts.append(f"the limits of {', '.join(limited)}")
     if mj.ngeom:
-        parts.append(f"{mj.ngeom} geoms' contacts (their shapes are drawn by render)")
+        parts.append(f"the contacts of {_count(mj.ngeom, 'geom')} (their shapes are drawn by render)")
     if mj.nu:
-        parts.append(f"{mj.nu} actuators' own dynamics (the hand model's B is its own)")
+        parts.append(f"the own dynamics of {_count(mj.nu, 'actuator')} (the hand model's B is its own)")
     if mj.nsensor:
-        parts.append(f"{mj.nsensor} sensors")
+        parts.append(_count(mj.nsensor, "sensor"))
     if mj.ntendon:
         parts.append(f"{mj.ntendon} tendons without inertia or stiffness")
     if not parts:

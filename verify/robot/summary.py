@@ -160,12 +160,13 @@ def _body_frame(model: pin.Model, j: int) -> int | None:
 
 
 def _gravity(loaded: LoadedDescription) -> Quantity | None:
-    own = loaded.facts.gravity
-    if own is None:
+    facts = loaded.facts
+    if facts.gravity_vector is not None:
+        vector = np.asarray(facts.gravity_vector, dtype=float)
+    elif facts.gravity is not None:  # a scalar g: the description's gravity along −z
+        vector = np.array([0.0, 0.0, -float(facts.gravity)])
+    else:
         return None
-    vector = np.atleast_1d(np.asarray(own, dtype=float))
-    if vector.size == 1:  # a scalar g: the description's gravity along −z
-        vector = np.array([0.0, 0.0, -float(vector[0])])
     recorded = getattr(loaded, "origins", None) or {}
     origin = recorded.get("gravity", DEFAULT_ORIGINS.get(loaded.format, "read from the file"))
     return Quantity("gravity", tuple(float(x) for x in vector), "m/s²", origin)
