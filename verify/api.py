@@ -246,6 +246,16 @@ def _urdf_arg(urdf: UrdfLike) -> str | LoadedDescription:
     return str(urdf)
 
 
+def _urdf_file_arg(urdf: UrdfLike, command: str) -> str:
+    """A URDF that ``command`` re-reads by name (a file path or XML text); a Pinocchio object is refused."""
+    if is_pinocchio_object(urdf):
+        raise PendverifyError(
+            f"{command} takes the URDF as a file path or its XML text (it reads the description again "
+            f"for each case); got a {type(urdf).__name__}: give the file the model was built from"
+        )
+    return str(_urdf_arg(urdf))
+
+
 def _count(key: str, value: Any) -> int:
     if isinstance(value, bool) or not isinstance(value, int) or value < 0:
         raise InputError(OPTIONS_SOURCE, key, value, "must be an integer >= 0")
@@ -495,7 +505,9 @@ def _model_targets(model: str | Path | None, urdf: str | Path | None, params: st
         return [default_target(name) for name in ([model] if model else MODELS)]
     return [
         plugin_target(
-            str(model), None if urdf is None else str(urdf), None if params is None else str(params)
+            str(model),
+            None if urdf is None else _urdf_file_arg(urdf, "mutate"),
+            None if params is None else str(params),
         )
     ]
 
@@ -607,7 +619,7 @@ def stress(
 
         if urdf is None or params is None:
             raise PendverifyError(f"{model}: a model file needs its urdf and params")
-        return run_generic(str(model), str(urdf), str(params), settings, cases, seed)
+        return run_generic(str(model), _urdf_file_arg(urdf, "stress"), str(params), settings, cases, seed)
     if urdf is not None or params is not None:
         raise PendverifyError("urdf and params go with a model file")
     for name in cases or ():

@@ -129,3 +129,10 @@ def test_a_certificate_embeds_the_urdf_text_only_when_it_builds_the_model(robot,
 
 def test_the_lazy_package_names_the_api():
     assert pendverify.ros_packages is api.ros_packages
+
+
+@pytest.mark.parametrize("command", ["stress", "mutate"])
+def test_commands_that_reread_the_file_refuse_a_model_saying_so(robot, command):
+    model = Path(__file__).resolve().parents[2] / "examples" / "minimal_double_pendulum.py"
+    with pytest.raises(PendverifyError, match=f"{command} takes the URDF as a file path"):
+        getattr(api, command)(model=model, urdf=robot.model, params=model.with_suffix(".toml"))
