@@ -31,6 +31,7 @@ import pinocchio as pin
 from pendverify.analytic import ParameterSet
 from pendverify.robot.mjcf import mjcf_visuals
 from pendverify.robot.packages import resolve_package_uris
+from pendverify.robot.sdf_visuals import sdf_visuals
 from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
 
@@ -106,6 +107,8 @@ class VisualSystem:
             visual_model = loaded.visual_model.copy()
         elif loaded.format == "mjcf":
             visual_model = mjcf_visuals(system.model, loaded.text, loaded.source)
+        elif loaded.format == "sdf":
+            visual_model = sdf_visuals(system.model, loaded.text)
         else:
             visual_model = _urdf_visuals(system.model, loaded.text, loaded.source)
         return cls(system, visual_model, visual_model.createData(), loaded.text)

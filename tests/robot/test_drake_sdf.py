@@ -151,3 +151,59 @@ def test_the_cross_check_tolerance_is_rounding_sized():
     """The cross-check's tolerance is ~1e-12 of the terms' scale: far below any modelling error."""
     n = 2
     assert sdf_drake.CROSS_CHECK_ULPS * n * np.finfo(float).eps < 1e-12
+
+
+#: each case's hand model as a model file (certify embeds a model file's text)
+MODEL_FILES = {
+    "cart_pole": (
+        "from pendverify.examples.cart_pole import CartPole\n\n\n"
+        "class DrakeCartPole(CartPole):\n"
+        '    urdf_joints = ("CartSlider", "PolePin")\n'
+    ),
+    "acrobot": (
+        "from pendverify.examples.hanging_double_pendulum import HangingDoublePendulum\n\n\n"
+        "class DrakeAcrobot(HangingDoublePendulum):\n"
+        '    urdf_joints = ("shoulder", "elbow")\n'
+        "    joint_transform = ((1.0, 0.0), (-1.0, 1.0))\n"
+        "    joint_offset = (0.0, 0.0)\n"
+    ),
+}
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_drakes_example_is_drawn_with_its_visual_geometry(case):
+    from pendverify.viz.geometry import VisualSystem
+
+    model, path, _, _ = CASES[case]
+    visuals = VisualSystem.for_model(model, path)
+    drawn = {o.parentJoint for o in visuals.objects}
+    assert set(range(1, visuals.system.model.njoints)) <= drawn, f"{case}: joints drawn {drawn}"
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_drakes_example_is_certified_and_rechecked(tmp_path, case):
+    model, path, params, mass = CASES[case]
+    model_file = tmp_path / f"drake_{case}.py"
+    model_file.write_text(MODEL_FILES[case])
+
+    def params_file(values: dict[str, float], name: str) -> Path:
+        out = tmp_path / f"{name}.toml"
+        lines = [f'model = "{model.name}"', f'name = "{model.name}"', "", "[parameters]"]
+        out.write_text("\n".join(lines + [f"{k} = {float(v)!r}" for k, v in values.items()]) + "\n")
+        return out
+
+    issued = api.certify_set(
+        tmp_path / "out", urdf=path, urdf_params=params_file(params, "right"), analytic=model_file, samples=20
+    )
+    assert issued.certified, f"{case}: {[(i.name, i.status) for i in issued.items]}"
+    assert (issued.path.parent / Path(path).name).read_text() == Path(path).read_text()
+    assert api.recheck(issued.path, run_embedded_code=True).passed
+    wrong = {**params, mass: params[mass] * 1.01}
+    refused = api.certify_set(
+        tmp_path / "wrong",
+        urdf=path,
+        urdf_params=params_file(wrong, "wrong"),
+        analytic=model_file,
+        samples=20,
+    )
+    assert not refused.certified

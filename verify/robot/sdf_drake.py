@@ -81,7 +81,7 @@ def build_from_drake(text: str, source: str) -> tuple[pin.Model, list[str]]:
     """(Pinocchio model, Drake's log lines) of an SDFormat document; see the module docstring."""
     Parser, MultibodyPlant = import_drake(source)
     plant = MultibodyPlant(0.0)
-    with _captured_drake_log() as log:
+    with captured_drake_log() as log:
         try:
             Parser(plant).AddModelsFromString(text, "sdf")
             plant.Finalize()
@@ -120,13 +120,14 @@ def _pinocchio_model(plant, source: str) -> tuple[pin.Model, list]:
         for joint in ready:
             pending.remove(joint)
             parent_joint, X_JP = carried[int(joint.parent_body().index())]
-            X_PF = _se3(joint.frame_on_parent().GetFixedPoseInBodyFrame())
-            X_CM = _se3(joint.frame_on_child().GetFixedPoseInBodyFrame())
+            X_PF = se3(joint.frame_on_parent().GetFixedPoseInBodyFrame())
+            X_CM = se3(joint.frame_on_child().GetFixedPoseInBodyFrame())
             child = joint.child_body()
             kind = joint.type_name()
             if kind == "weld":
-                X_JC = X_JP * X_PF * _se3(joint.X_FM()) * X_CM.inverse()
+                X_JC = X_JP * X_PF * se3(joint.X_FM()) * X_CM.inverse()
                 carried[int(child.index())] = (parent_joint, X_JC)
+                model.addBodyFrame(child.name(), parent_joint, X_JC, -1)  # where its visuals hang
                 if parent_joint != 0:
                     model.appendBodyToJoint(parent_joint, _inertia(child, X_JC), pin.SE3.Identity())
                 continue
@@ -162,7 +163,7 @@ def _pinocchio_model(plant, source: str) -> tuple[pin.Model, list]:
     return model, order
 
 
-def _se3(pose) -> pin.SE3:
+def se3(pose) -> pin.SE3:
     matrix = pose.GetAsMatrix4()
     return pin.SE3(np.array(matrix[:3, :3]), np.array(matrix[:3, 3]))
 
@@ -256,7 +257,7 @@ class _Collect(logging.Handler):
 
 
 @contextmanager
-def _captured_drake_log():
+def captured_drake_log():
     """Records of Python's ``drake`` logger (pydrake's spdlog sink) as lines, kept from the terminal:
     the logger's own handlers (pydrake may add one) are set aside meanwhile."""
     logger = logging.getLogger("drake")
