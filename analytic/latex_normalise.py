@@ -10,7 +10,19 @@ can point at the LaTeX the user wrote.
 from __future__ import annotations
 
 import re
+import unicodedata
 
+#: Unicode letters read as their LaTeX commands (φ and ϕ both as \\phi, as a reader reads them)
+UNICODE = dict(
+    zip(
+        "αβγδεζηθϑικλμνξπρσςτυφϕχψωΓΔΘΛΞΠΣΥΦΨΩ",
+        "alpha beta gamma delta epsilon zeta eta theta vartheta iota kappa lambda mu nu xi pi rho sigma "
+        "varsigma tau upsilon phi phi chi psi omega Gamma Delta Theta Lambda Xi Pi Sigma Upsilon Phi Psi "
+        "Omega".split(),
+        strict=True,
+    )
+)
+_SUBSCRIPT_DIGITS = str.maketrans("₀₁₂₃₄₅₆₇₈₉", "0123456789")
 _FONTS = r"mathbf|boldsymbol|bm|mathrm|mathit|mathsf|mathnormal|text"
 _SPACING = r"(?<!\\)\\[,;:! ]|\\q?quad\b|~|\\left\.|\\right\.|\\displaystyle\b"
 _OPEN = r"\\left\s*\(|\\left\s*\[|\\left\s*\\\{|\\[bB]ig+l?\s*[(\[]|\\[bB]ig+l?\s*\\\{|\[|\\\{"
@@ -92,6 +104,7 @@ class Stop(Exception):
 def normalise(text: str) -> Text:
     """The canonical form the grammar reads (module docstring), positions kept."""
     t = Text(text)
+    _unicode(t)
     t.sub(_SPACING, " ")
     t.sub(_OPEN, "(")
     t.sub(_CLOSE, ")")
@@ -107,6 +120,18 @@ def normalise(text: str) -> Text:
     t.sub(r"\^\s*(\w)", r"^{\1}")  # powers always braced
     t.sub(r"\s+", " ")
     return t
+
+
+def _unicode(t: Text) -> None:
+    """θ → \\theta, θ₁ → \\theta_1, ẋ (x and a combining dot) → \\dot{x}, ẍ → \\ddot{x}."""
+    t.sub(r"[^\x00-\x7f]", lambda m: unicodedata.normalize("NFD", m.group()))
+    letters = "".join(UNICODE)
+    t.sub(
+        rf"([{letters}])(?=([A-Za-z])?)", lambda m: "\\" + UNICODE[m.group(1)] + (" " if m.group(2) else "")
+    )
+    t.sub(r"([₀-₉]+)", lambda m: "_{" + m.group(1).translate(_SUBSCRIPT_DIGITS) + "}")
+    t.sub(r"(\\[A-Za-z]+|[A-Za-z])\s*\u0307", r"\\dot{\1}")
+    t.sub(r"(\\[A-Za-z]+|[A-Za-z])\s*\u0308", r"\\ddot{\1}")
 
 
 def canonical_symbol(key: str) -> str:

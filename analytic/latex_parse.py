@@ -33,7 +33,7 @@ Anything else is an error that shows the LaTeX and where reading stopped.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import sympy as sp
 from lark import Lark, Token, Transformer, v_args
@@ -87,6 +87,8 @@ class SymbolTable:
 
     entries: dict[str, sp.Expr]
     source: dict[str, str]  # canonical → the key as the file wrote it
+    #: the entries read by convention (``latex_names``), not written in the file's table
+    conventional: dict[str, object] = field(default_factory=dict)
 
     def grammar(self) -> str:
         # longest first, so that m_1 is read before m; a bare command (\\alpha) must end there
@@ -100,15 +102,17 @@ class SymbolTable:
 
 @v_args(inline=True)
 class _ToSympy(Transformer):
-    def __init__(self, table: SymbolTable):
+    def __init__(self, table: SymbolTable, used: dict):
         super().__init__()
-        self.table = table
+        self.table, self.used = table, used
 
     def number(self, tok):
         return limits.literal(str(tok))
 
     def symbol(self, tok):
-        return self.table.entries[str(tok).replace(" ", "")]
+        key = str(tok).replace(" ", "")
+        self.used.setdefault(key, None)
+        return self.table.entries[key]
 
     def sum(self, *items):
         """Terms with their signs (a leading sign optional), added in one flat ``Add``."""
@@ -211,6 +215,8 @@ class LatexReader:
 
     def __init__(self, table: SymbolTable):
         self.table = table
+        #: the symbols read so far, canonical LaTeX, in the order first read
+        self.used: dict[str, None] = {}
         self.parser = Lark(table.grammar(), parser="lalr", maybe_placeholders=False)
 
     def read(self, text: str) -> tuple[object, str]:
@@ -244,12 +250,16 @@ class LatexReader:
                 )
         return first, label
 
+    def conventions_used(self) -> list:
+        """The conventions (``latex_names.Convention``) the text read so far used, in order."""
+        return [self.table.conventional[k] for k in self.used if k in self.table.conventional]
+
     def _side(self, t: Text, a: int, b: int, original: str):
         piece = t.text[a:b]
         if not piece.strip():
             raise LatexError(_show(original, t.where(a), "an empty side of '='"))
         try:
-            return _ToSympy(self.table).transform(self.parser.parse(piece))
+            return _ToSympy(self.table, self.used).transform(self.parser.parse(piece))
         except UnexpectedInput as exc:
             at = t.where(a + _position(exc, piece))
             raise LatexError(_show(original, at, _why(exc, piece))) from None

@@ -69,6 +69,8 @@ class TextModelSpec:
     notation: str = "sympy"
     #: with notation = "latex": the file's [symbols] table, each LaTeX key with what it reads as
     latex_symbols: dict[str, object] = field(default_factory=dict)
+    #: with notation = "latex": the names its equations read by convention ("\\theta_1 → theta1")
+    latex_conventions: list[str] = field(default_factory=list)
     urdf_joints: tuple[str, ...] = ()
     joint_transform: tuple | None = None
     joint_offset: tuple | None = None
@@ -230,9 +232,7 @@ def _read_equations(reader: Reader, spec: TextModelSpec, data: dict) -> None:
     latex = None
     if spec.notation == "latex":
         everything = {s.name: s for g in "qvuwp" for s in spec.symbols[g]} | FUNCTIONS | CONSTANTS
-        latex = read_symbol_table(reader, data.get("symbols"), everything, parse_entry)
-        table = latex.table
-        spec.latex_symbols = {table.source[c]: value for c, value in table.entries.items()}
+        latex = read_symbol_table(reader, data.get("symbols"), everything, parse_entry, spec)
     for key, (shape, groups) in EQUATIONS.items():
         if key not in data:
             continue
@@ -243,6 +243,11 @@ def _read_equations(reader: Reader, spec: TextModelSpec, data: dict) -> None:
             spec.equations[key] = parse_latex_equation(reader, latex, key, data[key], rows, cols, allowed)
         else:
             spec.equations[key] = parse_equation(reader, key, data[key], rows, cols, allowed)
+    if latex is not None:
+        spec.latex_conventions = [str(c) for c in latex.conventions_used()]
+        table = latex.table
+        written = {table.source[c]: v for c, v in table.entries.items() if c not in table.conventional}
+        spec.latex_symbols = {c.latex: c.value for c in latex.conventions_used()} | written
 
 
 def _read_urdf(reader: Reader, spec: TextModelSpec, urdf) -> None:
