@@ -1,33 +1,49 @@
 """Read equations written in LaTeX, as they stand in a derivation, into SymPy.
 
 A text model with ``notation = "latex"`` gives its equations as LaTeX copied from
-the paper and a ``[symbols]`` table mapping the document's symbols to the model's
-names (``'\\theta_1' = "theta1"``, ``'\\dot{\\theta}_1' = "dtheta1"``, ``'m_1' = "m1"``)
-or defining them by an expression in SymPy syntax over those names
-(``'\\alpha' = "I1 + I2 + m1*r1**2 + m2*(l1**2 + r2**2)"``).
+the paper.  The names the file declares are read by convention (``m_1`` is m1,
+``\\theta_1`` theta1, ``\\dot{\\theta}_1`` dtheta1: ``pendverify.analytic.latex_names``);
+a ``[symbols]`` table maps the document's other symbols to the model's names
+(``'x_3' = "dtheta1"``) or defines them by an expression in SymPy syntax over those
+names (``'\\alpha' = "I1 + I2 + m1*r1**2 + m2*(l1**2 + r2**2)"``), and wins over the
+convention.
 
 What is read
 ------------
-* ``\\begin{bmatrix} … \\end{bmatrix}`` (and ``pmatrix``, ``Bmatrix``, ``matrix``),
-  cells split by ``&``, rows by ``\\\\``; matrix sums and products.
+* ``\\begin{bmatrix} … \\end{bmatrix}`` (and ``pmatrix``, ``Bmatrix``, ``matrix``,
+  ``array`` with its column specification), cells split by ``&``, rows by ``\\\\``
+  (``\\\\[2pt]`` too); matrix sums and products; a row ``[a, b]`` (``(a, b)``);
+  transposes ``^T``, ``^{T}``, ``^\\top``, ``^{\\mathsf{T}}`` (``^T`` is a power when the
+  table declares ``T``).
 * ``+ − \\cdot \\times * /``, ``\\frac{a}{b}``, ``\\sqrt{x}``, powers ``x^2``, ``x^{n}``;
   **implicit products** of declared symbols: ``m_1gr_1\\cos(\\theta_1)`` is
-  m1·g·r1·cos θ1 — the lexer matches the longest declared symbol first, so
-  declare every symbol the document uses.
-* ``\\sin \\cos \\tan \\exp`` with a parenthesised argument or one symbol
-  (``\\sin\\theta_1``, ``\\cos \\theta_1 \\sin \\theta_2`` is cos θ1 · sin θ2), and
-  powers of them (``\\sin^2(\\theta_1 - \\theta_2)`` is sin²(θ1 − θ2)).
+  m1·g·r1·cos θ1 — the lexer matches the longest declared symbol first.
+* ``\\sin \\cos \\tan \\exp`` (also ``\\operatorname{sin}``, ``\\mathrm{sin}``) and powers
+  of them (``\\sin^2(\\theta_1 - \\theta_2)`` is sin²(θ1 − θ2)).  **The argument of a
+  function** is what follows it in parentheses or braces; written without them it is
+  one symbol, a number times one symbol, or a ``\\frac``: ``\\sin 2\\theta_2`` is
+  sin(2θ2) (as the Furuta literature prints it), ``\\sin\\frac{\\theta}{2}`` is sin(θ/2),
+  and every factor after that argument multiplies the function: ``\\sin\\theta_1\\cos\\theta_2``
+  is sin θ1 · cos θ2 and ``\\cos\\theta\\,\\dot\\theta^2`` is cos θ · θ̇² (a product of two
+  symbols as an argument, sin(θ1θ2), must be written ``\\sin(\\theta_1\\theta_2)``).
 * ``( ) [ ] \\{ \\}`` and their ``\\left``/``\\right``/``\\bigl`` forms as grouping;
   ``\\mathbf{}``, ``\\boldsymbol{}``, ``\\bm{}``, ``\\mathrm{}`` are dropped around
   their content; ``\\underbrace{X}_{…}`` and ``\\overbrace{X}^{…}`` read as X;
   ``\\dot\\theta``, ``\\dot{\\theta_1}`` and ``\\dot{\\theta}_1`` are one symbol, as are
-  ``x_1`` and ``x_{1}``; spacing (``\\, \\; \\quad`` …) is ignored.
-* A chain ``LABEL = A = B``: a leading label of the form ``NAME(args)`` (such as
-  ``\\mathbf{M}(\\mathbf{x})`` or ``f(y,\\dot{y},u,w)``) is dropped, a leading ``=``
-  too, and every right-hand side must be read and be *equal* (the double-pendulum reference system prints each
-  matrix in θ and in x = (θ, θ̇) notation: both are read and compared).
+  ``x_1`` and ``x_{1}``, and ``θ₁`` is ``\\theta_1``; spacing (``\\, \\; \\! \\quad`` …),
+  ``\\label{…}``, ``\\nonumber``, ``\\notag``, a display's environment (``align``,
+  ``equation``, ``eqnarray`` …) or delimiters (``$$``, ``\\[ \\]``) and a closing ``,``/``.``
+  are ignored.
+* A chain ``LABEL = A = B``: a leading label — a name (a letter or command, with a
+  subscript, ⁻¹ or ᵀ) with or without its arguments, such as ``M``,
+  ``\\mathbf{M}(\\mathbf{q})``, ``\\det M`` or ``f(y,\\dot{y},u,w)`` — is dropped, a
+  leading ``=`` too; ``:=`` is ``=``; ``align``'s ``&=`` and ``eqnarray``'s ``&=&`` are ``=``
+  and a ``\\\\`` outside every matrix ends a line of the display.  Every right-hand side
+  must be read and be *equal* (the double-pendulum reference system prints each matrix in
+  θ and in x = (θ, θ̇) notation: both are read and compared).
 
-Anything else is an error that shows the LaTeX and where reading stopped.
+Anything else is an error that shows the LaTeX around the place where reading stopped,
+with a caret under it.
 """
 
 from __future__ import annotations
@@ -58,9 +74,11 @@ _GRAMMAR = r"""
 ?term: power (MULOP? power)*
 ?power: primary
     | primary "^" "{" sum "}"  -> pow
+    | primary TRANSPOSE        -> transpose
 ?primary: NUMBER          -> number
     | SYMBOL              -> symbol
     | "(" sum ")"
+    | "(" sum ("," sum)+ ")" -> listed_row
     | "{" sum "}"
     | FUNC arg            -> func
     | FUNC "^" "{" sum "}" arg -> funcpow
@@ -68,12 +86,15 @@ _GRAMMAR = r"""
     | "\\sqrt" "{" sum "}" -> sqrt
     | BEGIN rows END      -> matrix
 ?arg: "(" sum ")" | "{" sum "}" | SYMBOL -> symbol
+    | NUMBER SYMBOL -> scaled
+    | "\\frac" "{" sum "}" "{" sum "}" -> div
 rows: row (ROWSEP row)* ROWSEP?
 row: sum ("&" sum)*
 FUNC: /\\(sin|cos|tan|exp)(?![A-Za-z])/
 BEGIN: /\\begin\{[A-Za-z]+\}/
 END: /\\end\{[A-Za-z]+\}/
 ROWSEP: /\\\\/
+TRANSPOSE.3: "^{\\top}"
 SIGN: "+" | "-"
 MULOP: "*" | "/"
 NUMBER: /\d+(\.\d*)?|\.\d+/
@@ -168,6 +189,18 @@ class _ToSympy(Transformer):
     def funcpow(self, name, power, a):
         return limits.power(self.func(name, a), power)
 
+    def transpose(self, a, _):
+        return a.T if isinstance(a, sp.MatrixBase) else a
+
+    def listed_row(self, *cells):
+        """``[a, b]``: a row vector, as papers write one before its transpose."""
+        if any(isinstance(c, sp.MatrixBase) for c in cells):
+            raise ValueError("a matrix inside a row (a, b, …)")
+        return sp.Matrix([list(cells)])
+
+    def scaled(self, number, symbol):
+        return limits.checked(self.number(number) * self.symbol(symbol))
+
     def sqrt(self, a):
         return limits.checked(sp.sqrt(a))
 
@@ -191,11 +224,14 @@ class _ToSympy(Transformer):
         return sp.Matrix(rows)
 
 
-_LABEL = re.compile(r"^\s*(\\det\s*)?[A-Za-z](_\w)?\s*(\^\{-1\})?\s*\([^()=]*\)\s*$")
+#: a display's label: a name (a letter or a command, with a subscript, ⁻¹ or ᵀ) and its arguments
+_LABEL = re.compile(
+    r"^\s*(\\det\s*)?(\\[A-Za-z]+|[A-Za-z])\s*(_\w|_\{[^{}]*\})?\s*(\^\{(-1|\\top)\})?\s*(\([^()=]*\))?\s*$"
+)
 
 
 def _split_chain(t: Text) -> list[tuple[int, int]]:
-    """Spans of the sides of ``A = B = C`` at brace depth 0 (``=:`` and ``:=`` are not splits)."""
+    """Spans of the sides of ``A = B = C`` (or ``A := B``) at brace depth 0 (``=:`` is not a split)."""
     spans, depth, start = [], 0, 0
     s = t.text
     for i, c in enumerate(s):
@@ -203,8 +239,8 @@ def _split_chain(t: Text) -> list[tuple[int, int]]:
             depth += 1
         elif c in "})":
             depth -= 1
-        elif c == "=" and depth == 0 and s[i - 1 : i] != ":" and s[i + 1 : i + 2] != ":":
-            spans.append((start, i))
+        elif c == "=" and depth == 0 and s[i + 1 : i + 2] != ":":
+            spans.append((start, i - 1 if s[i - 1 : i] == ":" else i))
             start = i + 1
     spans.append((start, len(s)))
     return spans
@@ -225,7 +261,7 @@ class LatexReader:
         Raises ``LatexError`` with the LaTeX and where reading stopped.
         """
         try:
-            t = normalise(text)
+            t = normalise(text, transpose_letter="T" not in self.table.entries)
         except Stop as stop:
             raise LatexError(_show(text, stop.at, stop.why)) from None
         t.sub(r"[\s,.;]+$", "")  # a sentence's punctuation after a display
