@@ -7,8 +7,8 @@
 ``matrix``; the transposes ``^T``, ``^\\top``, ``^{\\mathsf{T}}``) to one form, removes what a
 paper's display adds around the mathematics (``\\label{…}``, ``\\nonumber``, the display's
 environment and delimiters, ``\\\\[2pt]``'s spacing, a ``\\\\`` between the lines of an
-``align``, whose ``&=`` becomes ``=``), and keeps for every character its position in the original, so that an error
-can point at the LaTeX the user wrote.
+``align``, whose ``&=`` becomes ``=``), and keeps for every character its position in the
+original, so that an error can point at the LaTeX the user wrote.
 """
 
 from __future__ import annotations
