@@ -57,7 +57,7 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput
 
 from pendverify.analytic import expression_limits as limits
 from pendverify.analytic.latex_normalise import Stop, Text, normalise
-from pendverify.errors import PendverifyError
+from pendverify.errors import ExcerptError, PendverifyError, excerpt
 
 #: commands that only typeset their argument: dropped around it
 FUNCTIONS = {"sin": sp.sin, "cos": sp.cos, "tan": sp.tan, "exp": sp.exp}
@@ -65,7 +65,14 @@ _MATRICES = ("bmatrix", "pmatrix", "Bmatrix", "matrix", "smallmatrix")
 
 
 class LatexError(PendverifyError):
-    """LaTeX that cannot be read: the message shows the text and where reading stopped."""
+    """LaTeX that cannot be read: why, and (when known) the text and the position where."""
+
+    def __init__(self, why: str, text: str | None = None, at: int | None = None):
+        self.why, self.text, self.at = why, text, at
+        pointer = ""
+        if text is not None and at is not None:
+            pointer = "\n" + ExcerptError("", *excerpt(text, at)).pointer()
+        super().__init__(why + pointer)
 
 
 _GRAMMAR = r"""
@@ -263,12 +270,15 @@ class LatexReader:
         try:
             t = normalise(text, transpose_letter="T" not in self.table.entries)
         except Stop as stop:
-            raise LatexError(_show(text, stop.at, stop.why)) from None
+            raise _stopped(text, stop.at, stop.why) from None
         t.sub(r"[\s,.;]+$", "")  # a sentence's punctuation after a display
-        try:
-            limits.check_nesting(t.text, "({", ")}")
-        except limits.ExpressionTooLarge as exc:
-            raise LatexError(f"{exc} in {_excerpt(text)}") from None
+        deep = _too_deep(t.text)
+        if deep is not None:
+            why = (
+                f"brackets nested {limits.nesting_depth(t.text, '({', ')}')} deep; "
+                f"the limit is {limits.MAX_NESTING} (a bracket opened here is one too many)"
+            )
+            raise LatexError(why, text, t.where(deep))
         sides = _split_chain(t)
         label = ""
         if len(sides) > 1 and not t.text[slice(*sides[0])].strip():
@@ -293,12 +303,12 @@ class LatexReader:
     def _side(self, t: Text, a: int, b: int, original: str):
         piece = t.text[a:b]
         if not piece.strip():
-            raise LatexError(_show(original, t.where(a), "an empty side of '='"))
+            raise _stopped(original, t.where(a), "an empty side of '='")
         try:
             return _ToSympy(self.table, self.used).transform(self.parser.parse(piece))
         except UnexpectedInput as exc:
             at = t.where(a + _position(exc, piece))
-            raise LatexError(_show(original, at, _why(exc, piece))) from None
+            raise _stopped(original, at, _why(exc, piece, original[at : at + 1])) from None
         except VisitError as exc:
             raise LatexError(f"{exc.orig_exc} in {_excerpt(original)}") from None
 
@@ -313,11 +323,28 @@ def _position(exc: UnexpectedInput, piece: str) -> int:
     return len(piece)
 
 
-def _why(exc: UnexpectedInput, piece: str) -> str:
+def _why(exc: UnexpectedInput, piece: str, written: str) -> str:
+    """What stopped the reading, and the fix when one is known; ``written``: the original character."""
     if isinstance(exc, UnexpectedCharacters):
-        m = re.match(r"\\[A-Za-z]+|[A-Za-z](_\w|_\{[^}]*\})?", piece[exc.pos_in_stream :])
+        rest = piece[exc.pos_in_stream :]
+        m = re.match(r"\\[A-Za-z]+|[A-Za-z](_\w|_\{[^}]*\})?", rest)
+        if m and written and not written.isascii():
+            return (
+                f"unknown symbol '{written}' (read as {m.group(0)}): declare it (a coordinate or "
+                f"parameter {m.group(0).lstrip(chr(92))}) or write it in [symbols] as '{m.group(0)}'"
+            )
+        if re.match(r"\\ddot\b", rest):
+            return (
+                "an acceleration (\\ddot) of no declared coordinate: this is an equation of motion; "
+                "give it under `equations`"
+            )
         if m:
-            return f"unknown symbol or command '{m.group(0)}' (declare symbols in [symbols])"
+            return (
+                f"unknown symbol or command '{m.group(0)}': declare it (a coordinate, input or "
+                "parameter) or give it in [symbols]"
+            )
+        if not written.isascii():
+            return f"unexpected '{written}': write it in LaTeX (a Greek letter as \\theta, …)"
         return f"unexpected '{piece[exc.pos_in_stream]}'"
     if isinstance(exc, UnexpectedEOF) or (isinstance(exc, UnexpectedToken) and exc.token.type == "$END"):
         return "the text ends too early (an unclosed bracket or a missing operand?)"
@@ -328,12 +355,21 @@ def _why(exc: UnexpectedInput, piece: str) -> str:
     return f"unexpected '{exc.token}'{hint}"
 
 
-def _show(text: str, at: int, why: str) -> str:
-    before, after = text[max(0, at - 40) : at], text[at : at + 30]
-    return (
-        f"cannot read the LaTeX at character {at + 1}: {why}: "
-        f"{'…' if at > 40 else ''}{before} ⟨stopped here⟩ {after}{'…' if at + 30 < len(text) else ''}"
-    ).replace("\n", " ")
+def _stopped(text: str, at: int, why: str) -> LatexError:
+    return LatexError(f"cannot read the LaTeX at character {at + 1}: {why}", text, at)
+
+
+def _too_deep(text: str) -> int | None:
+    """The position of the first bracket that opens beyond ``MAX_NESTING`` levels, or None."""
+    depth = 0
+    for i, c in enumerate(text):
+        if c in "({":
+            depth += 1
+            if depth > limits.MAX_NESTING:
+                return i
+        elif c in ")}":
+            depth -= 1
+    return None
 
 
 def _excerpt(text: str) -> str:

@@ -61,7 +61,9 @@ def parse_latex_equation(reader, latex: LatexReader, key: str, value, rows: int,
         try:
             return latex.read(text)[0]
         except LatexError as exc:
-            reader.fail(k, str(exc))
+            if exc.at is None:
+                reader.fail(k, exc.why)
+            reader.fail_at(k, exc.why, exc.text, exc.at)
 
     if isinstance(value, list):
         if cols is None or rows == 0:

@@ -36,7 +36,7 @@ from pendverify.analytic.params import read_toml
 from pendverify.analytic.text_expression import FUNCTIONS, ExpressionError, fragment, read_expression
 from pendverify.analytic.text_model_latex import parse_latex_equation, read_symbol_table
 from pendverify.display import shortened
-from pendverify.errors import PendverifyError
+from pendverify.errors import ExcerptError, PendverifyError, excerpt
 
 CONSTANTS = {"pi": sp.pi}
 TOP_KEYS = (
@@ -83,6 +83,10 @@ class Reader:
     def fail(self, key: str, problem: str):
         raise PendverifyError(f"{self.path}: key '{shortened(key, 80)}': {problem}")
 
+    def fail_at(self, key: str, problem: str, text: str, at: int):
+        """The problem at position ``at`` of the key's ``text``: one error with a caret under it."""
+        raise ExcerptError(f"{self.path}: key '{shortened(key, 80)}': {problem}", *excerpt(text, at))
+
     def names(self, data: dict, key: str) -> tuple[str, ...]:
         value = data.get(key, [])
         if not isinstance(value, list) or not all(isinstance(x, str) for x in value):
@@ -122,7 +126,7 @@ def parse_entry(reader: Reader, key: str, value, allowed: dict):
     try:
         expr = read_expression(text, allowed)
     except ExpressionError as exc:
-        reader.fail(key, f"{exc.why}, at character {exc.at + 1} of {fragment(text, exc.at)}")
+        reader.fail_at(key, f"{exc.why}, at character {exc.at + 1}", text, exc.at)
     if expr.has(sp.zoo, sp.oo, sp.nan):
         reader.fail(key, f"{fragment(text, 0)} is not finite")
     return expr
