@@ -55,15 +55,27 @@ def read_symbol_table(reader, table, allowed: dict, parse_entry, spec) -> LatexR
 def parse_latex_equation(reader, latex: LatexReader, key: str, value, rows: int, cols: int | None, allowed):
     """One equation in LaTeX: a matrix (rows × cols), a column vector (cols None) or a scalar (rows 0)."""
 
+    read_as_ddot = {c.value for c in latex.table.conventional.values() if c.latex.startswith("\\ddot")}
+
     def read(k: str, text):
         if not isinstance(text, str):
             reader.fail(k, f"must be LaTeX, as a string, got {shortened(repr(text), 60)}")
         try:
-            return latex.read(text)[0]
+            value = latex.read(text)[0]
         except LatexError as exc:
             if exc.at is None:
                 reader.fail(k, exc.why)
             reader.fail_at(k, exc.why, exc.text, exc.at)
+        if value.free_symbols & read_as_ddot and not (set(allowed.values()) >= read_as_ddot):
+            where = re.search(r"\\ddot|\u0308|[ẍÿ]", text)
+            reader.fail_at(
+                k,
+                "an acceleration (\\ddot): this is an equation of motion, not "
+                f"{key}; give it under `equations`",
+                text,
+                where.start() if where else 0,
+            )
+        return value
 
     if isinstance(value, list):
         if cols is None or rows == 0:
@@ -93,7 +105,6 @@ def parse_latex_equation(reader, latex: LatexReader, key: str, value, rows: int,
                 key, f"wrong shape: the LaTeX gives {given}; with {rows} coordinates {key} must be {kind}"
             )
     stray = parsed.free_symbols - set(allowed.values())
-    read_as_ddot = {c.value for c in latex.table.conventional.values() if c.latex.startswith("\\ddot")}
     accelerations = sorted(s.name for s in stray & read_as_ddot)
     if accelerations:
         reader.fail(

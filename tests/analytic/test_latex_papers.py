@@ -19,6 +19,8 @@ from pathlib import Path
 import pytest
 
 from pendverify import api
+from pendverify.cli import main
+from tests.error_message import one_error
 
 REPO = Path(__file__).resolve().parents[2]
 URDF = REPO / "urdf" / "double_pendulum.urdf"
@@ -120,3 +122,48 @@ def test_a_typo_in_a_paper_display_fails_its_check(key, old, new, check, tmp_pat
     rows = {r.check: r for r in report.results}
     assert rows[check].status.lower() == "fail"
     assert not report.passed
+
+
+# --- a malformed display: one error, the fragment, a caret under the place -------------------------
+@pytest.mark.parametrize(
+    "key, old, new, offender, words",
+    [
+        # an undeclared Greek letter
+        ("M", r"\alpha + 2\beta\cos\theta_2 &", r"\alpha + 2\beta\cos\vartheta_2 &", r"\vartheta",
+         ["unknown symbol or command '\\vartheta'", "declare it"]),
+        # an undeclared Unicode letter: read as its command, the fix named
+        ("M", r"\delta + \beta c_2 \\[2pt]", r"\delta + \beta\cos φ \\[2pt]", "φ",
+         ["unknown symbol 'φ' (read as \\phi)", "declare it"]),
+        # an equation of motion pasted as a part
+        ("det_M", r"\alpha\delta -", r"\alpha\delta\ddot{\theta}_1 -", r"\ddot",
+         ["this is an equation of motion", "under `equations`"]),
+        # a bracket closed twice
+        ("det_M", r"(1 + \cos 2\theta_2)", r"(1 + \cos 2\theta_2) m_2)", ")",
+         ["unexpected ')'"]),
+        # a transpose of nothing
+        ("B", r"\end{bmatrix}^\top", r"\end{bmatrix} + ^\top", "^", ["unexpected"]),
+    ],
+)  # fmt: skip
+def test_a_malformed_display_is_one_error_with_a_caret_under_the_place(
+    key, old, new, offender, words, tmp_path, capsys
+):
+    displays = dict(DISPLAYS)
+    assert old in displays[key]
+    displays[key] = displays[key].replace(old, new)
+    code = main(["show", str(_file(tmp_path, displays))])
+    err = capsys.readouterr().err
+    assert code == 2
+    headline, fragment, column = one_error(err)
+    assert f"key '{key}'" in headline
+    for word in words:
+        assert word in headline, headline
+    assert fragment[column:].startswith(offender), (fragment, column)
+
+
+def test_2000_nested_brackets_show_a_short_fragment_with_a_caret(tmp_path, capsys):
+    displays = dict(DISPLAYS)
+    displays["det_M"] = "m_1" + r"\sin(" * 2000 + "m_1" + ")" * 2000
+    code = main(["show", str(_file(tmp_path, displays))])
+    headline, fragment, column = one_error(capsys.readouterr().err)
+    assert code == 2 and "2000 deep" in headline and "limit is 100" in headline
+    assert len(fragment) <= 82 and fragment[column] == "("
