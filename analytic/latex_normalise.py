@@ -2,15 +2,31 @@
 
 ``normalise`` rewrites what only typesets (spacing, ``\\left``/``\\right``, fonts,
 ``\\underbrace``) and the spellings of one thing (``x_{1}`` and ``x_1``; ``\\dot\\theta``,
-``\\dot{\\theta_1}`` and ``\\dot{\\theta}_1``; ``[ ]`` and ``\\{ \\}`` as parentheses) to one
-form, and keeps for every character its position in the original, so that an error
-can point at the LaTeX the user wrote.
+``\\dot{\\theta_1}`` and ``\\dot{\\theta}_1``; ``[ ]`` and ``\\{ \\}`` as parentheses; ``θ₁`` and
+``\\theta_1``; ``ẋ`` and ``\\dot{x}``; ``\\operatorname{sin}`` and ``\\sin``; ``array`` and
+``matrix``; the transposes ``^T``, ``^\\top``, ``^{\\mathsf{T}}``) to one form, removes what a
+paper's display adds around the mathematics (``\\label{…}``, ``\\nonumber``, the display's
+environment and delimiters, ``\\\\[2pt]``'s spacing, a ``\\\\`` between the lines of an
+``align``, whose ``&=`` becomes ``=``), and keeps for every character its position in the
+original, so that an error can point at the LaTeX the user wrote.
 """
 
 from __future__ import annotations
 
 import re
+import unicodedata
 
+#: Unicode letters read as their LaTeX commands (φ and ϕ both as \\phi, as a reader reads them)
+UNICODE = dict(
+    zip(
+        "αβγδεζηθϑικλμνξπρσςτυφϕχψωΓΔΘΛΞΠΣΥΦΨΩ",
+        "alpha beta gamma delta epsilon zeta eta theta vartheta iota kappa lambda mu nu xi pi rho sigma "
+        "varsigma tau upsilon phi phi chi psi omega Gamma Delta Theta Lambda Xi Pi Sigma Upsilon Phi Psi "
+        "Omega".split(),
+        strict=True,
+    )
+)
+_SUBSCRIPT_DIGITS = str.maketrans("₀₁₂₃₄₅₆₇₈₉", "0123456789")
 _FONTS = r"mathbf|boldsymbol|bm|mathrm|mathit|mathsf|mathnormal|text"
 _SPACING = r"(?<!\\)\\[,;:! ]|\\q?quad\b|~|\\left\.|\\right\.|\\displaystyle\b"
 _OPEN = r"\\left\s*\(|\\left\s*\[|\\left\s*\\\{|\\[bB]ig+l?\s*[(\[]|\\[bB]ig+l?\s*\\\{|\[|\\\{"
@@ -89,9 +105,19 @@ class Stop(Exception):
         self.at, self.why = at, why
 
 
-def normalise(text: str) -> Text:
-    """The canonical form the grammar reads (module docstring), positions kept."""
+_DISPLAYS = r"equation|align|eqnarray|gather|multline|flalign|split|aligned|gathered|alignedat"
+_FUNCTION_NAMES = r"sin|cos|tan|exp"
+_MATRIX_ENVIRONMENTS = r"[bBpvV]?matrix|smallmatrix|array"
+
+
+def normalise(text: str, transpose_letter: bool = True) -> Text:
+    """The canonical form the grammar reads (module docstring), positions kept.
+
+    ``transpose_letter``: ``^T`` and ``^{T}`` are transposes (false when T is a symbol).
+    """
     t = Text(text)
+    _unicode(t)
+    _paper_layout(t)
     t.sub(_SPACING, " ")
     t.sub(_OPEN, "(")
     t.sub(_CLOSE, ")")
@@ -105,8 +131,50 @@ def normalise(text: str) -> Text:
     t.sub(r"\\(d?dot)\{\s*(\\[A-Za-z]+|[A-Za-z])\s*\}", r"\\\1{\2}")
     t.sub(r"([_^])\s*\{\s*(\w)\s*\}", r"\1\2")  # x_{1} → x_1, x^{2} → x^2
     t.sub(r"\^\s*(\w)", r"^{\1}")  # powers always braced
+    transposes = r"\^\s*\{\s*\\(?:top|intercal)\s*\}|\^\s*\\(?:top|intercal)(?![A-Za-z])"
+    t.sub(transposes + (r"|\^\{T\}" if transpose_letter else ""), r"^{\\top}")
+    t.sub(r"_\{([^{}]*)\}", lambda m: "_{" + re.sub(r"\s", "", m.group(1)) + "}")  # s_{1 + 2}
     t.sub(r"\s+", " ")
     return t
+
+
+def _paper_layout(t: Text) -> None:
+    """What a paper's display adds around the mathematics (module docstring), removed or made plain."""
+    t.sub(r"\\(?:label|tag)\*?\s*\{[^{}]*\}|\\nonumber\b|\\notag\b", " ")
+    t.sub(rf"\\(?:begin|end)\s*\{{(?:{_DISPLAYS})\*?\}}(?:\s*\{{\d+\}})?", " ")
+    t.sub(r"^\s*(?:\$\$?|\\\[)|(?:\$\$?|\\\])\s*$", " ")  # $…$, $$…$$, \[…\]
+    t.sub(r"(\\\\)\s*\[\s*-?[\d.]+\s*(?:pt|em|ex|mm|cm|in|bp|mu|sp|pc|dd)\s*\]", r"\1")  # \\[2pt]
+    t.sub(r"&\s*(:?=:?)\s*&?|(:?=:?)\s*&", lambda m: m.group(1) or m.group(2))  # &=&, &=, &:=
+    t.sub(r"(\\begin\s*\{array\})\s*\{[^{}]*\}", r"\1")  # the column specification
+    t.sub(r"\\begin\s*\{array\}", r"\\begin{matrix}")
+    t.sub(r"\\end\s*\{array\}", r"\\end{matrix}")
+    t.sub(rf"\\(?:operatorname\*?|mathrm|text)\s*\{{\s*({_FUNCTION_NAMES})\s*\}}", r"\\\1")
+    _line_breaks(t)
+
+
+def _line_breaks(t: Text) -> None:
+    """A ``\\\\`` outside every matrix ends a line of the display: it is a space."""
+    depth, spans = 0, []
+    for m in re.finditer(rf"\\(begin|end)\s*\{{(?:{_MATRIX_ENVIRONMENTS})\*?\}}|\\\\", t.text):
+        if m.group(1) == "begin":
+            depth += 1
+        elif m.group(1) == "end":
+            depth -= 1
+        elif depth == 0:
+            spans.append((m.start(), m.end()))
+    t.remove_spans(spans)
+
+
+def _unicode(t: Text) -> None:
+    """θ → \\theta, θ₁ → \\theta_1, ẋ (x and a combining dot) → \\dot{x}, ẍ → \\ddot{x}."""
+    t.sub(r"[^\x00-\x7f]", lambda m: unicodedata.normalize("NFD", m.group()))
+    letters = "".join(UNICODE)
+    t.sub(
+        rf"([{letters}])(?=([A-Za-z])?)", lambda m: "\\" + UNICODE[m.group(1)] + (" " if m.group(2) else "")
+    )
+    t.sub(r"([₀-₉]+)", lambda m: "_{" + m.group(1).translate(_SUBSCRIPT_DIGITS) + "}")
+    t.sub(r"(\\[A-Za-z]+|[A-Za-z])\s*\u0307", r"\\dot{\1}")
+    t.sub(r"(\\[A-Za-z]+|[A-Za-z])\s*\u0308", r"\\ddot{\1}")
 
 
 def canonical_symbol(key: str) -> str:

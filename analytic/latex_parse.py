@@ -1,39 +1,55 @@
 """Read equations written in LaTeX, as they stand in a derivation, into SymPy.
 
 A text model with ``notation = "latex"`` gives its equations as LaTeX copied from
-the paper and a ``[symbols]`` table mapping the document's symbols to the model's
-names (``'\\theta_1' = "theta1"``, ``'\\dot{\\theta}_1' = "dtheta1"``, ``'m_1' = "m1"``)
-or defining them by an expression in SymPy syntax over those names
-(``'\\alpha' = "I1 + I2 + m1*r1**2 + m2*(l1**2 + r2**2)"``).
+the paper.  The names the file declares are read by convention (``m_1`` is m1,
+``\\theta_1`` theta1, ``\\dot{\\theta}_1`` dtheta1: ``pendverify.analytic.latex_names``);
+a ``[symbols]`` table maps the document's other symbols to the model's names
+(``'x_3' = "dtheta1"``) or defines them by an expression in SymPy syntax over those
+names (``'\\alpha' = "I1 + I2 + m1*r1**2 + m2*(l1**2 + r2**2)"``), and wins over the
+convention.
 
 What is read
 ------------
-* ``\\begin{bmatrix} … \\end{bmatrix}`` (and ``pmatrix``, ``Bmatrix``, ``matrix``),
-  cells split by ``&``, rows by ``\\\\``; matrix sums and products.
+* ``\\begin{bmatrix} … \\end{bmatrix}`` (and ``pmatrix``, ``Bmatrix``, ``matrix``,
+  ``array`` with its column specification), cells split by ``&``, rows by ``\\\\``
+  (``\\\\[2pt]`` too); matrix sums and products; a row ``[a, b]`` (``(a, b)``);
+  transposes ``^T``, ``^{T}``, ``^\\top``, ``^{\\mathsf{T}}`` (``^T`` is a power when the
+  table declares ``T``).
 * ``+ − \\cdot \\times * /``, ``\\frac{a}{b}``, ``\\sqrt{x}``, powers ``x^2``, ``x^{n}``;
   **implicit products** of declared symbols: ``m_1gr_1\\cos(\\theta_1)`` is
-  m1·g·r1·cos θ1 — the lexer matches the longest declared symbol first, so
-  declare every symbol the document uses.
-* ``\\sin \\cos \\tan \\exp`` with a parenthesised argument or one symbol
-  (``\\sin\\theta_1``, ``\\cos \\theta_1 \\sin \\theta_2`` is cos θ1 · sin θ2), and
-  powers of them (``\\sin^2(\\theta_1 - \\theta_2)`` is sin²(θ1 − θ2)).
+  m1·g·r1·cos θ1 — the lexer matches the longest declared symbol first.
+* ``\\sin \\cos \\tan \\exp`` (also ``\\operatorname{sin}``, ``\\mathrm{sin}``) and powers
+  of them (``\\sin^2(\\theta_1 - \\theta_2)`` is sin²(θ1 − θ2)).  **The argument of a
+  function** is what follows it in parentheses or braces; written without them it is
+  one symbol, a number times one symbol, or a ``\\frac``: ``\\sin 2\\theta_2`` is
+  sin(2θ2) (as the Furuta literature prints it), ``\\sin\\frac{\\theta}{2}`` is sin(θ/2),
+  and every factor after that argument multiplies the function: ``\\sin\\theta_1\\cos\\theta_2``
+  is sin θ1 · cos θ2 and ``\\cos\\theta\\,\\dot\\theta^2`` is cos θ · θ̇² (a product of two
+  symbols as an argument, sin(θ1θ2), must be written ``\\sin(\\theta_1\\theta_2)``).
 * ``( ) [ ] \\{ \\}`` and their ``\\left``/``\\right``/``\\bigl`` forms as grouping;
   ``\\mathbf{}``, ``\\boldsymbol{}``, ``\\bm{}``, ``\\mathrm{}`` are dropped around
   their content; ``\\underbrace{X}_{…}`` and ``\\overbrace{X}^{…}`` read as X;
   ``\\dot\\theta``, ``\\dot{\\theta_1}`` and ``\\dot{\\theta}_1`` are one symbol, as are
-  ``x_1`` and ``x_{1}``; spacing (``\\, \\; \\quad`` …) is ignored.
-* A chain ``LABEL = A = B``: a leading label of the form ``NAME(args)`` (such as
-  ``\\mathbf{M}(\\mathbf{x})`` or ``f(y,\\dot{y},u,w)``) is dropped, a leading ``=``
-  too, and every right-hand side must be read and be *equal* (the double-pendulum reference system prints each
-  matrix in θ and in x = (θ, θ̇) notation: both are read and compared).
+  ``x_1`` and ``x_{1}``, and ``θ₁`` is ``\\theta_1``; spacing (``\\, \\; \\! \\quad`` …),
+  ``\\label{…}``, ``\\nonumber``, ``\\notag``, a display's environment (``align``,
+  ``equation``, ``eqnarray`` …) or delimiters (``$$``, ``\\[ \\]``) and a closing ``,``/``.``
+  are ignored.
+* A chain ``LABEL = A = B``: a leading label — a name (a letter or command, with a
+  subscript, ⁻¹ or ᵀ) with or without its arguments, such as ``M``,
+  ``\\mathbf{M}(\\mathbf{q})``, ``\\det M`` or ``f(y,\\dot{y},u,w)`` — is dropped, a
+  leading ``=`` too; ``:=`` is ``=``; ``align``'s ``&=`` and ``eqnarray``'s ``&=&`` are ``=``
+  and a ``\\\\`` outside every matrix ends a line of the display.  Every right-hand side
+  must be read and be *equal* (the double-pendulum reference system prints each matrix in
+  θ and in x = (θ, θ̇) notation: both are read and compared).
 
-Anything else is an error that shows the LaTeX and where reading stopped.
+Anything else is an error that shows the LaTeX around the place where reading stopped,
+with a caret under it.
 """
 
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import sympy as sp
 from lark import Lark, Token, Transformer, v_args
@@ -41,7 +57,7 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput
 
 from pendverify.analytic import expression_limits as limits
 from pendverify.analytic.latex_normalise import Stop, Text, normalise
-from pendverify.errors import PendverifyError
+from pendverify.errors import ExcerptError, PendverifyError, excerpt
 
 #: commands that only typeset their argument: dropped around it
 FUNCTIONS = {"sin": sp.sin, "cos": sp.cos, "tan": sp.tan, "exp": sp.exp}
@@ -49,7 +65,14 @@ _MATRICES = ("bmatrix", "pmatrix", "Bmatrix", "matrix", "smallmatrix")
 
 
 class LatexError(PendverifyError):
-    """LaTeX that cannot be read: the message shows the text and where reading stopped."""
+    """LaTeX that cannot be read: why, and (when known) the text and the position where."""
+
+    def __init__(self, why: str, text: str | None = None, at: int | None = None):
+        self.why, self.text, self.at = why, text, at
+        pointer = ""
+        if text is not None and at is not None:
+            pointer = "\n" + ExcerptError("", *excerpt(text, at)).pointer()
+        super().__init__(why + pointer)
 
 
 _GRAMMAR = r"""
@@ -58,9 +81,11 @@ _GRAMMAR = r"""
 ?term: power (MULOP? power)*
 ?power: primary
     | primary "^" "{" sum "}"  -> pow
+    | primary TRANSPOSE        -> transpose
 ?primary: NUMBER          -> number
     | SYMBOL              -> symbol
     | "(" sum ")"
+    | "(" sum ("," sum)+ ")" -> listed_row
     | "{" sum "}"
     | FUNC arg            -> func
     | FUNC "^" "{" sum "}" arg -> funcpow
@@ -68,12 +93,15 @@ _GRAMMAR = r"""
     | "\\sqrt" "{" sum "}" -> sqrt
     | BEGIN rows END      -> matrix
 ?arg: "(" sum ")" | "{" sum "}" | SYMBOL -> symbol
+    | NUMBER SYMBOL -> scaled
+    | "\\frac" "{" sum "}" "{" sum "}" -> div
 rows: row (ROWSEP row)* ROWSEP?
 row: sum ("&" sum)*
 FUNC: /\\(sin|cos|tan|exp)(?![A-Za-z])/
 BEGIN: /\\begin\{[A-Za-z]+\}/
 END: /\\end\{[A-Za-z]+\}/
 ROWSEP: /\\\\/
+TRANSPOSE.3: "^{\\top}"
 SIGN: "+" | "-"
 MULOP: "*" | "/"
 NUMBER: /\d+(\.\d*)?|\.\d+/
@@ -87,6 +115,8 @@ class SymbolTable:
 
     entries: dict[str, sp.Expr]
     source: dict[str, str]  # canonical → the key as the file wrote it
+    #: the entries read by convention (``latex_names``), not written in the file's table
+    conventional: dict[str, object] = field(default_factory=dict)
 
     def grammar(self) -> str:
         # longest first, so that m_1 is read before m; a bare command (\\alpha) must end there
@@ -100,15 +130,17 @@ class SymbolTable:
 
 @v_args(inline=True)
 class _ToSympy(Transformer):
-    def __init__(self, table: SymbolTable):
+    def __init__(self, table: SymbolTable, used: dict):
         super().__init__()
-        self.table = table
+        self.table, self.used = table, used
 
     def number(self, tok):
         return limits.literal(str(tok))
 
     def symbol(self, tok):
-        return self.table.entries[str(tok).replace(" ", "")]
+        key = str(tok).replace(" ", "")
+        self.used.setdefault(key, None)
+        return self.table.entries[key]
 
     def sum(self, *items):
         """Terms with their signs (a leading sign optional), added in one flat ``Add``."""
@@ -164,6 +196,18 @@ class _ToSympy(Transformer):
     def funcpow(self, name, power, a):
         return limits.power(self.func(name, a), power)
 
+    def transpose(self, a, _):
+        return a.T if isinstance(a, sp.MatrixBase) else a
+
+    def listed_row(self, *cells):
+        """``[a, b]``: a row vector, as papers write one before its transpose."""
+        if any(isinstance(c, sp.MatrixBase) for c in cells):
+            raise ValueError("a matrix inside a row (a, b, …)")
+        return sp.Matrix([list(cells)])
+
+    def scaled(self, number, symbol):
+        return limits.checked(self.number(number) * self.symbol(symbol))
+
     def sqrt(self, a):
         return limits.checked(sp.sqrt(a))
 
@@ -187,11 +231,14 @@ class _ToSympy(Transformer):
         return sp.Matrix(rows)
 
 
-_LABEL = re.compile(r"^\s*(\\det\s*)?[A-Za-z](_\w)?\s*(\^\{-1\})?\s*\([^()=]*\)\s*$")
+#: a display's label: a name (a letter or a command, with a subscript, ⁻¹ or ᵀ) and its arguments
+_LABEL = re.compile(
+    r"^\s*(\\det\s*)?(\\[A-Za-z]+|[A-Za-z])\s*(_\w|_\{[^{}]*\})?\s*(\^\{(-1|\\top)\})?\s*(\([^()=]*\))?\s*$"
+)
 
 
 def _split_chain(t: Text) -> list[tuple[int, int]]:
-    """Spans of the sides of ``A = B = C`` at brace depth 0 (``=:`` and ``:=`` are not splits)."""
+    """Spans of the sides of ``A = B = C`` (or ``A := B``) at brace depth 0 (``=:`` is not a split)."""
     spans, depth, start = [], 0, 0
     s = t.text
     for i, c in enumerate(s):
@@ -199,8 +246,8 @@ def _split_chain(t: Text) -> list[tuple[int, int]]:
             depth += 1
         elif c in "})":
             depth -= 1
-        elif c == "=" and depth == 0 and s[i - 1 : i] != ":" and s[i + 1 : i + 2] != ":":
-            spans.append((start, i))
+        elif c == "=" and depth == 0 and s[i + 1 : i + 2] != ":":
+            spans.append((start, i - 1 if s[i - 1 : i] == ":" else i))
             start = i + 1
     spans.append((start, len(s)))
     return spans
@@ -211,6 +258,8 @@ class LatexReader:
 
     def __init__(self, table: SymbolTable):
         self.table = table
+        #: the symbols read so far, canonical LaTeX, in the order first read
+        self.used: dict[str, None] = {}
         self.parser = Lark(table.grammar(), parser="lalr", maybe_placeholders=False)
 
     def read(self, text: str) -> tuple[object, str]:
@@ -219,14 +268,17 @@ class LatexReader:
         Raises ``LatexError`` with the LaTeX and where reading stopped.
         """
         try:
-            t = normalise(text)
+            t = normalise(text, transpose_letter="T" not in self.table.entries)
         except Stop as stop:
-            raise LatexError(_show(text, stop.at, stop.why)) from None
+            raise _stopped(text, stop.at, stop.why) from None
         t.sub(r"[\s,.;]+$", "")  # a sentence's punctuation after a display
-        try:
-            limits.check_nesting(t.text, "({", ")}")
-        except limits.ExpressionTooLarge as exc:
-            raise LatexError(f"{exc} in {_excerpt(text)}") from None
+        deep = _too_deep(t.text)
+        if deep is not None:
+            why = (
+                f"brackets nested {limits.nesting_depth(t.text, '({', ')}')} deep; "
+                f"the limit is {limits.MAX_NESTING} (a bracket opened here is one too many)"
+            )
+            raise LatexError(why, text, t.where(deep))
         sides = _split_chain(t)
         label = ""
         if len(sides) > 1 and not t.text[slice(*sides[0])].strip():
@@ -244,15 +296,19 @@ class LatexReader:
                 )
         return first, label
 
+    def conventions_used(self) -> list:
+        """The conventions (``latex_names.Convention``) the text read so far used, in order."""
+        return [self.table.conventional[k] for k in self.used if k in self.table.conventional]
+
     def _side(self, t: Text, a: int, b: int, original: str):
         piece = t.text[a:b]
         if not piece.strip():
-            raise LatexError(_show(original, t.where(a), "an empty side of '='"))
+            raise _stopped(original, t.where(a), "an empty side of '='")
         try:
-            return _ToSympy(self.table).transform(self.parser.parse(piece))
+            return _ToSympy(self.table, self.used).transform(self.parser.parse(piece))
         except UnexpectedInput as exc:
             at = t.where(a + _position(exc, piece))
-            raise LatexError(_show(original, at, _why(exc, piece))) from None
+            raise _stopped(original, at, _why(exc, piece, original[at : at + 1])) from None
         except VisitError as exc:
             raise LatexError(f"{exc.orig_exc} in {_excerpt(original)}") from None
 
@@ -267,11 +323,28 @@ def _position(exc: UnexpectedInput, piece: str) -> int:
     return len(piece)
 
 
-def _why(exc: UnexpectedInput, piece: str) -> str:
+def _why(exc: UnexpectedInput, piece: str, written: str) -> str:
+    """What stopped the reading, and the fix when one is known; ``written``: the original character."""
     if isinstance(exc, UnexpectedCharacters):
-        m = re.match(r"\\[A-Za-z]+|[A-Za-z](_\w|_\{[^}]*\})?", piece[exc.pos_in_stream :])
+        rest = piece[exc.pos_in_stream :]
+        m = re.match(r"\\[A-Za-z]+|[A-Za-z](_\w|_\{[^}]*\})?", rest)
+        if m and written and not written.isascii():
+            return (
+                f"unknown symbol '{written}' (read as {m.group(0)}): declare it (a coordinate or "
+                f"parameter {m.group(0).lstrip(chr(92))}) or write it in [symbols] as '{m.group(0)}'"
+            )
+        if re.match(r"\\ddot\b", rest):
+            return (
+                "an acceleration (\\ddot) of no declared coordinate: this is an equation of motion; "
+                "give it under `equations`"
+            )
         if m:
-            return f"unknown symbol or command '{m.group(0)}' (declare symbols in [symbols])"
+            return (
+                f"unknown symbol or command '{m.group(0)}': declare it (a coordinate, input or "
+                "parameter) or give it in [symbols]"
+            )
+        if not written.isascii():
+            return f"unexpected '{written}': write it in LaTeX (a Greek letter as \\theta, …)"
         return f"unexpected '{piece[exc.pos_in_stream]}'"
     if isinstance(exc, UnexpectedEOF) or (isinstance(exc, UnexpectedToken) and exc.token.type == "$END"):
         return "the text ends too early (an unclosed bracket or a missing operand?)"
@@ -282,12 +355,21 @@ def _why(exc: UnexpectedInput, piece: str) -> str:
     return f"unexpected '{exc.token}'{hint}"
 
 
-def _show(text: str, at: int, why: str) -> str:
-    before, after = text[max(0, at - 40) : at], text[at : at + 30]
-    return (
-        f"cannot read the LaTeX at character {at + 1}: {why}: "
-        f"{'…' if at > 40 else ''}{before} ⟨stopped here⟩ {after}{'…' if at + 30 < len(text) else ''}"
-    ).replace("\n", " ")
+def _stopped(text: str, at: int, why: str) -> LatexError:
+    return LatexError(f"cannot read the LaTeX at character {at + 1}: {why}", text, at)
+
+
+def _too_deep(text: str) -> int | None:
+    """The position of the first bracket that opens beyond ``MAX_NESTING`` levels, or None."""
+    depth = 0
+    for i, c in enumerate(text):
+        if c in "({":
+            depth += 1
+            if depth > limits.MAX_NESTING:
+                return i
+        elif c in ")}":
+            depth -= 1
+    return None
 
 
 def _excerpt(text: str) -> str:

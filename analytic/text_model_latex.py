@@ -11,18 +11,28 @@ that read as the same symbol (``x_1`` and ``x_{1}``) are refused.
 
 from __future__ import annotations
 
+import re
+
 import sympy as sp
 
+from pendverify.analytic.latex_names import conventions
 from pendverify.analytic.latex_normalise import canonical_symbol
 from pendverify.analytic.latex_parse import LatexError, LatexReader, SymbolTable
 from pendverify.display import shortened
 
 
-def read_symbol_table(reader, table, allowed: dict, parse_entry) -> LatexReader:
-    """The ``[symbols]`` table read into a ``LatexReader`` (each value parsed by ``parse_entry``)."""
-    if not isinstance(table, dict) or not table:
-        reader.fail("symbols", 'missing: with notation = "latex", a table such as \'\\theta_1\' = "theta1"')
-    entries, source = {}, {}
+def read_symbol_table(reader, table, allowed: dict, parse_entry, spec) -> LatexReader:
+    """The names by convention (``latex_names``) and the ``[symbols]`` table over them (the table
+    wins), read into a ``LatexReader``; each table value is parsed by ``parse_entry``."""
+    if table is None:
+        table = {}
+    if not isinstance(table, dict):
+        reader.fail("symbols", "must be a table such as '\\beta' = \"m2*l1*r2\"")
+    declared = (*spec.inputs, *spec.disturbances, *spec.parameters)
+    by_convention = conventions(spec.coordinates, declared, allowed)
+    entries = {k: c.value for k, c in by_convention.items()}
+    source = {k: k for k in by_convention}
+    written: dict[str, str] = {}
     for key, value in table.items():
         if not isinstance(value, str):
             reader.fail(
@@ -32,25 +42,40 @@ def read_symbol_table(reader, table, allowed: dict, parse_entry) -> LatexReader:
             canonical = canonical_symbol(key)
         except LatexError as exc:
             reader.fail(f"symbols.{key}", str(exc))
-        if not canonical or any(c in canonical for c in "+-*/=&()"):
+        if not canonical or any(c in re.sub(r"_\{[^{}]*\}", "", canonical) for c in "+-*/=&()"):
             reader.fail(f"symbols.{key}", "is not one LaTeX symbol (a letter or command, with a subscript)")
-        if canonical in entries:
-            reader.fail(f"symbols.{key}", f"reads as the same symbol as '{source[canonical]}'")
+        if canonical in written:
+            reader.fail(f"symbols.{key}", f"reads as the same symbol as '{written[canonical]}'")
         entries[canonical] = parse_entry(reader, f"symbols.{key}", value, allowed)
-        source[canonical] = key
-    return LatexReader(SymbolTable(entries, source))
+        source[canonical] = written[canonical] = key
+    conventional = {k: c for k, c in by_convention.items() if k not in written}
+    return LatexReader(SymbolTable(entries, source, conventional))
 
 
 def parse_latex_equation(reader, latex: LatexReader, key: str, value, rows: int, cols: int | None, allowed):
     """One equation in LaTeX: a matrix (rows × cols), a column vector (cols None) or a scalar (rows 0)."""
 
+    read_as_ddot = {c.value for c in latex.table.conventional.values() if c.latex.startswith("\\ddot")}
+
     def read(k: str, text):
         if not isinstance(text, str):
             reader.fail(k, f"must be LaTeX, as a string, got {shortened(repr(text), 60)}")
         try:
-            return latex.read(text)[0]
+            value = latex.read(text)[0]
         except LatexError as exc:
-            reader.fail(k, str(exc))
+            if exc.at is None:
+                reader.fail(k, exc.why)
+            reader.fail_at(k, exc.why, exc.text, exc.at)
+        if value.free_symbols & read_as_ddot and not (set(allowed.values()) >= read_as_ddot):
+            where = re.search(r"\\ddot|\u0308|[ẍÿ]", text)
+            reader.fail_at(
+                k,
+                "an acceleration (\\ddot): this is an equation of motion, not "
+                f"{key}; give it under `equations`",
+                text,
+                where.start() if where else 0,
+            )
+        return value
 
     if isinstance(value, list):
         if cols is None or rows == 0:
@@ -80,6 +105,13 @@ def parse_latex_equation(reader, latex: LatexReader, key: str, value, rows: int,
                 key, f"wrong shape: the LaTeX gives {given}; with {rows} coordinates {key} must be {kind}"
             )
     stray = parsed.free_symbols - set(allowed.values())
+    accelerations = sorted(s.name for s in stray & read_as_ddot)
+    if accelerations:
+        reader.fail(
+            key,
+            f"holds the acceleration {', '.join(accelerations)} (a \\ddot): this is an equation of motion, "
+            f"not {key}; give it under `equations`",
+        )
     if stray:
         names = ", ".join(sorted(s.name for s in stray))
         reader.fail(key, f"depends on {names}, which {key} may not (its arguments: {_args(allowed)})")

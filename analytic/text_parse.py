@@ -39,7 +39,7 @@ from pendverify.analytic.text_equations import latex_side, read_equations, split
 from pendverify.analytic.text_expression import FUNCTIONS, ExpressionError, fragment, read_expression
 from pendverify.analytic.text_model_latex import parse_latex_equation, read_symbol_table
 from pendverify.display import shortened
-from pendverify.errors import PendverifyError
+from pendverify.errors import ExcerptError, PendverifyError, excerpt
 
 CONSTANTS = {"pi": sp.pi}
 TOP_KEYS = (
@@ -76,6 +76,8 @@ class TextModelSpec:
     notation: str = "sympy"
     #: with notation = "latex": the file's [symbols] table, each LaTeX key with what it reads as
     latex_symbols: dict[str, object] = field(default_factory=dict)
+    #: with notation = "latex": the names its equations read by convention ("\\theta_1 → theta1")
+    latex_conventions: list[str] = field(default_factory=list)
     urdf_joints: tuple[str, ...] = ()
     joint_transform: tuple | None = None
     joint_offset: tuple | None = None
@@ -87,6 +89,10 @@ class Reader:
 
     def fail(self, key: str, problem: str):
         raise PendverifyError(f"{self.path}: key '{shortened(key, 80)}': {problem}")
+
+    def fail_at(self, key: str, problem: str, text: str, at: int):
+        """The problem at position ``at`` of the key's ``text``: one error with a caret under it."""
+        raise ExcerptError(f"{self.path}: key '{shortened(key, 80)}': {problem}", *excerpt(text, at))
 
     def names(self, data: dict, key: str) -> tuple[str, ...]:
         value = data.get(key, [])
@@ -127,7 +133,7 @@ def parse_entry(reader: Reader, key: str, value, allowed: dict):
     try:
         expr = read_expression(text, allowed)
     except ExpressionError as exc:
-        reader.fail(key, f"{exc.why}, at character {exc.at + 1} of {fragment(text, exc.at)}")
+        reader.fail_at(key, f"{exc.why}, at character {exc.at + 1}", text, exc.at)
     if expr.has(sp.zoo, sp.oo, sp.nan):
         reader.fail(key, f"{fragment(text, 0)} is not finite")
     return expr
@@ -250,9 +256,7 @@ def _read_equations(reader: Reader, spec: TextModelSpec, data: dict) -> None:
     latex = None
     if spec.notation == "latex":
         everything = {s.name: s for g in "qvuwap" for s in spec.symbols[g]} | FUNCTIONS | CONSTANTS
-        latex = read_symbol_table(reader, data.get("symbols"), everything, parse_entry)
-        table = latex.table
-        spec.latex_symbols = {table.source[c]: value for c, value in table.entries.items()}
+        latex = read_symbol_table(reader, data.get("symbols"), everything, parse_entry, spec)
     for key, (shape, groups) in EQUATIONS.items():
         if key not in data:
             continue
@@ -266,6 +270,11 @@ def _read_equations(reader: Reader, spec: TextModelSpec, data: dict) -> None:
             spec.equations[key] = parse_latex_equation(reader, latex, key, data[key], rows, cols, allowed)
         else:
             spec.equations[key] = parse_equation(reader, key, data[key], rows, cols, allowed)
+    if latex is not None:
+        spec.latex_conventions = [str(c) for c in latex.conventions_used()]
+        table = latex.table
+        written = {table.source[c]: v for c, v in table.entries.items() if c not in table.conventional}
+        spec.latex_symbols = {c.latex: c.value for c in latex.conventions_used()} | written
 
 
 def _read_whole_equations(reader: Reader, spec: TextModelSpec, data: dict, key: str, allowed, latex) -> None:

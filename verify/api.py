@@ -558,11 +558,13 @@ class Equation(NamedTuple):
 
 
 class ModelReading(NamedTuple):
-    """A model as SymPy reads it: its class, its parameters' symbols and its equations."""
+    """A model as SymPy reads it: its class, its parameters' symbols and its equations, and for a
+    LaTeX model the symbols its equations read by convention (``"\\theta_1 → theta1"``)."""
 
     model_cls: type[ClosedFormModel]
     parameters: tuple[str, ...]
     equations: list[Equation]
+    conventions: tuple[str, ...] = ()
 
 
 def read_model(model: ModelLike) -> ModelReading:
@@ -580,7 +582,8 @@ def read_model(model: ModelLike) -> ModelReading:
         Equation(method, derived.get(keys.get(method, "")) or None, sm.evaluate(method, form.args))
         for method, form in cls.written_closed_forms().items()
     ]
-    return ModelReading(cls, tuple(sm.parameters), equations)
+    conventions = tuple(spec.latex_conventions) if spec is not None else ()
+    return ModelReading(cls, tuple(sm.parameters), equations, conventions)
 
 
 def read_robot(description: str | Path) -> RobotSummary:

@@ -46,6 +46,44 @@ class PlaceError(PendverifyError):
         return f"{self.source}: {self.problem}"
 
 
+@dataclass
+class ExcerptError(PendverifyError):
+    """A problem at a place in an expression: the headline (file, key, rule and fix), then the
+    fragment of the expression around the place and a caret under it, on two more lines.
+
+    One logical error: the CLI prints the headline on one line and keeps the two lines below it
+    (``pendverify.exitcodes.classify``).  ``column`` is the caret's position in ``fragment``.
+    """
+
+    headline: str
+    fragment: str
+    column: int
+
+    def __str__(self) -> str:
+        return f"{self.headline}\n{self.pointer()}"
+
+    def pointer(self) -> str:
+        """The fragment and the caret under the place, each indented by two spaces."""
+        return f"  {self.fragment}\n  {' ' * self.column}^"
+
+
+#: the most characters of an expression a message quotes around the place of a problem
+EXCERPT_WIDTH = 80
+
+
+def excerpt(text: str, at: int, width: int = EXCERPT_WIDTH) -> tuple[str, int]:
+    """(at most ``width`` characters of ``text`` around position ``at`` on one line, the position
+    of ``at`` in it): line breaks and tabs become spaces, a cut end shows "…"."""
+    one = "".join(" " if c.isspace() else c for c in text)
+    at = max(0, min(at, len(one)))
+    if len(one) <= width:
+        return one, at
+    start = max(0, min(at - width // 2, len(one) - width))
+    piece = one[start : start + width]
+    head = "…" if start > 0 else ""
+    return head + piece + ("…" if start + width < len(one) else ""), len(head) + at - start
+
+
 class UrdfShapeError(PlaceError):
     """A URDF does not have the structure a model needs."""
 

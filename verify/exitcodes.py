@@ -23,7 +23,7 @@ from __future__ import annotations
 import traceback
 
 from pendverify.analytic.plugin import user_code_error
-from pendverify.errors import PendverifyError
+from pendverify.errors import ExcerptError, PendverifyError
 from pendverify.signals import Terminated
 
 PASSED = 0
@@ -48,6 +48,8 @@ def classify(exc: BaseException) -> tuple[int, str]:
         return INTERRUPTED, "interrupted"
     if isinstance(exc, BrokenPipeError):
         return PIPE_CLOSED, ""
+    if isinstance(exc, ExcerptError):  # one error: its headline, then the fragment and the caret
+        return BAD_INPUT, f"error: {one_line(exc.headline)}\n{exc.pointer()}"
     if isinstance(exc, PendverifyError):
         return BAD_INPUT, f"error: {one_line(str(exc))}"
     user = user_code_error(exc)

@@ -63,6 +63,8 @@ def _show_model(args: argparse.Namespace) -> None:
     if cls.inputs or cls.disturbances:
         print(f"inputs {', '.join(cls.inputs) or '-'}; disturbances {', '.join(cls.disturbances) or '-'}")
     print(f"parameters {', '.join(reading.parameters)}")
+    if reading.conventions:
+        print(f"names by convention: {', '.join(reading.conventions)}")
     for method, derived, value in reading.equations:
         note = f" (derived: {derived})" if derived else ""
         if args.pretty:
