@@ -7,62 +7,25 @@ gymnasium's constants as the parameters, and verified against URDFs built here f
 constants: the inputs do not span the coordinates (one force, one torque), so M is not
 determined and only ``aba`` runs, over states and inputs.  A planted error fails; the
 "nips" acrobot variant, which leaves out the term m2 l1 lc2 θ̇1² sin θ2 of ddθ2, fails too.
-The constants are read from the installed gymnasium (its source is not copied).
+The constants are read from the installed gymnasium (its source is not copied); the URDFs are
+``tests/analytic/gym_robots.py``'s.
 """
 
 from __future__ import annotations
 
-import textwrap
 from pathlib import Path
 
 import pytest
 
 import pendverify
 from pendverify.analytic.plugin import load_model_class
+from tests.analytic.gym_robots import acrobot_urdf, cart_pole_urdf
 
 gymnasium = pytest.importorskip("gymnasium")
 from gymnasium.envs.classic_control.acrobot import AcrobotEnv  # noqa: E402
 from gymnasium.envs.classic_control.cartpole import CartPoleEnv  # noqa: E402
 
 SAMPLES = 100  # the zero state plus 100 random states and inputs
-
-
-def _inertial(mass: float, com_z: float, ixx: float, iyy: float, izz: float) -> str:
-    return (
-        f'<inertial><origin xyz="0 0 {com_z}"/><mass value="{mass}"/>'
-        f'<inertia ixx="{ixx}" ixy="0" ixz="0" iyy="{iyy}" iyz="0" izz="{izz}"/></inertial>'
-    )
-
-
-def cart_pole_urdf(env) -> str:
-    """The cart on a rail along x, the pole hinged about y, θ = 0 upright and tip at +x for θ > 0."""
-    m, half = env.masspole, env.length
-    rod = m * (2 * half) ** 2 / 12  # a uniform rod of length 2·length about its centre: gymnasium's 4/3
-    return textwrap.dedent(f"""\
-        <robot name="gym_cart_pole">
-          <link name="world"/>
-          <link name="cart">{_inertial(env.masscart, 0, 0.01, 0.01, 0.01)}</link>
-          <link name="pole">{_inertial(m, half, rod, rod, 1e-6)}</link>
-          <joint name="slider" type="prismatic"><parent link="world"/><child link="cart"/>
-            <axis xyz="1 0 0"/><limit lower="-100" upper="100" effort="100" velocity="100"/></joint>
-          <joint name="hinge" type="continuous"><parent link="cart"/><child link="pole"/>
-            <axis xyz="0 1 0"/></joint>
-        </robot>""")
-
-
-def acrobot_urdf(env) -> str:
-    """Two links hanging down at θ = 0 (gymnasium's zero), both joints about y, θ2 relative."""
-    moi = env.LINK_MOI
-    return textwrap.dedent(f"""\
-        <robot name="gym_acrobot">
-          <link name="world"/>
-          <link name="link1">{_inertial(env.LINK_MASS_1, -env.LINK_COM_POS_1, moi, moi, moi)}</link>
-          <link name="link2">{_inertial(env.LINK_MASS_2, -env.LINK_COM_POS_2, moi, moi, moi)}</link>
-          <joint name="joint1" type="continuous"><parent link="world"/><child link="link1"/>
-            <axis xyz="0 1 0"/></joint>
-          <joint name="joint2" type="continuous"><parent link="link1"/><child link="link2"/>
-            <origin xyz="0 0 {-env.LINK_LENGTH_1}"/><axis xyz="0 1 0"/></joint>
-        </robot>""")
 
 
 def _substituted(text: str, definitions: list[tuple[str, str]]) -> str:
