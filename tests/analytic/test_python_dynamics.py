@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 import pendverify
-from pendverify.api import load_model, read_model
+from pendverify.api import load_model, load_scene, read_model, stress
 from pendverify.cli import main
 from pendverify.errors import PendverifyError
 from tests.analytic.gym_robots import acrobot_urdf, cart_pole_urdf
@@ -283,3 +283,36 @@ def test_the_function_is_evaluated_with_the_parameters_by_keyword(tmp_path):
     # both are gymnasium's arithmetic; the env's difference of float64 states of size ~1 over
     # tau = 0.02 loses about 50 ε of the rates' size, so 1e-12 of the accelerations' size is ample
     assert np.allclose(got, expected, rtol=1e-12, atol=1e-12 * np.max(np.abs(expected))), (got, expected)
+
+
+def _params_file(tmp_path: Path, values: dict) -> Path:
+    params = tmp_path / "params.toml"
+    lines = "".join(f"{k} = {v}\n" for k, v in values.items())
+    params.write_text(f'model = "gym_cart_pole"\n[parameters]\n{lines}')
+    return params
+
+
+def test_stress_runs_without_the_near_singular_case_and_says_why(tmp_path):
+    model, urdf, values = files(tmp_path, "cart-pole")
+    report = stress(model, urdf, _params_file(tmp_path, values), quick=True)
+    names = [r.case for r in report.results]
+    assert "nominal" in names and not any("near-singular" in n for n in names), names
+    assert "no near-singular case: GymCartPole gives q̈ alone, no M" in " ".join(report.notes)
+    assert next(r for r in report.results if r.case == "nominal").passed
+
+
+def test_simulate_refuses_a_model_without_M_in_one_line(tmp_path):
+    model, urdf, values = files(tmp_path, "cart-pole")
+    scene = {
+        "name": "cart-pole",
+        "model": str(model),
+        "params": str(_params_file(tmp_path, values)),
+        "urdf": str(urdf),
+        "initial": {"q": [0.0, 0.1]},
+        "time": {"duration": 1.0, "sample_rate": 50.0},
+        "integrator": {"method": "DOP853", "rtol": 1e-10, "atol": 1e-10},
+    }
+    with pytest.raises(PendverifyError) as info:
+        load_scene(scene)
+    message = str(info.value)
+    assert "\n" not in message and "GymCartPole gives q̈ alone (no M, H, V)" in message, message
