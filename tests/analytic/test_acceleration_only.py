@@ -148,3 +148,48 @@ def test_q_ddot_alone_needs_B_when_there_are_inputs(tmp_path):
     model.write_text(model.read_text().replace('B = [["1"], ["0"]]\n', ""))
     with pytest.raises(pendverify.PendverifyError, match="q̈ alone needs B too"):
         load_model_class(model)
+
+
+# cartpole.py, step() printed as a paper would: T is its `temp`, θ̈ written out in ẍ
+CART_POLE_LATEX = r"""name = "gym_cart_pole"
+notation = "latex"
+inputs = ["force"]
+qddot = '''
+\begin{bmatrix}
+T - \frac{m_p l \cos\theta}{m_c + m_p}\,
+  \frac{g\sin\theta - T\cos\theta}{l\left(\frac{4}{3} - \frac{m_p\cos^2\theta}{m_c + m_p}\right)} \\
+\frac{g\sin\theta - T\cos\theta}{l\left(\frac{4}{3} - \frac{m_p\cos^2\theta}{m_c + m_p}\right)}
+\end{bmatrix}
+'''
+B = '\begin{bmatrix} 1 \\ 0 \end{bmatrix}'
+[coordinates]
+x = "position"
+theta = "angle"
+[parameters]
+masscart = { kind = "mass" }
+masspole = { kind = "mass" }
+length = { kind = "offset" }
+g = { kind = "gravity" }
+[symbols]
+'\theta' = "theta"
+'g' = "g"
+'m_c' = "masscart"
+'m_p' = "masspole"
+'l' = "length"
+'T' = "(force + masspole*length*dtheta**2*sin(theta))/(masscart + masspole)"
+[urdf]
+joints = ["slider", "hinge"]
+"""
+
+
+@pytest.mark.parametrize("planted", [False, True])
+def test_q_ddot_alone_in_latex_verifies_and_a_planted_error_fails(planted, tmp_path):
+    """LaTeX q̈ without M (one input, two coordinates): aba only; the rod's 4/3 made 5/3 fails."""
+    _, urdf, params = cart_pole_files(tmp_path)
+    text = CART_POLE_LATEX.replace(r"\frac{4}{3}", r"\frac{5}{3}") if planted else CART_POLE_LATEX
+    assert (text != CART_POLE_LATEX) == planted
+    model = tmp_path / "gym_cart_pole_latex.toml"
+    model.write_text(text)
+    report = pendverify.check(model, urdf, params, samples=SAMPLES, explain=False)
+    assert report.checks == ("aba",)
+    assert report["aba"].status == ("fail" if planted else "pass"), report
