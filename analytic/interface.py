@@ -142,6 +142,9 @@ class ClosedFormModel(metaclass=ModelClass):
     has_coriolis_matrix: ClassVar[bool] = True
     #: False for models that give q̈ alone (``AccelerationOnlyModel``).
     has_mass_matrix: ClassVar[bool] = True
+    #: Why the model's code is evaluated numerically only ("" when SymPy reads it): then no SymPy
+    #: reading (``show``, ``sympy``, ``mutate``, generated NumPy) and no high-precision re-judge.
+    numeric_only: ClassVar[str] = ""
     #: The motion ``pendverify certify`` simulates; None: derived from the model's scales.
     battery_motion: ClassVar[BatteryMotion | None] = None
 
@@ -353,6 +356,11 @@ class AccelerationOnlyModel(ClosedFormModel):
 
     has_mass_matrix: ClassVar[bool] = False
     has_coriolis_matrix: ClassVar[bool] = False
+    #: why M, C·q̇, H and V are not there (the checks that need them say it)
+    without_mass_matrix: ClassVar[str] = (
+        "its inputs do not span the coordinates (∂q̈/∂u = M⁻¹B is not square), "
+        "so M, C·q̇, H and V are not determined"
+    )
     closed_forms: ClassVar[dict[str, ClosedForm]] = {
         "acceleration": ClosedForm(INTERFACE["acceleration"].args, "M**-1*(B*u + W*w - D*v - C*v - H)")
     }

@@ -15,6 +15,10 @@ exactly one concrete subclass of ``pendverify.analytic.ClosedFormModel``
   too when it declares ``inputs``), and the coordinate map
   (``urdf_joints``, ``joint_transform``, ``joint_offset``; see ``pendverify.robot.joint_map``).
 
+A file without such a class may instead define ``METHOD`` (a ``sympy.physics.mechanics``
+derivation, ``pendverify.analytic.mechanics_model``) or ``DYNAMICS`` (a right-hand side
+ẋ = f(x, u) in Python, ``pendverify.analytic.python_dynamics``), each with its ``DECLARATION``.
+
 ``validate_model_class`` checks these rules on any class (the Python API applies it to a
 class written in the caller's own code).  ``examples/cart_pole.py`` is a complete
 plug-in.  The built-in models are plug-ins of the same kind: ``--analytic
@@ -178,13 +182,14 @@ def load_model_class(path: str | Path) -> type[ClosedFormModel]:
     if not found:
         # deferred on purpose: SymPy's mechanics loads only for a model file that declares one
         from pendverify.analytic.mechanics_model import model_file_declaration
+        from pendverify.analytic.python_dynamics import model_file_dynamics
 
-        declared = model_file_declaration(module, path)
+        declared = model_file_dynamics(module, path) or model_file_declaration(module, path)
         if declared is not None:
             validate_model_class(declared, path)
             return declared
         raise PendverifyError(
-            f"{path}: defines no subclass of pendverify.analytic.ClosedFormModel "
+            f"{path}: defines no subclass of pendverify.analytic.ClosedFormModel, no METHOD and no DYNAMICS "
             "(see examples/cart_pole.py for a complete model file)"
         )
     if len(found) > 1:
@@ -248,6 +253,8 @@ def check_model_outputs(model: ClosedFormModel) -> None:
             if user is not None:
                 raise user from None
             raise UserCodeError(place, f"must return numbers; at the zero state: {exc}") from None
+        except PendverifyError:  # the model's own one-line refusal (a right-hand side's, say)
+            raise
         except BaseException as exc:
             raise (user_code_error(exc) or UserCodeError(place, f"raised {_described(exc)}")) from None
         if value.shape != shape:

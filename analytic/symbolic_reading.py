@@ -70,6 +70,8 @@ class SymbolicModel:
 
     @classmethod
     def of(cls, model_cls: type[ClosedFormModel]) -> SymbolicModel:
+        if model_cls.numeric_only:
+            raise PendverifyError(f"{where(model_cls)}: {model_cls.__name__}: {model_cls.numeric_only}")
         params_type = model_cls.params_type
         params = object.__new__(params_type)  # symbols, not numbers: skip the validation
         parameters = {}

@@ -264,11 +264,15 @@ def _energies(self, q, v, u, w) -> Energies:
     )
 
 
-def build_model_class(spec: TextModelSpec, module: types.ModuleType | None = None) -> type[ClosedFormModel]:
-    """The ``ClosedFormModel`` (or ``BiasOnlyModel``) subclass of a parsed text model.
+def build_model_class(
+    spec: TextModelSpec, module: types.ModuleType | None = None, base: type[ClosedFormModel] | None = None
+) -> type[ClosedFormModel]:
+    """The ``ClosedFormModel`` (``BiasOnlyModel``, ``AccelerationOnlyModel``) subclass of a text model.
 
     ``module``: the module the class is to live in (a Python model file's own); None: a stand-in
-    module naming ``spec.path`` (a text file, or the object a model was made from).
+    module naming ``spec.path`` (a text file, or the object a model was made from).  ``base``: the
+    class a model without M derives from instead of ``AccelerationOnlyModel`` (one whose q̈ is
+    code, ``pendverify.analytic.python_dynamics``).
     """
     class_name = "".join(part.capitalize() for part in spec.name.split("_")) or "TextModel"
     if module is None:
@@ -299,7 +303,7 @@ def build_model_class(spec: TextModelSpec, module: types.ModuleType | None = Non
         if key in spec.equations:
             namespace[method] = _method(key, args, spec)
     if "M" not in spec.equations:  # q̈ alone, M not determined (``_mass_from_acceleration``)
-        base = AccelerationOnlyModel
+        base = base or AccelerationOnlyModel
         del namespace["energies"]
     elif "Cqdot" in spec.equations:
         base = BiasOnlyModel

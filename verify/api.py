@@ -129,15 +129,29 @@ def load_model(
     ``sympy.physics.mechanics`` derivation — a ``LagrangesMethod``, a ``KanesMethod`` or a
     ``(mass_matrix, forcing)`` pair — with its ``declaration``: the coordinates' kinds, the
     parameters' kinds, the inputs and the URDF map, as a text model file declares them
-    (``pendverify.analytic.mechanics_model``).
+    (``pendverify.analytic.mechanics_model``), or a right-hand side in Python — ẋ = f(x, u),
+    f(t, x, u) or q̈ = qddot(q, v, u) — with its ``declaration``, which adds the signature, the
+    state layout and B, D, W (``pendverify.analytic.python_dynamics``).
     """
+    if callable(source) and not isinstance(source, type):
+        from pendverify.analytic.python_dynamics import python_dynamics_model
+
+        if declaration is None:
+            raise PendverifyError(
+                f"a function ({getattr(source, '__name__', type(source).__name__)}) needs a declaration: "
+                "its coordinates, parameters, inputs, B and urdf joints "
+                "(see pendverify.analytic.python_dynamics)"
+            )
+        cls = python_dynamics_model(source, declaration)
+        validate_model_class(cls, "<declaration>")
+        return cls
     if declaration is not None or _is_mechanics(source):
         from pendverify.analytic.mechanics_model import is_mechanics, mechanics_model
 
         if not is_mechanics(source):
             raise PendverifyError(
-                "a declaration goes with a LagrangesMethod, a KanesMethod or a (mass_matrix, forcing) "
-                f"pair; got a {type(source).__name__}"
+                "a declaration goes with a LagrangesMethod, a KanesMethod, a (mass_matrix, forcing) "
+                f"pair or a right-hand side function; got a {type(source).__name__}"
             )
         if declaration is None:
             raise PendverifyError(
@@ -305,8 +319,8 @@ def check(
     drawn with ``seed`` (plus each model's special states); ``strict`` counts warnings as
     failures; ``model_form_rtol`` is the largest relative size of a URDF term the closed form
     cannot express (``--model-form-rtol``); ``explain=False`` skips the diagnosis of failing
-    models (``--no-explain``).  ``declaration`` goes with a ``sympy.physics.mechanics`` model
-    (``load_model``): ``check(model=lagranges_method, urdf=..., params=..., declaration={...})``.
+    models (``--no-explain``).  ``declaration`` goes with a ``sympy.physics.mechanics`` model or a
+    right-hand side function (``load_model``): ``check(model=f, urdf=..., params=..., declaration={...})``.
 
     Returns a ``CheckReport``: ``report["crba"]`` is one check's rows, ``print(report)`` the
     CLI's table.  A failing check is a result, not an exception (see

@@ -7,62 +7,25 @@ gymnasium's constants as the parameters, and verified against URDFs built here f
 constants: the inputs do not span the coordinates (one force, one torque), so M is not
 determined and only ``aba`` runs, over states and inputs.  A planted error fails; the
 "nips" acrobot variant, which leaves out the term m2 l1 lc2 θ̇1² sin θ2 of ddθ2, fails too.
-The constants are read from the installed gymnasium (its source is not copied).
+The constants are read from the installed gymnasium (its source is not copied); the URDFs are
+``tests/analytic/gym_robots.py``'s.
 """
 
 from __future__ import annotations
 
-import textwrap
 from pathlib import Path
 
 import pytest
 
 import pendverify
 from pendverify.analytic.plugin import load_model_class
+from tests.analytic.gym_robots import acrobot_urdf, cart_pole_urdf
 
 gymnasium = pytest.importorskip("gymnasium")
 from gymnasium.envs.classic_control.acrobot import AcrobotEnv  # noqa: E402
 from gymnasium.envs.classic_control.cartpole import CartPoleEnv  # noqa: E402
 
 SAMPLES = 100  # the zero state plus 100 random states and inputs
-
-
-def _inertial(mass: float, com_z: float, ixx: float, iyy: float, izz: float) -> str:
-    return (
-        f'<inertial><origin xyz="0 0 {com_z}"/><mass value="{mass}"/>'
-        f'<inertia ixx="{ixx}" ixy="0" ixz="0" iyy="{iyy}" iyz="0" izz="{izz}"/></inertial>'
-    )
-
-
-def cart_pole_urdf(env) -> str:
-    """The cart on a rail along x, the pole hinged about y, θ = 0 upright and tip at +x for θ > 0."""
-    m, half = env.masspole, env.length
-    rod = m * (2 * half) ** 2 / 12  # a uniform rod of length 2·length about its centre: gymnasium's 4/3
-    return textwrap.dedent(f"""\
-        <robot name="gym_cart_pole">
-          <link name="world"/>
-          <link name="cart">{_inertial(env.masscart, 0, 0.01, 0.01, 0.01)}</link>
-          <link name="pole">{_inertial(m, half, rod, rod, 1e-6)}</link>
-          <joint name="slider" type="prismatic"><parent link="world"/><child link="cart"/>
-            <axis xyz="1 0 0"/><limit lower="-100" upper="100" effort="100" velocity="100"/></joint>
-          <joint name="hinge" type="continuous"><parent link="cart"/><child link="pole"/>
-            <axis xyz="0 1 0"/></joint>
-        </robot>""")
-
-
-def acrobot_urdf(env) -> str:
-    """Two links hanging down at θ = 0 (gymnasium's zero), both joints about y, θ2 relative."""
-    moi = env.LINK_MOI
-    return textwrap.dedent(f"""\
-        <robot name="gym_acrobot">
-          <link name="world"/>
-          <link name="link1">{_inertial(env.LINK_MASS_1, -env.LINK_COM_POS_1, moi, moi, moi)}</link>
-          <link name="link2">{_inertial(env.LINK_MASS_2, -env.LINK_COM_POS_2, moi, moi, moi)}</link>
-          <joint name="joint1" type="continuous"><parent link="world"/><child link="link1"/>
-            <axis xyz="0 1 0"/></joint>
-          <joint name="joint2" type="continuous"><parent link="link1"/><child link="link2"/>
-            <origin xyz="0 0 {-env.LINK_LENGTH_1}"/><axis xyz="0 1 0"/></joint>
-        </robot>""")
 
 
 def _substituted(text: str, definitions: list[tuple[str, str]]) -> str:
@@ -185,3 +148,48 @@ def test_q_ddot_alone_needs_B_when_there_are_inputs(tmp_path):
     model.write_text(model.read_text().replace('B = [["1"], ["0"]]\n', ""))
     with pytest.raises(pendverify.PendverifyError, match="q̈ alone needs B too"):
         load_model_class(model)
+
+
+# cartpole.py, step() printed as a paper would: T is its `temp`, θ̈ written out in ẍ
+CART_POLE_LATEX = r"""name = "gym_cart_pole"
+notation = "latex"
+inputs = ["force"]
+qddot = '''
+\begin{bmatrix}
+T - \frac{m_p l \cos\theta}{m_c + m_p}\,
+  \frac{g\sin\theta - T\cos\theta}{l\left(\frac{4}{3} - \frac{m_p\cos^2\theta}{m_c + m_p}\right)} \\
+\frac{g\sin\theta - T\cos\theta}{l\left(\frac{4}{3} - \frac{m_p\cos^2\theta}{m_c + m_p}\right)}
+\end{bmatrix}
+'''
+B = '\begin{bmatrix} 1 \\ 0 \end{bmatrix}'
+[coordinates]
+x = "position"
+theta = "angle"
+[parameters]
+masscart = { kind = "mass" }
+masspole = { kind = "mass" }
+length = { kind = "offset" }
+g = { kind = "gravity" }
+[symbols]
+'\theta' = "theta"
+'g' = "g"
+'m_c' = "masscart"
+'m_p' = "masspole"
+'l' = "length"
+'T' = "(force + masspole*length*dtheta**2*sin(theta))/(masscart + masspole)"
+[urdf]
+joints = ["slider", "hinge"]
+"""
+
+
+@pytest.mark.parametrize("planted", [False, True])
+def test_q_ddot_alone_in_latex_verifies_and_a_planted_error_fails(planted, tmp_path):
+    """LaTeX q̈ without M (one input, two coordinates): aba only; the rod's 4/3 made 5/3 fails."""
+    _, urdf, params = cart_pole_files(tmp_path)
+    text = CART_POLE_LATEX.replace(r"\frac{4}{3}", r"\frac{5}{3}") if planted else CART_POLE_LATEX
+    assert (text != CART_POLE_LATEX) == planted
+    model = tmp_path / "gym_cart_pole_latex.toml"
+    model.write_text(text)
+    report = pendverify.check(model, urdf, params, samples=SAMPLES, explain=False)
+    assert report.checks == ("aba",)
+    assert report["aba"].status == ("fail" if planted else "pass"), report

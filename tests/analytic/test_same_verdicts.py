@@ -3,9 +3,11 @@
 The double pendulum reference system as a class (``examples/minimal_double_pendulum.py``), a
 text file (``examples/minimal_double_pendulum_text.toml``), LaTeX parts
 (``examples/double_pendulum_latex.toml``), LaTeX whole equations, q̈ alone (M derived from
-q̈ and B) and a ``LagrangesMethod``: against the same URDF and parameter values, each check
-that runs on two forms has the same verdict on both (all pass); doubling link 2's inertia in
-M's last entry (or, for the mechanics model, in link 2's body) fails crba in every form.
+q̈ and B), a ``LagrangesMethod`` and q̈ as Python code (``qddot(q, v, u)`` solving M q̈ = f with
+NumPy, B = I): against the same URDF and parameter values, each check that runs on two forms
+has the same verdict on both (all pass); doubling link 2's inertia in M's last entry (or, for
+the mechanics model, in link 2's body) fails crba in every form that gives M, and aba in the
+code form, which gives q̈ alone (``pendverify.analytic.python_dynamics``: only aba and damping run).
 """
 
 from __future__ import annotations
@@ -56,6 +58,40 @@ def _qddot_file(tmp_path: Path, m22: str = M22) -> Path:
     return path
 
 
+CODE = f"""\
+import numpy as np
+from math import cos, sin
+
+
+def qddot(q, v, u, *, m1, m2, l1, r1, r2, I1, I2, b1, b2, g):
+    theta1, theta2 = q
+    dtheta1, dtheta2 = v
+    tau1, tau2 = u
+    M = np.array([[{M11}, {M12}], [{M12}, {M22}]])
+    f = np.array([{F1}, {F2}])
+    return np.linalg.solve(M, f)
+
+
+DYNAMICS = qddot
+DECLARATION = {{
+    **DECLARATION,
+    "dynamics": "qddot(q, v, u)",
+    "B": [["1", "0"], ["0", "1"]],
+    "D": [["b1", "0"], ["0", "b2"]],
+}}
+"""
+
+
+def _code_file(tmp_path: Path, m22: str = M22) -> Path:
+    """q̈ as Python code: M and f as NumPy arrays, solved; its declaration the mechanics model's."""
+    path = tmp_path / "qddot_code.py"
+    head = "from tests.analytic.mechanics_double_pendulum import DECLARATION\n"
+    code = CODE.replace(f", {M22}]])", f", {m22}]])")
+    assert (code != CODE) == (m22 != M22)
+    path.write_text(head + code)
+    return path
+
+
 def _forms(tmp_path: Path, planted: bool) -> dict[str, dict]:
     """Each form's check arguments (right, or with link 2's inertia doubled in M's last entry)."""
     folder = tmp_path / ("planted" if planted else "right")
@@ -80,7 +116,12 @@ def _forms(tmp_path: Path, planted: bool) -> dict[str, dict]:
         ),
         "q̈ alone": dict(model=_qddot_file(folder, "(2*I2 + m2*r2**2)" if planted else M22)),
         "LagrangesMethod": dict(model=lagrange(2 if planted else 1), declaration=DECLARATION),
+        "q̈ as code": dict(model=_code_file(folder, "(2*I2 + m2*r2**2)" if planted else M22)),
     }
+
+
+#: the forms that give q̈ alone: only aba and damping run on them
+ACCELERATION_ONLY = ("q̈ as code",)
 
 
 def _verdicts(arguments: dict) -> dict[str, str]:
@@ -92,7 +133,10 @@ def _verdicts(arguments: dict) -> dict[str, str]:
 def test_every_form_gives_the_same_verdicts(tmp_path):
     verdicts = {name: _verdicts(arguments) for name, arguments in _forms(tmp_path, False).items()}
     for name, found in verdicts.items():
-        assert {"crba", "rnea", "gravity", "aba", "energy"} <= set(found), name
+        if name in ACCELERATION_ONLY:
+            assert set(found) == {"aba", "damping"}, (name, found)
+        else:
+            assert {"crba", "rnea", "gravity", "aba", "energy"} <= set(found), name
         for other, theirs in verdicts.items():
             for check in set(found) & set(theirs):
                 assert found[check] == theirs[check], (name, other, check)
@@ -100,7 +144,10 @@ def test_every_form_gives_the_same_verdicts(tmp_path):
 
 
 @pytest.mark.parametrize(
-    "form", ["class", "text", "LaTeX parts", "LaTeX whole equations", "q̈ alone", "LagrangesMethod"]
+    "form",
+    ["class", "text", "LaTeX parts", "LaTeX whole equations", "q̈ alone", "LagrangesMethod", "q̈ as code"],
 )
 def test_a_doubled_inertia_in_M_fails_crba_in_every_form(form, tmp_path):
-    assert _verdicts(_forms(tmp_path, True)[form])["crba"] == "fail"
+    """crba in every form that gives M; aba in a form that gives q̈ alone (crba does not run)."""
+    check = "aba" if form in ACCELERATION_ONLY else "crba"
+    assert _verdicts(_forms(tmp_path, True)[form])[check] == "fail"

@@ -204,7 +204,7 @@ def test_errors_of_the_model_key(tmp_path):
     path = _scene(tmp_path, "empty.py", "")
     assert _error(path) == (
         f"{path}: key 'model' = 'empty.py': not a usable model file: {tmp_path / 'empty.py'}: defines "
-        "no subclass of pendverify.analytic.ClosedFormModel "
+        "no subclass of pendverify.analytic.ClosedFormModel, no METHOD and no DYNAMICS "
         "(see examples/cart_pole.py for a complete model file)"
     )
 

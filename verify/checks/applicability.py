@@ -19,8 +19,8 @@ def needs_mass_matrix(model, system) -> str:
     if model.has_mass_matrix:
         return ""
     return (
-        f"not run: {_class(model).__name__} gives q̈ alone and its inputs do not span the coordinates "
-        "(∂q̈/∂u = M⁻¹B is not square), so M, C·q̇, H and V are not determined; q̈ is checked by aba"
+        f"not run: {_class(model).__name__} gives q̈ alone and {model.without_mass_matrix}; "
+        "q̈ is checked by aba"
     )
 
 

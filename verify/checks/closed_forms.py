@@ -7,8 +7,9 @@ batch axis first (``constant(name)`` for a method without arguments).  How:
   (``pendverify.numerics.codegen.vectorised``: the model's code read by SymPy and printed
   as elementwise ufuncs over the states);
 * a method the model writes itself that SymPy cannot read (a branch on a value, a
-  numerical solve) is the model's own Python at each state, stacked; ``per_state`` says
-  which and why, and the report names them;
+  numerical solve), or any method of a model that is evaluated numerically only
+  (``ClosedFormModel.numeric_only``), is the model's own Python at each state, stacked;
+  ``per_state`` says which and why, and the report names them;
 * a method the model leaves to the interface is formed from the batch of its parts as
   ``ClosedFormModel`` forms it: the bias C q̇ + H (or C·q̇ + H), T = ½ q̇ᵀ M q̇, det M by LU,
   M⁻¹ by solving with M, q̈ = M⁻¹ (B u + W w − D q̇ − bias); the derived inertia scale
@@ -93,7 +94,9 @@ class ClosedForms:
 
     def _written(self, name: str) -> np.ndarray:
         own = np.asarray(self._call(name, 0), dtype=float)
-        if self.python_only:
+        if self.model.numeric_only and not self.python_only:
+            self.per_state[name] = self.model.numeric_only
+        if self.python_only or self.model.numeric_only:
             return self._python(name, first=own)
         module = generated(type(self.model))
         function = module.FUNCTIONS.get(name)

@@ -27,8 +27,9 @@ python_only=True)``).  The state is then judged by the same check, tolerance and
 * A wrong formula is wrong in any precision: the state still fails, and so does
   the check (a planted error in the same M⁻¹ is caught, ``tests/stress/test_stress_generic.py``).
 * A closed form that cannot run on mpmath numbers (it calls ``np.cos`` or
-  ``np.linalg`` rather than ``self.math`` and plain arithmetic) is judged in double
-  only; the note says why.
+  ``np.linalg`` rather than ``self.math`` and plain arithmetic), or a model evaluated
+  numerically only (``ClosedFormModel.numeric_only``: q̈ as Python code), is judged in
+  double only; the note says why.
 
 Cost: only failing states are evaluated again, worst first, and the first state
 that still fails ends the search, so a real error costs one evaluation (about a
@@ -105,6 +106,8 @@ def _precise(method, name: str):
 
 def precise_model(model):
     """A copy of ``model`` whose hand-written methods run in ``DIGITS`` digits, rounded to double."""
+    if model.numeric_only:  # its code is not ours to run on mpmath numbers: it would round to double
+        raise PrecisionUnavailable(f"{model.numeric_only}: judged in double only")
     try:
         with mpmath.workdps(DIGITS):
             twin = _mp_instance(model)

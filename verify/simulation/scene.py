@@ -217,6 +217,13 @@ def parse_scene(data: dict, source: str, base: Path | None = None) -> Scene:
     top.only(TOP_KEYS)
     scene_path = base or Path(source)
     model_cls, model_file = _model(top, scene_path)
+    if not model_cls.has_mass_matrix:
+        top.fail(
+            "model",
+            top.get("model"),
+            f"{model_cls.__name__} gives q̈ alone (no M, H, V): a scene's invariants (energy, momentum) "
+            "need them; check q̈ with pendverify check instead",
+        )
     model = model_cls.name
     n = len(model_cls.coordinates)
     params, params_source = _parameters(top, model_cls, scene_path, model_file)

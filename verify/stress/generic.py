@@ -11,7 +11,8 @@ parameter set (``pendverify stress --analytic FILE --urdf URDF --params PARAMS``
 * ``high speed``: rates up to 1e3;
 * ``zero gravity``: g = 0;
 * ``near singular``: the parameter and state that drive M nearest to singular, found from
-  its conditioning (``pendverify.stress.singular``), walked towards the singularity.
+  its conditioning (``pendverify.stress.singular``), walked towards the singularity (not for
+  a model given by q̈ alone, which has no M).
 
 A changed set's URDF is the given URDF with the parameter's values rewritten where they
 sit (``pendverify.robot.rebind``).  A parameter that cannot be rewritten there, or whose
@@ -103,7 +104,10 @@ def generic_cases(model_cls, params, urdf: str, source: str = "<URDF>") -> tuple
         cases.append(_on(zero_g, urdf, cls))
     else:
         notes.append("the parameter set has no g: no zero-gravity case")
-    cases.append(_on(near_singular_case(cls, params, binding), urdf, cls))
+    if cls.has_mass_matrix:
+        cases.append(_on(near_singular_case(cls, params, binding), urdf, cls))
+    else:
+        notes.append(f"no near-singular case: {cls.__name__} gives q̈ alone, no M to drive towards singular")
     return cases, notes
 
 
