@@ -43,24 +43,10 @@ LATEX = r"""
   + b_2\dot{\theta}_2 + g m_2 r_2\cos(\theta_1 + \theta_2) &= \tau_2 \label{eq:eom}
 \end{align}
 """
+#: only the shorthands: every other symbol (\theta_1, \dot{\theta}_1, \ddot{\theta}_1, \tau_1, m_1 …)
+#: is the model's name by convention (``pendverify.analytic.latex_names``)
 SYMBOLS = r"""
 [symbols]
-'\theta_1' = "theta1"
-'\theta_2' = "theta2"
-'\dot{\theta}_1' = "dtheta1"
-'\dot{\theta}_2' = "dtheta2"
-'\ddot{\theta}_1' = "ddtheta1"
-'\ddot{\theta}_2' = "ddtheta2"
-'\tau_1' = "tau1"
-'\tau_2' = "tau2"
-'m_1' = "m1"
-'m_2' = "m2"
-'l_1' = "l1"
-'r_1' = "r1"
-'r_2' = "r2"
-'b_1' = "b1"
-'b_2' = "b2"
-'g' = "g"
 '\alpha' = "I1 + I2 + m1*r1**2 + m2*(l1**2 + r2**2)"
 '\beta' = "m2*l1*r2"
 '\delta' = "I2 + m2*r2**2"
