@@ -29,9 +29,7 @@ import numpy as np
 import pinocchio as pin
 
 from pendverify.analytic import ParameterSet
-from pendverify.robot.mjcf import mjcf_visuals
 from pendverify.robot.packages import resolve_package_uris
-from pendverify.robot.sdf_visuals import sdf_visuals
 from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
 
@@ -106,8 +104,12 @@ class VisualSystem:
         if loaded.visual_model is not None:  # given with a Pinocchio model
             visual_model = loaded.visual_model.copy()
         elif loaded.format == "mjcf":
+            from pendverify.robot.mjcf import mjcf_visuals  # imports MuJoCo: only for an MJCF
+
             visual_model = mjcf_visuals(system.model, loaded.text, loaded.source)
         elif loaded.format == "sdf":
+            from pendverify.robot.sdf_visuals import sdf_visuals
+
             visual_model = sdf_visuals(system.model, loaded.text)
         else:
             visual_model = _urdf_visuals(system.model, loaded.text, loaded.source)

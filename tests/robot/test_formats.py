@@ -9,6 +9,7 @@ exit status 2; an SDF is read by Drake, and refused without it naming the extra.
 from __future__ import annotations
 
 import json
+import subprocess
 import sys
 from pathlib import Path
 
@@ -415,3 +416,16 @@ def test_systems_on_one_read_description_leave_it_as_it_was():
     fresh = PinocchioSystem.for_model(SEED_MODEL, MJCF, 9.81)
     assert np.array_equal(at_g.gravity(q), fresh.gravity(q))
     assert np.array_equal(at_zero.gravity(q), np.zeros(2)) and at_g.notes == fresh.notes
+
+
+def test_mujoco_and_drake_are_imported_only_for_their_files():
+    """A URDF's check, and everything the CLI imports, load neither MuJoCo nor Drake: they are
+    imported when an MJCF or SDF file is read (each adds a quarter of a second or more)."""
+    code = (
+        "import sys, pendverify.cli, pendverify.api, pendverify.viz.geometry; "
+        "from pendverify.robot.description import load_description; "
+        f"load_description({str(URDF)!r}); "
+        "print(sorted(m for m in ('mujoco', 'pydrake') if m in sys.modules))"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert done.stdout.strip() == "[]"

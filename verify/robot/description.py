@@ -11,8 +11,12 @@ format (``FORMATS``) is decided before anything is read into Pinocchio:
 * **MJCF** — root ``<mujoco>``: its numbers read strictly, compiled by MuJoCo, copied into
   Pinocchio and cross-checked against MuJoCo (``pendverify.robot.mjcf``); its text is the file's
   with includes in place.
-* **SDFormat** — root ``<sdf>``: Pinocchio's SDFormat reader if this build has one, else
-  refused (``pendverify.robot.sdf``).
+* **SDFormat** — root ``<sdf>``: its numbers read strictly, parsed by Drake (the optional extra
+  ``pendverify[sdf]``; without it, refused naming the extra), copied into Pinocchio and
+  cross-checked against Drake (``pendverify.robot.sdf``).
+
+MuJoCo and Drake are imported only when a file of theirs is read.  (A ``pinocchio.Model`` given
+to the Python API becomes a ``LoadedDescription`` in ``pendverify.robot.pinocchio_model``.)
 
 Whatever the format, the model's fixed base is then moved to the origin (``anchor_base``)
 and the result is one ``LoadedDescription``: the model, the facts Pinocchio does not keep
@@ -31,8 +35,6 @@ import pinocchio as pin
 
 from pendverify.display import shortened
 from pendverify.errors import UrdfShapeError
-from pendverify.robot.mjcf import build_mjcf_model
-from pendverify.robot.sdf import build_sdf_model
 from pendverify.robot.strict import DescriptionFacts
 from pendverify.robot.urdfdom import build_pinocchio_model
 from pendverify.robot.xacro_expand import XACRO_SUFFIXES, expand_xacro, uses_xacro
@@ -147,9 +149,13 @@ def load_description(description: str | Path, source: str | None = None) -> Load
                 f"extension elements urdfdom ignores, so the model leaves them out: {shortened(listed, 300)}"
             )
     elif fmt == "mjcf":
+        from pendverify.robot.mjcf import build_mjcf_model  # imports MuJoCo: only for an MJCF
+
         model, reading, log = build_mjcf_model(text, source, path)
         facts, notes, origins, text = reading.facts, reading.notes, reading.origins, reading.text
     else:
+        from pendverify.robot.sdf import build_sdf_model  # Drake's reader: only for an SDF
+
         model, facts, log = build_sdf_model(text, source)
     offset = anchor_base(model)
     return LoadedDescription(model, source, text, facts, offset, log, fmt, notes, origins)
