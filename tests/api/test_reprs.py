@@ -75,7 +75,10 @@ def report():
 # --- reports ----------------------------------------------------------------------------------------
 def test_report_repr_is_short_and_says_verdict_size_and_models(report):
     text = short(repr(report))
-    assert text.startswith("<CheckReport pass: 42 checks on 4 model(s), ")
+    # erd's mesh URDFs put link 1's centre of mass 2 µm off the joint line: a model-form term
+    # within its threshold, which passes with a warning (the verdict "warn")
+    assert text.startswith("<CheckReport warn: 42 checks on 4 model(s), ")
+    assert {r.status for r in report.results if r.check == "model-form"} == {"warn"}
     assert f"{sum(report.states.values())} states, seed 20260301" in text
     assert "erd:double_pendulum_simple" in text
     assert len(repr(report.results)) > 10 * REPR_LIMIT  # what it replaces: the whole evidence
@@ -88,7 +91,7 @@ def test_report_repr_stays_short_with_many_long_model_labels(report):
         results=list(report.results),
     )
     text = short(repr(many))
-    assert "…" in text and text.startswith("<Report pass: 42 checks on 44 model(s), 400 states, seed 1")
+    assert "…" in text and text.startswith("<Report warn: 42 checks on 44 model(s), 400 states, seed 1")
 
 
 def test_report_html_shows_the_rows_of_the_cli_table(report, capsys):
@@ -100,7 +103,8 @@ def test_report_html_shows_the_rows_of_the_cli_table(report, capsys):
     assert parsed.rows[0] == re.split(r"\s{2,}", lines[0].strip())
     assert parsed.rows[1:] == cli_rows and len(report.results) == 42
     # the notes and the verdict line are those under the CLI's table (the timing aside)
-    under = [TIMING.sub(", … s: ", line) for line in lines if line.startswith(("note", "largest"))]
+    kept = ("note", "warning", "largest")
+    under = [TIMING.sub(", … s: ", line) for line in lines if line.startswith(kept)]
     assert [TIMING.sub(", … s: ", item) for item in parsed.items] == under
     assert TIMING.sub(", … s: ", lines[-1]) in TIMING.sub(", … s: ", report._repr_html_())
 

@@ -19,7 +19,9 @@ def test_default_check_passes_and_writes_json(tmp_path, capsys):
     out_json = tmp_path / "sub" / "report.json"
     assert main(["check", "--samples", "50", "--json", str(out_json)]) == 0
     out = capsys.readouterr().out
-    assert "all checks pass" in out
+    # erd's mesh URDFs put link 1's centre of mass 2 µm off the joint line: within the model-form
+    # threshold, a pass with a warning each (erd:double_pendulum and its continuous twin)
+    assert "pass with 2 warning(s)" in out
     for label in ("double_pendulum", "cart_double_pendulum", "erd:double_pendulum_simple"):
         assert label in out
     report = json.loads(out_json.read_text())
