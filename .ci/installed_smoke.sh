@@ -88,5 +88,9 @@ step pendverify bench certify
 step pendverify example cart_pole cart_pole
 step pendverify check --analytic cart_pole/cart_pole.py --urdf cart_pole/cart_pole.urdf --params cart_pole/cart_pole.toml
 step pendverify simulate cart_pole/cart_pole_lqr_push.toml
+# the shipped MJCF, compiled by MuJoCo (a dependency, no extra): shown, then checked
+mjcf=$(shipped examples double_pendulum.mjcf.xml)
+step pendverify show --robot "$mjcf"
+step pendverify check --model double_pendulum --urdf "$mjcf"
 step python -m pendverify --version
 echo "installed smoke test passed"
