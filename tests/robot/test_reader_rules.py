@@ -2,11 +2,12 @@
 
 Rules (``pendverify.robot.xml_reading``, ``strict``, ``urdf_numbers``): each row of
 ``URDF_RULES`` is (rule, a published-style file the rule accepts, the same file breaking the
-rule, the start of the refusal).  (An MJCF's rules are MuJoCo's compiler's, and its numbers'
-strict reading is tested in ``test_mjcf_mujoco.py``.)  The accepted file is read the whole way (strict reader, then Pinocchio); the
-refused one gives one line naming the file, the place and the value.  Published files from
-installed packages (example-robot-data) that the format's tools read are read as well, and
-an error message quotes at most a short fragment of a long value.
+rule, the start of the refusal).  (An MJCF's rules are MuJoCo's compiler's; its numbers'
+strict reading is tested in ``test_mjcf_mujoco.py``.)  The accepted file is read the whole
+way (strict reader, then Pinocchio); the refused one gives one line naming the file, the
+place and the value.  Published files from installed packages (example-robot-data) that the
+format's tools read are read as well, and an error message quotes at most a short fragment
+of a long value.
 """
 
 from __future__ import annotations
