@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 
 import pendverify
+from pendverify.analytic.matrix_equation import MatrixEquationError, read_terms
 from pendverify.analytic.plugin import load_model_class
 from pendverify.api import read_model
 from pendverify.errors import PendverifyError
@@ -255,3 +256,40 @@ def test_a_coordinate_named_q_keeps_scalar_equations(tmp_path):
     )
     spec = load_model_class(path).text_spec
     assert "coefficients of the accelerations" in spec.derived["M"]
+
+
+@pytest.mark.parametrize(
+    "equation, latex, read",
+    [
+        (
+            r"\mathbf{M}\ddot{\mathbf{q}} + \mathbf{h}(\mathbf{q},\dot{\mathbf{q}})"
+            r" = \mathbf{B}\boldsymbol{\tau}",
+            True,
+            [(1, "M", "ddq"), (1, "h", None), (-1, "B", "tau")],
+        ),
+        (r"\mathbf{\ddot q}\,? = 0", True, None),
+        (
+            r"M\ddot q + W w = B u - G",
+            True,
+            [(1, "M", "ddq"), (1, "W", "w"), (-1, "B", "u"), (1, "G", None)],
+        ),
+        ("-M*ddq - h + B*u = 0", False, [(-1, "M", "ddq"), (-1, "h", None), (1, "B", "u")]),
+        ("0 = M*ddq + W*w - tau", False, [(-1, "M", "ddq"), (-1, "W", "w"), (1, None, "tau")]),
+    ],
+)
+def test_terms_and_their_signs(equation, latex, read):
+    """Each term moved to the left-hand side: (sign, key, vector) as written, LaTeX fonts dropped."""
+    if read is None:
+        with pytest.raises(MatrixEquationError, match="unexpected '\\?'"):
+            read_terms(equation, latex)
+        return
+    terms = read_terms(equation, latex)
+    found = [(t.sign, t.key and t.key.name, t.vector and t.vector.name) for t in terms]
+    assert found == read, found
+
+
+def test_a_V_that_disagrees_with_the_equations_gravity_is_refused(tmp_path):
+    v = 'V = "g*((m1*r1 + m2*l1)*sin(theta1) + m2*r2*sin(theta1 + theta2))"'
+    assert load_model_class(text_file(tmp_path, "M*ddq + C*dq + D*dq + G = B*u", V=v)).text_spec
+    with pytest.raises(PendverifyError, match=r"key 'V': ∂V/∂q is not the gravity vector H \(−G: the matrix"):
+        load_model_class(text_file(tmp_path, "M*ddq + C*dq + D*dq - G = B*u", name="bad.toml", V=v))
