@@ -33,7 +33,8 @@ from pathlib import Path
 
 import sympy as sp
 
-from pendverify.analytic.matrix_equation import matrix_text, names_vectors, read_matrix_equation
+from pendverify.analytic.matrix_equation import matrix_text, read_matrix_equation
+from pendverify.analytic.matrix_equation_parse import names_vectors
 from pendverify.analytic.parameter_set import KIND_RULES
 from pendverify.analytic.params import read_toml
 from pendverify.analytic.text_equations import latex_side, read_equations, split_equations

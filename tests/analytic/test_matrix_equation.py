@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 import pendverify
-from pendverify.analytic.matrix_equation import MatrixEquationError, read_terms
+from pendverify.analytic.matrix_equation_parse import MatrixEquationError, read_terms
 from pendverify.analytic.plugin import load_model_class
 from pendverify.api import read_model
 from pendverify.errors import PendverifyError
