@@ -10,7 +10,9 @@ some derivations print it; needs ``D``) or ``Cqdot`` (the vector C·q̇), ``H``
 from H), optional ``D``, ``B``, ``W``, ``det_M``, ``M_inv``, ``qddot`` — or, instead
 of C, H, D, B and W, ``f``, the right-hand side of M q̈ = f(q, q̇, u, w) — or, instead of
 all of them, ``equations``, the equations of motion whole (``lhs = rhs``, one per
-coordinate, ``pendverify.analytic.text_equations``) — with the rates named
+coordinate, ``pendverify.analytic.text_equations``, or one matrix equation ``M*ddq + C*dq + G = B*u``
+over the keys M, C, D, B, W, G (the gravity vector, as H) and h (the bias),
+``pendverify.analytic.matrix_equation``) — with the rates named
 ``d<coordinate>`` and the accelerations ``dd<coordinate>``; and ``[urdf]`` (``joints``, ``transform``,
 ``offset``).  With ``notation = "latex"`` the equations are LaTeX and a
 ``[symbols]`` table maps the document's symbols (``pendverify.analytic.text_model_latex``).
