@@ -94,7 +94,7 @@ def complete_equations(reader: Reader, spec: TextModelSpec) -> None:
         eq["V"] = _integrated(reader, eq["H"], q)
         spec.derived["V"] = "integrated from H"
     elif "H" in spec.derived and not all(_is_zero(sp.diff(eq["V"], x) - eq["H"][i]) for i, x in enumerate(q)):
-        reader.fail("f", "its gravity part −f(q, 0, 0, 0) is not ∂V/∂q of the V given")
+        reader.fail("V", f"∂V/∂q is not the gravity vector H ({spec.derived['H']})")
     if spec.inputs and "B" not in eq:
         reader.fail("B", f"missing: the model declares inputs {', '.join(spec.inputs)}")
 

@@ -10,7 +10,9 @@ some derivations print it; needs ``D``) or ``Cqdot`` (the vector C·q̇), ``H``
 from H), optional ``D``, ``B``, ``W``, ``det_M``, ``M_inv``, ``qddot`` — or, instead
 of C, H, D, B and W, ``f``, the right-hand side of M q̈ = f(q, q̇, u, w) — or, instead of
 all of them, ``equations``, the equations of motion whole (``lhs = rhs``, one per
-coordinate, ``pendverify.analytic.text_equations``) — with the rates named
+coordinate, ``pendverify.analytic.text_equations``, or one matrix equation ``M*ddq + C*dq + G = B*u``
+over the keys M, C, D, B, W, G (the gravity vector, as H) and h (the bias),
+``pendverify.analytic.matrix_equation``) — with the rates named
 ``d<coordinate>`` and the accelerations ``dd<coordinate>``; and ``[urdf]`` (``joints``, ``transform``,
 ``offset``).  With ``notation = "latex"`` the equations are LaTeX and a
 ``[symbols]`` table maps the document's symbols (``pendverify.analytic.text_model_latex``).
@@ -33,6 +35,8 @@ from pathlib import Path
 
 import sympy as sp
 
+from pendverify.analytic.matrix_equation import matrix_text, read_matrix_equation
+from pendverify.analytic.matrix_equation_parse import names_vectors
 from pendverify.analytic.parameter_set import KIND_RULES
 from pendverify.analytic.params import read_toml
 from pendverify.analytic.text_equations import latex_side, read_equations, split_equations
@@ -45,7 +49,7 @@ CONSTANTS = {"pi": sp.pi}
 TOP_KEYS = (
     "name", "notation", "coordinates", "inputs", "disturbances", "parameters", "symbols", "urdf",
     "M", "C", "C_plus_D", "Cqdot", "H", "V", "D", "B", "W", "f", "det_M", "M_inv", "qddot",
-    "equations",
+    "G", "h", "equations",
 )  # fmt: skip
 #: the keys of a declaration without equations (a Python model file's ``DECLARATION``, the API's
 #: ``declaration``): the equations come from elsewhere (``pendverify.analytic.mechanics_model``)
@@ -55,7 +59,8 @@ NOTATIONS = ("sympy", "latex")
 EQUATIONS = {
     "M": ("nn", "q"), "C": ("nn", "qv"), "C_plus_D": ("nn", "qv"), "Cqdot": ("n", "qv"), "H": ("n", "q"),
     "V": ("", "q"), "D": ("nn", ""), "B": ("nu", ""), "W": ("nw", ""), "f": ("n", "qvuw"),
-    "det_M": ("", "q"), "M_inv": ("nn", "q"), "qddot": ("n", "qvuw"), "equations": ("e", "qvuwa"),
+    "det_M": ("", "q"), "M_inv": ("nn", "q"), "qddot": ("n", "qvuw"), "G": ("n", "q"), "h": ("n", "qv"),
+    "equations": ("e", "qvuwa"),
 }  # fmt: skip
 
 
@@ -270,6 +275,11 @@ def _read_equations(reader: Reader, spec: TextModelSpec, data: dict) -> None:
             spec.equations[key] = parse_latex_equation(reader, latex, key, data[key], rows, cols, allowed)
         else:
             spec.equations[key] = parse_equation(reader, key, data[key], rows, cols, allowed)
+    for k in ("G", "h"):
+        if k in data and "equations" not in data:
+            reader.fail(
+                k, "names a term of a matrix equation (under `equations`); without one, give H (and C)"
+            )
     if latex is not None:
         spec.latex_conventions = [str(c) for c in latex.conventions_used()]
         table = latex.table
@@ -278,8 +288,20 @@ def _read_equations(reader: Reader, spec: TextModelSpec, data: dict) -> None:
 
 
 def _read_whole_equations(reader: Reader, spec: TextModelSpec, data: dict, key: str, allowed, latex) -> None:
-    """The ``equations`` key: M and f of M q̈ = f (``pendverify.analytic.text_equations``)."""
-    given = [k for k in ("M", "f", "C", "C_plus_D", "Cqdot", "H", "D", "B", "W", "qddot") if k in data]
+    """The ``equations`` key: M and f of M q̈ = f (``pendverify.analytic.text_equations``), or one
+    matrix equation over the file's M, C, G, … (``pendverify.analytic.matrix_equation``)."""
+    text = matrix_text(data[key])
+    if text is not None and names_vectors(text, latex is not None, spec.coordinates):
+        other = [k for k in ("f", "C_plus_D", "Cqdot") if k in data]
+        if other:
+            reader.fail(
+                other[0], f"not with a matrix equation under '{key}': give its terms' keys (M, C, G, …)"
+            )
+        read_matrix_equation(reader, spec, key, text)
+        return
+    given = [
+        k for k in ("M", "f", "C", "C_plus_D", "Cqdot", "H", "D", "B", "W", "qddot", "G", "h") if k in data
+    ]
     if given:
         reader.fail(
             key, f"give the equations or their parts, not both (the file also gives {', '.join(given)})"

@@ -2,7 +2,8 @@
 
 The double pendulum reference system as a class (``examples/minimal_double_pendulum.py``), a
 text file (``examples/minimal_double_pendulum_text.toml``), LaTeX parts
-(``examples/double_pendulum_latex.toml``), LaTeX whole equations, q̈ alone (M derived from
+(``examples/double_pendulum_latex.toml``), LaTeX whole equations, a LaTeX matrix equation over
+LaTeX parts (M q̈ + C q̇ + D q̇ + G = B u), q̈ alone (M derived from
 q̈ and B), a ``LagrangesMethod`` and q̈ as Python code (``qddot(q, v, u)`` solving M q̈ = f with
 NumPy, B = I): against the same URDF and parameter values, each check that runs on two forms
 has the same verdict on both (all pass); doubling link 2's inertia in M's last entry (or, for
@@ -18,6 +19,7 @@ import pytest
 
 import pendverify
 from tests.analytic.mechanics_double_pendulum import DECLARATION, lagrange
+from tests.analytic.test_matrix_equation import latex_file
 from tests.analytic.test_whole_equations import LATEX, equations_file
 
 REPO = Path(__file__).resolve().parents[2]
@@ -102,6 +104,7 @@ def _forms(tmp_path: Path, planted: bool) -> dict[str, dict]:
         "text": ('"I2 + m2*r2**2"]', '"2*I2 + m2*r2**2"]'),
         "latex": ("'\\delta' = \"I2 + m2*r2**2\"", "'\\delta' = \"2*I2 + m2*r2**2\""),
         "whole": (r"\delta\,\ddot{\theta}_2", r"2\delta\,\ddot{\theta}_2"),
+        "matrix": ("'\\delta' = \"I2 + m2*r2**2\"", "'\\delta' = \"2*I2 + m2*r2**2\""),
     }
     change = {k: (v if planted else ("", "")) for k, v in doubled.items()}
     return {
@@ -113,6 +116,9 @@ def _forms(tmp_path: Path, planted: bool) -> dict[str, dict]:
         ),
         "LaTeX whole equations": dict(
             model=equations_file(folder, LATEX.replace(*change["whole"]), latex=True)
+        ),
+        "LaTeX matrix equation": dict(
+            model=latex_file(folder, r"M\ddot{q} + C\dot{q} + D\dot{q} + G = B u", **dict([change["matrix"]]))
         ),
         "q̈ alone": dict(model=_qddot_file(folder, "(2*I2 + m2*r2**2)" if planted else M22)),
         "LagrangesMethod": dict(model=lagrange(2 if planted else 1), declaration=DECLARATION),
@@ -145,7 +151,16 @@ def test_every_form_gives_the_same_verdicts(tmp_path):
 
 @pytest.mark.parametrize(
     "form",
-    ["class", "text", "LaTeX parts", "LaTeX whole equations", "q̈ alone", "LagrangesMethod", "q̈ as code"],
+    [
+        "class",
+        "text",
+        "LaTeX parts",
+        "LaTeX whole equations",
+        "LaTeX matrix equation",
+        "q̈ alone",
+        "LagrangesMethod",
+        "q̈ as code",
+    ],
 )
 def test_a_doubled_inertia_in_M_fails_crba_in_every_form(form, tmp_path):
     """crba in every form that gives M; aba in a form that gives q̈ alone (crba does not run)."""
