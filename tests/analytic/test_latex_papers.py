@@ -20,34 +20,17 @@ import pytest
 
 from pendverify import api
 from pendverify.cli import main
+from tests.analytic.test_latex_conventions import HEAD
+from tests.analytic.test_latex_conventions import TABLES as CONVENTION_TABLES
 from tests.error_message import one_error
 
 REPO = Path(__file__).resolve().parents[2]
 URDF = REPO / "urdf" / "double_pendulum.urdf"
 PARAMS = REPO / "analytic" / "params" / "double_pendulum.toml"
 
-HEAD = """name = "double_pendulum"
-notation = "latex"
-inputs = ["tau1", "tau2"]
-"""
-TABLES = r"""
-[coordinates]
-theta1 = "angle"
-theta2 = "angle"
-
-[parameters]
-m1 = { kind = "mass", unit = "kg" }
-m2 = { kind = "mass", unit = "kg" }
-l1 = { kind = "length", unit = "m" }
-l2 = { kind = "length", unit = "m" }
-r1 = { kind = "offset", unit = "m" }
-r2 = { kind = "offset", unit = "m" }
-I1 = { kind = "inertia", unit = "kg·m²" }
-I2 = { kind = "inertia", unit = "kg·m²" }
-b1 = { kind = "damping", unit = "N·m·s/rad" }
-b2 = { kind = "damping", unit = "N·m·s/rad" }
-g = { kind = "gravity", unit = "m/s²" }
-
+TABLES = (
+    CONVENTION_TABLES
+    + r"""
 [symbols]
 '\alpha' = "I1 + I2 + m1*r1**2 + m2*(l1**2 + r2**2)"
 '\beta' = "m2*l1*r2"
@@ -56,6 +39,7 @@ g = { kind = "gravity", unit = "m/s²" }
 [urdf]
 joints = ["joint1", "joint2"]
 """
+)
 
 #: one display per key, each printed as a paper prints it
 DISPLAYS = {
