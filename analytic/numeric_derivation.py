@@ -116,9 +116,9 @@ def derive(acceleration, q, B: np.ndarray, n_disturbances: int, fail) -> Derivat
             bound = 4.0 * rho * force
             if not float(np.linalg.norm(residual)) <= bound:
                 fail(
-                    f"q̈ is not affine in the inputs at q = {q.tolist()}: q̈(e{j + 1} + e{k + 1}) − q̈(e{j + 1}) − "
-                    f"q̈(e{k + 1}) + q̈(0) = {(residual * wts).tolist()}, beyond its rounding bound "
-                    f"(scaled {bound:.2g}); M = B (∂q̈/∂u)⁻¹ needs q̈ = M⁻¹(B u + …)"
+                    f"q̈ is not affine in the inputs at q = {q.tolist()}: q̈(e{j + 1} + e{k + 1}) − "
+                    f"q̈(e{j + 1}) − q̈(e{k + 1}) + q̈(0) = {(residual * wts).tolist()}, "
+                    f"beyond its rounding bound (scaled {bound:.2g}); M = B (∂q̈/∂u)⁻¹ needs q̈ = M⁻¹(B u + …)"
                 )
     return Derivation(M, rest)
 

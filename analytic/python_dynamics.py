@@ -190,11 +190,13 @@ class DerivedPythonDynamicsModel(PythonDynamicsModel):
 
     def coriolis_force(self, q, v):
         found, v = self._derived(q), np.asarray(v, dtype=float)
-        return -found.M @ (self._moving(q, v) - found.rest) - np.asarray(self.damping_matrix(), dtype=float) @ v
+        D = np.asarray(self.damping_matrix(), dtype=float)
+        return -found.M @ (self._moving(q, v) - found.rest) - D @ v
 
     def bias(self, q, v):
         found, v = self._derived(q), np.asarray(v, dtype=float)
-        return -found.M @ self._moving(q, v) - np.asarray(self.damping_matrix(), dtype=float) @ v
+        D = np.asarray(self.damping_matrix(), dtype=float)
+        return -found.M @ self._moving(q, v) - D @ v
 
 
 def _resolved(filename: str) -> str:
