@@ -103,8 +103,10 @@ def derive(acceleration, q, B: np.ndarray, n_disturbances: int, fail) -> Derivat
         M = B @ np.linalg.inv(A)
     except np.linalg.LinAlgError:
         M = np.full((n, n), np.nan)
-    if not np.all(np.isfinite(M)) or np.any(np.diag(M) <= 0):
+    if not np.all(np.isfinite(M)):
         fail(f"∂q̈/∂u = {A.tolist()} at q = {q.tolist()} is not invertible: M = B (∂q̈/∂u)⁻¹ cannot be formed")
+    if np.any(np.diag(M) <= 0):
+        fail(f"M = B (∂q̈/∂u)⁻¹ = {M.tolist()} at q = {q.tolist()} has a diagonal entry ≤ 0")
     wts = 1.0 / np.sqrt(np.abs(np.diag(M)))
     rho = one_rounding(M, float(np.max(np.abs(q), initial=0.0)))
     gravity = float(np.linalg.norm(wts * (M @ rest)))

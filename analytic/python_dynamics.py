@@ -173,6 +173,8 @@ class DerivedPythonDynamicsModel(PythonDynamicsModel):
                 raise UserCodeError(self.source, f"{self._name()}: {message}")
 
             B = np.asarray(self.input_matrix(), dtype=float)
+            if not np.isfinite(np.linalg.cond(B)) or np.linalg.cond(B) * np.finfo(float).eps >= 1:
+                fail(f"B = {B.tolist()} is singular at these parameters: M = B (∂q̈/∂u)⁻¹ cannot be formed")
             cache[key] = derive(self.acceleration, q, B, len(self.disturbances), fail)
         return cache[key]
 

@@ -73,6 +73,9 @@ def test_the_acrobot_with_torques_on_both_joints_passes_crba_gravity_rnea(tmp_pa
     assert "energy not run" in notes and "not V" in notes
     assert "coriolis, skew not run" in notes
     assert "det not run" in notes and "minverse not run" in notes
+    for check in ("crba", "gravity", "rnea"):
+        (result,) = report[check]
+        assert any("derived numerically from the model's q̈" in n for n in result.notes), result.notes
 
 
 def test_the_double_pendulum_code_passes_and_names_what_is_derived(tmp_path):

@@ -94,6 +94,12 @@ def collect(check: Check, batch) -> Evidence:
         i = int(judged[k])
         note = m.describe(i) if noted[k] else "NaN"
         notes.append(f"{batch.states[i].label}: {note}")
+    derived = np.broadcast_to(np.asarray(m.derived, dtype=float), (n,))
+    if np.any(derived > 0):
+        notes.append(
+            "derived numerically from the model's q̈ (pendverify.analytic.numeric_derivation): the "
+            f"tolerance includes the derivation's rounding bound, at most {np.max(derived):.2g}"
+        )
     return Evidence(judged, r.copy(), np.where(nan, np.inf, rel_err), rel_tol, error.copy(), refused, notes)
 
 
