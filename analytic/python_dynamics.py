@@ -36,7 +36,7 @@ in high precision (code written with ``math``/NumPy functions would round to dou
 
 With as many inputs as coordinates and B invertible, M, H and C·q̇ are derived numerically at
 each state the checks evaluate (``DerivedPythonDynamicsModel``,
-``pendverify.analytic.numeric_derivation``: M = B (∂q̈/∂u)⁻¹ from differences of step 1,
+``pendverify.analytic.numeric_derivation``: M = B (∂q̈/∂u)⁻¹ from differences (steps of 1 or a power of 2),
 q̈ being affine in u, H = −M q̈(q, 0, 0), C·q̇ = −M (q̈(q, q̇, 0) − q̈(q, 0, 0)) − D q̇), so ``crba``,
 ``gravity`` and ``rnea`` run too, each with the derivation's rounding bound added to its
 tolerance; V (``energy``), a matrix C (``coriolis``, ``skew``), det M and M⁻¹ (``det``,
@@ -177,6 +177,10 @@ class DerivedPythonDynamicsModel(PythonDynamicsModel):
                 fail(f"B = {B.tolist()} is singular at these parameters: M = B (∂q̈/∂u)⁻¹ cannot be formed")
             cache[key] = derive(self.acceleration, q, B, len(self.disturbances), fail)
         return cache[key]
+
+    def derivation_steps(self, q) -> np.ndarray:
+        """The steps h of the inputs the derivation at q took (``numeric_derivation.rounding_bounds``)."""
+        return self._derived(q).steps
 
     def mass_matrix(self, q):
         return self._derived(q).M

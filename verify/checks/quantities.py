@@ -114,7 +114,9 @@ class Terms:
         q̈ (``pendverify.analytic.numeric_derivation``), from Pinocchio's M; zeros for any other model."""
         if not self.batch.model.mass_from_acceleration:
             return 0.0, 0.0
-        return rounding_bounds(self.M_pin, self.S, self.B, self.g_scale, self.batch.angle)
+        model = self.batch.model
+        steps = np.array([model.derivation_steps(q) for q in self.q])
+        return rounding_bounds(self.M_pin, self.S, self.B, self.g_scale, self.batch.angle, steps)
 
     @cached_property
     def D_urdf(self):
