@@ -36,13 +36,13 @@ in high precision (code written with ``math``/NumPy functions would round to dou
 
 With as many inputs as coordinates and B invertible, M, H and C·q̇ are derived numerically at
 each state the checks evaluate (``DerivedPythonDynamicsModel``,
-``pendverify.analytic.numeric_derivation``: M = B (∂q̈/∂u)⁻¹ from differences (steps of 1 or a power of 2),
-q̈ being affine in u, H = −M q̈(q, 0, 0), C·q̇ = −M (q̈(q, q̇, 0) − q̈(q, 0, 0)) − D q̇), so ``crba``,
-``gravity`` and ``rnea`` run too, each with the derivation's rounding bound added to its
-tolerance; V (``energy``), a matrix C (``coriolis``, ``skew``), det M and M⁻¹ (``det``,
-``minverse``) are numbers at states, not closed forms, and are not checked.  With fewer inputs
-M is not determined: only ``aba`` (and ``damping``) run, and the report says why the others do
-not.  An exception the function raises is one line naming its
+``pendverify.analytic.numeric_derivation``: M = B (∂q̈/∂u)⁻¹ from differences, q̈ being affine
+in u, H = −M q̈(q, 0, 0), C·q̇ = −M (q̈(q, q̇, 0) − q̈(q, 0, 0)) − D q̇), so ``crba``, ``gravity``
+and ``rnea`` run too, each with the derivation's rounding bound added to its tolerance; V
+(``energy``), a matrix C (``coriolis``, ``skew``), det M and M⁻¹ (``det``, ``minverse``) are
+numbers at states, not closed forms, and are not checked.  With fewer inputs M is not
+determined: only ``aba`` (and ``damping``) run, and the report says why the others do not.
+An exception the function raises is one line naming its
 file and line and the exception (``UserCodeError``).
 """
 
@@ -85,7 +85,8 @@ class PythonDynamicsModel(AccelerationOnlyModel):
 
     numeric_only: ClassVar[str] = NUMERIC_ONLY
     without_mass_matrix: ClassVar[str] = (
-        "its q̈ is Python code, evaluated numerically: M, C·q̇, H and V are not derived from it"
+        "its inputs do not span the coordinates (∂q̈/∂u = M⁻¹B is not square), so M, C·q̇, H and V "
+        "are not determined from its code"
     )
     dynamics: ClassVar[Callable]
     signature: ClassVar[str] = "f(x, u)"
@@ -158,10 +159,6 @@ class DerivedPythonDynamicsModel(PythonDynamicsModel):
     """
 
     mass_from_acceleration: ClassVar[str] = DERIVED
-    without_mass_matrix: ClassVar[str] = (
-        "its M, H and C·q̇ are derived from q̈ numerically at each state (crba, gravity, rnea check "
-        "them), but no matrix C, det M, M⁻¹ or V"
-    )
 
     def _derived(self, q) -> Derivation:
         q = np.asarray(q, dtype=float)
