@@ -142,6 +142,11 @@ class ClosedFormModel(metaclass=ModelClass):
     has_coriolis_matrix: ClassVar[bool] = True
     #: False for models that give q̈ alone (``AccelerationOnlyModel``).
     has_mass_matrix: ClassVar[bool] = True
+    #: How a model that gives q̈ alone derives M, H and C·q̇ from it at each state ("" when it does
+    #: not): then crba, gravity and rnea run on the derived forms, with the derivation's rounding
+    #: in their tolerance (``pendverify.analytic.numeric_derivation``); such a model gives
+    #: ``derivation_steps(q)``, the input steps its derivation took at q.
+    mass_from_acceleration: ClassVar[str] = ""
     #: Why the model's code is evaluated numerically only ("" when SymPy reads it): then no SymPy
     #: reading (``show``, ``sympy``, ``mutate``, generated NumPy) and no high-precision re-judge.
     numeric_only: ClassVar[str] = ""

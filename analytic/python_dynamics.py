@@ -34,11 +34,15 @@ SymPy does not read it (``pendverify show``, ``sympy``, ``mutate`` refuse in one
 call it state by state rather than as generated NumPy, and a failing state is not judged again
 in high precision (code written with ``math``/NumPy functions would round to double anyway).
 
-M is not derived, even with as many inputs as coordinates: q̈ is affine in u, so
-∂q̈/∂u = M⁻¹B is exact from differences of step 1 and M = B (M⁻¹B)⁻¹ would follow, but H, C·q̇
-and V would then be numbers at states, not closed forms, and V (the energy check) has no
-numerical counterpart without integrating H; so only ``aba`` (and ``damping``) run, and the
-report says why the others do not.  An exception the function raises is one line naming its
+With as many inputs as coordinates and B invertible, M, H and C·q̇ are derived numerically at
+each state the checks evaluate (``DerivedPythonDynamicsModel``,
+``pendverify.analytic.numeric_derivation``: M = B (∂q̈/∂u)⁻¹ from differences, q̈ being affine
+in u, H = −M q̈(q, 0, 0), C·q̇ = −M (q̈(q, q̇, 0) − q̈(q, 0, 0)) − D q̇), so ``crba``, ``gravity``
+and ``rnea`` run too, each with the derivation's rounding bound added to its tolerance; V
+(``energy``), a matrix C (``coriolis``, ``skew``), det M and M⁻¹ (``det``, ``minverse``) are
+numbers at states, not closed forms, and are not checked.  With fewer inputs M is not
+determined: only ``aba`` (and ``damping``) run, and the report says why the others do not.
+An exception the function raises is one line naming its
 file and line and the exception (``UserCodeError``).
 """
 
@@ -54,6 +58,7 @@ import numpy as np
 
 from pendverify.analytic.forms import NUMERIC_MATH
 from pendverify.analytic.interface import AccelerationOnlyModel
+from pendverify.analytic.numeric_derivation import DERIVED, Derivation, derive
 from pendverify.display import shortened
 from pendverify.errors import PendverifyError, UserCodeError
 
@@ -80,7 +85,8 @@ class PythonDynamicsModel(AccelerationOnlyModel):
 
     numeric_only: ClassVar[str] = NUMERIC_ONLY
     without_mass_matrix: ClassVar[str] = (
-        "its q̈ is Python code, evaluated numerically: M, C·q̇, H and V are not derived from it"
+        "its inputs do not span the coordinates (∂q̈/∂u = M⁻¹B is not square), so M, C·q̇, H and V "
+        "are not determined from its code"
     )
     dynamics: ClassVar[Callable]
     signature: ClassVar[str] = "f(x, u)"
@@ -143,6 +149,57 @@ class PythonDynamicsModel(AccelerationOnlyModel):
                 f"at q = {q.tolist()}, q̇ = {v.tolist()}, u = {forces.tolist()}",
             )
         return array
+
+
+class DerivedPythonDynamicsModel(PythonDynamicsModel):
+    """A ``PythonDynamicsModel`` with B square and invertible: M, H and C·q̇ derived from its q̈.
+
+    Each is derived at the configurations the checks evaluate, once per configuration
+    (``pendverify.analytic.numeric_derivation``); q̈ stays the code's own, checked by aba.
+    """
+
+    mass_from_acceleration: ClassVar[str] = DERIVED
+
+    def _derived(self, q) -> Derivation:
+        q = np.asarray(q, dtype=float)
+        cache = self.__dict__.setdefault("_derivations", {})
+        key = q.tobytes()
+        if key not in cache:
+
+            def fail(message: str):
+                raise UserCodeError(self.source, f"{self._name()}: {message}")
+
+            B = np.asarray(self.input_matrix(), dtype=float)
+            if not np.isfinite(np.linalg.cond(B)) or np.linalg.cond(B) * np.finfo(float).eps >= 1:
+                fail(f"B = {B.tolist()} is singular at these parameters: M = B (∂q̈/∂u)⁻¹ cannot be formed")
+            cache[key] = derive(self.acceleration, q, B, len(self.disturbances), fail)
+        return cache[key]
+
+    def derivation_steps(self, q) -> np.ndarray:
+        """The steps h of the inputs the derivation at q took (``numeric_derivation.rounding_bounds``)."""
+        return self._derived(q).steps
+
+    def mass_matrix(self, q):
+        return self._derived(q).M
+
+    def gravity(self, q):
+        found = self._derived(q)
+        return -found.M @ found.rest
+
+    def _moving(self, q, v) -> np.ndarray:
+        """q̈(q, q̇, 0, 0)."""
+        n = self.nv
+        return np.asarray(self.acceleration(q, v, np.zeros(n), np.zeros(len(self.disturbances))), dtype=float)
+
+    def coriolis_force(self, q, v):
+        found, v = self._derived(q), np.asarray(v, dtype=float)
+        D = np.asarray(self.damping_matrix(), dtype=float)
+        return -found.M @ (self._moving(q, v) - found.rest) - D @ v
+
+    def bias(self, q, v):
+        found, v = self._derived(q), np.asarray(v, dtype=float)
+        D = np.asarray(self.damping_matrix(), dtype=float)
+        return -found.M @ self._moving(q, v) - D @ v
 
 
 def _resolved(filename: str) -> str:
@@ -220,11 +277,20 @@ def python_dynamics_model(function, declaration: Mapping, source: str | Path | N
         )
     except ValueError:  # no signature to read (a builtin): it is called as declared and answers then
         pass
-    cls = build_model_class(spec, module, base=PythonDynamicsModel)
+    cls = build_model_class(spec, module, base=_base(spec))
     cls.dynamics = staticmethod(function)
     cls.signature, cls.positions, cls.rates = signature, positions, rates
     cls.source = _function_file(function)
     return cls
+
+
+def _base(spec) -> type[PythonDynamicsModel]:
+    """``DerivedPythonDynamicsModel`` where B is square and invertible (for all parameters but
+    those that zero det B), else ``PythonDynamicsModel``."""
+    B = spec.equations.get("B")
+    if B is not None and B.rows == B.cols == len(spec.coordinates) and B.det() != 0:
+        return DerivedPythonDynamicsModel
+    return PythonDynamicsModel
 
 
 def model_file_dynamics(module, path: Path):

@@ -3,7 +3,8 @@
 A check is not run when there is nothing to compare: ``coriolis`` and ``skew`` need a
 matrix C (a ``BiasOnlyModel`` gives only C·q̇); ``det`` and ``minverse`` need a
 hand-written det M and M⁻¹ (the interface's defaults derive them from M, by LU and by
-solving); ``damping`` needs a URDF that declares ``<dynamics damping>``.  Each
+solving); ``damping`` needs a URDF that declares ``<dynamics damping>``; ``energy`` needs V, which a
+model deriving M, H and C·q̇ from its q̈ (``mass_from_acceleration``) does not give.  Each
 ``requires`` function returns "" when its check applies, else the reason, which the
 report prints.  ``derived_notes`` says what the model left to the interface's defaults
 (what is derived, and how: ``pendverify.analytic.forms.INTERFACE``).
@@ -15,8 +16,9 @@ from pendverify.analytic.forms import INTERFACE, STATES, TOLERANCE
 
 
 def needs_mass_matrix(model, system) -> str:
-    """A ``requires``: the check compares M or what is built with it, which q̈ alone may not give."""
-    if model.has_mass_matrix:
+    """A ``requires``: the check compares M or what is built with it, which q̈ alone may not give
+    (it does where the model derives M, H and C·q̇ from q̈: ``mass_from_acceleration``)."""
+    if model.has_mass_matrix or model.mass_from_acceleration:
         return ""
     return (
         f"not run: {_class(model).__name__} gives q̈ alone and {model.without_mass_matrix}; "
@@ -31,6 +33,16 @@ def needs_mass_matrix_and(requires):
         return needs_mass_matrix(model, system) or requires(model, system)
 
     return both
+
+
+def needs_potential_energy(model, system) -> str:
+    """A ``requires``: the check compares V, which a model deriving M, H and C·q̇ from q̈ does not give."""
+    if not model.mass_from_acceleration:
+        return ""
+    return (
+        f"not run: {_class(model).__name__} derives M, H and C·q̇ from its q̈ at states, not V "
+        "(the energy check needs V(q), an integral of H over q)"
+    )
 
 
 def needs_matrix_c(model, system) -> str:
@@ -71,6 +83,12 @@ def derived_notes(model) -> list[str]:
     """
     written = set(_class(model).hand_written())
     notes = []
+    if model.mass_from_acceleration:
+        notes.append(
+            f"crba, gravity, rnea: {model.mass_from_acceleration}; the inertia and gravity scales "
+            "their tolerances are judged against are the URDF's"
+        )
+        return notes
     if not model.has_mass_matrix:
         notes.append(
             "aba: q̈ is the model's own; the model gives no M, so the sizes its tolerance is judged "

@@ -43,6 +43,7 @@ from pendverify.checks.applicability import (
     needs_mass_matrix,
     needs_mass_matrix_and,
     needs_matrix_c,
+    needs_potential_energy,
     needs_urdf_damping,
 )
 from pendverify.checks.batch import CheckBatch
@@ -110,7 +111,7 @@ CHECKS: tuple[Check, ...] = (
         "½q̇ᵀMq̇, V(q) − V(0)",
         16,
         quantities.measure_energy,
-        needs_mass_matrix,
+        needs_mass_matrix_and(needs_potential_energy),
     ),
     # Tᵀ·diag(b)·T: each entry a sum of at most n products of exact decimals' roundings
     Check(

@@ -2,7 +2,8 @@
 
 ``collect`` runs a check's measure (``pendverify.checks.quantities``) on a batch
 (``pendverify.checks.batch.CheckBatch``) and forms, per state, the rounding tolerance
-K·ε·((1 + |θ|max)·c_T + (A − 1)), the relative error e/s and the relative tolerance
+K·ε·((1 + |θ|max)·c_T + (A − 1)) (plus the rounding of forms the model derives from its q̈,
+``Measure.derived``), the relative error e/s and the relative tolerance
 rounding + a/s (the argument for them is in ``pendverify.checks.catalogue``): the
 ``Evidence``.  A state whose rounding tolerance exceeds the trust limit is refused, not
 judged.  ``conclude`` re-judges failing states with the closed forms in high precision
@@ -66,8 +67,9 @@ def collect(check: Check, batch) -> Evidence:
     n = len(batch)
     with np.errstate(all="ignore"):
         lever = batch.lever if check.world_frame else 1.0
-        rounding = np.broadcast_to(rounding_tolerance(check, batch.angle, batch.c_T, lever), (n,))
         m = check.measure(batch.terms)
+        own = rounding_tolerance(check, batch.angle, batch.c_T, lever) + np.asarray(m.derived, dtype=float)
+        rounding = np.broadcast_to(own, (n,))
         error, scale, allowance = (
             np.broadcast_to(np.asarray(x, dtype=float), (n,)) for x in (m.error, m.scale, m.allowance)
         )
@@ -92,6 +94,12 @@ def collect(check: Check, batch) -> Evidence:
         i = int(judged[k])
         note = m.describe(i) if noted[k] else "NaN"
         notes.append(f"{batch.states[i].label}: {note}")
+    derived = np.broadcast_to(np.asarray(m.derived, dtype=float), (n,))
+    if np.any(derived > 0):
+        notes.append(
+            "derived numerically from the model's q̈ (pendverify.analytic.numeric_derivation): the "
+            f"tolerance includes the derivation's rounding bound, at most {np.max(derived):.2g}"
+        )
     return Evidence(judged, r.copy(), np.where(nan, np.inf, rel_err), rel_tol, error.copy(), refused, notes)
 
 

@@ -32,6 +32,7 @@ from functools import cached_property
 
 import numpy as np
 
+from pendverify.analytic.numeric_derivation import rounding_bounds
 from pendverify.checks.scaling import (
     damping_rate_of,
     force_scale_of,
@@ -59,6 +60,9 @@ class Measure:
     #: the error of each entry (batch axis first) whose largest is ``error``, where the
     #: quantity has entries (``pendverify.diagnosis.entries`` names those that differ)
     entries: object = None
+    #: the relative rounding the model's own forms carry beyond a closed form's, added to the
+    #: check's rounding tolerance: forms derived numerically from q̈ (``Terms.derivation``)
+    derived: object = 0.0
 
 
 class Terms:
@@ -103,6 +107,16 @@ class Terms:
     def energy_allowance(self):
         """|ΔV(θ) − ΔV(0)| a model-form term may cause, per state (``PinocchioSystem.energy_allowance``)."""
         return self.batch.system.energy_allowance(self.q)
+
+    @cached_property
+    def derivation(self):
+        """(crba's, gravity's and rnea's) relative rounding bounds of forms the model derives from its
+        q̈ (``pendverify.analytic.numeric_derivation``), from Pinocchio's M; zeros for any other model."""
+        if not self.batch.model.mass_from_acceleration:
+            return 0.0, 0.0
+        model = self.batch.model
+        steps = np.array([model.derivation_steps(q) for q in self.q])
+        return rounding_bounds(self.M_pin, self.S, self.B, self.g_scale, self.batch.angle, steps)
 
     @cached_property
     def D_urdf(self):
@@ -231,14 +245,20 @@ def _at_least_one(x):
 # --- the measures ----------------------------------------------------------------------------
 def measure_crba(t):
     entries = np.abs(scaled_matrix(t.M_pin - t.M_hand, t.w))
-    return Measure(_max2(entries), 1.0, entries=entries)
+    return Measure(_max2(entries), 1.0, entries=entries, derived=t.derivation[0])
 
 
 def measure_rnea(t):
     w = t.w
     entries = w * np.abs(t.bias_pin - t.bias_hand)
     scale = (t.rate + t.d_rate) * total(np.abs(t.v / w)) + np.max(w * t.g_scale, axis=-1)
-    return Measure(np.max(entries, axis=-1), scale, np.max(w * t.allowance, axis=-1), entries=entries)
+    return Measure(
+        np.max(entries, axis=-1),
+        scale,
+        np.max(w * t.allowance, axis=-1),
+        entries=entries,
+        derived=t.derivation[1],
+    )
 
 
 def measure_gravity(t):
@@ -249,6 +269,7 @@ def measure_gravity(t):
         np.max(w * t.g_scale, axis=-1),
         np.max(w * t.allowance, axis=-1),
         entries=entries,
+        derived=t.derivation[1],
     )
 
 

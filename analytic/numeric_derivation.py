@@ -1,0 +1,174 @@
+"""M, H and C·q̇ derived numerically from a q̈ given as code, where the inputs span the coordinates.
+
+A mechanical system's q̈ is affine in its inputs,
+
+    q̈(q, q̇, u) = M(q)⁻¹ (B u − C(q, q̇) q̇ − D q̇ − H(q)),
+
+so with B square and invertible (as many inputs as coordinates), at one configuration q:
+
+* A(q) = ∂q̈/∂u = M⁻¹B, column j = (q̈(q, 0, h_j e_j) − q̈(q, 0, 0))/h_j (any step is exact up
+  to rounding, q̈ being affine in u).  h_j is 1, or where a unit input moves q̈ less than
+  gravity does (|q̈̃(e_j) − q̈̃(0)| < |q̈̃(0)|, scaled as below, from a first pass with steps of
+  1) the power of 2 that lifts it to |q̈̃(0)|: the difference then does not cancel the digits of
+  q̈(0) (a unit torque on a 10⁶ kg pendulum would leave 10⁻⁶ of them), and dividing by h_j is exact;
+* M(q) = B A(q)⁻¹;
+* H(q) = −M(q) q̈(q, 0, 0);
+* C(q, q̇)·q̇ = −M(q) (q̈(q, q̇, 0) − q̈(q, 0, 0)) − D q̇, so that C·q̇ + H = −M q̈(q, q̇, 0) − D q̇.
+
+Affinity is checked at every configuration derived: for j ≤ k, with u_j = h_j e_j,
+q̈(u_j + u_k) − q̈(u_j) − q̈(u_k) + q̈(0) (j = k: q̈(2u_j) − 2 q̈(u_j) + q̈(0)) must vanish within
+four times the rounding of one q̈ (below); if not, the derivation is refused (``UserCodeError``
+naming q).
+
+Rounding bound
+--------------
+All in the checks' scaled coordinates (``pendverify.checks.scaling``): w = 1/√S, M̃ = W M W,
+forces W f, accelerations q̈/w, B̃ = W B (steps of 1 in the inputs), n coordinates.
+
+1. One q̈ of the code, q̈ = M⁻¹f however it is solved (``np.linalg.solve``, Cramer, an explicit
+   inverse), is trusted to the aba check's error model: δq̈̃ ≤ K ε γ (‖M̃⁻¹‖ F + κ̃ ‖q̈̃‖) ≤
+   K ε γ ‖M̃⁻¹‖ (1 + κ̃) F =: ρ F, with F the 2-norm of the forces' terms, γ = 1 + |θ|max and
+   K = ``K_CODE`` (the aba check's K): the rounding of f (ε F) amplified by ‖M̃⁻¹‖, plus a
+   backward-stable solve's κ̃ ε relative error.
+2. Column j of Ã = M̃⁻¹B̃ is a difference of two q̈ with forces √n F₀ + h_j‖b̃_j‖ at most
+   (F₀ = max_i w_i g_i, g the gravity scale: the gravity at rest, 2-norm ≤ √n F₀), over h_j, so
+   ‖δÃ‖₂ ≤ ‖δÃ‖_F = 2ρ·(Σ_j ((√n F₀ + h_j‖b̃_j‖)/h_j)²)^½.  The steps are the derivation's own
+   (h_j ≥ 1: they can only narrow the bound a step of 1 gives).
+3. M̃ = B̃ Ã⁻¹, δ(Ã⁻¹) = −Ã⁻¹ δÃ Ã⁻¹ and Ã⁻¹ = B̃⁻¹M̃: ‖δM̃‖ ≤ ‖M̃‖² ‖B̃⁻¹‖ ‖δÃ‖, plus the
+   inversion's own rounding K ε κ(Ã) κ(B̃) ‖M̃‖ ≤ K ε κ̃ κ(B̃)² ‖M̃‖.  This is ``crba``'s bound
+   (its scale is 1: M̃'s entries are of order one).
+4. H̃ = −M̃ q̈̃₀ with ‖q̈̃₀‖ ≤ ‖M̃⁻¹‖ √n F₀ (each entry of the gravity ≤ F₀ = max_i w_i g_i, the
+   gravity check's scale): δH̃ ≤ (‖δM̃‖ ‖M̃⁻¹‖ + ‖M̃‖ ρ) √n F₀, so the relative bound is
+   √n (‖δM̃‖ ‖M̃⁻¹‖ + ‖M̃‖ ρ).  C·q̇ + H = −M̃ q̈̃ − D̃ q̇ is the same with the forces at q̇ in place
+   of F₀ (the rnea check's scale, the size of the terms acting), so ``rnea``'s bound is the same.
+
+The matrices in the bound are Pinocchio's at the state (the URDF's M, scaled by its own
+diagonal, and its gravity bound): the code's own numbers, which are what is checked, never
+widen their tolerance.  Relative to a hand-written M (ε-sized rounding) the bound grows like
+κ̃³ for H and C·q̇ (κ̃² for M): the code's solve (κ̃) and the inversion of Ã (κ̃ again) amplify
+rounding that the hand-written forms do not have.  The checks add it to their own rounding
+tolerance (``pendverify.checks.judge.collect``); where the sum exceeds the trust limit the
+state is refused, not judged.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+EPS = float(np.finfo(float).eps)
+#: the code's q̈ is trusted to the aba check's constant (``pendverify.checks.catalogue``)
+K_CODE = 16
+#: what the derivation is called in the report's notes
+DERIVED = (
+    "M = B (∂q̈/∂u)⁻¹, H = −M q̈(q, 0, 0) and C·q̇ + H = −M q̈(q, q̇, 0) − D q̇ are derived from the "
+    "code's q̈ at each state (pendverify.analytic.numeric_derivation); crba, gravity and rnea add "
+    "the derivation's rounding bound (∝ κ̃(M)² to κ̃(M)³, Pinocchio's M) to their tolerance"
+)
+
+
+@dataclass(frozen=True)
+class Derivation:
+    """M, q̈(q, 0, 0) and the inputs' steps h at one configuration (``derive``)."""
+
+    M: np.ndarray
+    rest: np.ndarray
+    steps: np.ndarray
+
+
+def _norms(A: np.ndarray) -> tuple[float, float]:
+    s = np.linalg.svd(A, compute_uv=False)
+    return float(s[0]), float(1.0 / s[-1]) if s[-1] > 0 else np.inf
+
+
+def one_rounding(M: np.ndarray, angle: float) -> float:
+    """ρ of the module docstring for one M (scaled by its own diagonal): δq̈̃ ≤ ρ·F."""
+    w = 1.0 / np.sqrt(np.abs(np.diag(M)))
+    norm, inv = _norms(M * np.outer(w, w))
+    return K_CODE * EPS * (1.0 + angle) * inv * (1.0 + norm * inv)
+
+
+def _mass(A, B, q, fail) -> np.ndarray:
+    n = len(q)
+    try:
+        M = B @ np.linalg.inv(A)
+    except np.linalg.LinAlgError:
+        M = np.full((n, n), np.nan)
+    if not np.all(np.isfinite(M)):
+        fail(f"∂q̈/∂u = {A.tolist()} at q = {q.tolist()} is not invertible: M = B (∂q̈/∂u)⁻¹ cannot be formed")
+    if np.any(np.diag(M) <= 0):
+        fail(f"M = B (∂q̈/∂u)⁻¹ = {M.tolist()} at q = {q.tolist()} has a diagonal entry ≤ 0")
+    return M
+
+
+def derive(acceleration, q, B: np.ndarray, n_disturbances: int, fail) -> Derivation:
+    """M(q) and q̈(q, 0, 0) from ``acceleration(q, v, u, w)`` and the declared B (module docstring).
+
+    ``fail(message)`` raises: called when q̈ is not affine in u at q within its rounding, or
+    ∂q̈/∂u is not invertible.
+    """
+    n = len(q)
+    zero, w = np.zeros(n), np.zeros(n_disturbances)
+
+    def at(u) -> np.ndarray:
+        return np.asarray(acceleration(q, zero, np.asarray(u, dtype=float), w), dtype=float)
+
+    eye = np.eye(n)
+    rest = at(np.zeros(n))
+    unit = np.stack([at(eye[j]) - rest for j in range(n)], axis=1)
+    wts = 1.0 / np.sqrt(np.abs(np.diag(_mass(unit, B, q, fail))))
+    steps = np.array([_step(rest / wts, unit[:, j] / wts) for j in range(n)])
+    pushed = [at(steps[j] * eye[j]) for j in range(n)]
+    A = np.stack([(p - rest) / h for p, h in zip(pushed, steps, strict=True)], axis=1)
+    M = _mass(A, B, q, fail)
+    wts = 1.0 / np.sqrt(np.abs(np.diag(M)))
+    rho = one_rounding(M, float(np.max(np.abs(q), initial=0.0)))
+    gravity = float(np.linalg.norm(wts * (M @ rest)))
+    for j in range(n):
+        for k in range(j, n):
+            u = steps[j] * eye[j] + steps[k] * eye[k]
+            residual = (at(u) - pushed[j] - pushed[k] + rest) / wts
+            bound = 4.0 * rho * (gravity + float(np.linalg.norm(wts * (B @ u))))
+            if not float(np.linalg.norm(residual)) <= bound:
+                fail(
+                    f"q̈ is not affine in the inputs at q = {q.tolist()}: q̈(u{j + 1} + u{k + 1}) − "
+                    f"q̈(u{j + 1}) − q̈(u{k + 1}) + q̈(0) = {(residual * wts).tolist()} for steps "
+                    f"{steps.tolist()}, beyond its rounding bound (scaled {bound:.2g}); "
+                    "M = B (∂q̈/∂u)⁻¹ needs q̈ = M⁻¹(B u + …)"
+                )
+    return Derivation(M, rest, steps)
+
+
+def _step(rest: np.ndarray, column: np.ndarray) -> float:
+    """h_j: 1, or the power of 2 (exact to divide by) that lifts a unit input's q̈ to the size of q̈ at rest."""
+    size, unit = float(np.linalg.norm(rest)), float(np.linalg.norm(column))
+    if not (unit > 0 and size > unit and np.isfinite(size / unit)):
+        return 1.0
+    return float(2.0 ** np.ceil(np.log2(size / unit)))
+
+
+def rounding_bounds(M, S, B, gravity_scale, angle, steps) -> tuple[np.ndarray, np.ndarray]:
+    """(crba's, gravity's and rnea's) relative rounding bounds per state (module docstring).
+
+    ``M`` (N, n, n) and ``S`` (N, n): Pinocchio's M and the scales at the states; ``B`` (n, n);
+    ``gravity_scale`` (n,) the gravity bound; ``angle`` (N,) |θ|max; ``steps`` (N, n) the steps
+    h the derivation took.  Returns (the crba bound, the gravity and rnea bound), each (N,).
+    """
+    M, S = np.asarray(M, dtype=float), np.asarray(S, dtype=float)
+    n = M.shape[-1]
+    w = 1.0 / np.sqrt(S)
+    Mt = M * (w[:, :, None] * w[:, None, :])
+    s = np.linalg.svd(Mt, compute_uv=False)
+    norm, inv = s[:, 0], 1.0 / s[:, -1]
+    kappa = norm * inv
+    Bt = w[:, :, None] * np.asarray(B, dtype=float)[None]
+    sb = np.linalg.svd(Bt, compute_uv=False)
+    b_inv, kappa_b = 1.0 / sb[:, -1], sb[:, 0] / sb[:, -1]
+    rho = K_CODE * EPS * (1.0 + np.asarray(angle)) * inv * (1.0 + kappa)
+    F0 = np.max(w * np.asarray(gravity_scale, dtype=float), axis=-1)
+    columns = np.linalg.norm(Bt, axis=-2)
+    h = np.asarray(steps, dtype=float)
+    dA = 2.0 * rho * np.sqrt(np.sum(((np.sqrt(n) * F0[:, None] + h * columns) / h) ** 2, axis=-1))
+    dM = norm**2 * b_inv * dA + K_CODE * EPS * kappa * kappa_b**2 * norm
+    return dM, np.sqrt(n) * (dM * inv + norm * rho)
