@@ -43,21 +43,14 @@ import numpy as np
 
 from pendverify.analytic import ClosedFormModel
 from pendverify.analytic.parameter_set import ParameterSet, quantity
+from pendverify.examples.cart_pole import CartPoleParams
 
 
 @dataclasses.dataclass(frozen=True)
-class MjCartPoleParams(ParameterSet):
-    """A cart-pole's parameters, SI units."""
+class MjCartPoleParams(CartPoleParams):
+    """A cart-pole's parameters (the example cart-pole's set), SI units."""
 
     model = "mjcf_cart_pole"
-
-    mc: float = quantity("mass", "mass of the cart in [kg]")
-    mp: float = quantity("mass", "mass of the pole in [kg]")
-    r: float = quantity("offset", "hinge to the pole's centre of mass in [m]")
-    I: float = quantity("inertia", "pole about its centre of mass, about y, in [kg·m²]")  # noqa: E741
-    bx: float = quantity("damping", "slider damping in [N·s/m]")
-    bt: float = quantity("damping", "hinge damping in [N·m·s/rad]")
-    g: float = quantity("gravity", "gravitational acceleration in [m/s²]")
 
 
 class MjCartPole(ClosedFormModel):
