@@ -35,6 +35,7 @@ import pinocchio as pin
 from pendverify.analytic import ParameterSet
 from pendverify.robot.jacobian import joint_jacobians
 from pendverify.robot.packages import resolve_package_uris
+from pendverify.robot.pinocchio_model import FORMAT as PINOCCHIO_FORMAT
 from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
 from pendverify.viz.skeleton import with_skeleton
@@ -117,6 +118,8 @@ class VisualSystem:
         loaded = system.urdf  # the verified text: a xacro file's is the URDF it expanded to
         if loaded.visual_model is not None:  # given with a Pinocchio model
             visual_model = loaded.visual_model.copy()
+        elif loaded.format == PINOCCHIO_FORMAT and not loaded.text:  # a bare model: nothing to draw
+            visual_model = pin.GeometryModel()
         elif loaded.format == "mjcf":
             from pendverify.robot.mjcf import mjcf_visuals  # imports MuJoCo: only for an MJCF
 

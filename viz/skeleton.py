@@ -36,8 +36,8 @@ import pinocchio as pin
 
 from pendverify.robot.jacobian import joint_jacobian, joint_jacobians
 
-#: the size [m] of a robot whose every offset is zero (a point mass on its joint)
-DEFAULT_LENGTH = 0.2
+#: L [m] of a robot whose every offset is zero (a point mass on its joint): a cart-sized box
+DEFAULT_LENGTH = 0.5
 LINK_RADIUS = 0.02  # × L: a rod's radius
 MARKER_HALF = (0.05, 0.05, 0.12)  # × L: half sides of a joint marker, the long one along its axis
 COM_RADIUS = 0.07  # × L: a centre-of-mass sphere
