@@ -97,7 +97,7 @@ class VisualSystem:
     def _drawn(cls, system: PinocchioSystem, visual_model: pin.GeometryModel, urdf: str) -> VisualSystem:
         """The system with its visuals, a skeleton added where a moving body has none
         (``pendverify.viz.skeleton``)."""
-        visual_model, notes = with_skeleton(system.model, visual_model, LINK_COLOURS)
+        visual_model, notes = with_skeleton(system.model, visual_model, LINK_COLOURS, system.source)
         return cls(system, visual_model, visual_model.createData(), urdf, notes)
 
     @classmethod

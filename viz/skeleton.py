@@ -47,11 +47,12 @@ PREFIX = "skeleton"
 
 
 def with_skeleton(
-    model: pin.Model, visuals: pin.GeometryModel, colours: tuple[tuple[float, ...], ...]
+    model: pin.Model, visuals: pin.GeometryModel, colours: tuple[tuple[float, ...], ...], source: str
 ) -> tuple[pin.GeometryModel, tuple[str, ...]]:
     """``visuals`` plus a skeleton for each moving joint that carries no visual, and the note.
 
-    ``colours`` are the links' RGBA, one per joint in turn (cycled)."""
+    ``colours`` are the links' RGBA, one per joint in turn (cycled); ``source`` names the
+    description in the note."""
     drawn = {obj.parentJoint for obj in visuals.geometryObjects}
     bare = [j for j in range(1, model.njoints) if j not in drawn]
     if not bare:
@@ -86,17 +87,20 @@ def with_skeleton(
         if rod is not None and c in bare:
             _add(out, f"base_{model.names[c]}", 0, 0, *rod)
             out.geometryObjects[-1].meshColor = np.array(BASE_RGBA)
-    return out, (_note(model, bare, not visuals.geometryObjects),)
+    return out, (_note(model, bare, not visuals.geometryObjects, source),)
 
 
-def _note(model: pin.Model, bare: list[int], none: bool) -> str:
+def _note(model: pin.Model, bare: list[int], none: bool, source: str) -> str:
     if none:
         return (
-            "the description has no visual geometry: a skeleton is drawn (joints as dark boxes along "
-            "their axes, links as rods, centres of mass as spheres)"
+            f"{source} has no visual geometry: a skeleton is drawn (joints as dark boxes along their "
+            "axes, links as rods, centres of mass as spheres)"
         )
     names = ", ".join(model.names[j] for j in bare)
-    return f"no visual geometry on the bodies of joint(s) {names}: drawn as a skeleton (rods, masses)"
+    return (
+        f"{source} has no visual geometry on the bodies of joint(s) {names}: they are drawn as a "
+        "skeleton (joint boxes, rods, centres of mass)"
+    )
 
 
 def _robot_length(model: pin.Model) -> float:

@@ -34,7 +34,7 @@ from ..conftest import default_params
 from ..robot.one_joint import PENDULUM_URDF, dm_control_pendulum, write_one_joint
 from .test_viz import SHOT_SIZE, _hsv, browser, needs_chromium, wait_for_clock  # noqa: F401
 
-NOTE = "note: the description has no visual geometry: a skeleton is drawn"
+NOTE = "has no visual geometry: a skeleton is drawn"
 SKELETON = ("skeleton_joint_hinge", "skeleton_link_hinge_0", "skeleton_com_hinge")
 R = 0.5  # m, the pendulum's pivot to its bob
 ATOL = 1e-6  # m: keyframes are float32 (7 digits) of positions of at most 1 m
@@ -93,7 +93,8 @@ def test_a_pendulum_without_visuals_is_drawn_as_a_moving_skeleton(fmt, tmp_path)
     text = {"urdf": None, "mjcf": MJCF_NO_GEOMS, "sdf": SDF_NO_VISUAL}[fmt]
     traj = _pendulum_trajectory(tmp_path, text, {"urdf": ".urdf", "mjcf": ".xml", "sdf": ".sdf"}[fmt])
     page = animation_page(traj)
-    assert page.notes and page.notes[0].startswith(NOTE.removeprefix("note: ")), f"{fmt=}: {page.notes}"
+    (note,) = page.notes
+    assert note.startswith(f"{traj.urdf} {NOTE}"), f"{fmt=}: {page.notes}"
     commands = _commands(build_scene(traj))
     drawn = {c["path"].rsplit("/", 1)[-1] for c in commands if c["type"] == "set_object"}
     assert set(SKELETON) <= drawn, f"{fmt=}: {sorted(drawn)}"
@@ -121,7 +122,7 @@ def test_render_and_simulate_print_the_note_and_write_the_page(tmp_path, capsys)
     ):
         assert main(argv) == 0, capsys.readouterr().err
         out = capsys.readouterr().out
-        assert out.count(NOTE) == 1, out
+        assert out.count(f"note: {scene.parent.parent / 'pend.urdf'} {NOTE}") == 1, out
     for name in ("r", "s"):
         page = (tmp_path / f"{name}.html").read_text()
         assert page.startswith("<!DOCTYPE html>") or "<html" in page[:500]
@@ -161,7 +162,10 @@ def test_a_bare_pinocchio_model_is_drawn_as_a_skeleton():
     model = pin.buildModelFromXML(urdf_for(default_params("double_pendulum")))
     visual = VisualSystem.for_model(MODELS["double_pendulum"], describe_model(model))
     assert {o.parentJoint for o in visual.objects if o.name.startswith("skeleton_com")} == {1, 2}
-    assert visual.notes[0].startswith(NOTE.removeprefix("note: "))
+    assert visual.notes == (
+        f"<pinocchio.Model {model.name!r}> {NOTE} (joints as dark boxes along their axes, "
+        "links as rods, centres of mass as spheres)",
+    )
 
 
 def test_a_one_joint_skeleton_cart_slides_along_its_rail(tmp_path):
@@ -204,3 +208,13 @@ def test_the_skeleton_is_seen_and_swings_in_chromium(tmp_path, browser):  # noqa
     moved = int((rod1 ^ rod2).sum())
     assert moved >= MIN_MOVED_PIXELS, f"the skeleton did not move ({moved} pixels changed)"
     assert np.asarray(Image.open(first)).shape[:2] == (SHOT_SIZE[1], SHOT_SIZE[0])
+
+
+def test_a_broken_description_without_visuals_is_still_refused_in_one_line(tmp_path, capsys):
+    robot = write_one_joint("pendulum", tmp_path)
+    robot.robot.write_text(robot.robot.read_text().replace('"2.0"', '"-2.0"'))
+    out = tmp_path / "r.html"
+    assert main(["render", str(robot.scene()), "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "pend.urdf" in err and "must be ≥ 0" in err and "Traceback" not in err
+    assert not out.exists()
