@@ -67,8 +67,7 @@ def with_skeleton(
     for j in bare:
         colour = colours[(j - 1) % len(colours)]
         frame = _joint_frame(model, j)
-        _add(out, f"joint_{model.names[j]}", j, frame, *_marker(model, data, j, length))
-        out.geometryObjects[-1].meshColor = np.array(JOINT_RGBA)
+        _add(out, f"joint_{model.names[j]}", j, frame, *_marker(model, data, j, length), JOINT_RGBA)
         ends = [model.jointPlacements[c].translation for c in children[j]]
         inertia = model.inertias[j]
         if not children[j] and inertia.mass > 0:
@@ -76,17 +75,14 @@ def with_skeleton(
         for k, end in enumerate(ends):
             rod = _rod(np.zeros(3), np.asarray(end, dtype=float), LINK_RADIUS * length)
             if rod is not None:
-                _add(out, f"link_{model.names[j]}_{k}", j, frame, *rod)
-                out.geometryObjects[-1].meshColor = np.array(colour)
+                _add(out, f"link_{model.names[j]}_{k}", j, frame, *rod, colour)
         if inertia.mass > 0:
             at = pin.SE3(np.eye(3), np.asarray(inertia.lever, dtype=float))
-            _add(out, f"com_{model.names[j]}", j, frame, at, coal.Sphere(COM_RADIUS * length))
-            out.geometryObjects[-1].meshColor = np.array(colour)
+            _add(out, f"com_{model.names[j]}", j, frame, at, coal.Sphere(COM_RADIUS * length), colour)
     for c in children[0]:
         rod = _rod(np.zeros(3), model.jointPlacements[c].translation, LINK_RADIUS * length)
         if rod is not None and c in bare:
-            _add(out, f"base_{model.names[c]}", 0, 0, *rod)
-            out.geometryObjects[-1].meshColor = np.array(BASE_RGBA)
+            _add(out, f"base_{model.names[c]}", 0, 0, *rod, BASE_RGBA)
     return out, (_note(model, bare, not visuals.geometryObjects, source),)
 
 
@@ -147,8 +143,11 @@ def _rod(start: np.ndarray, end: np.ndarray, radius: float) -> tuple[pin.SE3, co
     return placement, coal.Cylinder(radius, length)
 
 
-def _add(out: pin.GeometryModel, name: str, joint: int, frame: int, placement, geometry) -> None:
+def _add(out: pin.GeometryModel, name: str, joint: int, frame: int, placement, geometry, rgba) -> None:
+    """Add one skeleton object of colour ``rgba``, named ``skeleton_NAME`` (numbered if taken)."""
     unique, k = f"{PREFIX}_{name}", 1
     while out.existGeometryName(unique):
         unique, k = f"{PREFIX}_{name}_{k}", k + 1
-    out.addGeometryObject(pin.GeometryObject(unique, joint, frame, placement, geometry))
+    obj = pin.GeometryObject(unique, joint, frame, placement, geometry)
+    obj.meshColor = np.array(rgba, dtype=float)
+    out.addGeometryObject(obj)
