@@ -63,7 +63,7 @@ if TYPE_CHECKING:
     from pendverify.stress.catalogue import StressReport
     from pendverify.symbolic.compare import SymbolicReport
     from pendverify.symbolic.mutation_report import MutationReport
-    from pendverify.viz.animation import Trajectory
+    from pendverify.viz.animation import AnimationPage, Trajectory
     from pendverify.viz.review_folder import ReviewFolder
     from pendverify.worked_examples import WorkedExample
 
@@ -87,6 +87,7 @@ __all__ = [
     "PinocchioRobot",
     "UrdfLike",
     "animation_html",
+    "animation_page",
     "bench_accuracy",
     "bench_certify",
     "bench_explain",
@@ -460,9 +461,15 @@ def trajectory(run: Run | str | Path, model_file: str | Path | None = None) -> T
 def animation_html(source: Trajectory, trace: bool = False) -> str:
     """The self-contained HTML page (meshcat, plays from file://) that animates ``source`` in
     real time; ``trace`` draws the path of the tip.  ``pendverify render``."""
-    from pendverify.viz.animation import render_html
+    return animation_page(source, trace).html
 
-    return render_html(source, trace=_flag("trace", trace))
+
+def animation_page(source: Trajectory, trace: bool = False) -> AnimationPage:
+    """``animation_html``'s page (``.html``) with what drawing it noticed (``.notes``: e.g. that
+    a description without visual geometry is drawn as a skeleton).  ``pendverify render``."""
+    from pendverify.viz.animation import animation_page as page
+
+    return page(source, trace=_flag("trace", trace))
 
 
 def review_scenes(folder: str | Path | None = None) -> list[Path]:

@@ -15,7 +15,8 @@
    vector) and where each number came from (``pendverify.robot.mjcf_origins``).
 
 ``mjcf_visuals`` draws MuJoCo's compiled geoms (boxes, spheres, capsules, cylinders,
-ellipsoids; planes and meshes are left out) on the model's body frames.
+ellipsoids; planes and meshes are left out) on the model's body frames, in the colour MuJoCo
+shows: a geom's ``rgba`` where it differs from MuJoCo's default, else its material's.
 """
 
 from __future__ import annotations
@@ -122,6 +123,20 @@ def mjcf_visuals(model: pin.Model, text: str, source: str) -> pin.GeometryModel:
             joint, placement = frame.parentJoint, frame.placement * pose(mj.geom_quat[g], mj.geom_pos[g])
         name = mujoco.mj_id2name(mj, mujoco.mjtObj.mjOBJ_GEOM, g) or f"geom{g}"
         obj = pin.GeometryObject(name, joint, placement, make(np.array(mj.geom_size[g], dtype=float)))
-        obj.meshColor = np.array(mj.geom_rgba[g], dtype=float)
+        obj.meshColor = _geom_colour(mj, g)
         visuals.addGeometryObject(obj)
     return visuals
+
+
+#: MuJoCo's default geom rgba: a geom with this colour and a material is shown in the material's
+GEOM_DEFAULT_RGBA = (0.5, 0.5, 0.5, 1.0)
+
+
+def _geom_colour(mj, g: int) -> np.ndarray:
+    """The RGBA MuJoCo shows geom ``g`` in: its own ``rgba``, unless that is the default and the
+    geom has a material, whose ``rgba`` then applies."""
+    own = np.array(mj.geom_rgba[g], dtype=float)
+    material = int(mj.geom_matid[g])
+    if material >= 0 and np.array_equal(own, np.array(GEOM_DEFAULT_RGBA, dtype=np.float32)):
+        return np.array(mj.mat_rgba[material], dtype=float)
+    return own
