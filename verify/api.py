@@ -636,7 +636,9 @@ def stress(
         from pendverify.stress.generic import run_generic
 
         if urdf is None:
-            raise PendverifyError(f"{model}: a model file needs its urdf (and params, unless it gives PARAMS)")
+            raise PendverifyError(
+                f"{model}: a model file needs its urdf (and params, unless the file gives PARAMS)"
+            )
         params_file = None if params is None else str(params)
         return run_generic(str(model), _urdf_file_arg(urdf, "stress"), params_file, settings, cases, seed)
     if urdf is not None or params is not None:
