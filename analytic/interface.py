@@ -36,7 +36,8 @@ Writing your own model (a plug-in)
 ----------------------------------
 A model file for ``pendverify check --analytic FILE`` defines one subclass of
 ``ClosedFormModel`` and its parameter set (a frozen dataclass subclassing
-``ParameterSet`` whose ``model`` equals the class's ``name``); ``examples/cart_pole.py``
+``ParameterSet`` whose ``model`` equals the class's ``name``), importing them as
+``from pendverify import ClosedFormModel, ParameterSet, quantity``; ``examples/cart_pole.py``
 is a complete one, ``examples/minimal_double_pendulum.py`` a minimal one.  Beyond
 the abstract methods below it declares:
 
