@@ -197,7 +197,7 @@ def load_model_class(path: str | Path) -> type[ClosedFormModel]:
             return declared
         raise PendverifyError(
             f"{path}: defines no subclass of pendverify.ClosedFormModel, no functions M, C, G, no METHOD "
-            "and no DYNAMICS (see examples/cart_pole.py, examples/pendulum_functions.py)"
+            "and no DYNAMICS (examples/cart_pole.py is a complete model file; docs/models.md shows each form)"
         )
     if len(found) > 1:
         raise PendverifyError(

@@ -1,11 +1,12 @@
 """Models given as NumPy functions M(q, p), C(q, v, p) (Cqdot, h), G(q, p), D(p), B(p).
 
-The single pendulum of docs/models.md (``examples/pendulum_functions.py``) and the double
-pendulum (``examples/minimal_double_pendulum.py``'s formulas, written as functions) pass against
-their URDFs; one planted wrong entry in M, in C and in G each fails, the diagnosis naming the
-entry; the bias given as C, as C·q̇ and as h = C·q̇ + G passes alike; malformed files are refused
-in one line; the commands that read closed forms with SymPy refuse in one line, and the others
-(stress, simulate, certify) run, taking the file's PARAMS when no parameter file is named.
+The single pendulum of docs/models.md (``tests/analytic/data/pendulum_functions.py``, shown
+there verbatim) and the double pendulum (``examples/minimal_double_pendulum.py``'s formulas,
+written as functions) pass against their URDFs; one planted wrong entry in M, in C and in G each
+fails, the diagnosis naming the entry; the bias given as C, as C·q̇ and as h = C·q̇ + G passes
+alike; malformed files are refused in one line; the commands that read closed forms with SymPy
+refuse in one line, and the others (stress, simulate, certify) run, taking the file's PARAMS when
+no parameter file is named.
 """
 
 from __future__ import annotations
@@ -23,8 +24,8 @@ from pendverify.cli import main
 from pendverify.errors import PendverifyError
 
 REPO = Path(__file__).resolve().parents[2]
-PENDULUM = REPO / "examples" / "pendulum_functions.py"
-PENDULUM_URDF = REPO / "examples" / "pendulum_functions.urdf"
+PENDULUM = REPO / "tests" / "analytic" / "data" / "pendulum_functions.py"
+PENDULUM_URDF = REPO / "tests" / "analytic" / "data" / "pendulum_functions.urdf"
 DP_URDF = REPO / "urdf" / "double_pendulum.urdf"
 DP_PARAMS = REPO / "examples" / "minimal_double_pendulum.toml"
 SAMPLES = ["--samples", "60"]
@@ -99,6 +100,12 @@ def _changed(text: str, old: str, new: str) -> str:
 
 def _double(tmp_path: Path, text: str = DOUBLE_PENDULUM) -> list[str]:
     return ["--analytic", str(_file(tmp_path, text)), "--urdf", str(DP_URDF), "--params", str(DP_PARAMS)]
+
+
+def test_the_docs_show_the_tested_pendulum_verbatim():
+    docs = (REPO / "docs" / "models.md").read_text(encoding="utf-8")
+    assert f"```python\n{PENDULUM.read_text()}```" in docs
+    assert f"```xml\n{PENDULUM_URDF.read_text()}```" in docs
 
 
 def test_the_documented_single_pendulum_passes_with_its_own_params(capsys):

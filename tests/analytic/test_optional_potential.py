@@ -19,10 +19,10 @@ from pendverify.cli import main
 from pendverify.errors import PendverifyError
 
 REPO = Path(__file__).resolve().parents[2]
-URDF = REPO / "examples" / "pendulum_functions.urdf"
+URDF = REPO / "tests" / "analytic" / "data" / "pendulum_functions.urdf"
 
-# the single pendulum of examples/pendulum_functions.py as a class: θ from hanging down about y,
-# V = −m g l cos θ, G = ∂V/∂θ = m g l sin θ
+# the single pendulum of tests/analytic/data/pendulum_functions.py as a class: θ from hanging
+# down about y, V = −m g l cos θ, G = ∂V/∂θ = m g l sin θ
 PENDULUM = """\
 import dataclasses
 

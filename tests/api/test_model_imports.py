@@ -21,7 +21,7 @@ from pendverify.analytic.plugin import load_model_class
 from tests.analytic.test_optional_potential import PARAMS, PENDULUM
 
 REPO = Path(__file__).resolve().parents[2]
-URDF = REPO / "examples" / "pendulum_functions.urdf"
+URDF = REPO / "tests" / "analytic" / "data" / "pendulum_functions.urdf"
 MODEL_NAMES = ("ClosedFormModel", "BiasOnlyModel", "ParameterSet", "quantity", "Energies")
 
 

@@ -205,7 +205,7 @@ def test_errors_of_the_model_key(tmp_path):
     assert _error(path) == (
         f"{path}: key 'model' = 'empty.py': not a usable model file: {tmp_path / 'empty.py'}: defines "
         "no subclass of pendverify.ClosedFormModel, no functions M, C, G, no METHOD and no DYNAMICS "
-        "(see examples/cart_pole.py, examples/pendulum_functions.py)"
+        "(examples/cart_pole.py is a complete model file; docs/models.md shows each form)"
     )
 
 
