@@ -179,6 +179,16 @@ def test_a_planted_wrong_entry_fails_naming_it(old, new, entry, check, tmp_path,
     assert f"]: {entry} (" in out, out  # the diagnosis names the entry
 
 
+@pytest.mark.parametrize(("factor", "status"), [("", "pass"), (" * 1.01", "fail")], ids=["right", "wrong"])
+def test_a_given_v_is_checked_by_energy(factor, status, tmp_path):
+    """V(q, p) = −m g l cos θ makes the energy check run; 1 % off, it fails it alone."""
+    v = f"def V(q, p):\n    return -p.m * p.g * p.l * np.cos(q[0]){factor}\n\n\n"
+    model = _file(tmp_path, _changed(PENDULUM.read_text(), "def D(p):", v + "def D(p):"))
+    report = pendverify.check(model, PENDULUM_URDF, samples=60)
+    assert "energy" in report.checks and report.status == status, report
+    assert [r.check for r in report.results if r.status == "fail"] == ([] if status == "pass" else ["energy"])
+
+
 def test_p_gives_the_parameters_by_attribute_and_by_key(tmp_path):
     text = _changed(DOUBLE_PENDULUM, "return p.g * np.array(", 'return p["g"] * np.array(')
     report = pendverify.check(_file(tmp_path, text), DP_URDF, DP_PARAMS, samples=60)
