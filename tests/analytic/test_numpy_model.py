@@ -157,7 +157,7 @@ def test_h_gives_g_and_the_bias(tmp_path):
     assert np.array_equal(model.gravity(q), expected.gravity(q))  # h(q, 0) adds C(q, 0)·0 = 0 exactly
     assert np.array_equal(model.bias(q, v), expected.bias(q, v))  # the same arithmetic as C·q̇ + G
     # C·q̇ = (C·q̇ + G) − G: the sum's and the difference's roundings, each at most ε/2 of the
-    # larger of |C·q̇ + G| and |G|, so within ε of that size; 2ε leaves room for the matrix product
+    # larger of |C·q̇ + G| and |G| (C·q̇ itself is the same arithmetic on both sides): within ε; 2ε
     scale = max(np.max(np.abs(expected.bias(q, v))), np.max(np.abs(expected.gravity(q))))
     assert np.allclose(
         model.coriolis_force(q, v),
