@@ -194,29 +194,23 @@ class NumpyFunctionModel(ClosedFormModel):
         sizes = {"n": self.nv, "u": len(self.inputs), "w": len(self.disturbances)}
         return tuple(sizes[d] for d in FUNCTIONS[key][1])
 
-    def _grid_maximum(self, values: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
-        """max over the configuration grid (module docstring) of |values(q)|, entry by entry."""
-        cached = self.__dict__.setdefault("_grid_maxima", {})
-        key = values.__name__
-        if key not in cached:
-            cached[key] = np.max(np.abs([values(q) for q in configuration_grid(self.angular)]), axis=0)
-        return cached[key]
+    def _grid_maximum(self, key: str, values: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+        """max over the configuration grid (module docstring) of |values(q)|, entry by entry; kept
+        under ``key`` for this instance's parameter set."""
+        cache = self.__dict__.setdefault("_grid_maxima", {})
+        cached = cache.get(key)
+        if cached is None or cached[0] is not self.params:
+            found = np.max(np.abs([values(q) for q in configuration_grid(self.angular)]), axis=0)
+            cached = cache[key] = (self.params, found)
+        return cached[1]
 
     def gravity_scale(self) -> np.ndarray:
         """max |G_i(q)| over the configuration grid (module docstring)."""
-
-        def gravity(q):
-            return self.gravity(q)
-
-        return self._grid_maximum(gravity)
+        return self._grid_maximum("gravity", self.gravity)
 
     def diagonal_scale(self, q) -> np.ndarray:
         """max |M_ii(q)| over the configuration grid (module docstring), the same at every q."""
-
-        def diagonal(q):
-            return np.diagonal(self.mass_matrix(q))
-
-        return self._grid_maximum(diagonal).copy()
+        return self._grid_maximum("diagonal", lambda x: np.diagonal(self.mass_matrix(x))).copy()
 
 
 class NumpyBiasModel(NumpyFunctionModel, BiasOnlyModel):
