@@ -43,10 +43,13 @@ The tolerance scales a closed form gets as Σ|terms| (``pendverify.analytic.deri
 taken here from the functions' values on a grid of configurations (``GRID`` points over [−π, π)
 per angle, positions at zero; beyond ``GRID_ANGLES`` angles the same number of seeded random
 configurations): the diagonal scale S_i = max |M_ii| and the gravity scale max |G_i| over the grid.
-M_ii and G_i of a chain of rigid bodies are sums of products of sinusoids of the angles whose
-Σ|terms| is attained where every angle is 0 or π, points of the grid, or (for a single sinusoid
-a cos(θ − φ)) at least cos(π/GRID) ≈ 0.92 of it on the grid: the same size of the terms that
-the tolerances of a closed form are judged against.
+M_ii and G_i of a chain of rigid bodies are sums of products of sinusoids of the angles.
+Σ|terms| bounds their maximum from above; where the terms are cosines of sums of angles (the
+double pendulum's α + 2β cos θ2, its g(a cos θ1 + b cos(θ1 + θ2))) the maximum equals Σ|terms| at
+angles 0, a grid point; a single sinusoid a cos(θ − φ) reaches at least cos(π/GRID) ≈ 0.92 of its
+|a| on the grid; where terms of different phases add (cos θ + sin θ) the grid's largest value is
+the size the function reaches (√2, not Σ|terms| = 2).  Either way it is the size of the terms that
+the relative errors are measured against, as Σ|terms| is for a closed form.
 """
 
 from __future__ import annotations
