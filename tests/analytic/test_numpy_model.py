@@ -324,3 +324,22 @@ def test_the_scales_are_the_functions_largest_values_on_the_grid(tmp_path):
     # each is one evaluation of the same arithmetic at θ = 0: a few roundings of its size
     assert np.allclose(model.diagonal_scale(np.array([0.4, 2.0])), expected_diagonal, rtol=1e-14, atol=0)
     assert np.allclose(model.gravity_scale(), expected_gravity, rtol=1e-14, atol=0)
+
+
+def test_render_and_report_take_the_functions(tmp_path, capsys):
+    dp = _file(tmp_path, DOUBLE_PENDULUM + "PARAMS = " + repr(_values()) + "\n")
+    scenes = tmp_path / "scenes"
+    scenes.mkdir()
+    scene = scenes / "swing.toml"
+    scene.write_text(
+        f'name = "swing"\nmodel = "{dp}"\nurdf = "{DP_URDF}"\nengine = "both"\n'
+        "[initial]\nq = [0.4, 0.9]\n[time]\nduration = 0.5\nsample_rate = 20.0\n"
+        '[integrator]\nmethod = "DOP853"\nrtol = 1e-10\natol = 1e-10\n'
+        "[effects]\ngravity = true\ndamping = true\n"
+    )
+    assert main(["render", str(scene), "-o", str(tmp_path / "swing.html")]) == 0
+    assert (tmp_path / "swing.html").stat().st_size > 0
+    review = tmp_path / "review"
+    assert main(["report", "-o", str(review), "--scenes", str(scenes), "--samples", "20"]) == 0
+    assert (review / "index.html").is_file()
+    capsys.readouterr()
