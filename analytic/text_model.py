@@ -264,6 +264,22 @@ def _energies(self, q, v, u, w) -> Energies:
     )
 
 
+def parameter_type(spec: TextModelSpec, class_name: str) -> type[ParameterSet]:
+    """The ``ParameterSet`` dataclass ``<class_name>Params`` of the declared parameters (kind, unit)."""
+    fields = [
+        (p, float, dataclasses.field(metadata={"kind": kind, "unit": unit, "doc": f"{p} in [{unit}]"}))
+        for p, (kind, unit) in spec.parameters.items()
+    ]
+    return dataclasses.make_dataclass(
+        f"{class_name}Params", fields, bases=(ParameterSet,), frozen=True, namespace={"model": spec.name}
+    )
+
+
+def class_name_of(spec: TextModelSpec) -> str:
+    """The model class's name: the model's name in CamelCase (``double_pendulum`` → ``DoublePendulum``)."""
+    return "".join(part.capitalize() for part in spec.name.split("_")) or "TextModel"
+
+
 def build_model_class(
     spec: TextModelSpec, module: types.ModuleType | None = None, base: type[ClosedFormModel] | None = None
 ) -> type[ClosedFormModel]:
@@ -274,18 +290,12 @@ def build_model_class(
     class a model without M derives from instead of ``AccelerationOnlyModel`` (one whose q̈ is
     code, ``pendverify.analytic.python_dynamics``).
     """
-    class_name = "".join(part.capitalize() for part in spec.name.split("_")) or "TextModel"
+    class_name = class_name_of(spec)
     if module is None:
         module = types.ModuleType(module_name(spec.path))
         setattr(module, TEXT_FILE, str(spec.path))
         sys.modules[module.__name__] = module
-    fields = [
-        (p, float, dataclasses.field(metadata={"kind": kind, "unit": unit, "doc": f"{p} in [{unit}]"}))
-        for p, (kind, unit) in spec.parameters.items()
-    ]
-    params_type = dataclasses.make_dataclass(
-        f"{class_name}Params", fields, bases=(ParameterSet,), frozen=True, namespace={"model": spec.name}
-    )
+    params_type = parameter_type(spec, class_name)
     namespace = {
         "name": spec.name,
         "params_type": params_type,

@@ -8,6 +8,10 @@ The Python API (``pendverify.api``, ``pendverify.testing``)::
     report["crba"]                                   # one check's rows (CheckRows), one per model
     run = pendverify.simulate("scenes/damped_double_pendulum.toml")   # a Run
 
+A model file imports what it builds on from here::
+
+    from pendverify import ClosedFormModel, ParameterSet, quantity   # BiasOnlyModel, Energies too
+
 The names below are imported on first use, so ``import pendverify`` stays cheap: it imports
 neither Pinocchio nor SymPy.
 """
@@ -31,11 +35,21 @@ _LAZY = {
     "Run": "pendverify.simulation.simulate",
     "assert_verified": "pendverify.testing",
     "PendverifyError": "pendverify.errors",
+    # what a model file builds on (docs/models.md)
+    "ClosedFormModel": "pendverify.analytic.interface",
+    "BiasOnlyModel": "pendverify.analytic.interface",
+    "ParameterSet": "pendverify.analytic.parameter_set",
+    "quantity": "pendverify.analytic.parameter_set",
+    "Energies": "pendverify.analytic.forms",
 }
 
 __all__ = [
+    "BiasOnlyModel",
     "CheckReport",
     "CheckRows",
+    "ClosedFormModel",
+    "Energies",
+    "ParameterSet",
     "PendverifyError",
     "Run",
     "__version__",
@@ -45,11 +59,15 @@ __all__ = [
     "load_model",
     "load_params",
     "load_urdf",
+    "quantity",
     "ros_packages",
     "simulate",
 ]
 
 if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
+    from pendverify.analytic.forms import Energies
+    from pendverify.analytic.interface import BiasOnlyModel, ClosedFormModel
+    from pendverify.analytic.parameter_set import ParameterSet, quantity
     from pendverify.api import (
         certify_set,
         check,

@@ -629,7 +629,8 @@ def stress(
     """The catalogue of numerically hard cases: ``pendverify stress``.
 
     ``model`` None runs the catalogue of the reference systems (``cases``: only these);
-    a model file (``.py``) with its ``urdf`` and ``params`` file runs the hard cases derived
+    a model file (``.py``) with its ``urdf`` and ``params`` file (None: the file's ``PARAMS``) runs
+    the hard cases derived
     from its parameters' kinds.  ``quick``: fewer states and shorter horizons, same cases;
     ``seed``: the state sampler's (default ``pendverify.stress.framework.SEED``).
     """
@@ -641,9 +642,12 @@ def stress(
     if model is not None:
         from pendverify.stress.generic import run_generic
 
-        if urdf is None or params is None:
-            raise PendverifyError(f"{model}: a model file needs its urdf and params")
-        return run_generic(str(model), _urdf_file_arg(urdf, "stress"), str(params), settings, cases, seed)
+        if urdf is None:
+            raise PendverifyError(
+                f"{model}: a model file needs its urdf (and params, unless the file gives PARAMS)"
+            )
+        params_file = None if params is None else str(params)
+        return run_generic(str(model), _urdf_file_arg(urdf, "stress"), params_file, settings, cases, seed)
     if urdf is not None or params is not None:
         raise PendverifyError("urdf and params go with a model file")
     for name in cases or ():

@@ -26,7 +26,7 @@ extra closed forms             what their ``equals`` says, e.g. the cart referen
 
 det M, M⁻¹ and q̈ that the model does not write (``hand_written``) are derived by
 the interface from M and the other parts: they are listed as ``skipped``, with
-the reason, and not compared.
+the reason, and not compared; so is V when the model does not write it (it is optional).
 """
 
 from __future__ import annotations
@@ -189,11 +189,15 @@ def compare(model_cls: type[ClosedFormModel], label: str | None = None) -> Symbo
         _coriolis(sm, lag),
         _compare("H", "gravity", "hand − ∂V/∂q", sm.evaluate("gravity", "q") - lag.H, angles),
     ]
-    dV = sm.evaluate("potential_energy", "q") - lag.V
-    potential = _compare(
-        "V", "potential_energy", "∂(hand − V)/∂q", sp.Matrix([dV.diff(x) for x in q]), angles
-    )
-    potential.note = "equal up to a constant" if potential.status == EQUAL else ""
+    if model_cls.has_potential_energy():
+        dV = sm.evaluate("potential_energy", "q") - lag.V
+        potential = _compare(
+            "V", "potential_energy", "∂(hand − V)/∂q", sp.Matrix([dV.diff(x) for x in q]), angles
+        )
+        potential.note = "equal up to a constant" if potential.status == EQUAL else ""
+    else:  # optional: H is compared with ∂V/∂q of the energies' V above
+        note = "not run: the model gives no potential energy V(q) (potential_energy), nothing to compare"
+        potential = Comparison("V", "potential_energy", "∂(hand − V)/∂q", SKIPPED, 0, note=note)
     out.append(potential)
     out.append(
         _compare("D", "damping_matrix", "hand − ∂²R/∂q̇²", sm.evaluate("damping_matrix", "") - lag.D, angles)
