@@ -27,7 +27,7 @@ from pathlib import Path
 import pytest
 
 from pendverify.worked_examples import EXAMPLES
-from tests.doc_blocks import Step, output_difference, page_name, same_number, steps
+from tests.doc_blocks import FENCE, Step, output_difference, page_name, same_number, steps
 
 ROOT = Path(__file__).resolve().parents[1]
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.md"))]
@@ -178,6 +178,26 @@ def test_the_pages_hold_shell_blocks_and_outputs_to_compare():
     assert sum(1 for s in all_steps if runs(s)) >= 10
     assert any(s.output for s in all_steps if runs(s) and s.page == "docs/getting-started.md")
     assert any(s.file == "my_pendulum.py" for s in all_steps if s.page == "docs/getting-started.md")
+
+
+def escaping_blocks(text: str) -> list[str]:
+    """The first lines of the blocks ``steps`` would not see as commands but a reader would: a
+    block labelled ``bash``, ``shell``, ``zsh`` or ``shell-session``, a prompt outside ``console``."""
+    found = []
+    for fence in FENCE.finditer(text):
+        info, body = fence["info"].strip(), fence["body"]
+        shell = info.split()[:1] in (["bash"], ["shell"], ["zsh"], ["shell-session"])
+        if shell or (body.startswith("$ ") and info != "console"):
+            found.append(body.splitlines()[0])
+    return found
+
+
+def test_no_shell_block_escapes_the_reading():
+    """The manual labels commands ``sh`` and prompts ``console``: nothing is skipped unseen."""
+    for path in PAGES:
+        assert escaping_blocks(path.read_text(encoding="utf-8")) == [], page_name(path, ROOT)
+    planted = "```bash\npendverify check\n```\n\n```\n$ pendverify show x.toml\nout\n```\n"
+    assert escaping_blocks(planted) == ["pendverify check", "$ pendverify show x.toml"]
 
 
 # --- the reading and the comparison themselves, on planted differences ------------------------------
