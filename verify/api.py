@@ -791,8 +791,10 @@ def worked_example(name: str) -> WorkedExample:
 
 
 def copy_example(name: str, folder: str | Path, force: bool = False) -> list[Path]:
-    """Copy the worked example ``name`` into ``folder`` (created if missing), ready to run; files
-    already there are refused unless ``force``.  The paths written, in the catalogue's order."""
+    """Copy the worked example ``name`` into ``folder`` (created if missing), each file at the path
+    the manual names it by (``urdf/double_pendulum.urdf``), ready to run; a file already there with
+    the same content is left as it is, one with other content refused unless ``force``.  The paths
+    written, in the catalogue's order."""
     from pendverify.worked_examples import copy_example as copy_files
 
     return copy_files(worked_example(name), Path(folder), force=_flag("force", force))

@@ -22,6 +22,7 @@ from pendverify.analytic.plugin import load_model_class
 from pendverify.errors import UrdfShapeError
 from pendverify.robot.description import load_description
 from pendverify.robot.mjcf_origins import DEFAULT, FROM_GEOMS, WRITTEN
+from pendverify.robot.mujoco_warnings import caught
 from tests.robot.mjcf_hand_models import GymCartDoublePole, GymCartPole, MjAcrobot, MjCartPole
 from tests.robot.one_joint import write_one_joint
 
@@ -34,7 +35,8 @@ EXAMPLE = REPO / "examples" / "double_pendulum.mjcf.xml"
 
 
 def compiled(path: Path) -> mujoco.MjModel:
-    return mujoco.MjModel.from_xml_path(str(path))
+    with caught():  # MuJoCo's default handler would leave MUJOCO_LOG.TXT in the working folder
+        return mujoco.MjModel.from_xml_path(str(path))
 
 
 def body(mj: mujoco.MjModel, name: str) -> tuple[float, np.ndarray, float]:
