@@ -104,8 +104,8 @@ def _double(tmp_path: Path, text: str = DOUBLE_PENDULUM) -> list[str]:
 
 def test_the_docs_show_the_tested_pendulum_verbatim():
     docs = (REPO / "docs" / "models.md").read_text(encoding="utf-8")
-    assert f"```python\n{PENDULUM.read_text()}```" in docs
-    assert f"```xml\n{PENDULUM_URDF.read_text()}```" in docs
+    assert f'```python title="pendulum.py"\n{PENDULUM.read_text()}```' in docs
+    assert f'```xml title="pendulum.urdf"\n{PENDULUM_URDF.read_text()}```' in docs
 
 
 def test_the_documented_single_pendulum_passes_with_its_own_params(capsys):
