@@ -7,8 +7,10 @@
 ``matrix``; the transposes ``^T``, ``^\\top``, ``^{\\mathsf{T}}``) to one form, removes what a
 paper's display adds around the mathematics (``\\label{…}``, ``\\nonumber``, the display's
 environment and delimiters, ``\\\\[2pt]``'s spacing, a ``\\\\`` between the lines of an
-``align``, whose ``&=`` becomes ``=``), and keeps for every character its position in the
-original, so that an error can point at the LaTeX the user wrote.
+``align``, whose ``&=`` becomes ``=``; a notebook's ``&&`` between every two cells of a matrix
+becomes ``&``), and keeps for every character its position in the original, so that an error can
+point at the LaTeX the user wrote.  ``toml_escapes`` tells LaTeX that TOML's double quotes
+corrupted (``"\\theta"`` read as a tab and ``heta``) from LaTeX that holds real whitespace.
 """
 
 from __future__ import annotations
