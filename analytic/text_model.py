@@ -32,7 +32,7 @@ from pendverify.analytic.interface import AccelerationOnlyModel, BiasOnlyModel, 
 from pendverify.analytic.module_names import module_name
 from pendverify.analytic.parameter_set import ParameterSet
 from pendverify.analytic.source_file import TEXT_FILE
-from pendverify.analytic.text_parse import Reader, TextModelSpec, read_text_model
+from pendverify.analytic.text_parse import EQUATIONS, Reader, TextModelSpec, read_text_model
 from pendverify.display import shortened
 
 #: equation key → (method, its arguments)
@@ -218,7 +218,8 @@ def _method(key: str, args: str, spec: TextModelSpec):
     syms = [s for g in args + "p" for s in spec.symbols[g]]
     params = [s.name for s in spec.symbols["p"]]
     entries = expr.tolist() if isinstance(expr, sp.MatrixBase) else expr
-    vector = isinstance(expr, sp.MatrixBase) and expr.cols == 1 and key not in ("B", "W")
+    # a vector by its key's declared shape, never by its own: a 1 × 1 M (one coordinate) is a matrix
+    vector = isinstance(expr, sp.MatrixBase) and EQUATIONS[key][0] == "n"
     if vector:
         entries = [row[0] for row in entries]
     compiled: dict[int, tuple] = {}
