@@ -135,6 +135,21 @@ INTERFACE: dict[str, InterfaceMethod] = {
     "kinetic_energy": InterfaceMethod("qv", COMPOSED, ("T", "from M (½ q̇ᵀ M q̇)")),
 }
 
+
+def entry_position(method: str, shape: tuple[int, int], index: int) -> tuple[int, ...]:
+    """The zero-based position of flat entry ``index`` of ``method``'s value, a matrix of ``shape``.
+
+    (row,) for a vector, (row, column) for a matrix.  Which it is, the interface says, not the
+    value's shape: with one coordinate M is a 1×1 matrix and H a one-entry vector, both one column.
+    A model's own closed form outside the interface is a vector when it has one column.
+    """
+    cols = shape[1]
+    interface = INTERFACE.get(method)
+    vector = len(interface.shape) == 1 if interface is not None and interface.shape else cols == 1
+    r, c = divmod(index, cols)
+    return (r,) if vector else (r, c)
+
+
 #: The interface's own closed forms, in the order the tools report them.
 STANDARD_CLOSED_FORMS: dict[str, ClosedForm] = {
     name: ClosedForm(method.args) for name, method in INTERFACE.items() if method.closed_form

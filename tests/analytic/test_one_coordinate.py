@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import sympy as sp
 
 from pendverify.analytic.plugin import load_model_class
 from pendverify.cli import main
@@ -160,3 +161,21 @@ def test_a_quantity_of_the_wrong_shape_is_still_refused(suffix, model, words, tm
     headline, _, _ = one_error(err)
     for word in words:
         assert word in headline, headline
+
+
+def test_a_one_coordinate_entry_is_labelled_by_the_interface_not_by_its_one_column(tmp_path, capsys):
+    """A 1×1 M is the matrix entry M[1,1] in every label (diagnosis, repair, sympy, mutate); H is H[1]."""
+    from pendverify.diagnosis.slots import entry_label
+    from pendverify.symbolic.mutants import entry_label as mutant_label
+
+    x = sp.Symbol("x")
+    assert entry_label("mass_matrix", sp.Matrix([[x]]), 0) == "M[1,1]"
+    assert entry_label("gravity", sp.Matrix([x]), 0) == "H[1]"
+    assert entry_label("gravity", sp.Matrix([x, x]), 1) == "H[2]"
+    assert mutant_label("damping_matrix", sp.Matrix([[x]]), 0) == "damping_matrix[0,0]"
+    assert mutant_label("gravity", sp.Matrix([x]), 0) == "gravity[0]"
+    suffix, text, _ = FORMS["text, every key"]
+    code, _, out, _ = _check(tmp_path, capsys, text.replace('M = [["m*l**2"]]', 'M = [["2*m*l**2"]]'), suffix)
+    assert code == 1
+    repairs = [line for line in out.splitlines() if "makes every check pass" in line]
+    assert repairs and all("entry M[1,1])" in line for line in repairs), out[-3000:]

@@ -38,6 +38,7 @@ from dataclasses import dataclass, field
 import sympy as sp
 
 from pendverify.analytic import ClosedFormModel
+from pendverify.analytic.forms import entry_position
 from pendverify.analytic.source_file import where
 from pendverify.analytic.symbolic_reading import SymbolicModel, entries, to_sympy
 from pendverify.checks.verdict import CHRISTOFFEL_CONSISTENT, NON_CHRISTOFFEL
@@ -86,19 +87,17 @@ class SymbolicReport:
         }
 
 
-def _label(shape_of, i: int) -> str:
+def _label(method: str, shape_of, i: int) -> str:
     if not isinstance(shape_of, sp.MatrixBase):
         return ""
-    cols = shape_of.shape[1]
-    r, c = divmod(i, cols)
-    return f"[{r}]" if cols == 1 else f"[{r},{c}]"
+    return f"[{','.join(map(str, entry_position(method, shape_of.shape, i)))}]"
 
 
 def _compare(quantity, method, relation, residual, angles) -> Comparison:
     """Every entry of ``residual`` (hand − derived, or a residual) must be zero."""
     items = entries(residual)
     differences = [
-        f"{quantity}{_label(residual, i)}: {show(e, angles)}"
+        f"{quantity}{_label(method, residual, i)}: {show(e, angles)}"
         for i, e in enumerate(items)
         if not is_zero(e, angles)
     ]
