@@ -13,7 +13,7 @@ import pytest
 from pendverify.checks.trust import EPS
 from pendverify.stress.framework import QUICK
 from pendverify.stress.generic import run_generic
-from pendverify.stress.singular import LIMIT_MARGIN, MASS_FLOOR, lightest_mass
+from pendverify.stress.singular import LIMIT_MARGIN, MASS_FLOOR, lightest_changed, link_masses
 
 from ..robot.one_joint import PENDULUM_URDF, write_one_joint
 
@@ -42,9 +42,13 @@ def test_below_the_floor_pinocchio_moves_the_centre_of_mass(mass):
     assert M < 0.99 * mass * 0.25
 
 
-def test_lightest_mass_ignores_massless_links():
-    assert lightest_mass(PENDULUM_URDF) == 2.0
-    assert lightest_mass(PENDULUM_URDF.replace('value="2.0"', 'value="0"')) == float("inf")
+def test_the_floor_applies_to_the_masses_the_walk_changes():
+    """A link the walk leaves as given is the nominal case's to judge; a massless link adds nothing."""
+    nominal = link_masses(PENDULUM_URDF)
+    assert nominal == [2.0]
+    assert lightest_changed(PENDULUM_URDF, nominal) == float("inf")
+    assert lightest_changed(PENDULUM_URDF.replace('value="2.0"', 'value="2e-16"'), nominal) == 2e-16
+    assert lightest_changed(PENDULUM_URDF.replace('value="2.0"', 'value="0"'), nominal) == float("inf")
 
 
 def _walk(tmp_path, model_text=None):

@@ -65,10 +65,16 @@ def _scaled(params, names, factor):
     return params.replace(**{n: getattr(params, n) * factor for n in names})
 
 
-def lightest_mass(urdf_text: str) -> float:
-    """The smallest non-zero ``<link><inertial><mass value>`` of a URDF in [kg] (inf if none)."""
-    masses = (float(e.get("value", "0")) for e in parse_xml(urdf_text, "<rewritten URDF>").iter("mass"))
-    return min((m for m in masses if m > 0), default=math.inf)
+def link_masses(urdf_text: str) -> list[float]:
+    """Every ``<link><inertial><mass value>`` of a URDF in [kg], in document order."""
+    return [float(e.get("value", "0")) for e in parse_xml(urdf_text, "<rewritten URDF>").iter("mass")]
+
+
+def lightest_changed(urdf_text: str, nominal: list[float]) -> float:
+    """The smallest non-zero link mass [kg] of a rewritten URDF among those that differ from
+    ``nominal`` (the given URDF's, ``link_masses``); inf if the walk changed none."""
+    changed = (m for m, m0 in zip(link_masses(urdf_text), nominal, strict=True) if m != m0 and m > 0)
+    return min(changed, default=math.inf)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -83,26 +89,25 @@ class Step:
 
 def walk_steps(params, names, sign: int, binding) -> tuple[list[Step], str]:
     """The walk's steps, 10^(sign·k) for k in ``WALK_EXPONENTS``, kept where Pinocchio's inertia
-    sums are exact (every link's mass 0 or ≥ ``MASS_FLOOR``, module docstring); and what ended it
+    sums are exact (every link mass the walk changes 0 or ≥ ``MASS_FLOOR``, module docstring; the
+    masses the URDF is given with are the nominal case's to judge); and what ended it
     early ("" when it ran to the end).  The first step past the floor becomes the factor that
     puts the lightest link at ``LIMIT_MARGIN``·``MASS_FLOOR``, the walk's last step."""
     steps: list[Step] = []
-    floor = None
+    nominal = link_masses(binding.rewrite(params))
     for k in WALK_EXPONENTS:
         factor = 10.0 ** (sign * k)
         changed = _scaled(params, names, factor)
         urdf = binding.rewrite(changed)
-        light = lightest_mass(urdf)
-        if floor is None:  # the nominal URDF's own lightest link stays as it is given
-            floor = min(MASS_FLOOR, light)
-        if light >= floor:
+        light = lightest_changed(urdf, nominal)
+        if light >= MASS_FLOOR or k == 0:  # the given URDF's own masses are the nominal case's
             steps.append(Step(sign * k, factor, changed, urdf))
             continue
-        limit = factor * LIMIT_MARGIN * MASS_FLOOR / light  # masses scale with the factor
-        if abs(limit) < abs(steps[-1].factor):
+        limit = factor * LIMIT_MARGIN * MASS_FLOOR / light  # the changed masses scale with the factor
+        if limit < steps[-1].factor:
             changed = _scaled(params, names, limit)
             urdf = binding.rewrite(changed)
-            if lightest_mass(urdf) >= MASS_FLOOR:
+            if lightest_changed(urdf, nominal) >= MASS_FLOOR:
                 steps.append(Step(math.log10(limit), limit, changed, urdf))
         stop = (
             f"stopped at ×{steps[-1].factor:.3g}: further, a link would weigh {light:.3g} kg < ε = "
