@@ -58,12 +58,7 @@ NOT_HERE = {
     ("stress", "dm_pendulum"): "an MJCF is refused by stress",
 }
 #: known failures outside the rendering and robot-summary code, left to their owners
-KNOWN = {
-    ("stress", "pendulum"): "the near-singular walk takes the only mass below ε, where Pinocchio's inertia "
-    "sum clamps it (the lever comes out wrong): a false FAIL",
-    ("certify+recheck", "cart"): "the battery's large-angle case takes max() over the angular coordinates, "
-    "and the cart has none (ValueError, exit 3)",
-}
+KNOWN: dict[tuple[str, str], str] = {}
 
 
 def _cases():

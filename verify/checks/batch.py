@@ -140,7 +140,9 @@ def urdf_gravity_scale(model, system) -> np.ndarray:
     angular = np.array(model.angular)
     points = np.linspace(-np.pi, np.pi, GRAVITY_GRID, endpoint=False)
     k = int(np.count_nonzero(angular))
-    if k > 4:  # a grid too large: the same number of seeded random configurations instead
+    if k == 0:  # no angle: gravity does not change with a position, one configuration tells
+        grid = np.zeros((1, 0))
+    elif k > 4:  # a grid too large: the same number of seeded random configurations instead
         grid = np.random.default_rng(0).uniform(-np.pi, np.pi, (GRAVITY_GRID**4, k))
     else:
         grid = np.stack(np.meshgrid(*[points] * k, indexing="ij"), axis=-1).reshape(-1, k)

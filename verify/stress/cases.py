@@ -66,11 +66,27 @@ def shifted_states(model, states: list[State], shift: float = ANGLE_SHIFT) -> li
 def large_angle_case(
     name: str, params_fn, model_cls=None, expect: str = "none", shift: float = ANGLE_SHIFT
 ) -> Case:
-    """|θ| ≈ ``shift`` (1e6 rad); ``expect`` says which refusals by the trust rule are acceptable (EXPECT)."""
+    """|θ| ≈ ``shift`` (1e6 rad); ``expect`` says which refusals by the trust rule are acceptable (EXPECT).
+
+    A model without an angular coordinate has no angle to shift: the case is not run (its
+    result says so) rather than compare unshifted states and call that an invariance.
+    """
 
     def run(ctx: Context, name: str) -> StressResult:
         params = params_fn()
         model = model_of(params, model_cls)
+        if not any(model.angular):
+            return StressResult(
+                name,
+                "no angular coordinate",
+                None,
+                None,
+                None,
+                None,
+                None,
+                True,
+                "not run: no angle to shift",
+            )
         system = ctx.system(params)
         states = shifted_states(model, sampled_states(model, ctx), shift)
         direct = compare(name, model, system, states, ctx.seed)

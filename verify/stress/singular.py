@@ -10,6 +10,25 @@ of 100, at the winning state, and every step runs the guarded comparison (trust 
 then the core checks) on the URDF rewritten for that step.  It passes when every step
 the rule accepts verifies, the first step is accepted, and, if the walk's predicted
 rounding crosses the refusal limit, the rule refuses there.
+
+Where the walk stops: Pinocchio's own arithmetic.  Pinocchio stores a body's inertia as
+(m, c, I_c) and sums two of them (a link into its joint's inertia as the description is
+read, a subtree into its parent in CRBA) as ``InertiaTpl::__pequ__`` does::
+
+    c_ab = (m_a c_a + m_b c_b) / max(m_a + m_b, ε)        ε = 2.2e-16, in the file's kg
+
+While m_a + m_b ≥ ε this is the weighted mean of the centres to a few ulps (products and a
+sum of non-negative weights: a relative error of at most 3ε of |c|).  Below, the quotient
+is clamped: the centre comes out scaled by (m_a + m_b)/ε, and since the URDF reader sums a
+link twice (measured, Pinocchio 4.1: c·(m/ε)²), M's m|c|² term by up to (m/ε)⁴: the 2 kg
+pendulum's bob at 2e-16 kg sits at 0.406 m instead of 0.5 m and its M is 34 % low.  That
+is Pinocchio's M being wrong, not the model.  Rounding is monotone, so fl(m_a + m_b) ≥ m_a
+for m_b ≥ 0: every sum that includes a link of mass ≥ ε is ≥ ε.  Hence the limit
+(``MASS_FLOOR``): the walk runs only while every link of the rewritten URDF has mass 0 (a
+massless link adds nothing, whatever its lever) or ≥ ε kg, an absolute limit because the
+clamp is.  The first step that would take a link lighter (and below what the nominal URDF
+already holds) is replaced by the factor that puts the lightest link at ``LIMIT_MARGIN``·ε,
+and the walk ends there.
 """
 
 from __future__ import annotations
@@ -20,14 +39,20 @@ import math
 import numpy as np
 
 from pendverify.checks.sampling import State, sample_states
-from pendverify.checks.trust import REFUSE_REL, assess, conditioning
+from pendverify.checks.trust import EPS, REFUSE_REL, assess, conditioning
 from pendverify.errors import PendverifyError
 from pendverify.robot.system import PinocchioSystem
+from pendverify.robot.xml_reading import parse_xml
 from pendverify.stress.framework import Case, Context, StressResult, compare, error_ratio
 
 WALK_EXPONENTS = tuple(range(0, 17, 2))  # the parameter × 10^-k
 SEARCH_KINDS = ("mass", "length", "offset")  # alone; inertias go with their link's mass
 SEARCH_ITERATIONS = 200
+#: kg: the lightest non-zero link mass at which Pinocchio's inertia sums are not clamped (module docstring)
+MASS_FLOOR = EPS
+#: the walk's last step puts the lightest link at this multiple of ``MASS_FLOOR``, so that the
+#: rounding of the scale factor (a relative ε) cannot take it under the floor
+LIMIT_MARGIN = 2.0
 
 
 def _kappa(model, q) -> float:
@@ -38,6 +63,58 @@ def _kappa(model, q) -> float:
 
 def _scaled(params, names, factor):
     return params.replace(**{n: getattr(params, n) * factor for n in names})
+
+
+def link_masses(urdf_text: str) -> list[float]:
+    """Every ``<link><inertial><mass value>`` of a URDF in [kg], in document order."""
+    return [float(e.get("value", "0")) for e in parse_xml(urdf_text, "<rewritten URDF>").iter("mass")]
+
+
+def lightest_changed(urdf_text: str, nominal: list[float]) -> float:
+    """The smallest non-zero link mass [kg] of a rewritten URDF among those that differ from
+    ``nominal`` (the given URDF's, ``link_masses``); inf if the walk changed none."""
+    changed = (m for m, m0 in zip(link_masses(urdf_text), nominal, strict=True) if m != m0 and m > 0)
+    return min(changed, default=math.inf)
+
+
+@dataclasses.dataclass(frozen=True)
+class Step:
+    """One step of the walk: the parameters scaled by ``factor`` (log10 ``exponent``), and its URDF."""
+
+    exponent: float
+    factor: float
+    params: object
+    urdf: str
+
+
+def walk_steps(params, names, sign: int, binding) -> tuple[list[Step], str]:
+    """The walk's steps, 10^(sign·k) for k in ``WALK_EXPONENTS``, kept where Pinocchio's inertia
+    sums are exact (every link mass the walk changes 0 or ≥ ``MASS_FLOOR``, module docstring; the
+    masses the URDF is given with are the nominal case's to judge); and what ended it
+    early ("" when it ran to the end).  The first step past the floor becomes the factor that
+    puts the lightest link at ``LIMIT_MARGIN``·``MASS_FLOOR``, the walk's last step."""
+    steps: list[Step] = []
+    nominal = link_masses(binding.rewrite(params))
+    for k in WALK_EXPONENTS:
+        factor = 10.0 ** (sign * k)
+        changed = _scaled(params, names, factor)
+        urdf = binding.rewrite(changed)
+        light = lightest_changed(urdf, nominal)
+        if light >= MASS_FLOOR or k == 0:  # the given URDF's own masses are the nominal case's
+            steps.append(Step(sign * k, factor, changed, urdf))
+            continue
+        limit = factor * LIMIT_MARGIN * MASS_FLOOR / light  # the changed masses scale with the factor
+        if limit < steps[-1].factor:
+            changed = _scaled(params, names, limit)
+            urdf = binding.rewrite(changed)
+            if lightest_changed(urdf, nominal) >= MASS_FLOOR:
+                steps.append(Step(math.log10(limit), limit, changed, urdf))
+        stop = (
+            f"stopped at ×{steps[-1].factor:.3g}: further, a link would weigh {light:.3g} kg < ε = "
+            f"{MASS_FLOOR:.3g} kg, where Pinocchio's inertia sums clamp the mass (its own M is wrong)"
+        )
+        return steps, stop
+    return steps, ""
 
 
 def _directions(params, binding) -> dict[str, tuple[str, ...]]:
@@ -97,16 +174,14 @@ def near_singular_case(model_cls, params, binding, name: str = "near-singular M"
             return StressResult(name, "no parameter to vary", None, None, None, None, None, True, "not run")
         key, names, sign, state, _ = best
         at_rest = dataclasses.replace(state, label=f"{state.label}, at rest", v=np.zeros_like(state.v))
+        walk, stop = walk_steps(params, names, sign, binding)
         steps, results, refused, kappa_raw, kappa_scaled = [], [], 0, 0.0, 0.0
-        for k in WALK_EXPONENTS:
-            changed = _scaled(params, names, 10.0 ** (sign * k))
-            model = model_cls(changed)
-            system = PinocchioSystem.for_model(
-                model_cls, binding.rewrite(changed), getattr(changed, "g", None)
-            )
+        for step in walk:
+            model = model_cls(step.params)
+            system = PinocchioSystem.for_model(model_cls, step.urdf, getattr(step.params, "g", None))
             verdict = assess(model, state.q, system)
-            comp = compare(f"{name} ×1e{sign * k}", model, system, [state, at_rest], ctx.seed)
-            steps.append((k, comp.kept, len(comp.refused), verdict.bound))
+            comp = compare(f"{name} ×{step.factor:.3g}", model, system, [state, at_rest], ctx.seed)
+            steps.append((f"{abs(step.exponent):.3g}", comp.kept, len(comp.refused), verdict.bound))
             results += comp.results
             refused += len(comp.refused)
             if comp.kept:
@@ -120,9 +195,11 @@ def near_singular_case(model_cls, params, binding, name: str = "near-singular M"
         walk = (
             f"{key} × 10^{'-' if sign < 0 else ''}k at q = {np.array2string(state.q, precision=3)}: "
             "verified at k = "
-            f"{', '.join(map(str, verified)) or 'none'}; refused at k = "
-            f"{', '.join(map(str, refusing)) or 'none'}"
+            f"{', '.join(verified) or 'none'}; refused at k = "
+            f"{', '.join(refusing) or 'none'}"
         )
+        if stop:
+            walk += f"; {stop}"
         if not crossed:
             walk += f"; the rounding bound stays ≤ {REFUSE_REL:g}: M never comes near singular"
         notes = [f"FAIL {r.check} at {r.worst_state['label']}" for r in failed]
