@@ -47,7 +47,7 @@ from meshcat.animation import Animation
 from pendverify.analytic import MODELS, PARAMETER_TYPES, ParameterSet
 from pendverify.analytic.plugin import load_model_class
 from pendverify.display import shortened
-from pendverify.errors import TrajectoryError
+from pendverify.errors import TrajectoryError, folder_given, missing_file
 from pendverify.simulation.limits import environment_limit
 from pendverify.viz.geometry import ROOT, UP, VisualSystem
 from pendverify.viz.recorder import SceneRecorder
@@ -124,8 +124,10 @@ class Trajectory:
         """
         path = Path(path)
         source = str(path)
+        if path.is_dir():
+            raise folder_given(path, "saved run (.npz)")
         if not path.is_file():
-            raise TrajectoryError(source, "<file>", source, "trajectory file not found")
+            raise missing_file(path, "saved run (.npz)", "`pendverify simulate SCENE -o FILE.npz` saves one")
         t, q, meta = read_saved_arrays(path, source)
         if not isinstance(meta, dict):
             raise TrajectoryError(source, "metadata", type(meta).__name__, "must be a JSON object")
