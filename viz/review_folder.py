@@ -103,14 +103,6 @@ def scene_targets(scenes: list[Scene], erd: bool = True) -> Selection:
     return selection
 
 
-def _shown(path: Path) -> str:
-    """A scene's path relative to the working directory when it is below it."""
-    try:
-        return str(path.resolve().relative_to(Path.cwd().resolve()))
-    except ValueError:
-        return str(path)
-
-
 def _review(path: Path, scene: Scene, out: Path, trace: bool) -> SceneReview:
     result = run_scene(scene)
     animation, plot = f"scenes/{path.stem}.html", f"plots/{path.stem}.svg"
@@ -118,7 +110,7 @@ def _review(path: Path, scene: Scene, out: Path, trace: bool) -> SceneReview:
     write_atomic(out / plot, energy_plot_svg(result))
     return SceneReview(
         name=scene.name,
-        source=_shown(path),
+        source=path.name,  # relative to the scenes folder: the page is shared, the folder is the author's
         animation=animation,
         plot=plot,
         invariants=[*result.invariants, *([result.engine_comparison] if result.engine_comparison else [])],

@@ -12,7 +12,8 @@ re-runs its battery, each invariant item on the engine it records.
 
 Every name that becomes a file name is checked where it is read
 (``pendverify.certify.names``): a parameter file's ``name``, a URDF's stem, a sweep's
-set names.
+set names.  A set certified on a URDF is named after its model, then the URDF
+(``names.set_name``).
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ from pendverify.certify.battery_item import BatteryItem
 from pendverify.certify.bundle import check_files_beside, refuse_existing, verify_signature, write_bundle
 from pendverify.certify.certificate import build_certificate, compare_items, derived_constants, verify_digest
 from pendverify.certify.model_source import ModelSource
-from pendverify.certify.names import check_name
+from pendverify.certify.names import check_name, set_name
 from pendverify.certify.reading import read_certificate
 from pendverify.certify.schema import check_derived, check_schema
 from pendverify.certify.signing import fingerprint
@@ -75,7 +76,9 @@ def certification_input(
                 raise ParameterError(
                     urdf_params, "model", model_name, f"must be {model!r}, the model named with it"
                 )
-            return CertificationInput(name, ModelSource.of_builtin(model_name), params, text)
+            return CertificationInput(
+                set_name(model_name, name, str(urdf_params)), ModelSource.of_builtin(model_name), params, text
+            )
         if not model:
             raise PendverifyError(f"with a URDF, name the model or give the parameter set ({PARAMS_HINT})")
         params = PinocchioSystem.from_urdf(model, text, source=str(path)).geometry.params
@@ -84,6 +87,7 @@ def certification_input(
                 f"{path}: give the parameter set ({PARAMS_HINT}): "
                 f"a {model} URDF alone does not fix the closed form"
             )
+        name = set_name(model, name, str(path))
         return CertificationInput(name, ModelSource.of_builtin(model), params, text)
     if params_file:
         model_name, name, params = load_parameter_file(params_file)
@@ -110,8 +114,8 @@ def _plugin_input(model_file: str, urdf: str | None, params_file: str | None) ->
             None,
             "certify needs a gravity parameter g: its runs set gravity by it",
         )
-    _, name, text = _urdf_input(urdf)
-    return CertificationInput(name, source, params, text)
+    path, name, text = _urdf_input(urdf)
+    return CertificationInput(set_name(cls.name, name, path), source, params, text)
 
 
 def _urdf_input(urdf: str | LoadedDescription) -> tuple[str, str, str]:
@@ -196,7 +200,7 @@ def write_certificate(
     Only what is each run's own differs: ``date`` (the time of certification), ``digest``
     (which covers it) and, when signed, ``signature``'s key.  (A sweep names its sets
     itself, by the model's name and the set's index; a set certified alone is named by its
-    parameter file or URDF.)"""
+    parameter file, or by its model and URDF.)"""
     check_name(name, "<certify>", "name")
     keyid = fingerprint(key.public_key()) if key is not None else None
     cert = build_certificate(name, model, params, urdf, settings, battery, keyid=keyid)
