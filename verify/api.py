@@ -44,6 +44,7 @@ from pendverify.analytic.plugin import load_model_class, validate_model_class
 from pendverify.checks.report import CheckReport
 from pendverify.checks.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
 from pendverify.checks.verification import build_report
+from pendverify.display import REPR_LIMIT, html_table, shortened
 from pendverify.errors import InputError, PendverifyError, UnknownNameError
 from pendverify.robot import erd as erd_data
 from pendverify.robot.description import LoadedDescription
@@ -598,6 +599,16 @@ class ModelReading(NamedTuple):
     parameters: tuple[str, ...]
     equations: list[Equation]
     conventions: tuple[str, ...] = ()
+
+    def __repr__(self) -> str:
+        methods = ", ".join(e.method for e in self.equations)
+        head = f"<ModelReading {self.model_cls.name!r}: {len(self.equations)} closed forms ("
+        return f"{head}{shortened(methods, REPR_LIMIT - len(head) - 40)}), {len(self.parameters)} parameters>"
+
+    def _repr_html_(self) -> str:
+        """Each closed form as SymPy reads it (its text; a derived one says how it is derived)."""
+        rows = [(e.method, e.derived or "written", str(e.value)) for e in self.equations]
+        return html_table(("closed form", "", "as SymPy reads it"), rows, f"model {self.model_cls.name}")
 
 
 def read_model(model: ModelLike) -> ModelReading:

@@ -46,7 +46,7 @@ from meshcat.animation import Animation
 
 from pendverify.analytic import MODELS, PARAMETER_TYPES, ParameterSet
 from pendverify.analytic.plugin import load_model_class
-from pendverify.display import shortened
+from pendverify.display import html_fields, shortened
 from pendverify.errors import TrajectoryError, folder_given, missing_file
 from pendverify.simulation.limits import environment_limit
 from pendverify.viz.geometry import ROOT, UP, VisualSystem
@@ -86,6 +86,22 @@ class Trajectory:
     urdf: str | None = None
     #: what reading a saved run noticed (printed by ``render``)
     notes: tuple[str, ...] = ()
+
+    def __repr__(self) -> str:
+        span = f"{len(self.t)} samples over {self.t[-1] - self.t[0]:g} s" if len(self.t) else "no samples"
+        where = shortened(self.source, 80)
+        title = shortened(self.title, 80)
+        return f"<Trajectory {title}: {span}, {self.q.shape[1]} coordinates, from {where}>"
+
+    def _repr_html_(self) -> str:
+        fields = [
+            ("samples", len(self.t)),
+            ("duration [s]", f"{self.t[-1] - self.t[0]:g}"),
+            ("coordinates", self.q.shape[1]),
+            ("source", self.source),
+            *(("note", n) for n in self.notes),
+        ]
+        return html_fields(self.title, fields)
 
     def __post_init__(self) -> None:
         if self.t.ndim != 1 or len(self.t) < 2:

@@ -37,6 +37,7 @@ from pathlib import Path
 from pendverify.analytic.params import default_parameter_file, load_parameter_file
 from pendverify.atomic import write_atomic
 from pendverify.checks.verification import build_report
+from pendverify.display import REPR_LIMIT, html_table, shortened
 from pendverify.errors import InputError, SceneError
 from pendverify.progress import bar
 from pendverify.robot import erd as erd_data
@@ -66,6 +67,19 @@ class ReviewFolder:
     @property
     def passed(self) -> bool:
         return self.report.passed and all(r.passed for r in self.reviews)
+
+    def __repr__(self) -> str:
+        head = f"<ReviewFolder {'pass' if self.passed else 'FAIL'}: {len(self.reviews)} scene(s), "
+        return (
+            f"{head}checks {self.report.status}; {shortened(str(self.index), REPR_LIMIT - len(head) - 20)}>"
+        )
+
+    def _repr_html_(self) -> str:
+        rows = [(r.name, r.source, r.model, "pass" if r.passed else "FAIL") for r in self.reviews]
+        caption = f"review page {self.index}: checks {self.report.status}"
+        return html_table(
+            ("scene", "file", "model", "invariants"), rows, caption, [not r.passed for r in self.reviews]
+        )
 
 
 def _is_default(scene: Scene) -> bool:

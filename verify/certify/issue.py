@@ -25,7 +25,7 @@ from pendverify.analytic import ParameterSet
 from pendverify.analytic.params import load_parameter_file
 from pendverify.analytic.plugin import plugin_parameters
 from pendverify.certify.battery import BatteryRun, BatterySettings, run_battery
-from pendverify.certify.battery_item import BatteryItem
+from pendverify.certify.battery_item import BatteryItem, items_html
 from pendverify.certify.bundle import check_files_beside, refuse_existing, verify_signature, write_bundle
 from pendverify.certify.certificate import build_certificate, compare_items, derived_constants, verify_digest
 from pendverify.certify.model_source import ModelSource
@@ -35,7 +35,7 @@ from pendverify.certify.schema import check_derived, check_schema
 from pendverify.certify.signing import fingerprint
 from pendverify.certify.simulations import recorded_engines
 from pendverify.certify.sweep_task import SetResult
-from pendverify.display import listed, shortened
+from pendverify.display import REPR_LIMIT, html_lines, listed, shortened
 from pendverify.errors import CertificateError, ParameterError, PendverifyError
 from pendverify.robot.description import LoadedDescription, load_description
 from pendverify.robot.erd import resolve_urdf
@@ -162,6 +162,10 @@ class Issued:
             return f"<Issued certified: {len(self.items)} items pass; {shortened(str(self.path), 200)}>"
         return f"<Issued not certified: {len(failed)} of {len(self.items)} items fail: {listed(failed, 200)}>"
 
+    def _repr_html_(self) -> str:
+        where = f": {self.path}" if self.certified else ": some items fail, no certificate written"
+        return items_html(self.items, f"{'certified' if self.certified else 'not certified'}{where}")
+
 
 def issue(
     target: CertificationInput, settings: BatterySettings, output, force: bool = False, key=None
@@ -233,6 +237,19 @@ class Rechecked:
     @property
     def passed(self) -> bool:
         return not self.differences and all(i.passed for i in self.items)
+
+    def __repr__(self) -> str:
+        name = shortened(str(self.certificate.get("name", "?")), 60)
+        failed = [i.name for i in self.items if not i.passed]
+        head = f"<Rechecked {name}: {'passed' if self.passed else 'FAILED'}, {len(self.items)} items"
+        tail = f", {len(failed)} fail ({listed(failed, 80)})" if failed else ""
+        tail += f", {len(self.differences)} difference(s) from the certificate" if self.differences else ""
+        return f"{head}{tail}; {shortened(self.signature, REPR_LIMIT - len(head) - len(tail) - 3)}>"
+
+    def _repr_html_(self) -> str:
+        name = self.certificate.get("name", "?")
+        caption = f"recheck of {name}: {'passed' if self.passed else 'FAILED'}; {self.signature}"
+        return items_html(self.items, caption) + html_lines(self.differences)
 
 
 RUN_EMBEDDED_CODE = "--run-embedded-code"
