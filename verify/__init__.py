@@ -32,7 +32,7 @@ _LAZY = {
     "assert_verified": "pendverify.testing",
     "PendverifyError": "pendverify.errors",
     "ClosedFormModel": "pendverify.analytic",
-    "BiasOnlyModel": "pendverify.analytic",
+    "BiasOnlyModel": "pendverify.analytic.interface",
     "ParameterSet": "pendverify.analytic",
     "quantity": "pendverify.analytic.parameter_set",
 }
@@ -59,7 +59,8 @@ __all__ = [
 ]
 
 if _typing.TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
-    from pendverify.analytic import BiasOnlyModel, ClosedFormModel, ParameterSet
+    from pendverify.analytic import ClosedFormModel, ParameterSet
+    from pendverify.analytic.interface import BiasOnlyModel
     from pendverify.analytic.parameter_set import quantity
     from pendverify.api import (
         certify_set,

@@ -52,6 +52,9 @@ class BatteryItem:
             f"vs tolerance {self.tolerance:.2e}{at}>"
         )
 
+    def _repr_html_(self) -> str:
+        return items_html([self], f"battery item {self.name}: {self.detail}" if self.detail else self.name)
+
     def as_dict(self) -> dict:
         record = asdict(self)
         if not record["engine"]:

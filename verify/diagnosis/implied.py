@@ -178,6 +178,10 @@ class Combination:
         values = f"model {self.model_value:.6g}, URDF {self.urdf_value:.6g} [{self.unit}]"
         return f"<Combination {shortened(self.name, REPR_LIMIT - len(values) - 20)}: {values}>"
 
+    def _repr_html_(self) -> str:
+        row = (f"{self.model_value:.6g}", f"{self.urdf_value:.6g}", self.unit, f"{self.rounding:.2g}")
+        return html_table(("model", "URDF", "unit", "rounding"), [row], self.name, [self.differs])
+
 
 @dataclass
 class ImpliedParameters:
