@@ -118,9 +118,11 @@ class ParameterSet:
             ) from None
 
     def as_dict(self) -> dict[str, float]:
+        """The values by parameter name, in the fields' order."""
         return dataclasses.asdict(self)
 
     def replace(self: P, **changes: float) -> P:
+        """A copy with the named values changed (``params.replace(m1=2.0)``), validated again."""
         return dataclasses.replace(self, **changes)
 
     def to_toml(self, name: str = "") -> str:
