@@ -14,9 +14,14 @@ import pytest
 import pendverify
 from pendverify import api
 from pendverify.analytic.params import default_parameter_file
+from pendverify.bench.certify import PARTS, SetCost
+from pendverify.bench.explain import ExplainBench
+from pendverify.bench.run import Results
+from pendverify.bench.workprecision import QUICK as QUICK_BENCH
 from pendverify.certify.issue import Issued
 from pendverify.checks.report import CheckRows, model_label
 from pendverify.cli import main
+from pendverify.diagnosis.corpus import ModelScores
 from pendverify.display import REPR_LIMIT
 from pendverify.shipped import shipped_file
 from pendverify.stress.catalogue import StressReport
@@ -60,6 +65,9 @@ def objects(tmp_path_factory) -> dict[str, object]:
         "MutationReport": MutationReport("x" * 400, "y" * 400, 1, 10, outcomes, []),
         "StressReport": StressReport(QUICK, 7, many),
         "ReviewFolder": ReviewFolder(report, [], tmp / ("deep" * 100) / "index.html"),
+        "Results": Results(QUICK_BENCH, {}, [], {}),
+        "SetCost": SetCost("x" * 200, 0.1, {p: 0.01 for p in PARTS}, {"checks": 0.01, "stress": 0.01}, 10),
+        "ExplainBench": ExplainBench([ModelScores(f"model {i}" * 10) for i in range(50)], {}, True),
     }
 
 
@@ -80,6 +88,9 @@ RESULTS = (
     "MutationReport",
     "StressReport",
     "ReviewFolder",
+    "Results",
+    "SetCost",
+    "ExplainBench",
 )
 
 
