@@ -27,6 +27,9 @@ CART_POLE = [str(shipped_file("examples", f"cart_pole{suffix}")) for suffix in (
     ("model", "urdf", "name"),
     [
         ("cart_pole", "cart_pole", "cart_pole"),  # the URDF of the model's own name adds nothing
+        ("cart_pole", "cart_pole_heavy", "cart_pole_heavy"),  # nor one whose name starts with it
+        ("cart_pole", "cart_pole-3", "cart_pole-3"),  # a sweep's set
+        ("cart_pole", "cart_poles", "cart_pole-cart_poles"),  # another word
         ("double_pendulum", "erd_double_pendulum", "double_pendulum-erd_double_pendulum"),
         ("minimal_double_pendulum", "double_pendulum", "minimal_double_pendulum-double_pendulum"),
     ],

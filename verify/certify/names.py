@@ -36,13 +36,18 @@ def check_name(value: object, source: str, key: str) -> str:
 
 def set_name(model: str, urdf_name: str, source: str) -> str:
     """The name of a set certified on a URDF: its model's name, then the URDF's (its stem, or
-    ``erd_<stem>``) when that is another name — ``cart_pole`` for the cart-pole model on
-    ``cart_pole.urdf``, ``double_pendulum-erd_double_pendulum`` on example-robot-data's — so one
-    model certified on two URDFs into one folder gets two bundles.  Checked as every name is.
+    ``erd_<stem>``) when that is another name — ``double_pendulum-bench_rig`` for the double
+    pendulum on ``bench_rig.urdf``, ``double_pendulum-erd_double_pendulum`` on
+    example-robot-data's — so one model certified on two URDFs into one folder gets two bundles.
+    A URDF whose name starts with the model's (``cart_pole.urdf``, ``cart_pole_heavy.urdf``, a
+    sweep's ``cart_pole-3.urdf``) names the set alone: it names the model already, and a set a
+    sweep certified keeps its name when certified again from its bundle's files.  Checked as
+    every name is.
 
     (Certificates issued before this rule are named by the URDF alone; recheck reads the name a
     certificate records, so they are read as they are.)"""
-    name = model if urdf_name == model else f"{model}-{urdf_name}"
+    names_the_model = urdf_name == model or urdf_name.startswith((f"{model}-", f"{model}_", f"{model}."))
+    name = urdf_name if names_the_model else f"{model}-{urdf_name}"
     return check_name(name, source, "bundle name (the model's name, then the URDF's)")
 
 
