@@ -45,7 +45,7 @@ from pendverify.checks.report import CheckReport
 from pendverify.checks.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
 from pendverify.checks.verification import build_report
 from pendverify.display import REPR_LIMIT, html_table, shortened
-from pendverify.errors import InputError, PendverifyError, UnknownNameError
+from pendverify.errors import InputError, PendverifyError, UnknownNameError, missing_file
 from pendverify.robot import erd as erd_data
 from pendverify.robot.description import LoadedDescription
 from pendverify.robot.geometry import MODEL_FORM_RTOL
@@ -469,8 +469,8 @@ def animation_html(source: Trajectory, trace: bool = False) -> str:
 def review_scenes(folder: str | Path | None = None) -> list[Path]:
     """The scene files ``review`` runs: those in ``folder``, or the scenes installed with
     pendverify (``pendverify.shipped``) when None.  A TOML file that is plainly another kind
-    (a parameter file or a text model beside the scenes, ``pendverify.file_kinds``) is left out:
-    ``skipped_files`` names them."""
+    (a parameter file or a text model beside the scenes, ``pendverify.file_kinds``) is left out;
+    ``review`` notes each one it leaves out."""
     return _scene_files(folder)[0]
 
 
@@ -480,6 +480,8 @@ def _scene_files(folder: str | Path | None) -> tuple[list[Path], list[str]]:
     from pendverify.shipped import shipped_folder
 
     path = Path(folder) if folder else shipped_folder("scenes")
+    if folder and not path.exists():
+        raise missing_file(path, "folder of scenes")
     if folder and not path.is_dir():
         raise InputError(OPTIONS_SOURCE, "scenes", str(path), "not a folder: give the folder of scene files")
     scenes, skipped = [], []

@@ -282,6 +282,8 @@ def test_report_skips_a_non_scene_toml_and_shows_no_absolute_path(tmp_path, caps
     assert "note: skipped model.toml: a model file, not a scene" in printed
     page = (out / "index.html").read_text(encoding="utf-8")
     assert "swing.toml" in page and str(tmp_path) not in page and str(Path.cwd()) not in page
+    assert main(["report", "-o", str(out), "--scenes", str(tmp_path / "none"), "--force"]) == 2
+    assert error(capsys).startswith(f"folder of scenes not found: {tmp_path / 'none'}; check the path")
     (scenes / "broken.toml").write_text('model = "double_pendulum"\nspeed = 3\n')  # no kind: read, refused
     assert main([*argv, "--force"]) == 2
     assert "broken.toml" in error(capsys)
