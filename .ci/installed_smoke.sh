@@ -68,12 +68,12 @@ case "$scene$sweep_200" in "$clone"/*) echo "FAILED: the shipped data resolves i
 step pendverify check
 step pendverify keygen -o keys
 step pendverify example double_pendulum reference
-step pendverify certify reference/double_pendulum.toml -o certs --key keys/pendverify-signing.key.pem
+step pendverify certify reference/analytic/params/double_pendulum.toml -o certs --key keys/pendverify-signing.key.pem
 step pendverify recheck certs/double_pendulum.cert.json --trust keys/pendverify-signing.pub.pem
 # a typo in the LaTeX model (2\delta for \delta in M's last entry): the diagnosis repairs it
-sed 's/& \\delta \\end{bmatrix}/\& 2\\delta \\end{bmatrix}/g' reference/double_pendulum_latex.toml >typo.toml
-step python -c 'import sys, pendverify; r = pendverify.check("typo.toml", "reference/double_pendulum.urdf", "reference/double_pendulum.toml"); sys.exit(r.passed or not any(f.kind == "repair" and f.details["checks_pass"] for fs in r.diagnoses.values() for f in fs))'
-step python -c 'import pendverify, sys; sys.exit(not pendverify.certify_set("api-certs", "reference/double_pendulum.toml", samples=200).certified)'
+sed 's/& \\delta \\end{bmatrix}/\& 2\\delta \\end{bmatrix}/g' reference/examples/double_pendulum_latex.toml >typo.toml
+step python -c 'import sys, pendverify; r = pendverify.check("typo.toml", "reference/urdf/double_pendulum.urdf", "reference/analytic/params/double_pendulum.toml"); sys.exit(r.passed or not any(f.kind == "repair" and f.details["checks_pass"] for fs in r.diagnoses.values() for f in fs))'
+step python -c 'import pendverify, sys; sys.exit(not pendverify.certify_set("api-certs", "reference/analytic/params/double_pendulum.toml", samples=200).certified)'
 
 sed 's/^count = 200$/count = 20/' "$sweep_200" >sweep_20.toml
 grep -q '^count = 20$' sweep_20.toml || { echo "FAILED: could not set count = 20 in $sweep_200"; exit 1; }
@@ -86,8 +86,8 @@ step pendverify report -o review
 step pendverify stress --quick
 step pendverify bench certify
 step pendverify example cart_pole cart_pole
-step pendverify check --analytic cart_pole/cart_pole.py --urdf cart_pole/cart_pole.urdf --params cart_pole/cart_pole.toml
-step pendverify simulate cart_pole/cart_pole_lqr_push.toml
+step pendverify check --analytic cart_pole/examples/cart_pole.py --urdf cart_pole/examples/cart_pole.urdf --params cart_pole/examples/cart_pole.toml
+step pendverify simulate cart_pole/scenes/cart_pole_lqr_push.toml
 # the shipped MJCF, compiled by MuJoCo (a dependency, no extra): shown, then checked
 mjcf=$(shipped examples double_pendulum.mjcf.xml)
 step pendverify show --robot "$mjcf"

@@ -73,6 +73,7 @@ class ClosedForm:
 #: The kinds of interface method (``InterfaceMethod.kind``).
 REQUIRED = "required"  # abstract: every model writes it (C or C·q̇: ``coriolis_force`` in a BiasOnlyModel)
 DEFAULT = "default"  # optional; the interface's default is exact (no friction, no disturbances)
+OPTIONAL = "optional"  # optional, with no default: without it the checks that compare it are not run
 DERIVED = "derived"  # optional; derived from the other methods when not written, then not checked alone
 TOLERANCE = "tolerance"  # a tolerance scale, derived from M or H when not written
 STATES = "states"  # the named states every check visits
@@ -84,7 +85,7 @@ class InterfaceMethod:
     """One method of the model interface (``pendverify.analytic.interface.ClosedFormModel``).
 
     ``args`` names its arguments in order from "q", "v", "u", "w" (``""``: none).
-    ``kind`` is one of REQUIRED, DEFAULT, DERIVED, TOLERANCE, STATES, COMPOSED (above).
+    ``kind`` is one of REQUIRED, DEFAULT, OPTIONAL, DERIVED, TOLERANCE, STATES, COMPOSED (above).
     ``derived``: for a method the interface can derive, its name in reports and how it is
     derived, e.g. ``("det M", "from M (LU)")``; ``("", "")`` otherwise.
     ``shape``: its result's shape in the dimensions "n" (coordinates), "u" (inputs) and
@@ -103,7 +104,7 @@ class InterfaceMethod:
     def equation(self) -> bool:
         """A part of the equations of motion (required, defaulted or derived), not a tolerance,
         the states or a composition of the others."""
-        return self.kind in (REQUIRED, DEFAULT, DERIVED)
+        return self.kind in (REQUIRED, DEFAULT, OPTIONAL, DERIVED)
 
 
 #: The model interface, in its order: each method's arguments, kind and result.
@@ -112,7 +113,7 @@ INTERFACE: dict[str, InterfaceMethod] = {
     "coriolis_matrix": InterfaceMethod("qv", REQUIRED, shape=("n", "n"), closed_form=True),
     "coriolis_force": InterfaceMethod("qv", REQUIRED, shape=("n",)),
     "gravity": InterfaceMethod("q", REQUIRED, shape=("n",), closed_form=True),
-    "potential_energy": InterfaceMethod("q", REQUIRED, closed_form=True),
+    "potential_energy": InterfaceMethod("q", OPTIONAL, closed_form=True),
     "damping_matrix": InterfaceMethod("", DEFAULT, shape=("n", "n"), closed_form=True),
     "input_matrix": InterfaceMethod("", DEFAULT, shape=("n", "u"), closed_form=True),
     "disturbance_matrix": InterfaceMethod("", DEFAULT, shape=("n", "w"), closed_form=True),
@@ -133,6 +134,21 @@ INTERFACE: dict[str, InterfaceMethod] = {
     "bias": InterfaceMethod("qv", COMPOSED, ("the bias C·q̇ + H", "from C (or C·q̇) and H"), shape=("n",)),
     "kinetic_energy": InterfaceMethod("qv", COMPOSED, ("T", "from M (½ q̇ᵀ M q̇)")),
 }
+
+
+def entry_position(method: str, shape: tuple[int, int], index: int) -> tuple[int, ...]:
+    """The zero-based position of flat entry ``index`` of ``method``'s value, a matrix of ``shape``.
+
+    (row,) for a vector, (row, column) for a matrix.  Which it is, the interface says, not the
+    value's shape: with one coordinate M is a 1×1 matrix and H a one-entry vector, both one column.
+    A model's own closed form outside the interface is a vector when it has one column.
+    """
+    cols = shape[1]
+    interface = INTERFACE.get(method)
+    vector = len(interface.shape) == 1 if interface is not None and interface.shape else cols == 1
+    r, c = divmod(index, cols)
+    return (r,) if vector else (r, c)
+
 
 #: The interface's own closed forms, in the order the tools report them.
 STANDARD_CLOSED_FORMS: dict[str, ClosedForm] = {

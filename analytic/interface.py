@@ -15,8 +15,10 @@ disturbance map.
 What a model must and may write
 -------------------------------
 Required (abstract): ``mass_matrix`` M(q), ``coriolis_matrix`` C(q, q̇) (or
-``coriolis_force`` C·q̇ in a ``BiasOnlyModel``), ``gravity`` H(q) and
-``potential_energy`` V(q).  Optional, with a default: ``damping_matrix`` D (zero),
+``coriolis_force`` C·q̇ in a ``BiasOnlyModel``) and ``gravity`` H(q).  Optional without a
+default: ``potential_energy`` V(q); a model that does not write it is checked without it
+(the ``energy`` check is not run, and says why; ``sympy`` leaves V out; a simulation's energy
+is Pinocchio's, or not recorded).  Optional, with a default: ``damping_matrix`` D (zero),
 ``input_matrix`` B (required when ``inputs`` are declared), ``disturbance_matrix``
 W (zero).  Optional and *derived* when not written: ``det_mass_matrix`` (LU of M),
 ``inverse_mass_matrix`` (solving with M), ``acceleration`` (M⁻¹(B u + W w − D q̇ −
@@ -34,7 +36,8 @@ Writing your own model (a plug-in)
 ----------------------------------
 A model file for ``pendverify check --analytic FILE`` defines one subclass of
 ``ClosedFormModel`` and its parameter set (a frozen dataclass subclassing
-``ParameterSet`` whose ``model`` equals the class's ``name``); ``examples/cart_pole.py``
+``ParameterSet`` whose ``model`` equals the class's ``name``), importing them as
+``from pendverify import ClosedFormModel, ParameterSet, quantity``; ``examples/cart_pole.py``
 is a complete one, ``examples/minimal_double_pendulum.py`` a minimal one.  Beyond
 the abstract methods below it declares:
 
@@ -150,6 +153,9 @@ class ClosedFormModel(metaclass=ModelClass):
     #: Why the model's code is evaluated numerically only ("" when SymPy reads it): then no SymPy
     #: reading (``show``, ``sympy``, ``mutate``, generated NumPy) and no high-precision re-judge.
     numeric_only: ClassVar[str] = ""
+    #: The parameter set a model file gives with the model (``PARAMS``), used when none is named;
+    #: None: the parameters must be named (``--params``, a scene's ``params``).
+    default_params: ClassVar[ParameterSet | None] = None
     #: The motion ``pendverify certify`` simulates; None: derived from the model's scales.
     battery_motion: ClassVar[BatteryMotion | None] = None
 
@@ -182,9 +188,14 @@ class ClosedFormModel(metaclass=ModelClass):
     def gravity(self, q: np.ndarray) -> np.ndarray:
         """H(q) = ∂V/∂q."""
 
-    @abstractmethod
     def potential_energy(self, q: np.ndarray) -> float:
-        """V(q), up to a constant."""
+        """V(q), up to a constant; optional: a model that does not write it gives no V."""
+        raise NotImplementedError(f"{self.name} gives no potential energy V(q) (potential_energy)")
+
+    @classmethod
+    def has_potential_energy(cls) -> bool:
+        """Whether the model writes V(q) (``potential_energy``): the ``energy`` check needs it."""
+        return "potential_energy" in cls.hand_written()
 
     def damping_matrix(self) -> np.ndarray:
         """D: the generalized friction force is D·q̇; none (frictionless) by default."""

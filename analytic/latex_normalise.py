@@ -7,8 +7,10 @@
 ``matrix``; the transposes ``^T``, ``^\\top``, ``^{\\mathsf{T}}``) to one form, removes what a
 paper's display adds around the mathematics (``\\label{…}``, ``\\nonumber``, the display's
 environment and delimiters, ``\\\\[2pt]``'s spacing, a ``\\\\`` between the lines of an
-``align``, whose ``&=`` becomes ``=``), and keeps for every character its position in the
-original, so that an error can point at the LaTeX the user wrote.
+``align``, whose ``&=`` becomes ``=``; a notebook's ``&&`` between every two cells of a matrix
+becomes ``&``), and keeps for every character its position in the original, so that an error can
+point at the LaTeX the user wrote.  ``toml_escapes`` tells LaTeX that TOML's double quotes
+corrupted (``"\\theta"`` read as a tab and ``heta``) from LaTeX that holds real whitespace.
 """
 
 from __future__ import annotations
@@ -150,6 +152,39 @@ def _paper_layout(t: Text) -> None:
     t.sub(r"\\end\s*\{array\}", r"\\end{matrix}")
     t.sub(rf"\\(?:operatorname\*?|mathrm|text)\s*\{{\s*({_FUNCTION_NAMES})\s*\}}", r"\\\1")
     _line_breaks(t)
+    _double_ampersands(t)
+
+
+def _double_ampersands(t: Text) -> None:
+    """A matrix whose every column separator is ``&&`` has ``&`` there instead.
+
+    In amsmath ``a && b`` inside a ``bmatrix`` is three cells, the middle one empty; a notebook
+    that writes every separator so means one.  ``&&`` is read as one separator only when every
+    ``&`` of the matrix (at its own level, not in a matrix inside it) is half of an ``&&``: the
+    matrix is then rectangular either way (every row has the same empty columns between its
+    cells), and without them it is the matrix meant.  A matrix that mixes ``&&`` with single
+    ``&`` is refused at its first ``&&``; ``a & & b`` (an empty cell between separators) is left
+    as written, an error of the grammar.
+    """
+    frames: list[list[re.Match]] = []
+    spans = []
+    pattern = rf"\\(begin|end)\s*\{{(?:{_MATRIX_ENVIRONMENTS})\*?\}}|\\[&\\]|&&?"
+    for m in re.finditer(pattern, t.text):
+        if m.group(1) == "begin":
+            frames.append([])
+        elif m.group(1) == "end":
+            separators = frames.pop() if frames else []
+            doubled = [s for s in separators if s.group() == "&&"]
+            if doubled and len(doubled) != len(separators):
+                raise Stop(
+                    t.where(doubled[0].start()),
+                    "a matrix separating its columns with both '&&' and '&': '&&' is read as one "
+                    "separator only when every separator of the matrix is '&&'",
+                )
+            spans += [(s.start() + 1, s.end()) for s in doubled]
+        elif m.group().startswith("&") and frames:
+            frames[-1].append(m)
+    t.remove_spans(spans)
 
 
 def _line_breaks(t: Text) -> None:
@@ -175,6 +210,56 @@ def _unicode(t: Text) -> None:
     t.sub(r"([₀-₉]+)", lambda m: "_{" + m.group(1).translate(_SUBSCRIPT_DIGITS) + "}")
     t.sub(r"(\\[A-Za-z]+|[A-Za-z])\s*\u0307", r"\\dot{\1}")
     t.sub(r"(\\[A-Za-z]+|[A-Za-z])\s*\u0308", r"\\ddot{\1}")
+
+
+#: TOML's escapes that turn the start of a LaTeX command into a control character
+_ESCAPES = {"\b": ("b", "a backspace"), "\t": ("t", "a tab"), "\n": ("n", "a line break"),
+            "\f": ("f", "a form feed"), "\r": ("r", "a carriage return")}  # fmt: skip
+#: the commands that begin with t, n or r (a tab, line break or carriage return can be real)
+_TNR_COMMANDS = {c for c in UNICODE.values() if c[0] in "tnr"} | {
+    "tan", "times", "text", "textrm", "top", "to", "tfrac", "tilde", "nabla", "neq", "ne", "ni",
+    "nonumber", "notag", "newline", "right", "rangle", "rbrace", "rbrack", "rm",
+}  # fmt: skip
+
+
+def toml_escapes(text: str) -> str | None:
+    """Why ``text`` is LaTeX that TOML's double quotes corrupted, or None.
+
+    In a double-quoted TOML string ``\\b \\t \\n \\f \\r`` are escapes: ``"\\beta"`` is a
+    backspace and ``eta``, ``"\\theta"`` a tab and ``heta``, ``"\\frac"`` a form feed and ``rac``;
+    every other backslash-letter pair is a TOML error, so LaTeX in double quotes whose commands
+    all begin with b, t, n, f or r is read silently corrupted.  A backspace, a form feed or any
+    other control character but tab, line break and carriage return is never written in LaTeX:
+    each is refused.  A tab, a line break or a carriage return can be real (a ``'''…'''`` block
+    is written over lines, indented with tabs); one is refused when the letters right after it
+    spell, after the escape's letter, a LaTeX command (``heta`` after a tab: ``\\theta``).  A tab
+    indents and a carriage return ends a line: neither is followed by such letters in real
+    LaTeX.  A line of real LaTeX may start with ``u`` (``\\nu``) or ``e`` (``\\ne``), so a line
+    break is refused only if besides the text holds no backslash (double quotes that TOML read
+    leave one only where ``\\\\`` was written, while LaTeX in single quotes keeps its commands')
+    or the letters are three or more (``abla``, ``onumber``), which start no line of LaTeX.
+    """
+    found: dict[str, str] = {}
+    for m in re.finditer(r"([\x00-\x08\x0b-\x1f\x7f])([A-Za-z]*)|([\t\n\r])([A-Za-z]+)", text):
+        control, letters = (m.group(1), m.group(2)) if m.group(1) else (m.group(3), m.group(4))
+        letter, _ = _ESCAPES.get(control, ("", ""))
+        if m.group(3) and not (
+            letter + letters in _TNR_COMMANDS and (control != "\n" or "\\" not in text or len(letters) >= 3)
+        ):
+            continue
+        found.setdefault(control, f"\\{letter}{letters}" if letter and letters else "")
+    if not found:
+        return None
+    turned = " and ".join(
+        f"\\{_ESCAPES[c][0]} into {_ESCAPES[c][1]}" + (f' (in "{word}")' if word else "")
+        if c in _ESCAPES
+        else f"a control character U+{ord(c):04X}"
+        for c, word in found.items()
+    )
+    return (
+        f"this LaTeX was written in double quotes: TOML turned {turned}; "
+        "use single quotes '…' or '''…''' (no escapes)"
+    )
 
 
 def canonical_symbol(key: str) -> str:

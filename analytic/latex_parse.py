@@ -11,7 +11,9 @@ convention.
 What is read
 ------------
 * ``\\begin{bmatrix} … \\end{bmatrix}`` (and ``pmatrix``, ``Bmatrix``, ``matrix``,
-  ``array`` with its column specification), cells split by ``&``, rows by ``\\\\``
+  ``array`` with its column specification), cells split by ``&`` (by ``&&`` in a matrix whose
+  every separator is ``&&``, as notebooks write them; amsmath would read an empty column
+  there, the same in every row: ``latex_normalise``), rows by ``\\\\``
   (``\\\\[2pt]`` too); matrix sums and products; a row ``[a, b]`` (``(a, b)``);
   transposes ``^T``, ``^{T}``, ``^\\top``, ``^{\\mathsf{T}}`` (``^T`` is a power when the
   table declares ``T``).

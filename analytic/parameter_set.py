@@ -85,6 +85,7 @@ class ParameterSet:
 
     @classmethod
     def keys(cls) -> tuple[str, ...]:
+        """The parameters' names, in the order the dataclass declares them."""
         return tuple(f.name for f in dataclasses.fields(cls))
 
     @classmethod
@@ -118,11 +119,11 @@ class ParameterSet:
             ) from None
 
     def as_dict(self) -> dict[str, float]:
-        """The values by parameter name, in the fields' order."""
+        """The values by name: ``{"m1": 1.0, ...}``."""
         return dataclasses.asdict(self)
 
     def replace(self: P, **changes: float) -> P:
-        """A copy with the named values changed (``params.replace(m1=2.0)``), validated again."""
+        """A copy with the named values changed, validated as a new set is."""
         return dataclasses.replace(self, **changes)
 
     def to_toml(self, name: str = "") -> str:

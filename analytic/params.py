@@ -10,11 +10,16 @@ A parameter file looks like::
 
 Unknown and missing keys are errors, as are booleans, strings and non-finite
 numbers.  Every error names the file, the key, the value and the rule.
+
+``ParameterSet``, ``quantity`` and ``check_value`` live in ``pendverify.analytic.parameter_set``
+(a model file imports the first two as ``from pendverify import ParameterSet, quantity``); reached
+through this module they still work, with a ``DeprecationWarning`` naming their home.
 """
 
 from __future__ import annotations
 
 import sys
+import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -23,6 +28,13 @@ from pendverify.file_kinds import KINDS, expect_kind, suffix_kind
 
 if TYPE_CHECKING:
     from pendverify.analytic.parameter_set import ParameterSet
+
+#: the names that moved to ``pendverify.analytic.parameter_set``, each with the import to use now
+MOVED = {
+    "ParameterSet": "from pendverify import ParameterSet",
+    "quantity": "from pendverify import quantity",
+    "check_value": "from pendverify.analytic.parameter_set import check_value",
+}
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -113,3 +125,18 @@ def default_parameter_file(model: str) -> Path:
     from importlib.resources import files
 
     return Path(str(files("pendverify.analytic") / "params" / f"{model}.toml"))
+
+
+def __getattr__(name: str) -> Any:
+    """A name that moved to ``pendverify.analytic.parameter_set``, with a ``DeprecationWarning``."""
+    if name not in MOVED:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    warnings.warn(
+        f"pendverify.analytic.params.{name} moved to pendverify.analytic.parameter_set.{name}; "
+        f"import it as `{MOVED[name]}`",
+        DeprecationWarning,
+        stacklevel=2,
+    )
+    from pendverify.analytic import parameter_set
+
+    return getattr(parameter_set, name)

@@ -11,13 +11,15 @@ exactly one concrete subclass of ``pendverify.analytic.ClosedFormModel``
 * ``params_type``: a frozen dataclass subclassing ``ParameterSet`` whose fields
   are ``quantity(kind, doc)`` entries;
 * ``coordinates`` and ``angular`` of equal length, ``inputs`` and ``disturbances``;
-* every abstract method of the interface (M, C or C·q̇, H, V; ``input_matrix``
-  too when it declares ``inputs``), and the coordinate map
+* every abstract method of the interface (M, C or C·q̇, H; ``input_matrix``
+  too when it declares ``inputs``; V is optional), and the coordinate map
   (``urdf_joints``, ``joint_transform``, ``joint_offset``; see ``pendverify.robot.joint_map``).
 
 A file without such a class may instead define ``METHOD`` (a ``sympy.physics.mechanics``
-derivation, ``pendverify.analytic.mechanics_model``) or ``DYNAMICS`` (a right-hand side
-ẋ = f(x, u) in Python, ``pendverify.analytic.python_dynamics``), each with its ``DECLARATION``.
+derivation, ``pendverify.analytic.mechanics_model``), ``DYNAMICS`` (a right-hand side
+ẋ = f(x, u) in Python, ``pendverify.analytic.python_dynamics``) or the functions ``M(q, p)``,
+``C(q, v, p)``, ``G(q, p)``, … (NumPy code, ``pendverify.analytic.numpy_model``), each with its
+``DECLARATION``; which it is, is decided in that order.
 
 ``validate_model_class`` checks these rules on any class (the Python API applies it to a
 class written in the caller's own code).  ``examples/cart_pole.py`` is a complete
@@ -194,15 +196,20 @@ def load_model_class(path: str | Path) -> type[ClosedFormModel]:
     if not found:
         # deferred on purpose: SymPy's mechanics loads only for a model file that declares one
         from pendverify.analytic.mechanics_model import model_file_declaration
+        from pendverify.analytic.numpy_model import model_file_functions
         from pendverify.analytic.python_dynamics import model_file_dynamics
 
-        declared = model_file_dynamics(module, path) or model_file_declaration(module, path)
+        declared = (
+            model_file_dynamics(module, path)
+            or model_file_declaration(module, path)
+            or model_file_functions(module, path)
+        )
         if declared is not None:
             validate_model_class(declared, path)
             return declared
         raise PendverifyError(
-            f"{path}: defines no subclass of pendverify.analytic.ClosedFormModel, no METHOD and no DYNAMICS "
-            "(see examples/cart_pole.py for a complete model file)"
+            f"{path}: defines no subclass of pendverify.ClosedFormModel, no functions M, C, G, no METHOD "
+            "and no DYNAMICS (examples/cart_pole.py is a complete model file; docs/models.md shows each form)"
         )
     if len(found) > 1:
         raise PendverifyError(

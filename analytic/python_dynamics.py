@@ -257,9 +257,7 @@ def python_dynamics_model(function, declaration: Mapping, source: str | Path | N
         reader.fail("dynamics", f"{shortened(repr(signature), 60)}: must be one of {', '.join(SIGNATURES)}")
     if "state" in declaration and signature == "qddot(q, v, u)":
         reader.fail("state", "goes with f(x, u) or f(t, x, u); qddot(q, v, u) takes q and q̇ apart")
-    for name, (kind, _) in spec.parameters.items():
-        if kind == "gravity" and name != "g":
-            reader.fail(f"parameters.{name}", "name the gravity g: Pinocchio's gravity is taken from g")
+    require_gravity_named_g(reader, spec)
     positions, rates = _layout(reader.fail, declaration, spec.coordinates)
     if spec.inputs and "B" not in spec.equations:
         reader.fail("B", f"missing: the model declares inputs {', '.join(spec.inputs)}")
@@ -282,6 +280,13 @@ def python_dynamics_model(function, declaration: Mapping, source: str | Path | N
     cls.signature, cls.positions, cls.rates = signature, positions, rates
     cls.source = _function_file(function)
     return cls
+
+
+def require_gravity_named_g(reader, spec) -> None:
+    """A declared parameter of kind gravity must be named g: Pinocchio's gravity is set from ``g``."""
+    for name, (kind, _) in spec.parameters.items():
+        if kind == "gravity" and name != "g":
+            reader.fail(f"parameters.{name}", "name the gravity g: Pinocchio's gravity is taken from g")
 
 
 def _base(spec) -> type[PythonDynamicsModel]:

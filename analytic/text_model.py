@@ -32,7 +32,7 @@ from pendverify.analytic.interface import AccelerationOnlyModel, BiasOnlyModel, 
 from pendverify.analytic.module_names import module_name
 from pendverify.analytic.parameter_set import ParameterSet
 from pendverify.analytic.source_file import TEXT_FILE
-from pendverify.analytic.text_parse import Reader, TextModelSpec, read_text_model
+from pendverify.analytic.text_parse import EQUATIONS, Reader, TextModelSpec, read_text_model
 from pendverify.display import shortened
 
 #: equation key → (method, its arguments)
@@ -218,7 +218,8 @@ def _method(key: str, args: str, spec: TextModelSpec):
     syms = [s for g in args + "p" for s in spec.symbols[g]]
     params = [s.name for s in spec.symbols["p"]]
     entries = expr.tolist() if isinstance(expr, sp.MatrixBase) else expr
-    vector = isinstance(expr, sp.MatrixBase) and expr.cols == 1 and key not in ("B", "W")
+    # a vector by its key's declared shape, never by its own: a 1 × 1 M (one coordinate) is a matrix
+    vector = isinstance(expr, sp.MatrixBase) and EQUATIONS[key][0] == "n"
     if vector:
         entries = [row[0] for row in entries]
     compiled: dict[int, tuple] = {}
@@ -282,6 +283,22 @@ def _how_to_name_joints(spec: TextModelSpec):
     return classmethod(lambda cls: text)
 
 
+def parameter_type(spec: TextModelSpec, class_name: str) -> type[ParameterSet]:
+    """The ``ParameterSet`` dataclass ``<class_name>Params`` of the declared parameters (kind, unit)."""
+    fields = [
+        (p, float, dataclasses.field(metadata={"kind": kind, "unit": unit, "doc": f"{p} in [{unit}]"}))
+        for p, (kind, unit) in spec.parameters.items()
+    ]
+    return dataclasses.make_dataclass(
+        f"{class_name}Params", fields, bases=(ParameterSet,), frozen=True, namespace={"model": spec.name}
+    )
+
+
+def class_name_of(spec: TextModelSpec) -> str:
+    """The model class's name: the model's name in CamelCase (``double_pendulum`` → ``DoublePendulum``)."""
+    return "".join(part.capitalize() for part in spec.name.split("_")) or "TextModel"
+
+
 def build_model_class(
     spec: TextModelSpec, module: types.ModuleType | None = None, base: type[ClosedFormModel] | None = None
 ) -> type[ClosedFormModel]:
@@ -292,18 +309,12 @@ def build_model_class(
     class a model without M derives from instead of ``AccelerationOnlyModel`` (one whose q̈ is
     code, ``pendverify.analytic.python_dynamics``).
     """
-    class_name = "".join(part.capitalize() for part in spec.name.split("_")) or "TextModel"
+    class_name = class_name_of(spec)
     if module is None:
         module = types.ModuleType(module_name(spec.path))
         setattr(module, TEXT_FILE, str(spec.path))
         sys.modules[module.__name__] = module
-    fields = [
-        (p, float, dataclasses.field(metadata={"kind": kind, "unit": unit, "doc": f"{p} in [{unit}]"}))
-        for p, (kind, unit) in spec.parameters.items()
-    ]
-    params_type = dataclasses.make_dataclass(
-        f"{class_name}Params", fields, bases=(ParameterSet,), frozen=True, namespace={"model": spec.name}
-    )
+    params_type = parameter_type(spec, class_name)
     namespace = {
         "name": spec.name,
         "params_type": params_type,

@@ -6,7 +6,9 @@ list of rows of LaTeX entries.  ``[symbols]`` maps each LaTeX symbol the equatio
 use to an expression in SymPy syntax over the model's names (coordinates, their
 rates ``d<coordinate>``, inputs, disturbances, parameters): usually just a name
 (``'\\theta_1' = "theta1"``), or a definition (``'\\beta' = "m2*l1*r2"``).  Two keys
-that read as the same symbol (``x_1`` and ``x_{1}``) are refused.
+that read as the same symbol (``x_1`` and ``x_{1}``, ``'θ_2'`` and ``'\\theta_2'``) are one
+declaration when they say the same (their expressions' difference expands to zero), and
+refused when they do not.
 """
 
 from __future__ import annotations
@@ -16,9 +18,32 @@ import re
 import sympy as sp
 
 from pendverify.analytic.latex_names import conventions
-from pendverify.analytic.latex_normalise import canonical_symbol
+from pendverify.analytic.latex_normalise import canonical_symbol, toml_escapes
 from pendverify.analytic.latex_parse import LatexError, LatexReader, SymbolTable
 from pendverify.display import shortened
+
+
+def refuse_toml_escapes(reader, data: dict, keys) -> None:
+    """Refuse LaTeX that TOML's double quotes corrupted (``latex_normalise.toml_escapes``): the
+    strings under ``keys`` (each entry of a list by its index) and the ``[symbols]`` table's keys."""
+
+    def walk(key: str, value, index: tuple[int, ...] = ()):
+        if isinstance(value, str):
+            why = toml_escapes(value)
+            if why is not None:
+                reader.fail(key + (f"[{','.join(map(str, index))}]" if index else ""), why)
+        elif isinstance(value, list):
+            for i, x in enumerate(value):
+                walk(key, x, (*index, i))
+
+    for key in keys:
+        walk(key, data.get(key))
+    table = data.get("symbols")
+    if isinstance(table, dict):
+        for key in table:
+            why = toml_escapes(key)
+            if why is not None:
+                reader.fail("symbols", f"a key {why[len('this LaTeX ') :]}")
 
 
 def read_symbol_table(reader, table, allowed: dict, parse_entry, spec) -> LatexReader:
@@ -44,9 +69,16 @@ def read_symbol_table(reader, table, allowed: dict, parse_entry, spec) -> LatexR
             reader.fail(f"symbols.{key}", str(exc))
         if not canonical or any(c in re.sub(r"_\{[^{}]*\}", "", canonical) for c in "+-*/=&()"):
             reader.fail(f"symbols.{key}", "is not one LaTeX symbol (a letter or command, with a subscript)")
+        parsed = parse_entry(reader, f"symbols.{key}", value, allowed)
         if canonical in written:
-            reader.fail(f"symbols.{key}", f"reads as the same symbol as '{written[canonical]}'")
-        entries[canonical] = parse_entry(reader, f"symbols.{key}", value, allowed)
+            if sp.expand(parsed - entries[canonical]) != 0:
+                reader.fail(
+                    f"symbols.{key}",
+                    f"reads as the same symbol as '{written[canonical]}', which says "
+                    f"{shortened(sp.sstr(entries[canonical]), 60)}, not {shortened(sp.sstr(parsed), 60)}",
+                )
+            continue  # the same declaration twice: the first spelling names it
+        entries[canonical] = parsed
         source[canonical] = written[canonical] = key
     conventional = {k: c for k, c in by_convention.items() if k not in written}
     return LatexReader(SymbolTable(entries, source, conventional))
@@ -80,6 +112,13 @@ def parse_latex_equation(reader, latex: LatexReader, key: str, value, rows: int,
     if isinstance(value, list):
         if cols is None or rows == 0:
             value = [value] if rows == 0 else [[x] for x in value]
+        elif not all(isinstance(r, list) for r in value):
+            reader.fail(
+                key,
+                "wrong shape: a matrix is one LaTeX string (a bmatrix) or a list of rows, "
+                f"each a list of LaTeX entries; with {rows} coordinate{'s' if rows != 1 else ''} "
+                f"{key} must be {rows} × {cols}",
+            )
         parsed = sp.Matrix(
             [[read(f"{key}[{i},{j}]", x) for j, x in enumerate(r)] for i, r in enumerate(value)]
         )
@@ -102,7 +141,9 @@ def parse_latex_equation(reader, latex: LatexReader, key: str, value, rows: int,
             kind = f"{rows} × {cols}" if cols is not None else f"a vector of {rows}"
             given = _shape(parsed)
             reader.fail(
-                key, f"wrong shape: the LaTeX gives {given}; with {rows} coordinates {key} must be {kind}"
+                key,
+                f"wrong shape: the LaTeX gives {given}; with {rows} coordinate{'s' if rows != 1 else ''} "
+                f"{key} must be {kind}",
             )
     stray = parsed.free_symbols - set(allowed.values())
     accelerations = sorted(s.name for s in stray & read_as_ddot)

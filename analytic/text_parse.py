@@ -41,7 +41,7 @@ from pendverify.analytic.parameter_set import KIND_RULES
 from pendverify.analytic.params import read_toml
 from pendverify.analytic.text_equations import latex_side, read_equations, split_equations
 from pendverify.analytic.text_expression import FUNCTIONS, ExpressionError, fragment, read_expression
-from pendverify.analytic.text_model_latex import parse_latex_equation, read_symbol_table
+from pendverify.analytic.text_model_latex import parse_latex_equation, read_symbol_table, refuse_toml_escapes
 from pendverify.display import shortened
 from pendverify.errors import ExcerptError, ParameterError, PendverifyError, excerpt
 from pendverify.file_kinds import expect_kind
@@ -149,7 +149,11 @@ def parse_equation(reader: Reader, key: str, value, rows: int, cols: int | None,
     """A matrix (rows × cols), a column vector (cols None, rows entries) or a scalar (rows 0)."""
     if rows == 0:
         return parse_entry(reader, key, value, allowed)
-    want = f"{rows} × {cols} (a list of {rows} rows of {cols})" if cols is not None else f"{rows} entries"
+    want = (
+        f"{rows} × {cols} (a list of {_count(rows, 'row')}, each a list of {_count(cols, 'entry')})"
+        if cols is not None
+        else _count(rows, "entry")
+    )
     if cols is None:
         if not isinstance(value, list) or len(value) != rows or any(isinstance(x, list) for x in value):
             reader.fail(key, f"wrong shape: must be a vector of {want}")
@@ -166,6 +170,12 @@ def parse_equation(reader: Reader, key: str, value, rows: int, cols: int | None,
             for i, r in enumerate(value)
         ]
     )
+
+
+def _count(n: int, noun: str) -> str:
+    """``1 row``, ``2 rows``, ``1 entry``, ``3 entries``."""
+    plural = noun[:-1] + "ies" if noun.endswith("y") else noun + "s"
+    return f"{n} {noun if n == 1 else plural}"
 
 
 def read_text_model(path: str | Path) -> TextModelSpec:
@@ -262,6 +272,7 @@ def _read_equations(reader: Reader, spec: TextModelSpec, data: dict) -> None:
     dims = {"n": n, "u": len(spec.inputs), "w": len(spec.disturbances)}
     latex = None
     if spec.notation == "latex":
+        refuse_toml_escapes(reader, data, EQUATIONS)
         everything = {s.name: s for g in "qvuwap" for s in spec.symbols[g]} | FUNCTIONS | CONSTANTS
         latex = read_symbol_table(reader, data.get("symbols"), everything, parse_entry, spec)
     for key, (shape, groups) in EQUATIONS.items():

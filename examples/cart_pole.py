@@ -49,9 +49,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from pendverify.analytic import ClosedFormModel
-from pendverify.analytic.forms import STANDARD_CLOSED_FORMS, ClosedForm, Energies
-from pendverify.analytic.parameter_set import ParameterSet, quantity
+from pendverify import ClosedFormModel, Energies, ParameterSet, quantity
+from pendverify.analytic.forms import STANDARD_CLOSED_FORMS, ClosedForm
 
 
 @dataclasses.dataclass(frozen=True)

@@ -44,9 +44,9 @@ from typing import ClassVar
 
 import numpy as np
 
-from pendverify.analytic import ClosedFormModel, DoublePendulumParams
-from pendverify.analytic.forms import STANDARD_CLOSED_FORMS, ClosedForm, Energies
-from pendverify.analytic.parameter_set import ParameterSet, quantity
+from pendverify import ClosedFormModel, Energies, ParameterSet, quantity
+from pendverify.analytic import DoublePendulumParams
+from pendverify.analytic.forms import STANDARD_CLOSED_FORMS, ClosedForm
 
 
 @dataclasses.dataclass(frozen=True)

@@ -24,9 +24,7 @@ import dataclasses
 
 import numpy as np
 
-from pendverify.analytic import ClosedFormModel
-from pendverify.analytic.forms import Energies
-from pendverify.analytic.parameter_set import ParameterSet, quantity
+from pendverify import ClosedFormModel, Energies, ParameterSet, quantity
 
 
 @dataclasses.dataclass(frozen=True)

@@ -25,7 +25,7 @@ COMMAND_PAGES = DOCS / "commands"
 
 SETUP_COMMANDS = (
     "python3 -m venv .venv && . .venv/bin/activate && pip install -e . && pendverify check",
-    "python3 -m venv .venv && . .venv/bin/activate && pip install -e '.[test]' && python -m pytest",
+    "python3 -m venv .venv-test && . .venv-test/bin/activate && pip install -e '.[test]' && python -m pytest",
 )
 # user-facing text names the built-in systems "the two reference systems", never their origin
 FORBIDDEN = ("seed 000", "seed 001", "seed-000", "seed-001", "../shared", "source document", "issue-15")

@@ -8,6 +8,10 @@ The Python API (``pendverify.api``, ``pendverify.testing``)::
     report["crba"]                                   # one check's rows (CheckRows), one per model
     run = pendverify.simulate("scenes/damped_double_pendulum.toml")   # a Run
 
+A model file imports what it builds on from here::
+
+    from pendverify import ClosedFormModel, ParameterSet, quantity   # BiasOnlyModel, Energies too
+
 The names below are imported on first use, so ``import pendverify`` stays cheap: it imports
 neither Pinocchio nor SymPy.  ``dir(pendverify)`` lists exactly them (``__all__``), the names
 docs/python-api.md documents; the functions behind the other commands are in ``pendverify.api``.
@@ -31,10 +35,12 @@ _LAZY = {
     "Run": "pendverify.simulation.simulate",
     "assert_verified": "pendverify.testing",
     "PendverifyError": "pendverify.errors",
-    "ClosedFormModel": "pendverify.analytic",
+    # what a model file builds on (docs/models.md)
+    "ClosedFormModel": "pendverify.analytic.interface",
     "BiasOnlyModel": "pendverify.analytic.interface",
-    "ParameterSet": "pendverify.analytic",
+    "ParameterSet": "pendverify.analytic.parameter_set",
     "quantity": "pendverify.analytic.parameter_set",
+    "Energies": "pendverify.analytic.forms",
 }
 
 __all__ = [
@@ -42,6 +48,7 @@ __all__ = [
     "CheckReport",
     "CheckRows",
     "ClosedFormModel",
+    "Energies",
     "ParameterSet",
     "PendverifyError",
     "Run",
@@ -59,9 +66,9 @@ __all__ = [
 ]
 
 if _typing.TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
-    from pendverify.analytic import ClosedFormModel, ParameterSet
-    from pendverify.analytic.interface import BiasOnlyModel
-    from pendverify.analytic.parameter_set import quantity
+    from pendverify.analytic.forms import Energies
+    from pendverify.analytic.interface import BiasOnlyModel, ClosedFormModel
+    from pendverify.analytic.parameter_set import ParameterSet, quantity
     from pendverify.api import (
         certify_set,
         check,

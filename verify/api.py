@@ -64,7 +64,7 @@ if TYPE_CHECKING:
     from pendverify.stress.catalogue import StressReport
     from pendverify.symbolic.compare import SymbolicReport
     from pendverify.symbolic.mutation_report import MutationReport
-    from pendverify.viz.animation import Trajectory
+    from pendverify.viz.animation import AnimationPage, Trajectory
     from pendverify.viz.review_folder import ReviewFolder
     from pendverify.worked_examples import WorkedExample
 
@@ -88,6 +88,7 @@ __all__ = [
     "PinocchioRobot",
     "UrdfLike",
     "animation_html",
+    "animation_page",
     "bench_accuracy",
     "bench_certify",
     "bench_explain",
@@ -461,9 +462,15 @@ def trajectory(run: Run | str | Path, model_file: str | Path | None = None) -> T
 def animation_html(source: Trajectory, trace: bool = False) -> str:
     """The self-contained HTML page (meshcat, plays from file://) that animates ``source`` in
     real time; ``trace`` draws the path of the tip.  ``pendverify render``."""
-    from pendverify.viz.animation import render_html
+    return animation_page(source, trace).html
 
-    return render_html(source, trace=_flag("trace", trace))
+
+def animation_page(source: Trajectory, trace: bool = False) -> AnimationPage:
+    """``animation_html``'s page (``.html``) with what drawing it noticed (``.notes``: e.g. that
+    a description without visual geometry is drawn as a skeleton).  ``pendverify render``."""
+    from pendverify.viz.animation import animation_page as page
+
+    return page(source, trace=_flag("trace", trace))
 
 
 def review_scenes(folder: str | Path | None = None) -> list[Path]:
@@ -654,7 +661,8 @@ def stress(
     """The catalogue of numerically hard cases: ``pendverify stress``.
 
     ``model`` None runs the catalogue of the reference systems (``cases``: only these);
-    a model file (``.py``) with its ``urdf`` and ``params`` file runs the hard cases derived
+    a model file (``.py``) with its ``urdf`` and ``params`` file (None: the file's ``PARAMS``) runs
+    the hard cases derived
     from its parameters' kinds.  ``quick``: fewer states and shorter horizons, same cases;
     ``seed``: the state sampler's (default ``pendverify.stress.framework.SEED``).
     """
@@ -666,9 +674,12 @@ def stress(
     if model is not None:
         from pendverify.stress.generic import run_generic
 
-        if urdf is None or params is None:
-            raise PendverifyError(f"{model}: a model file needs its urdf and params")
-        return run_generic(str(model), _urdf_file_arg(urdf, "stress"), str(params), settings, cases, seed)
+        if urdf is None:
+            raise PendverifyError(
+                f"{model}: a model file needs its urdf (and params, unless the file gives PARAMS)"
+            )
+        params_file = None if params is None else str(params)
+        return run_generic(str(model), _urdf_file_arg(urdf, "stress"), params_file, settings, cases, seed)
     if urdf is not None or params is not None:
         raise PendverifyError("urdf and params go with a model file")
     for name in cases or ():
@@ -812,8 +823,10 @@ def worked_example(name: str) -> WorkedExample:
 
 
 def copy_example(name: str, folder: str | Path, force: bool = False) -> list[Path]:
-    """Copy the worked example ``name`` into ``folder`` (created if missing), ready to run; files
-    already there are refused unless ``force``.  The paths written, in the catalogue's order."""
+    """Copy the worked example ``name`` into ``folder`` (created if missing), each file at the path
+    the manual names it by (``urdf/double_pendulum.urdf``), ready to run; a file already there with
+    the same content is left as it is, one with other content refused unless ``force``.  The paths
+    written, in the catalogue's order."""
     from pendverify.worked_examples import copy_example as copy_files
 
     return copy_files(worked_example(name), Path(folder), force=_flag("force", force))

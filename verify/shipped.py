@@ -4,13 +4,15 @@ Each kind of shipped data is a folder inside the installed package, found throug
 ``importlib.resources`` (so wherever pendverify is installed, and never in a checkout
 unless that is what is installed).  In the installed layout the folders are siblings,
 ``pendverify/examples``, ``pendverify/scenes``, ..., which is what the scenes' relative
-paths (``../examples/cart_pole.py``) rely on.
+paths (``../examples/cart_pole.py``) rely on.  It is the repository's layout too (``urdf/``,
+``examples/``, ``analytic/params/`` at the clone's root), so a shipped file's ``shipped_path``
+is the path the manual names it by, and the path ``pendverify example`` copies it to.
 """
 
 from __future__ import annotations
 
 from importlib.resources import files
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 
 #: kind of shipped data -> (the package that holds it, the folder inside that package)
 FOLDERS = {
@@ -34,3 +36,12 @@ def shipped_folder(kind: str) -> Path:
 def shipped_file(kind: str, name: str) -> Path:
     """The installed file ``name`` of one kind of shipped data, e.g. ``shipped_file("scenes", "x.toml")``."""
     return shipped_folder(kind) / name
+
+
+def shipped_path(kind: str, name: str) -> PurePosixPath:
+    """The file's path inside the package's root folder, e.g. ``analytic/params/double_pendulum.toml``.
+
+    That is its path in a clone and in the manual's commands (``--urdf urdf/double_pendulum.urdf``).
+    """
+    package, folder = FOLDERS[kind]
+    return PurePosixPath(*package.split(".")[1:], *([folder] if folder else []), name)

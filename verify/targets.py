@@ -140,7 +140,12 @@ def model_target(
     system = PinocchioSystem.for_model(cls, urdf, g)
     notes = []
     read = system.geometry.params
-    if params is None:
+    if params is None and cls.default_params is not None:
+        params = cls.default_params
+        notes.append("parameters: the model file's PARAMS")
+        if read is not None:
+            notes += parameter_differences(read, params)
+    elif params is None:
         if read is None:
             raise PendverifyError(
                 f"{system.source}: give the parameter set ({PARAMS_HINT}): a {cls.name} URDF alone "

@@ -4,18 +4,20 @@ An example is a model written by hand (a Python model file, and a LaTeX or text 
 where one exists), the URDF it is checked against (with xacro and MJCF versions where
 they exist), its parameter file and a scene that simulates it.  The files come from the
 shipped folders (``pendverify.shipped``) and are listed in the shipped catalogue
-``examples/catalogue.toml``.  ``copy_example`` writes them side by side into
-one folder; the scene's relative paths (``../examples/cart_pole.py``) become the copies'
-names, so the folder runs on its own.
+``examples/catalogue.toml``.
+
+``copy_example`` lays them out in the folder as the package and the repository do, each at
+its ``shipped_path``: ``urdf/double_pendulum.urdf``, ``examples/minimal_double_pendulum.toml``,
+``scenes/...``.  So the manual's commands, which name the files that way, run unchanged in
+that folder, and a scene's relative paths (``../examples/cart_pole.py``) hold as shipped.
 """
 
 from __future__ import annotations
 
-import re
 import shlex
 import sys
 from dataclasses import dataclass
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 
 from pendverify.errors import FileAccessError, UnknownNameError
 
@@ -23,14 +25,7 @@ if sys.version_info >= (3, 11):
     import tomllib
 else:  # pragma: no cover - exercised on Python 3.10 only
     import tomli as tomllib
-from pendverify.shipped import shipped_file
-
-#: a scene's keys that name a file relative to the scene
-SCENE_PATH_KEYS = ("model", "params", "urdf")
-#: one such key's line, when its value goes up out of the scene's folder: ``model = "../examples/x.py"``
-_SCENE_PATH_LINE = re.compile(
-    rf'^(?P<key>{"|".join(SCENE_PATH_KEYS)})(?P<eq>\s*=\s*)"(?P<path>\.\./[^"]+)"', re.MULTILINE
-)
+from pendverify.shipped import shipped_file, shipped_path
 
 
 @dataclass(frozen=True)
@@ -44,6 +39,11 @@ class ShippedFile:
     @property
     def source(self) -> Path:
         return shipped_file(self.kind, self.name)
+
+    @property
+    def path(self) -> PurePosixPath:
+        """Where it is copied to in a folder, and how the manual names it: ``urdf/double_pendulum.urdf``."""
+        return shipped_path(self.kind, self.name)
 
 
 @dataclass(frozen=True)
@@ -128,47 +128,58 @@ def find_example(name: str) -> WorkedExample:
     raise UnknownNameError("example", name, NAMES)
 
 
-def scene_for_folder(text: str, copied: set[str]) -> str:
-    """A shipped scene's text with its relative paths (``../examples/X``) turned into ``X``.
+def _refuse_outside(folder: Path, target: Path) -> None:
+    """Refuse a ``target`` whose way down from ``folder`` leaves it: a file or a link in place of a folder."""
+    for part in reversed(target.relative_to(folder).parents[:-1]):  # urdf/, then deeper ones
+        here = folder / part
+        if here.is_symlink():
+            why = f"{here} is a symbolic link; the example is written only inside {folder}"
+            raise FileAccessError(str(target), "write", why)
+        if here.exists() and not here.is_dir():
+            raise FileAccessError(str(target), "write", f"{here} is a file, not a folder")
+    if target.is_dir():
+        raise FileAccessError(str(target), "write", "it is a folder, not a file")
+    if (target.exists() or target.is_symlink()) and not target.is_file():
+        raise FileAccessError(str(target), "write", "it is not a regular file")
 
-    ``copied`` is the set of file names copied beside it; a path to any other file is a
-    mistake in the catalogue, and raises ``ValueError`` naming it.
-    """
 
-    def local(match: re.Match) -> str:
-        name = Path(match["path"]).name
-        if name not in copied:
-            raise ValueError(f"the scene's {match['key']} {match['path']!r} is not one of the copied files")
-        return f'{match["key"]}{match["eq"]}"{name}"'
-
-    return _SCENE_PATH_LINE.sub(local, text)
+def _holds(target: Path, data: bytes) -> bool:
+    """Whether the file ``target`` (which exists) holds ``data``."""
+    try:
+        return target.stat().st_size == len(data) and target.read_bytes() == data
+    except OSError as exc:
+        raise FileAccessError(str(target), "read", exc.strerror or str(exc)) from None
 
 
 def copy_example(example: WorkedExample, folder: Path, force: bool = False) -> list[Path]:
-    """Write the example's files into ``folder`` (created if missing); the paths written, in order.
+    """Write the example's files into ``folder`` (created if missing), each at its ``path``; those written.
 
-    Refuses (``FileAccessError``, before writing anything) a ``folder`` that is a file or
-    cannot be written, a folder in the place of a file to be written, and, unless ``force``,
-    a file of the same name as one to be written.  Each file is written atomically.
+    A file already there with the same content is left as it is (two examples share
+    ``urdf/double_pendulum.urdf``; copying twice changes nothing).  Refuses
+    (``FileAccessError``, before writing anything) a ``folder`` that is a file or cannot be
+    written, a folder, a link or any other non-file in the place of a file, a file or a
+    symbolic link in the place of a subfolder (nothing is written outside ``folder``) and,
+    unless ``force``, a file of the same path with other content.  Each file is written atomically.
     """
     from pendverify.atomic import check_output, write_atomic
 
     check_output(folder, folder=True)
-    targets = [folder / f.name for f in example.files]
-    for target in targets:
-        if target.is_dir():
-            raise FileAccessError(str(target), "write", "it is a folder, not a file")
-    present = [t for t in targets if t.exists() or t.is_symlink()]
-    if present and not force:
-        more = f" (and {len(present) - 1} more of the example's files)" if len(present) > 1 else ""
-        raise FileAccessError(str(present[0]), "write", f"it exists already{more}; give --force to replace")
-    copied = {f.name for f in example.files}
-    for f, target in zip(example.files, targets, strict=True):
+    pending = []
+    for f in example.files:
+        target = folder / f.path
+        _refuse_outside(folder, target)
         data = f.source.read_bytes()
-        if f is example.scene:
-            data = scene_for_folder(data.decode("utf-8"), copied).encode("utf-8")
+        if target.is_file() and _holds(target, data):
+            continue
+        pending.append((target, data))
+    different = [target for target, _ in pending if target.exists() or target.is_symlink()]
+    if different and not force:
+        more = f" (and {len(different) - 1} more of the example's files)" if len(different) > 1 else ""
+        why = f"it exists already, with other content{more}; give --force to replace"
+        raise FileAccessError(str(different[0]), "write", why)
+    for target, data in pending:
         write_atomic(target, data)
-    return targets
+    return [target for target, _ in pending]
 
 
 def next_commands(example: WorkedExample, folder: str) -> list[str]:
@@ -180,7 +191,7 @@ def next_commands(example: WorkedExample, folder: str) -> list[str]:
     """
 
     def at(f: ShippedFile) -> str:
-        return shlex.quote(str(Path(folder) / f.name))
+        return shlex.quote(str(Path(folder) / f.path))
 
     pairs = [(m, example.urdf) for m in example.models] + [(example.model, d) for d in example.descriptions]
     checks = [

@@ -1,6 +1,7 @@
 """Visualisation: trajectories as self-contained browser animations, and the review page.
 
 * ``geometry``  — the URDF's visuals through Pinocchio's visual model, posed by forward kinematics;
+* ``skeleton``  — joints, rods and centres of mass for the bodies a description gives no visuals;
 * ``recorder``  — meshcat commands recorded in memory and written as one HTML file (no server);
 * ``animation`` — frames, camera, tip trace: ``render_html(Trajectory)``;
 * ``plots``     — energy and work-balance figures (matplotlib, SVG);

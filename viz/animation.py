@@ -344,6 +344,11 @@ def _visual_system(traj: Trajectory) -> VisualSystem:
 
 def build_scene(traj: Trajectory, trace: bool = False, fps: float = DEFAULT_FPS) -> SceneRecorder:
     """Record the model, the camera and the animation of a trajectory (no server involved)."""
+    return _record(traj, trace, fps)[0]
+
+
+def _record(traj: Trajectory, trace: bool, fps: float) -> tuple[SceneRecorder, tuple[str, ...]]:
+    """``build_scene``'s recorder and the notes of the visual system it drew."""
     if not FPS_RANGE[0] <= fps <= FPS_RANGE[1]:
         raise TrajectoryError(traj.source, "fps", fps, f"expected {FPS_RANGE[0]:g} to {FPS_RANGE[1]:g}")
     check_frames(traj, fps)
@@ -377,12 +382,25 @@ def build_scene(traj: Trajectory, trace: bool = False, fps: float = DEFAULT_FPS)
     )
     _set_camera(vis, camera)
     vis.set_animation(anim, play=True, repetitions=REPETITIONS)
-    return recorder
+    return recorder, visual.notes
+
+
+@dataclass(frozen=True)
+class AnimationPage:
+    """A rendered animation: the page's HTML and what drawing it noticed (e.g. a skeleton drawn)."""
+
+    html: str
+    notes: tuple[str, ...] = ()
+
+
+def animation_page(traj: Trajectory, trace: bool = False, fps: float = DEFAULT_FPS) -> AnimationPage:
+    """The self-contained HTML page that plays ``traj`` in real time, with the drawing's notes."""
+    recorder, notes = _record(traj, trace, fps)
+    duration = traj.t[-1] - traj.t[0]
+    caption = f"{traj.title} — {traj.params.model}, {duration:g} s"
+    return AnimationPage(recorder.html(f"{traj.title} (pendverify)", caption), notes)
 
 
 def render_html(traj: Trajectory, trace: bool = False, fps: float = DEFAULT_FPS) -> str:
     """The self-contained HTML page that plays ``traj`` in real time."""
-    recorder = build_scene(traj, trace, fps)
-    duration = traj.t[-1] - traj.t[0]
-    caption = f"{traj.title} — {traj.params.model}, {duration:g} s"
-    return recorder.html(f"{traj.title} (pendverify)", caption)
+    return animation_page(traj, trace, fps).html

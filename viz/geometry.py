@@ -16,6 +16,10 @@ the light grey background) takes the colour of its link from ``LINK_COLOURS``:
 one colour per link, in the order the links' visuals come, so that neighbouring
 links differ.  MJCF geoms keep their own colours (MuJoCo's default is mid grey).
 
+A moving body without any visual geometry (a dynamics-only description) is drawn as a
+skeleton, ``pendverify.viz.skeleton``: joint markers, rods between joints, centres of mass,
+and ``VisualSystem.notes`` says so.
+
 Only the poses of geometries attached to a moving joint are animated; those on
 the world (the pendulum's pivot block, the cart's rail) are placed once.
 """
@@ -29,9 +33,12 @@ import numpy as np
 import pinocchio as pin
 
 from pendverify.analytic import ParameterSet
+from pendverify.robot.jacobian import joint_jacobians
 from pendverify.robot.packages import resolve_package_uris
+from pendverify.robot.pinocchio_model import FORMAT as PINOCCHIO_FORMAT
 from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
+from pendverify.viz.skeleton import with_skeleton
 
 ROOT = "pendverify"
 
@@ -83,14 +90,22 @@ class VisualSystem:
     visual_model: pin.GeometryModel
     visual_data: pin.GeometryData
     urdf: str
+    #: what drawing it noticed (a skeleton drawn where the description has no visual geometry)
+    notes: tuple[str, ...] = ()
+
+    @classmethod
+    def _drawn(cls, system: PinocchioSystem, visual_model: pin.GeometryModel, urdf: str) -> VisualSystem:
+        """The system with its visuals, a skeleton added where a moving body has none
+        (``pendverify.viz.skeleton``)."""
+        visual_model, notes = with_skeleton(system.model, visual_model, LINK_COLOURS, system.source)
+        return cls(system, visual_model, visual_model.createData(), urdf, notes)
 
     @classmethod
     def from_params(cls, params: ParameterSet) -> VisualSystem:
         """The system whose URDF ``urdf_for(params)`` writes, with its visuals."""
         urdf = urdf_for(params)
         system = PinocchioSystem.from_urdf(params.model, urdf, params.g, f"<URDF of {params.model}>")
-        visual_model = _urdf_visuals(system.model, urdf)
-        return cls(system, visual_model, visual_model.createData(), urdf)
+        return cls._drawn(system, _urdf_visuals(system.model, urdf), urdf)
 
     @classmethod
     def for_model(cls, model_cls, urdf: str | Path, g: float | None = None) -> VisualSystem:
@@ -103,6 +118,8 @@ class VisualSystem:
         loaded = system.urdf  # the verified text: a xacro file's is the URDF it expanded to
         if loaded.visual_model is not None:  # given with a Pinocchio model
             visual_model = loaded.visual_model.copy()
+        elif loaded.format == PINOCCHIO_FORMAT and not loaded.text:  # a bare model: nothing to draw
+            visual_model = pin.GeometryModel()
         elif loaded.format == "mjcf":
             from pendverify.robot.mjcf import mjcf_visuals  # imports MuJoCo: only for an MJCF
 
@@ -113,7 +130,7 @@ class VisualSystem:
             visual_model = sdf_visuals(system.model, loaded.text)
         else:
             visual_model = _urdf_visuals(system.model, loaded.text, loaded.source)
-        return cls(system, visual_model, visual_model.createData(), loaded.text)
+        return cls._drawn(system, visual_model, loaded.text)
 
     @property
     def objects(self) -> list[pin.GeometryObject]:
@@ -175,8 +192,8 @@ class VisualSystem:
         fixed-base chain, the horizontal h = up × a of ``pendverify.robot.system`` does.
         """
         model, data = self.system.model, self.system.data
-        pin.computeJointJacobians(model, data, pin.neutral(model))
-        motion = data.J[:, 0]  # joint 1's motion: linear part for a slider, angular for a hinge
+        # joint 1's motion: linear part for a slider, angular for a hinge
+        motion = joint_jacobians(model, data, pin.neutral(model))[:, 0]
         if np.linalg.norm(motion[3:]) == 0.0:
             normal = np.cross(motion[:3], UP)  # then up × normal = the rail's direction
         else:

@@ -51,7 +51,7 @@ from pendverify.targets import (
     model_target,
     params_target,
 )
-from pendverify.viz.animation import Trajectory, render_html
+from pendverify.viz.animation import Trajectory, animation_page
 from pendverify.viz.plots import energy_plot_svg
 from pendverify.viz.review import SceneReview, review_page
 
@@ -120,7 +120,8 @@ def scene_targets(scenes: list[Scene], erd: bool = True) -> Selection:
 def _review(path: Path, scene: Scene, out: Path, trace: bool) -> SceneReview:
     result = run_scene(scene)
     animation, plot = f"scenes/{path.stem}.html", f"plots/{path.stem}.svg"
-    write_atomic(out / animation, render_html(Trajectory.from_run(result), trace=trace))
+    page = animation_page(Trajectory.from_run(result), trace=trace)
+    write_atomic(out / animation, page.html)
     write_atomic(out / plot, energy_plot_svg(result))
     return SceneReview(
         name=scene.name,
@@ -131,7 +132,7 @@ def _review(path: Path, scene: Scene, out: Path, trace: bool) -> SceneReview:
         passed=result.passed,
         model=scene.model,
         duration_s=scene.duration,
-        notes=list(result.notes),
+        notes=[*result.notes, *page.notes],
     )
 
 

@@ -154,3 +154,24 @@ def test_the_examples_keep_no_identity_line(example):
     ]
     assert identities == []
     assert len(table) <= 7  # x_1…x_4, α, β, δ at most: real definitions only
+
+
+def test_two_table_keys_for_one_symbol_are_one_declaration_when_they_agree(tmp_path):
+    """``'θ_2'`` and ``'\\theta_2'`` read as one symbol: saying the same, they are one declaration."""
+    latex = r"\begin{bmatrix} m_1 g \cos\theta_1 \\ m_2 g \cos\theta_2 \end{bmatrix}"
+    table = "\n[symbols]\n'θ_2' = \"theta2\"\n'\\theta_2' = \"theta2\"\n'x_1' = \"m1\"\n'x_{1}' = \"1*m1\"\n"
+    H, spec = _read(tmp_path, latex, table)
+    t1, t2, m1, m2, _, _, _, g = _names(spec)
+    assert list(H) == [m1 * g * sp.cos(t1), m2 * g * sp.cos(t2)]
+    assert spec.latex_symbols["θ_2"] == t2 and "\\theta_2" not in spec.latex_symbols
+    H, spec = _read(tmp_path, latex, "\n[symbols]\n'θ_2' = \"theta2\"\n")  # beside the convention
+    assert list(H) == [m1 * g * sp.cos(t1), m2 * g * sp.cos(t2)]
+
+
+def test_two_table_keys_for_one_symbol_that_disagree_are_refused(tmp_path):
+    table = "\n[symbols]\n'θ_2' = \"theta2\"\n'\\theta_2' = \"theta1\"\n"
+    with pytest.raises(PendverifyError) as info:
+        _read(tmp_path, r"\begin{bmatrix} 0 \\ \cos\theta_2 \end{bmatrix}", table)
+    message = str(info.value)
+    assert "key 'symbols.\\theta_2'" in message
+    assert "reads as the same symbol as 'θ_2', which says theta2, not theta1" in message

@@ -19,6 +19,7 @@ import sympy as sp
 from pendverify.analytic.latex_normalise import canonical_symbol
 from pendverify.analytic.latex_parse import LatexError, LatexReader, SymbolTable
 from pendverify.cli import main
+from tests.analytic.one_coordinate_models import FORMS
 from tests.error_message import one_error
 
 REPO = Path(__file__).resolve().parents[2]
@@ -200,7 +201,8 @@ def test_the_two_sides_of_a_display_must_agree(tmp_path, capsys):
          ["key 'M'"]),
         ("notation = \"latex\"", "notation = \"tex\"", ["key 'notation'", "'tex'"]),
         ("'\\beta' = \"m2*l1*r2\"", "'\\beta' = \"m2*l1*r7\"", ["key 'symbols.\\beta'", "r7"]),
-        ("'x_1' = \"theta1\"", "'x_1' = \"theta1\"\n'x_{1}' = \"theta1\"", ["symbols.x_{1}", "same symbol"]),
+        ("'x_1' = \"theta1\"", "'x_1' = \"theta1\"\n'x_{1}' = \"theta2\"",
+         ["symbols.x_{1}", "same symbol as 'x_1', which says theta1, not theta2"]),
         (r"D = '\begin{bmatrix} b_1 & 0 \\ 0 & b_2 \end{bmatrix}'", "", ["key 'C_plus_D'", "needs D"]),
         (r"\delta + \beta\cos(\theta_2) & \delta \end{bmatrix} =", r"\delta + \beta\cos(\theta_2) \end{bmatrix} =",
          ["key 'M'", "rows have"]),
@@ -282,6 +284,12 @@ t1, t2, w1, a1, m1, m2, g, r1, x12, al, u = sp.symbols("t1 t2 w1 a1 m1 m2 g r1 x
         (r"\begin{pmatrix} m_1 & 0 \\ 0 & m_2 \\ \end{pmatrix}", sp.Matrix([[m1, 0], [0, m2]])),
         (r"\begin{bmatrix} 1 & 2 \end{bmatrix} \begin{bmatrix} m_1 \\ m_2 \end{bmatrix}", sp.Matrix([[m1 + 2 * m2]])),
         (r"-2.5\alpha", -2.5 * al),
+        # a notebook's matrices: every column separator written &&
+        (r"\begin{bmatrix} m_1 && 0 \\ 0 && m_2 \end{bmatrix}", sp.Matrix([[m1, 0], [0, m2]])),
+        (r"\left[\begin{array}{ccc} m_1 && g && 0 \\ 0 && m_2&&g \end{array}\right]",
+         sp.Matrix([[m1, g, 0], [0, m2, g]])),
+        (r"\begin{bmatrix} m_1 && g \end{bmatrix} \begin{bmatrix} 1 & 0 \\ 0 & 1 \end{bmatrix}",
+         sp.Matrix([[m1, g]])),  # each matrix by its own separators
     ],
 )  # fmt: skip
 def test_the_reader_reads_latex_as_written(latex, expected):
@@ -304,6 +312,9 @@ def test_the_reader_reads_latex_as_written(latex, expected):
         (r"m_1 \underbrace{m_2", 5, "never closed"),
         (r"\begin{bmatrix} 1 & 0 \end{pmatrix}", None, "closed by"),
         (r"\begin{vmatrix} 1 & 0 \end{vmatrix}", None, "not a matrix"),
+        # && is one separator only where every separator is &&; an empty cell stays an error
+        (r"\begin{bmatrix} m_1 && 0 \\ 0 & m_2 \end{bmatrix}", 21, "both '&&' and '&'"),
+        (r"\begin{bmatrix} m_1 & & 0 \\ 0 & & m_2 \end{bmatrix}", 23, "unexpected '&'"),
     ],
 )
 def test_unreadable_latex_says_where_reading_stopped(latex, at, words):
@@ -322,3 +333,63 @@ def test_show_prints_the_latex_model_as_read(capsys):
     out = capsys.readouterr().out
     assert "det_mass_matrix = l1**2*l2**2*m2*" in out
     assert "gravity (derived: from f" in out and "coriolis_force (derived: from f" in out
+
+
+# --- LaTeX in TOML's double quotes: \b \t \n \f \r are escapes there -----------------------------
+ONE = FORMS["LaTeX, each entry alone"][1]  # the single pendulum, each entry bare LaTeX
+
+
+@pytest.mark.parametrize(
+    "old, new, key, words",
+    [
+        ("D = 'b'", r'D = "\beta"', "D", [r'TOML turned \b into a backspace (in "\beta")']),
+        (r"H = 'm g l \sin\theta'", r'H = "m g l \theta"', "H", [r'\t into a tab (in "\theta")']),
+        ("M = 'm l^2'", r'M = "\frac{m l^3}{l}"', "M", [r'\f into a form feed (in "\frac")']),
+        ("M = 'm l^2'", r'M = "m_p l \beta \theta"', "M",
+         [r'\b into a backspace (in "\beta") and \t into a tab (in "\theta")']),
+        ("M = 'm l^2'", r'M = [["\frac{m l^3}{l}"]]', "M[0,0]", [r'(in "\frac")']),
+        ("M = 'm l^2'", r'M = "\\frac{m l^3}{l} \nabla"', "M", [r'\n into a line break (in "\nabla")']),
+        ("M = 'm l^2'", "M = 'm l^2'\n" r'equations = "m l^2 \\ddot\\theta = \tau"', "equations",
+         [r'(in "\tau")']),
+        ("[coordinates]", '[symbols]\n"\\beta" = "b"\n\n[coordinates]', "symbols",
+         [r'a key was written in double quotes: TOML turned \b into a backspace (in "\beta")']),
+    ],
+)  # fmt: skip
+def test_latex_in_double_quotes_that_toml_corrupted_is_refused_in_one_line(
+    old, new, key, words, tmp_path, capsys
+):
+    assert old in ONE
+    path = tmp_path / "quotes.toml"
+    path.write_text(ONE.replace(old, new, 1))
+    code = main(["show", str(path)])
+    headline, _, _ = one_error(capsys.readouterr().err)
+    assert code == 2
+    assert headline.startswith(f"pendverify: error: {path}: key '{key}': ")
+    for word in [*words, "use single quotes '…' or '''…'''"]:
+        assert word in headline, headline
+
+
+@pytest.mark.parametrize(
+    "old, new",
+    [
+        # escaped backslashes in double quotes: what the LaTeX means
+        (r"H = 'm g l \sin\theta'", r'H = "m g l \\sin\\theta"'),
+        # real line breaks and tabs in a block: layout, read as spaces
+        ("M = 'm l^2'", "M = '''\n\t\\begin{bmatrix}\n\tm l^2\n\t\\end{bmatrix}\n'''"),
+        ("C = '0'", "C = '''\n0\n'''"),
+    ],
+)
+def test_latex_with_real_whitespace_or_escaped_backslashes_reads(old, new, tmp_path, capsys):
+    assert old in ONE
+    path = tmp_path / "fine.toml"
+    path.write_text(ONE.replace(old, new, 1))
+    assert main(["show", str(path)]) == 0, capsys.readouterr().err
+
+
+def test_unreadable_latex_in_single_quotes_is_still_refused_where_it_stops(tmp_path, capsys):
+    path = tmp_path / "typo.toml"
+    path.write_text(ONE.replace(r"H = 'm g l \sin\theta'", r"H = 'm g l eta'", 1))
+    code = main(["show", str(path)])
+    headline, fragment, column = one_error(capsys.readouterr().err)
+    assert code == 2 and "key 'H'" in headline and "unknown symbol or command 'e'" in headline
+    assert fragment[column:].startswith("eta")

@@ -151,3 +151,18 @@ def test_2000_nested_brackets_show_a_short_fragment_with_a_caret(tmp_path, capsy
     headline, fragment, column = one_error(capsys.readouterr().err)
     assert code == 2 and "2000 deep" in headline and "limit is 100" in headline
     assert len(fragment) <= 82 and fragment[column] == "("
+
+
+def test_a_notebooks_double_ampersands_verify_and_a_typo_among_them_fails(tmp_path):
+    """Every column separator of M and C written ``&&``, as a published notebook writes them."""
+    displays = dict(DISPLAYS)
+    for key in ("M", "C"):
+        assert displays[key].count(" & ") >= 2
+        displays[key] = displays[key].replace(" & ", " && ").replace("\n  & -", "\n  && -")
+    report = api.check(_file(tmp_path, displays), URDF, PARAMS)
+    assert report.passed and {r.check for r in report.results} >= {"crba", "coriolis"}
+    displays["M"] = displays["M"].replace(
+        r"\alpha + 2\beta\cos\theta_2 &&", r"\alpha + 2\beta\cos 2\theta_2 &&"
+    )
+    report = api.check(_file(tmp_path, displays), URDF, PARAMS)
+    assert {r.check: r.status.lower() for r in report.results}["crba"] == "fail"

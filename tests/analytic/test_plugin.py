@@ -135,7 +135,7 @@ def _run_file(tmp_path, capsys, text, extra=()):
 @pytest.mark.parametrize(
     ("text", "message"),
     [
-        ("x = 1\n", "defines no subclass of pendverify.analytic.ClosedFormModel"),
+        ("x = 1\n", "defines no subclass of pendverify.ClosedFormModel, no functions M, C, G, no METHOD"),
         ("def broken(:\n", "line 1: importing it failed: SyntaxError"),
         ("import numpy\nraise RuntimeError('boom')\n", "line 2: importing it failed: RuntimeError: boom"),
         (
@@ -325,6 +325,7 @@ def test_the_interface_table_gives_arguments_kinds_and_the_standard_closed_forms
         DEFAULT,
         DERIVED,
         INTERFACE,
+        OPTIONAL,
         REQUIRED,
         STANDARD_CLOSED_FORMS,
         STATES,
@@ -356,7 +357,8 @@ def test_the_interface_table_gives_arguments_kinds_and_the_standard_closed_forms
         for kind in {m.kind for m in INTERFACE.values()}
     }
     assert kinds == {
-        REQUIRED: ["mass_matrix", "coriolis_matrix", "coriolis_force", "gravity", "potential_energy"],
+        REQUIRED: ["mass_matrix", "coriolis_matrix", "coriolis_force", "gravity"],
+        OPTIONAL: ["potential_energy"],
         DEFAULT: ["damping_matrix", "input_matrix", "disturbance_matrix"],
         DERIVED: ["det_mass_matrix", "inverse_mass_matrix", "acceleration"],
         TOLERANCE: ["gravity_scale", "diagonal_scale"],
@@ -364,7 +366,8 @@ def test_the_interface_table_gives_arguments_kinds_and_the_standard_closed_forms
         COMPOSED: ["bias", "kinetic_energy"],
     }
     # every method the interface derives says how, and nothing else does
-    assert all(bool(m.derived[0]) == (m.kind not in (REQUIRED, DEFAULT)) for m in INTERFACE.values())
+    written = (REQUIRED, DEFAULT, OPTIONAL)
+    assert all(bool(m.derived[0]) == (m.kind not in written) for m in INTERFACE.values())
     assert INTERFACE["det_mass_matrix"].derived == ("det M", "from M (LU)")
     # the abstract methods of the interface are the required ones (C·q̇ in a BiasOnlyModel)
     assert ClosedFormModel.__abstractmethods__ == set(kinds[REQUIRED]) - {"coriolis_force"}

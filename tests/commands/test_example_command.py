@@ -1,4 +1,5 @@
-"""``pendverify example``: the list, each example copied and checked as the printed commands say, refusals."""
+"""``pendverify example``: the list, each example laid out as the manual names its files and checked as the
+printed commands say, files already there, refusals."""
 
 from __future__ import annotations
 
@@ -11,7 +12,7 @@ import pytest
 from pendverify.cli import main
 from pendverify.shipped import shipped_folder
 from pendverify.simulation.scene import load_scene
-from pendverify.worked_examples import EXAMPLES, NAMES, find_example, scene_for_folder
+from pendverify.worked_examples import EXAMPLES, NAMES, find_example
 
 REQUIRED = {
     "cart_pole",
@@ -39,14 +40,14 @@ def test_the_list_names_every_example_with_its_dof_and_files(capsys):
     for example in EXAMPLES:
         row = rows[example.name]
         assert f"{example.dof} dof" in row
-        assert all(f.name in row for f in example.files), row
+        assert all(str(f.path) in row for f in example.files), row
 
 
 def test_a_name_alone_shows_what_the_example_holds(capsys):
     assert main(["example", "furuta_pendulum"]) == 0
     out = capsys.readouterr().out
     for f in find_example("furuta_pendulum").files:
-        assert f.name in out
+        assert str(f.path) in out
     assert "pendverify example furuta_pendulum DIR" in out
 
 
@@ -56,13 +57,13 @@ def test_a_copied_example_runs_as_the_printed_commands_say(name, tmp_path, capsy
     folder = tmp_path / "copy"
     assert main(["example", name, str(folder)]) == 0
     out = capsys.readouterr().out
-    assert sorted(p.name for p in folder.iterdir()) == sorted(f.name for f in example.files)
+    copied = sorted(str(p.relative_to(folder).as_posix()) for p in folder.rglob("*") if p.is_file())
+    assert copied == sorted(str(f.path) for f in example.files)
     for f in example.files:
-        if f is not example.scene:
-            assert (folder / f.name).read_bytes() == f.source.read_bytes(), f.name
-    assert "../" not in (folder / example.scene.name).read_text(encoding="utf-8")
+        assert (folder / f.path).read_bytes() == f.source.read_bytes(), f.path
+        assert f"{folder / f.path}" in out, f.path
 
-    robot = pin.buildModelFromUrdf(str(folder / example.urdf.name))
+    robot = pin.buildModelFromUrdf(str(folder / example.urdf.path))
     assert robot.nv == example.dof
 
     checks = printed_commands(out, "check")
@@ -73,23 +74,44 @@ def test_a_copied_example_runs_as_the_printed_commands_say(name, tmp_path, capsy
     [simulate] = printed_commands(out, "simulate")
     scene = load_scene(simulate[1])
     assert len(scene.q0) == example.dof
+    copies = {(folder / f.path).resolve() for f in example.files}
     for used in (scene.model_file, scene.urdf):  # a plug-in scene runs on the copies
         if used is not None:
-            assert Path(used).resolve().parent == folder.resolve(), used
+            assert Path(used).resolve() in copies, used
 
 
 def test_the_copied_scene_simulates_with_the_copied_model(tmp_path, capsys):
     assert main(["example", "cart_pole", str(tmp_path)]) == 0
-    assert main(["simulate", str(tmp_path / "cart_pole_lqr_push.toml")]) == 0
+    assert main(["simulate", str(tmp_path / "scenes" / "cart_pole_lqr_push.toml")]) == 0
     assert "all invariants hold" in capsys.readouterr().out
 
 
-def test_a_scene_path_to_a_file_not_copied_is_a_catalogue_error():
-    text = 'model = "../examples/cart_pole.py"\nurdf = "../urdf/other.urdf"\n'
-    local = scene_for_folder(text, {"cart_pole.py", "other.urdf"})
-    assert local == 'model = "cart_pole.py"\nurdf = "other.urdf"\n'
-    with pytest.raises(ValueError, match=r"other\.urdf"):
-        scene_for_folder(text, {"cart_pole.py"})
+def test_the_manual_s_paths_run_unchanged_in_the_folder(tmp_path, monkeypatch, capsys):
+    """In the folder, ``--urdf urdf/double_pendulum.urdf --params examples/...`` as the manual prints it."""
+    monkeypatch.chdir(tmp_path)
+    assert main(["example", "minimal_double_pendulum", "."]) == 0
+    out = capsys.readouterr().out
+    manual = (
+        "pendverify check --analytic examples/minimal_double_pendulum.py "
+        "--urdf urdf/double_pendulum.urdf --params examples/minimal_double_pendulum.toml"
+    )
+    assert f"  {manual}" in out.splitlines()
+    args = shlex.split(manual)[1:]
+    assert main([*args, "--samples", "5", "--no-erd", "--quiet"]) == 0
+
+
+def test_two_examples_share_a_folder_and_a_second_copy_changes_nothing(tmp_path, capsys):
+    """``urdf/double_pendulum.urdf`` is in two examples: the second copy leaves it, and says so."""
+    assert main(["example", "minimal_double_pendulum", str(tmp_path)]) == 0
+    urdf = tmp_path / "urdf" / "double_pendulum.urdf"
+    before = urdf.stat()
+    capsys.readouterr()
+    assert main(["example", "double_pendulum", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "already there" in next(line for line in out.splitlines() if str(urdf) in line)
+    assert (urdf.stat().st_ino, urdf.stat().st_mtime_ns) == (before.st_ino, before.st_mtime_ns)
+    assert main(["example", "double_pendulum", str(tmp_path)]) == 0
+    assert capsys.readouterr().out.count("already there") == len(find_example("double_pendulum").files)
 
 
 def test_an_unknown_name_is_one_line_listing_the_known_ones(tmp_path, capsys):
@@ -101,37 +123,64 @@ def test_an_unknown_name_is_one_line_listing_the_known_ones(tmp_path, capsys):
     assert list(tmp_path.iterdir()) == []
 
 
-def test_an_existing_file_is_refused_and_nothing_is_written(tmp_path, capsys):
-    (tmp_path / "cart_pole.toml").write_text("mine\n", encoding="utf-8")
+def all_files(folder: Path) -> list[str]:
+    return sorted(p.relative_to(folder).as_posix() for p in folder.rglob("*"))
+
+
+def test_an_existing_file_with_other_content_is_refused_and_nothing_is_written(tmp_path, capsys):
+    (tmp_path / "examples").mkdir()
+    (tmp_path / "examples" / "cart_pole.toml").write_text("mine\n", encoding="utf-8")
     assert main(["example", "cart_pole", str(tmp_path)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1
-    assert "cart_pole.toml" in err and "--force" in err
-    assert [p.name for p in tmp_path.iterdir()] == ["cart_pole.toml"]
-    assert (tmp_path / "cart_pole.toml").read_text(encoding="utf-8") == "mine\n"
+    assert "examples/cart_pole.toml" in err and "other content" in err and "--force" in err
+    assert all_files(tmp_path) == ["examples", "examples/cart_pole.toml"]
+    assert (tmp_path / "examples" / "cart_pole.toml").read_text(encoding="utf-8") == "mine\n"
 
 
 def test_force_replaces_the_existing_files(tmp_path, capsys):
-    (tmp_path / "cart_pole.toml").write_text("mine\n", encoding="utf-8")
+    (tmp_path / "examples").mkdir()
+    (tmp_path / "examples" / "cart_pole.toml").write_text("mine\n", encoding="utf-8")
     (tmp_path / "notes.txt").write_text("kept\n", encoding="utf-8")
     assert main(["example", "cart_pole", str(tmp_path), "--force"]) == 0
     example = find_example("cart_pole")
-    assert (tmp_path / "cart_pole.toml").read_bytes() == example.params.source.read_bytes()
+    assert (tmp_path / "examples" / "cart_pole.toml").read_bytes() == example.params.source.read_bytes()
     assert (tmp_path / "notes.txt").read_text(encoding="utf-8") == "kept\n"
 
 
 def test_a_folder_in_the_place_of_a_file_is_refused_even_with_force(tmp_path, capsys):
-    (tmp_path / "cart_pole.urdf").mkdir()
+    (tmp_path / "examples" / "cart_pole.urdf").mkdir(parents=True)
     assert main(["example", "cart_pole", str(tmp_path), "--force"]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "cart_pole.urdf" in err
-    assert [p.name for p in tmp_path.iterdir()] == ["cart_pole.urdf"]
+    assert err.count("\n") == 1 and "cart_pole.urdf" in err and "a folder, not a file" in err
+    assert all_files(tmp_path) == ["examples", "examples/cart_pole.urdf"]
+
+
+def test_a_file_in_the_place_of_a_subfolder_is_refused_even_with_force(tmp_path, capsys):
+    (tmp_path / "scenes").write_text("mine\n", encoding="utf-8")
+    assert main(["example", "cart_pole", str(tmp_path), "--force"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "scenes is a file, not a folder" in err
+    assert all_files(tmp_path) == ["scenes"]
+
+
+def test_a_subfolder_linked_elsewhere_is_refused_and_nothing_is_written_there(tmp_path, capsys):
+    """``DIR/urdf`` a link to another folder: writing through it would write outside DIR."""
+    elsewhere, folder = tmp_path / "elsewhere", tmp_path / "copy"
+    elsewhere.mkdir()
+    folder.mkdir()
+    (folder / "urdf").symlink_to(elsewhere, target_is_directory=True)
+    assert main(["example", "minimal_double_pendulum", str(folder), "--force"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "symbolic link" in err and "only inside" in err
+    assert list(elsewhere.iterdir()) == []
+    assert all_files(folder) == ["urdf"]
 
 
 def test_a_folder_holding_other_files_is_accepted(tmp_path, capsys):
     (tmp_path / "notes.txt").write_text("kept\n", encoding="utf-8")
     assert main(["example", "triple_pendulum", str(tmp_path)]) == 0
-    assert (tmp_path / "triple_pendulum.py").is_file()
+    assert (tmp_path / "examples" / "triple_pendulum.py").is_file()
 
 
 def test_a_file_in_place_of_the_folder_is_refused(tmp_path, capsys):
@@ -155,11 +204,11 @@ def test_the_reference_systems_sweeps_are_copied_and_the_printed_sweep_certifies
         assert main(["example", example.name, str(folder)]) == 0
         out = capsys.readouterr().out
         for sweep in example.sweeps:
-            assert load_sweep(folder / sweep.name).model.name == example.name
+            assert load_sweep(folder / sweep.path).model.name == example.name
         [certify] = printed_commands(out, "certify")
-        first = folder / example.sweeps[0].name
+        first = folder / example.sweeps[0].path
         assert certify[:3] == ["certify", "--sweep", str(first)]
-    first = tmp_path / "double_pendulum" / "double_pendulum_200.toml"
+    first = tmp_path / "double_pendulum" / "sweeps" / "double_pendulum_200.toml"
     text = first.read_text(encoding="utf-8")
     assert text.count("count = 200") == 1
     first.write_text(text.replace("count = 200", "count = 2"), encoding="utf-8")
@@ -176,10 +225,11 @@ def test_every_example_s_scene_is_a_shipped_scene():
 def test_check_on_a_copy_fails_when_its_latex_is_wrong(tmp_path, capsys):
     """The copied files are what is checked: a sign flipped in the copied LaTeX C fails."""
     assert main(["example", "cart_pole", str(tmp_path)]) == 0
-    latex = tmp_path / "cart_pole_latex.toml"
+    latex = tmp_path / "examples" / "cart_pole_latex.toml"
     text = latex.read_text(encoding="utf-8")
     right = r"-m_p r\sin(\theta)\dot{\theta}"
     assert text.count(right) == 1
     latex.write_text(text.replace(right, right[1:]), encoding="utf-8")
-    files = ["--urdf", str(tmp_path / "cart_pole.urdf"), "--params", str(tmp_path / "cart_pole.toml")]
+    examples = tmp_path / "examples"
+    files = ["--urdf", str(examples / "cart_pole.urdf"), "--params", str(examples / "cart_pole.toml")]
     assert main(["check", "--analytic", str(latex), *files, "--samples", "5", "--no-erd", "--quiet"]) == 1

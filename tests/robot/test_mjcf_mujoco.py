@@ -18,10 +18,13 @@ import pytest
 
 import pendverify.robot.mjcf as mjcf_module
 from pendverify import api
+from pendverify.analytic.plugin import load_model_class
 from pendverify.errors import UrdfShapeError
 from pendverify.robot.description import load_description
 from pendverify.robot.mjcf_origins import DEFAULT, FROM_GEOMS, WRITTEN
+from pendverify.robot.mujoco_warnings import caught
 from tests.robot.mjcf_hand_models import GymCartDoublePole, GymCartPole, MjAcrobot, MjCartPole
+from tests.robot.one_joint import write_one_joint
 
 gymnasium = pytest.importorskip("gymnasium")
 dm_control = pytest.importorskip("dm_control")
@@ -32,7 +35,8 @@ EXAMPLE = REPO / "examples" / "double_pendulum.mjcf.xml"
 
 
 def compiled(path: Path) -> mujoco.MjModel:
-    return mujoco.MjModel.from_xml_path(str(path))
+    with caught():  # MuJoCo's default handler would leave MUJOCO_LOG.TXT in the working folder
+        return mujoco.MjModel.from_xml_path(str(path))
 
 
 def body(mj: mujoco.MjModel, name: str) -> tuple[float, np.ndarray, float]:
@@ -310,3 +314,24 @@ def test_a_shipped_mujoco_file_is_certified_and_rechecked(tmp_path, case):
         samples=20,
     )
     assert not refused.certified
+
+
+def test_an_mjcf_geom_is_drawn_in_the_colour_mujoco_shows(tmp_path):
+    """A geom with a material and no rgba of its own takes the material's colour (dm_control's
+    files colour everything so); a geom's own rgba wins over its material; a bare geom stays grey."""
+    from pendverify.viz.geometry import VisualSystem
+
+    path = tmp_path / "coloured.xml"
+    path.write_text(
+        '<mujoco><asset><material name="red" rgba="0.9 0.1 0.1 1"/></asset><worldbody>'
+        '<body name="bob"><joint name="hinge" type="hinge" axis="0 1 0"/>'
+        '<geom name="by_material" size="0.05" pos="0 0 -0.5" mass="2" material="red"/>'
+        '<geom name="own" size="0.02" pos="0 0 -0.25" mass="0" material="red" rgba="0.1 0.8 0.1 1"/>'
+        '<geom name="bare" size="0.02" pos="0 0 -0.1" mass="0"/>'
+        "</body></worldbody></mujoco>"
+    )
+    model_cls = load_model_class(write_one_joint("pendulum", tmp_path).model)
+    colours = {o.name: tuple(o.meshColor) for o in VisualSystem.for_model(model_cls, str(path)).objects}
+    assert colours["by_material"] == pytest.approx((0.9, 0.1, 0.1, 1.0))
+    assert colours["own"] == pytest.approx((0.1, 0.8, 0.1, 1.0))
+    assert colours["bare"] == pytest.approx((0.5, 0.5, 0.5, 1.0))

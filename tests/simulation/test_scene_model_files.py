@@ -204,8 +204,8 @@ def test_errors_of_the_model_key(tmp_path):
     path = _scene(tmp_path, "empty.py", "")
     assert _error(path) == (
         f"{path}: key 'model' = 'empty.py': not a usable model file: {tmp_path / 'empty.py'}: defines "
-        "no subclass of pendverify.analytic.ClosedFormModel, no METHOD and no DYNAMICS "
-        "(see examples/cart_pole.py for a complete model file)"
+        "no subclass of pendverify.ClosedFormModel, no functions M, C, G, no METHOD and no DYNAMICS "
+        "(examples/cart_pole.py is a complete model file; docs/models.md shows each form)"
     )
 
 

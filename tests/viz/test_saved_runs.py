@@ -48,11 +48,11 @@ def plugin_run(tmp_path) -> tuple[Path, Path, Path]:
     """
     folder = tmp_path / "example"
     assert main(["example", MINIMAL, str(folder)]) == 0
-    scene = folder / f"{MINIMAL}_release.toml"
+    scene = folder / "scenes" / f"{MINIMAL}_release.toml"
     scene.write_text(scene.read_text().replace("duration = 5.0", "duration = 0.3"))
     npz = tmp_path / "run.npz"
     assert main(["simulate", str(scene), "-o", str(npz)]) == 0
-    model_file = folder / f"{MINIMAL}.py"
+    model_file = folder / "examples" / f"{MINIMAL}.py"
     marker = tmp_path / "imported.marker"
     planted = model_file.read_text() + f"\nopen({str(marker)!r}, 'w').close()\n"
     model_file.write_text(planted)
@@ -123,9 +123,9 @@ def test_a_text_model_named_by_a_saved_run_is_read(tmp_path):
     """A text model runs nothing: the run names it and it is read without --analytic."""
     folder = tmp_path / "example"
     assert main(["example", MINIMAL, str(folder)]) == 0
-    scene = folder / "text.toml"
-    text = (folder / f"{MINIMAL}_release.toml").read_text()
-    text = text.replace(f'"{MINIMAL}.py"', f'"{MINIMAL}_text.toml"').replace(
+    scene = folder / "scenes" / "text.toml"
+    text = (folder / "scenes" / f"{MINIMAL}_release.toml").read_text()
+    text = text.replace(f'/{MINIMAL}.py"', f'/{MINIMAL}_text.toml"').replace(
         "duration = 5.0", "duration = 0.3"
     )
     scene.write_text(text)

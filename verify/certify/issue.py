@@ -97,19 +97,23 @@ def certification_input(
 
 
 def _plugin_input(model_file: str, urdf: str | None, params_file: str | None) -> CertificationInput:
-    """A model file, its URDF and its parameter file (as ``check --analytic``)."""
+    """A model file, its URDF and its parameter file (None: the model file's ``PARAMS``), as
+    ``check --analytic``."""
     source = ModelSource.of_file(model_file)
     cls = source.load()
     if urdf is None:
         raise PendverifyError(f"{model_file}: give the URDF to certify {cls.name} against (--urdf, urdf=)")
-    if params_file is None:
+    if params_file is None and cls.default_params is None:
         raise PendverifyError(
-            f"{model_file}: give the parameter set ({PARAMS_HINT}): a model file has no parameters of its own"
+            f"{model_file}: give the parameter set ({PARAMS_HINT}): the model file gives no PARAMS"
         )
-    params = plugin_parameters(cls, model_file, params_file)
+    if params_file is None:
+        params = cls.default_params
+    else:
+        params = plugin_parameters(cls, model_file, params_file)
     if not hasattr(params, "g"):
         raise ParameterError(
-            params_file,
+            params_file or model_file,
             "parameters.g",
             None,
             "certify needs a gravity parameter g: its runs set gravity by it",

@@ -4,7 +4,8 @@ A check is not run when there is nothing to compare: ``coriolis`` and ``skew`` n
 matrix C (a ``BiasOnlyModel`` gives only C·q̇); ``det`` and ``minverse`` need a
 hand-written det M and M⁻¹ (the interface's defaults derive them from M, by LU and by
 solving); ``damping`` needs a URDF that declares ``<dynamics damping>``; ``energy`` needs V, which a
-model deriving M, H and C·q̇ from its q̈ (``mass_from_acceleration``) does not give.  Each
+model may leave out (``potential_energy`` is optional) and a model deriving M, H and C·q̇ from its q̈
+(``mass_from_acceleration``) does not give.  Each
 ``requires`` function returns "" when its check applies, else the reason, which the
 report prints.  ``derived_notes`` says what the model left to the interface's defaults
 (what is derived, and how: ``pendverify.analytic.forms.INTERFACE``).
@@ -36,12 +37,18 @@ def needs_mass_matrix_and(requires):
 
 
 def needs_potential_energy(model, system) -> str:
-    """A ``requires``: the check compares V, which a model deriving M, H and C·q̇ from q̈ does not give."""
-    if not model.mass_from_acceleration:
+    """A ``requires``: the check compares V, which a model may leave out (it is optional) and a model
+    deriving M, H and C·q̇ from q̈ does not give."""
+    if model.mass_from_acceleration:
+        return (
+            f"not run: {_class(model).__name__} derives M, H and C·q̇ from its q̈ at states, not V "
+            "(the energy check needs V(q), an integral of H over q)"
+        )
+    if _class(model).has_potential_energy():
         return ""
     return (
-        f"not run: {_class(model).__name__} derives M, H and C·q̇ from its q̈ at states, not V "
-        "(the energy check needs V(q), an integral of H over q)"
+        f"not run: the model gives no potential energy V(q) ({_class(model).__name__} writes no "
+        "potential_energy); H is checked by gravity"
     )
 
 

@@ -123,7 +123,10 @@ def per_state_note(per_state: dict[str, str]) -> list[str]:
     """The note naming the closed forms evaluated with the model's own Python, state by state."""
     if not per_state:
         return []
-    why = "; ".join(f"{name}: {reason}" for name, reason in per_state.items())
+    by_reason: dict[str, list[str]] = {}
+    for name, reason in per_state.items():  # one reason, often shared by all: said once
+        by_reason.setdefault(reason, []).append(name)
+    why = "; ".join(f"{', '.join(names)}: {reason}" for reason, names in by_reason.items())
     return [
         f"evaluated with the model's own Python state by state, not as generated NumPy over all "
         f"states (slower, same verdicts): {why}"

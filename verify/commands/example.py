@@ -1,15 +1,22 @@
-"""``pendverify example [NAME [DIR]]``: list the worked examples, or copy one into a folder."""
+"""``pendverify example [NAME [DIR]]``: list the worked examples, or copy one into a folder.
+
+The files land in DIR at the paths the manual names them by (``urdf/double_pendulum.urdf``,
+``examples/...``, ``scenes/...``), so the manual's commands run unchanged inside DIR.
+"""
 
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from pendverify.commands import add_command
 
 DETAILS = (
     "Each example is a model written by hand (Python, and LaTeX or text where one exists), its URDF "
-    "(xacro and MJCF where they exist), its parameters and a scene whose paths point at the copies. "
-    "Files already in DIR are not replaced unless --force is given."
+    "(xacro and MJCF where they exist), its parameters and a scene. They are copied to the paths the "
+    "manual names them by (urdf/, examples/, scenes/, ...), so its commands run unchanged in DIR. "
+    "A file already in DIR with the same content is left as it is; one with other content is not "
+    "replaced unless --force is given."
 )
 
 
@@ -54,7 +61,7 @@ def run(args: argparse.Namespace) -> int:
         examples = api.worked_examples()
         width = max(len(e.name) for e in examples)
         for e in examples:
-            files = ", ".join(f.name for f in e.files)
+            files = ", ".join(str(f.path) for f in e.files)
             print(f"{e.name.ljust(width)}  {e.dof} dof  {e.summary}; files: {files}")
         print("copy one with: pendverify example NAME DIR")
         return 0
@@ -62,13 +69,15 @@ def run(args: argparse.Namespace) -> int:
     if args.folder is None:
         print(f"{example.name}: {example.summary} ({example.dof} dof)")
         for f in example.files:
-            print(f"  {f.name:<40} {f.role}")
+            print(f"  {f.path!s:<48} {f.role}")
         print(f"copy it with: pendverify example {example.name} DIR")
         return 0
-    written = api.copy_example(example.name, args.folder, force=args.force)
+    written = set(api.copy_example(example.name, args.folder, force=args.force))
     print(f"{example.name}: {example.summary} ({example.dof} dof), copied into {args.folder}:")
-    for f, path in zip(example.files, written, strict=True):
-        print(f"  {path!s:<48} {f.role}")
+    for f in example.files:
+        path = Path(args.folder) / f.path
+        kept = "" if path in written else " (already there, the same)"
+        print(f"  {path!s:<48} {f.role}{kept}")
     print("run it:")
     for command in next_commands(example, args.folder):
         print(f"  {command}")

@@ -80,9 +80,11 @@ def run(args: argparse.Namespace) -> int:
         if not result.passed:
             print(f"note: {traj.title}: an invariant FAILS (see `pendverify simulate {args.scene}`)")
             status = 1
-    page = api.animation_html(traj, trace=args.trace)
-    write_atomic(args.output, page)
+    page = api.animation_page(traj, trace=args.trace)
+    for note in page.notes:
+        print(f"note: {note}")
+    write_atomic(args.output, page.html)
     duration = traj.t[-1] - traj.t[0]
-    size_mb = len(page.encode()) / 1e6
+    size_mb = len(page.html.encode()) / 1e6
     print(f"animation of {traj.title} ({duration:g} s) written to {args.output} ({size_mb:.2f} MB)")
     return status

@@ -102,7 +102,10 @@ def run(args: argparse.Namespace) -> int:
             write_atomic(csv, result.to_csv())
             say(f"CSV written to {csv}")
     if args.html:
-        write_atomic(args.html, api.animation_html(api.trajectory(result)))
+        page = api.animation_page(api.trajectory(result))
+        for note in page.notes:
+            say(f"note: {note}")
+        write_atomic(args.html, page.html)
         say(f"animation written to {args.html}")
     if args.json:
         write_json_report(args, _json(result))

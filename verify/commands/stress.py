@@ -191,8 +191,10 @@ def run(args: argparse.Namespace) -> int:
     from pendverify.jsonio import to_json
 
     check_report_output(args.json)
-    if args.analytic and (not args.urdf or not args.params):
-        raise PendverifyError(f"{args.analytic}: give --urdf and --params with --analytic")
+    if args.analytic and not args.urdf:
+        raise PendverifyError(
+            f"{args.analytic}: give --urdf (and --params, unless the model file gives PARAMS) with --analytic"
+        )
     if not args.analytic and (args.urdf or args.params):
         raise PendverifyError("--urdf and --params go with --analytic (a model file)")
     report = api.stress(

@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import sympy as sp
 
+from pendverify.analytic.forms import entry_position
 from pendverify.analytic.symbolic_reading import SymbolicModel, entries
 from pendverify.analytic.text_expression import read_expression
 from pendverify.analytic.text_parse import CONSTANTS, FUNCTIONS
@@ -155,8 +156,7 @@ def _named(plant: Plant, findings, forms) -> bool:
     if quantity in (None, "B", "W") or (quantity == "D" and all(q != "D" for q, _ in named)):
         return bool(named)
     if isinstance(value, sp.MatrixBase):
-        r, c = divmod(plant.index, value.shape[1])
-        index = (r + 1,) if value.shape[1] == 1 else (r + 1, c + 1)
+        index = tuple(i + 1 for i in entry_position(plant.method, value.shape, plant.index))
     else:
         index = ()
     if quantity == "C":  # C is not unique: its row of C·q̇ is what differs

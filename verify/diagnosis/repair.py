@@ -27,6 +27,7 @@ import time
 import numpy as np
 import sympy as sp
 
+from pendverify.analytic.forms import entry_position
 from pendverify.analytic.symbolic_reading import SymbolicModel
 from pendverify.checks.catalogue import applicable_checks, run_checks
 from pendverify.diagnosis.candidates import (
@@ -188,8 +189,7 @@ def _findings(changes: dict, edit: Edit, slot: Slot, forms: dict, notation, alte
         quantity = QUANTITY.get(method)
         value = forms[method]
         if isinstance(value, sp.MatrixBase):
-            r, c = divmod(index, value.shape[1])
-            position = (r + 1,) if value.shape[1] == 1 else (r + 1, c + 1)
+            position = tuple(i + 1 for i in entry_position(method, value.shape, index))
         else:
             position = ()
         out.append(

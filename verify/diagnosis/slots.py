@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import sympy as sp
 
+from pendverify.analytic.forms import entry_position
 from pendverify.analytic.symbolic_reading import SymbolicModel, entries
 
 SCREEN_STATES = 24
@@ -219,8 +220,7 @@ def entry_label(method: str, value, index: int) -> str:
     name = QUANTITY.get(method, method)
     if not isinstance(value, sp.MatrixBase):
         return name
-    r, c = divmod(index, value.shape[1])
-    return f"{name}[{r + 1}]" if value.shape[1] == 1 else f"{name}[{r + 1},{c + 1}]"
+    return f"{name}[{','.join(str(i + 1) for i in entry_position(method, value.shape, index))}]"
 
 
 def find_slots(batch, sm: SymbolicModel) -> list[Slot]:

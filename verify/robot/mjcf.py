@@ -6,7 +6,9 @@
    ``pendverify.robot.mjcf_origins.expand_includes``): MuJoCo's own parser is lenient;
 2. MuJoCo's compiler (``pendverify.robot.mjcf_compile``): includes, default classes,
    ``childclass``, frames, angle units, ``inertiafromgeom``, ``fusestatic``; a compile error is one
-   line; what changes M or the bias and cannot be carried over is refused, the rest noted;
+   line; what changes M or the bias and cannot be carried over is refused, the rest noted; MuJoCo's
+   warnings (a deprecated attribute, an unstable state) are caught and become notes
+   (``pendverify.robot.mujoco_warnings``), never a ``MUJOCO_LOG.TXT`` in the working folder;
 3. the Pinocchio model built from the compiled ``MjModel`` at full double precision
    (``pendverify.robot.mjcf_pinocchio``);
 4. the cross-check of M and the bias forces between MuJoCo and that model on seeded states
@@ -15,7 +17,8 @@
    vector) and where each number came from (``pendverify.robot.mjcf_origins``).
 
 ``mjcf_visuals`` draws MuJoCo's compiled geoms (boxes, spheres, capsules, cylinders,
-ellipsoids; planes and meshes are left out) on the model's body frames.
+ellipsoids; planes and meshes are left out) on the model's body frames, in the colour MuJoCo
+shows: a geom's ``rgba`` where it differs from MuJoCo's default, else its material's.
 """
 
 from __future__ import annotations
@@ -33,6 +36,7 @@ from pendverify.robot.mjcf_crosscheck import cross_check
 from pendverify.robot.mjcf_origins import DEFAULT, expand_includes, origins
 from pendverify.robot.mjcf_pinocchio import body_name, build_pinocchio, joint_name, pose
 from pendverify.robot.mjcf_rules import Numbers, check_numbers
+from pendverify.robot.mujoco_warnings import caught
 from pendverify.robot.strict import DescriptionFacts, JointDynamics
 from pendverify.robot.xml_reading import parse_xml
 
@@ -58,10 +62,11 @@ def build_mjcf_model(
     expand_includes(root, None if path is None else path.parent, source)
     expanded = ET.tostring(root, encoding="unicode") if has_includes and path is not None else text
     check_numbers(root, Numbers(source))
-    mj = compile_mjcf(text, None if path is None else str(path), source, has_includes)
-    note = carried_over(mj, source)
-    model, joints = build_pinocchio(mj)
-    cross_check(mj, model, joints, source)
+    with caught() as warnings:
+        mj = compile_mjcf(text, None if path is None else str(path), source, has_includes)
+        note = carried_over(mj, source)
+        model, joints = build_pinocchio(mj)
+        cross_check(mj, model, joints, source)
     names = [joint_name(mj, j) for j in joints]
     bodies = [body_name(mj, b) for b in range(1, mj.nbody)]
     provenance = origins(root, bodies, [joint_name(mj, j) for j in range(mj.njnt)])
@@ -81,6 +86,7 @@ def build_mjcf_model(
     gravity = tuple(float(x) for x in mj.opt.gravity)
     facts = DescriptionFacts(dynamics, types, -gravity[2] + 0.0, gravity)
     notes = [note] if note else []
+    notes += [f"MuJoCo warns: {message}" for message in warnings]
     for k, j in enumerate(joints):
         armature = float(mj.dof_armature[int(mj.jnt_dofadr[j])])
         if armature:
@@ -101,7 +107,8 @@ def mjcf_visuals(model: pin.Model, text: str, source: str) -> pin.GeometryModel:
     import coal
 
     path = Path(source)
-    mj = compile_mjcf(text, str(path) if path.is_file() else None, source, False)
+    with caught():  # compiled by build_mjcf_model before: its warnings are noted there
+        mj = compile_mjcf(text, str(path) if path.is_file() else None, source, False)
     shapes = {
         int(mujoco.mjtGeom.mjGEOM_SPHERE): lambda s: coal.Sphere(s[0]),
         int(mujoco.mjtGeom.mjGEOM_CAPSULE): lambda s: coal.Capsule(s[0], 2 * s[1]),
@@ -122,6 +129,20 @@ def mjcf_visuals(model: pin.Model, text: str, source: str) -> pin.GeometryModel:
             joint, placement = frame.parentJoint, frame.placement * pose(mj.geom_quat[g], mj.geom_pos[g])
         name = mujoco.mj_id2name(mj, mujoco.mjtObj.mjOBJ_GEOM, g) or f"geom{g}"
         obj = pin.GeometryObject(name, joint, placement, make(np.array(mj.geom_size[g], dtype=float)))
-        obj.meshColor = np.array(mj.geom_rgba[g], dtype=float)
+        obj.meshColor = _geom_colour(mj, g)
         visuals.addGeometryObject(obj)
     return visuals
+
+
+#: MuJoCo's default geom rgba: a geom with this colour and a material is shown in the material's
+GEOM_DEFAULT_RGBA = (0.5, 0.5, 0.5, 1.0)
+
+
+def _geom_colour(mj, g: int) -> np.ndarray:
+    """The RGBA MuJoCo shows geom ``g`` in: its own ``rgba``, unless that is the default and the
+    geom has a material, whose ``rgba`` then applies."""
+    own = np.array(mj.geom_rgba[g], dtype=float)
+    material = int(mj.geom_matid[g])
+    if material >= 0 and np.array_equal(own, np.array(GEOM_DEFAULT_RGBA, dtype=np.float32)):
+        return np.array(mj.mat_rgba[material], dtype=float)
+    return own

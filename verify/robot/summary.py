@@ -26,6 +26,7 @@ import numpy as np
 import pinocchio as pin
 
 from pendverify.robot.description import READERS, LoadedDescription
+from pendverify.robot.jacobian import joint_jacobian, joint_jacobians
 
 #: format → where a number of its model came from, unless its reader recorded otherwise
 DEFAULT_ORIGINS = {
@@ -81,8 +82,7 @@ def robot_summary(loaded: LoadedDescription) -> RobotSummary:
     """What Pinocchio will use of ``loaded``, joint by joint (see the module docstring)."""
     model = loaded.model
     data = model.createData()
-    q0 = pin.neutral(model)
-    pin.computeJointJacobians(model, data, q0)
+    joint_jacobians(model, data, pin.neutral(model))
     joints = tuple(_joint(loaded, data, j) for j in range(1, model.njoints))
     return RobotSummary(loaded.source, loaded.format, joints, _gravity(loaded), tuple(loaded.notes()))
 
@@ -105,7 +105,7 @@ def _joint(loaded: LoadedDescription, data: pin.Data, j: int) -> JointSummary:
     model = loaded.model
     joint = model.joints[j]
     name = model.names[j]
-    subspace = pin.getJointJacobian(model, data, j, pin.LOCAL)[:, joint.idx_v : joint.idx_v + joint.nv]
+    subspace = joint_jacobian(model, data, j, pin.LOCAL)[:, joint.idx_v : joint.idx_v + joint.nv]
     linear, angular = subspace[:3, 0], subspace[3:, 0]
     revolute = bool(np.linalg.norm(angular) > 0)
     kind = "revolute" if revolute else "prismatic"

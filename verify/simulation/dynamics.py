@@ -89,6 +89,15 @@ def build_dynamics(scene: Scene, engine: str | None = None, urdf: str | None = N
     parameter set, e.g. to simulate a user's URDF that is being certified.
     """
     engine = engine or scene.engine
+    if engine == "closed_form" and not scene.model_cls.has_potential_energy():
+        raise SceneError(
+            scene.source,
+            "engine",
+            engine,
+            f"closed_form integrates {scene.model_cls.name}'s own equations and records their energy "
+            "½q̇ᵀMq̇ + V(q), but the model gives no potential energy V(q) (potential_energy): "
+            "use aba or both, whose energy is Pinocchio's",
+        )
     g = scene.gravity if scene.gravity is not None else 0.0
     params = scene.params.replace(g=g)
     model = scene.model_cls(params)

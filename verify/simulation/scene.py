@@ -163,6 +163,8 @@ def _parameters(
         return model_cls.params_type.from_mapping(table.table, top.source, "parameters."), "inline"
     if model_file is not None:
         ref = top.string("params", default=None) if top.has("params") else None
+        if (ref is None or ref == "default") and model_cls.default_params is not None:
+            return model_cls.default_params, f"{model_file} (PARAMS)"
         if ref is None or ref == "default":
             top.fail(
                 "params", ref, "a model file has no default parameter set: give params = FILE or [parameters]"

@@ -112,7 +112,7 @@ def generic_cases(model_cls, params, urdf: str, source: str = "<URDF>") -> tuple
 
 
 def run_generic(
-    model_file: str, urdf: str, params_file: str, settings: Settings, names=None, seed: int = SEED
+    model_file: str, urdf: str, params_file: str | None, settings: Settings, names=None, seed: int = SEED
 ):
     """``pendverify stress --analytic FILE --urdf URDF --params PARAMS``: the generic cases, run."""
     started = time.perf_counter()

@@ -26,7 +26,7 @@ extra closed forms             what their ``equals`` says, e.g. the cart referen
 
 det M, M⁻¹ and q̈ that the model does not write (``hand_written``) are derived by
 the interface from M and the other parts: they are listed as ``skipped``, with
-the reason, and not compared.
+the reason, and not compared; so is V when the model does not write it (it is optional).
 """
 
 from __future__ import annotations
@@ -38,6 +38,7 @@ from dataclasses import dataclass, field
 import sympy as sp
 
 from pendverify.analytic import ClosedFormModel
+from pendverify.analytic.forms import entry_position
 from pendverify.analytic.source_file import where
 from pendverify.analytic.symbolic_reading import SymbolicModel, entries, to_sympy
 from pendverify.checks.verdict import CHRISTOFFEL_CONSISTENT, NON_CHRISTOFFEL
@@ -96,19 +97,17 @@ class SymbolicReport:
         }
 
 
-def _label(shape_of, i: int) -> str:
+def _label(method: str, shape_of, i: int) -> str:
     if not isinstance(shape_of, sp.MatrixBase):
         return ""
-    cols = shape_of.shape[1]
-    r, c = divmod(i, cols)
-    return f"[{r}]" if cols == 1 else f"[{r},{c}]"
+    return f"[{','.join(map(str, entry_position(method, shape_of.shape, i)))}]"
 
 
 def _compare(quantity, method, relation, residual, angles) -> Comparison:
     """Every entry of ``residual`` (hand − derived, or a residual) must be zero."""
     items = entries(residual)
     differences = [
-        f"{quantity}{_label(residual, i)}: {show(e, angles)}"
+        f"{quantity}{_label(method, residual, i)}: {show(e, angles)}"
         for i, e in enumerate(items)
         if not is_zero(e, angles)
     ]
@@ -199,11 +198,15 @@ def compare(model_cls: type[ClosedFormModel], label: str | None = None) -> Symbo
         _coriolis(sm, lag),
         _compare("H", "gravity", "hand − ∂V/∂q", sm.evaluate("gravity", "q") - lag.H, angles),
     ]
-    dV = sm.evaluate("potential_energy", "q") - lag.V
-    potential = _compare(
-        "V", "potential_energy", "∂(hand − V)/∂q", sp.Matrix([dV.diff(x) for x in q]), angles
-    )
-    potential.note = "equal up to a constant" if potential.status == EQUAL else ""
+    if model_cls.has_potential_energy():
+        dV = sm.evaluate("potential_energy", "q") - lag.V
+        potential = _compare(
+            "V", "potential_energy", "∂(hand − V)/∂q", sp.Matrix([dV.diff(x) for x in q]), angles
+        )
+        potential.note = "equal up to a constant" if potential.status == EQUAL else ""
+    else:  # optional: H is compared with ∂V/∂q of the energies' V above
+        note = "not run: the model gives no potential energy V(q) (potential_energy), nothing to compare"
+        potential = Comparison("V", "potential_energy", "∂(hand − V)/∂q", SKIPPED, 0, note=note)
     out.append(potential)
     out.append(
         _compare("D", "damping_matrix", "hand − ∂²R/∂q̇²", sm.evaluate("damping_matrix", "") - lag.D, angles)

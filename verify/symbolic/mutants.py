@@ -30,6 +30,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
+from pendverify.analytic.forms import entry_position
 from pendverify.analytic.symbolic_reading import SymbolicModel, entries
 from pendverify.symbolic.edits import term_edits, trig_edits
 
@@ -55,9 +56,7 @@ class Mutant:
 def entry_label(method: str, value, index: int) -> str:
     if not isinstance(value, sp.MatrixBase):
         return method
-    cols = value.shape[1]
-    r, c = divmod(index, cols)
-    return f"{method}[{r}]" if cols == 1 else f"{method}[{r},{c}]"
+    return f"{method}[{','.join(map(str, entry_position(method, value.shape, index)))}]"
 
 
 def entry_mutants(expr, angles, rates) -> Iterator[tuple[str, str, sp.Expr]]:
