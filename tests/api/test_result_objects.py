@@ -198,9 +198,9 @@ def python_blocks(page: Path) -> list[str]:
 
 
 def test_every_python_block_of_the_guide_runs_as_written(tmp_path, monkeypatch, capsys):
-    """In a folder where ``pendverify example cart_pole examples`` copied the files, as the page says;
+    """In a folder where ``pendverify example cart_pole .`` copied the files, as the page says;
     the blocks run in order in one namespace, then the test functions they define are called."""
-    assert main(["example", "cart_pole", str(tmp_path / "examples")]) == 0
+    assert main(["example", "cart_pole", str(tmp_path)]) == 0
     monkeypatch.chdir(tmp_path)
     blocks = python_blocks(DOCS / "python-api.md")
     assert len(blocks) >= 3
