@@ -269,6 +269,17 @@ class ClosedFormModel(metaclass=ModelClass):
         """Named configurations every check visits (upright, folded...); the zero state by default."""
         return {"zero": np.zeros(self.nv)}
 
+    @classmethod
+    def how_to_name_joints(cls) -> str:
+        """How this model's own file names the URDF joint of each coordinate, for a message to the
+        person who wrote it (a class sets ``urdf_joints``; a text model overrides this with its
+        ``[urdf]`` table)."""
+        return (
+            f"set urdf_joints = (...) in class {cls.__name__}, the URDF joint of each coordinate "
+            f"({', '.join(cls.coordinates)}) in order, with joint_transform T and joint_offset θ0 when "
+            "q = T (θ − θ0) is not the identity"
+        )
+
     # --- which quantities are hand-written --------------------------------------------------
     @classmethod
     def hand_written(cls) -> tuple[str, ...]:

@@ -23,7 +23,8 @@ import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from pendverify.errors import FileAccessError, ParameterError
+from pendverify.errors import ParameterError, folder_given, missing_file, unreadable_file, wrong_kind
+from pendverify.file_kinds import KINDS, expect_kind, suffix_kind
 
 if TYPE_CHECKING:
     from pendverify.analytic.parameter_set import ParameterSet
@@ -41,17 +42,25 @@ else:  # pragma: no cover - exercised on Python 3.10 only
     import tomli as tomllib
 
 
-def read_toml(path: Path) -> dict[str, Any]:
-    """Parse a TOML file, turning syntax errors into a ParameterError that names the file."""
+def read_toml(path: Path, what: str = "TOML file") -> dict[str, Any]:
+    """Parse a TOML file (a ``what``: "parameter file", "scene file", ... in messages).
+
+    A missing, unreadable or folder path is a ``UserFileError`` naming the file and the next
+    step, as is a file whose name says it is another kind (``model.py``, ``robot.urdf``); a
+    syntax error, a ParameterError that names the file."""
+    if not path.name.lower().endswith(".toml"):
+        kind = suffix_kind(path)
+        if kind is not None:
+            raise wrong_kind(path, what, KINDS[kind].noun, KINDS[kind].given_as)
     try:
         with open(path, "rb") as fh:
             raw = fh.read()
     except FileNotFoundError:
-        raise ParameterError(str(path), "<file>", str(path), "file not found") from None
+        raise missing_file(path, what) from None
     except IsADirectoryError:
-        raise ParameterError(str(path), "<file>", str(path), "is a directory, not a TOML file") from None
+        raise folder_given(path, what) from None
     except OSError as exc:
-        raise FileAccessError(str(path), "read", exc.strerror or str(exc)) from None
+        raise unreadable_file(path, what, exc.strerror or str(exc)) from None
     try:
         text = raw.decode("utf-8-sig")  # a byte-order mark is allowed, as in URDFs
     except UnicodeDecodeError as exc:
@@ -79,7 +88,13 @@ def parse_parameter_document(data: dict[str, Any], source: str, registry: dict[s
             )
     model = data.get("model")
     if model not in registry:
-        raise ParameterError(source, "model", model, f"must be one of {', '.join(registry)}")
+        raise ParameterError(
+            source,
+            "model",
+            model,
+            f"must be one of {', '.join(registry)}; the parameters of a model file of your own go with "
+            "that file (--analytic FILE)",
+        )
     name = data.get("name", Path(source).stem if source != "<inline>" else model)
     if not isinstance(name, str):
         raise ParameterError(source, "name", name, "must be a string")
@@ -94,7 +109,15 @@ def load_parameter_file(path: str | Path, registry: dict[str, type[ParameterSet]
     if registry is None:  # the built-in models' registry; pendverify.analytic imports this module
         from pendverify.analytic import PARAMETER_TYPES as registry
     path = Path(path)
-    return parse_parameter_document(read_toml(path), str(path), registry)
+    return parse_parameter_document(read_parameter_toml(path), str(path), registry)
+
+
+def read_parameter_toml(path: Path) -> dict[str, Any]:
+    """A parameter file's TOML document; another kind of file (a text model, a scene) is refused
+    with what it is and how to give it (``pendverify.file_kinds``)."""
+    data = read_toml(path, "parameter file")
+    expect_kind(data, path, "params")
+    return data
 
 
 def default_parameter_file(model: str) -> Path:

@@ -43,9 +43,18 @@ import numpy as np
 from pendverify.analytic import ClosedFormModel, ParameterSet
 from pendverify.analytic.forms import INTERFACE
 from pendverify.analytic.module_names import module_name
-from pendverify.analytic.params import parse_parameter_document, read_toml
+from pendverify.analytic.params import parse_parameter_document, read_parameter_toml
 from pendverify.analytic.source_file import where
-from pendverify.errors import FileAccessError, ParameterError, PendverifyError, UserCodeError
+from pendverify.errors import (
+    FileAccessError,
+    ParameterError,
+    PendverifyError,
+    UserCodeError,
+    folder_given,
+    missing_file,
+    wrong_kind,
+)
+from pendverify.file_kinds import KINDS, suffix_kind
 
 #: the model files imported so far (resolved paths): an exception raised in one is the user's
 _LOADED: set[str] = set()
@@ -160,9 +169,9 @@ def load_model_class(path: str | Path) -> type[ClosedFormModel]:
     """The one ClosedFormModel subclass a model file defines, validated."""
     path = Path(path)
     if path.is_dir():
-        raise PendverifyError(f"{path}: is a directory, not a model file")
+        raise folder_given(path, "model file")
     if not path.is_file():
-        raise PendverifyError(f"{path}: model file not found")
+        raise missing_file(path, "model file")
     if path.suffix == ".toml":
         # deferred on purpose: SymPy loads only for a text model, not for every model file
         from pendverify.analytic.text_model import load_text_model
@@ -171,6 +180,9 @@ def load_model_class(path: str | Path) -> type[ClosedFormModel]:
         validate_model_class(cls, path)
         return cls
     if path.suffix != ".py":
+        kind = suffix_kind(path)
+        if kind is not None and kind != "model":
+            raise wrong_kind(path, "model file", KINDS[kind].noun, KINDS[kind].given_as)
         raise PendverifyError(f"{path}: a model file is Python source (.py) or a text model (.toml)")
     module = _import(path)
     found = [
@@ -210,7 +222,7 @@ def load_model_class(path: str | Path) -> type[ClosedFormModel]:
 
 def plugin_parameters(cls: type[ClosedFormModel], model_file: str, params_file: str) -> ParameterSet:
     """A parameter file for a plug-in: its ``model`` key must be the plug-in's name."""
-    data = read_toml(Path(params_file))
+    data = read_parameter_toml(Path(params_file))
     if data.get("model") != cls.name:
         raise ParameterError(
             params_file,

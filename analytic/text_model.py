@@ -265,6 +265,24 @@ def _energies(self, q, v, u, w) -> Energies:
     )
 
 
+def _how_to_name_joints(spec: TextModelSpec):
+    """A text model's ``how_to_name_joints``: in the terms of its TOML file, or of the declaration
+    that came with a derivation or a right-hand side (``pendverify.analytic.mechanics_model``)."""
+    coordinates = ", ".join(spec.coordinates)
+    joints = ", ".join(f'"<URDF joint of {c}>"' for c in spec.coordinates)
+    if str(spec.path).lower().endswith(".toml"):
+        text = (
+            f"add a [urdf] table with joints = [{joints}], the URDF joint of each coordinate ({coordinates}) "
+            "in order (and transform, offset when q = T (θ − θ0) is not the identity)"
+        )
+    else:
+        text = (
+            f'add "urdf": {{"joints": [{joints}]}} to its declaration, the URDF joint of each coordinate '
+            f"({coordinates}) in order"
+        )
+    return classmethod(lambda cls: text)
+
+
 def parameter_type(spec: TextModelSpec, class_name: str) -> type[ParameterSet]:
     """The ``ParameterSet`` dataclass ``<class_name>Params`` of the declared parameters (kind, unit)."""
     fields = [
@@ -308,6 +326,7 @@ def build_model_class(
         "joint_transform": spec.joint_transform,
         "joint_offset": spec.joint_offset,
         "text_spec": spec,
+        "how_to_name_joints": _how_to_name_joints(spec),
         "energies": _energies,
     }
     for key, (method, args) in METHODS.items():

@@ -43,7 +43,8 @@ from pendverify.analytic.text_equations import latex_side, read_equations, split
 from pendverify.analytic.text_expression import FUNCTIONS, ExpressionError, fragment, read_expression
 from pendverify.analytic.text_model_latex import parse_latex_equation, read_symbol_table, refuse_toml_escapes
 from pendverify.display import shortened
-from pendverify.errors import ExcerptError, PendverifyError, excerpt
+from pendverify.errors import ExcerptError, ParameterError, PendverifyError, excerpt
+from pendverify.file_kinds import expect_kind
 
 CONSTANTS = {"pi": sp.pi}
 TOP_KEYS = (
@@ -181,9 +182,10 @@ def read_text_model(path: str | Path) -> TextModelSpec:
     """Parse and check a text model file (module docstring)."""
     path = Path(path)
     try:
-        data = read_toml(path)
-    except PendverifyError as exc:
+        data = read_toml(path, "model file")
+    except ParameterError as exc:  # a syntax error: the file's, not a parameter's
         raise PendverifyError(str(exc)) from None
+    expect_kind(data, path, "model")
     return read_text_document(path, data)
 
 

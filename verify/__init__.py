@@ -13,17 +13,17 @@ A model file imports what it builds on from here::
     from pendverify import ClosedFormModel, ParameterSet, quantity   # BiasOnlyModel, Energies too
 
 The names below are imported on first use, so ``import pendverify`` stays cheap: it imports
-neither Pinocchio nor SymPy.
+neither Pinocchio nor SymPy.  ``dir(pendverify)`` lists exactly them (``__all__``), the names
+docs/python-api.md documents; the functions behind the other commands are in ``pendverify.api``.
 """
 
-from __future__ import annotations
-
-import importlib
-from typing import TYPE_CHECKING, Any
+import importlib as _importlib
+import typing as _typing
 
 #: public name -> the module that defines it, imported when the name is first used
 _LAZY = {
     "check": "pendverify.api",
+    "implied_parameters": "pendverify.api",
     "load_model": "pendverify.api",
     "load_params": "pendverify.api",
     "load_urdf": "pendverify.api",
@@ -56,6 +56,7 @@ __all__ = [
     "assert_verified",
     "certify_set",
     "check",
+    "implied_parameters",
     "load_model",
     "load_params",
     "load_urdf",
@@ -64,13 +65,14 @@ __all__ = [
     "simulate",
 ]
 
-if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
+if _typing.TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
     from pendverify.analytic.forms import Energies
     from pendverify.analytic.interface import BiasOnlyModel, ClosedFormModel
     from pendverify.analytic.parameter_set import ParameterSet, quantity
     from pendverify.api import (
         certify_set,
         check,
+        implied_parameters,
         load_model,
         load_params,
         load_urdf,
@@ -83,7 +85,7 @@ if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
     from pendverify.testing import assert_verified
 
 
-def __getattr__(name: str) -> Any:
+def __getattr__(name: str):
     if name == "__version__":  # the installed distribution's (pyproject.toml), read on first use
         from importlib.metadata import version
 
@@ -92,10 +94,12 @@ def __getattr__(name: str) -> Any:
     module = _LAZY.get(name)
     if module is None:
         raise AttributeError(f"module 'pendverify' has no attribute {name!r}")
-    value = getattr(importlib.import_module(module), name)
+    value = getattr(_importlib.import_module(module), name)
     globals()[name] = value
     return value
 
 
 def __dir__() -> list[str]:
-    return sorted({*globals(), *__all__})
+    """The public names only (``__all__``): not the submodules imported since, nor this module's own
+    helpers."""
+    return sorted(__all__)

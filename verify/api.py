@@ -44,7 +44,8 @@ from pendverify.analytic.plugin import load_model_class, validate_model_class
 from pendverify.checks.report import CheckReport
 from pendverify.checks.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
 from pendverify.checks.verification import build_report
-from pendverify.errors import InputError, PendverifyError, UnknownNameError
+from pendverify.display import REPR_LIMIT, html_table, shortened
+from pendverify.errors import InputError, PendverifyError, UnknownNameError, missing_file
 from pendverify.robot import erd as erd_data
 from pendverify.robot.description import LoadedDescription
 from pendverify.robot.geometry import MODEL_FORM_RTOL
@@ -474,14 +475,32 @@ def animation_page(source: Trajectory, trace: bool = False) -> AnimationPage:
 
 def review_scenes(folder: str | Path | None = None) -> list[Path]:
     """The scene files ``review`` runs: those in ``folder``, or the scenes installed with
-    pendverify (``pendverify.shipped``) when None."""
+    pendverify (``pendverify.shipped``) when None.  A TOML file that is plainly another kind
+    (a parameter file or a text model beside the scenes, ``pendverify.file_kinds``) is left out;
+    ``review`` notes each one it leaves out."""
+    return _scene_files(folder)[0]
+
+
+def _scene_files(folder: str | Path | None) -> tuple[list[Path], list[str]]:
+    """(the scene files of ``folder``, one note per TOML file left out as another kind)."""
+    from pendverify.file_kinds import KINDS, file_kind
     from pendverify.shipped import shipped_folder
 
     path = Path(folder) if folder else shipped_folder("scenes")
-    scenes = sorted(path.glob("*.toml")) if path.is_dir() else []
+    if folder and not path.exists():
+        raise missing_file(path, "folder of scenes")
+    if folder and not path.is_dir():
+        raise InputError(OPTIONS_SOURCE, "scenes", str(path), "not a folder: give the folder of scene files")
+    scenes, skipped = [], []
+    for file in sorted(path.glob("*.toml")) if path.is_dir() else []:
+        kind = file_kind(file)
+        if kind in (None, "scene"):  # one whose keys tell no kind is read as a scene, and its error shown
+            scenes.append(file)
+        else:
+            skipped.append(f"skipped {file.name}: a {KINDS[kind].noun}, not a scene")
     if not scenes:
         raise InputError(OPTIONS_SOURCE, "scenes", str(path), "no scene files (*.toml) in that folder")
-    return scenes
+    return scenes, skipped
 
 
 def review(
@@ -499,16 +518,19 @@ def review(
 
     Every model the scenes (``review_scenes(scenes)``) simulate is checked (``samples``
     random states drawn with ``seed``; example-robot-data's URDFs too when ``erd``), and
-    every scene is run, animated (``trace``: the tip's path) and plotted.  An existing
+    every scene is run, animated (``trace``: the tip's path) and plotted; a TOML file of another
+    kind in the folder is skipped with a note to ``log``.  An existing
     ``output`` is refused unless ``force``.  ``log`` takes each progress line.  Returns
     the ``pendverify.viz.review_folder.ReviewFolder`` (``report``, ``reviews``, ``index``,
     ``passed``).
     """
     from pendverify.viz.review_folder import write_review
 
-    paths = review_scenes(scenes)
+    paths, skipped = _scene_files(scenes)
     samples, seed = _count("samples", samples), _count("seed", seed)
     erd, trace, force = _flag("erd", erd), _flag("trace", trace), _flag("force", force)
+    for note in skipped:
+        log(f"note: {note}")
     return write_review(paths, Path(output), samples, seed, erd, trace, log=log, force=force)
 
 
@@ -586,6 +608,16 @@ class ModelReading(NamedTuple):
     parameters: tuple[str, ...]
     equations: list[Equation]
     conventions: tuple[str, ...] = ()
+
+    def __repr__(self) -> str:
+        methods = ", ".join(e.method for e in self.equations)
+        head = f"<ModelReading {self.model_cls.name!r}: {len(self.equations)} closed forms ("
+        return f"{head}{shortened(methods, REPR_LIMIT - len(head) - 40)}), {len(self.parameters)} parameters>"
+
+    def _repr_html_(self) -> str:
+        """Each closed form as SymPy reads it (its text; a derived one says how it is derived)."""
+        rows = [(e.method, e.derived or "written", str(e.value)) for e in self.equations]
+        return html_table(("closed form", "", "as SymPy reads it"), rows, f"model {self.model_cls.name}")
 
 
 def read_model(model: ModelLike) -> ModelReading:

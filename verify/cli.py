@@ -38,6 +38,23 @@ EXAMPLES = (
     "pendverify --debug simulate double_pendulum/damped_double_pendulum.toml",
     "pendverify certify double_pendulum/double_pendulum.toml -o certified",
 )
+#: the command modules in the order of a newcomer's path (``pendverify --help`` lists them so):
+#: check a model, read it back, copy an example, simulate and look, then the deeper tools; a
+#: module not named here comes after them, by name
+COMMAND_ORDER = (
+    "check",
+    "show",
+    "example",
+    "simulate",
+    "render",
+    "report",
+    "symbolic",  # sympy
+    "mutate",
+    "certify",  # certify, recheck
+    "keygen",
+    "stress",
+    "bench",
+)
 EXIT_STATUS = (
     "exit status: 0 passed, 1 a verification failed, 2 bad input or usage, "
     "3 internal error (a bug), 130 interrupted, 143 terminated (SIGTERM)"
@@ -84,11 +101,17 @@ def build_parser() -> argparse.ArgumentParser:
         "--version", action=VersionAction, help="print the versions of pendverify, Pinocchio and Python"
     )
     add_global_options(parser, top=True)
-    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for info in sorted(pkgutil.iter_modules(commands.__path__), key=lambda m: m.name):
-        if not info.name.startswith("_"):
-            importlib.import_module(f"{commands.__name__}.{info.name}").register(sub)
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name in command_modules():
+        importlib.import_module(f"{commands.__name__}.{name}").register(sub)
     return parser
+
+
+def command_modules() -> list[str]:
+    """The modules of ``pendverify.commands``, in ``COMMAND_ORDER`` and then by name."""
+    found = [info.name for info in pkgutil.iter_modules(commands.__path__) if not info.name.startswith("_")]
+    rank = {name: i for i, name in enumerate(COMMAND_ORDER)}
+    return sorted(found, key=lambda name: (rank.get(name, len(rank)), name))
 
 
 def refuse_unaccepted(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
@@ -121,6 +144,9 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
     """The parsed command line; argparse exits on a usage error (2), --help and --version (0)."""
     parser = build_parser()
     args = parser.parse_args(argv)
+    if args.command is None:  # `pendverify` alone: the commands, then the usage error (status 2)
+        parser.print_help(sys.stderr)
+        parser.exit(2, "\npendverify: error: give a command (`pendverify COMMAND --help`: what it takes)\n")
     refuse_unaccepted(parser, args)
     return args
 

@@ -49,6 +49,17 @@ def html_table(
     return "".join(out)
 
 
+def html_fields(caption: str, fields: Iterable[tuple[str, object]]) -> str:
+    """A two-column HTML table, field and value (escaped), under ``caption``: the notebook view of
+    a result that is one record rather than rows."""
+    return html_table(("", ""), [(name, str(value)) for name, value in fields], caption)
+
+
+def html_text(text: str) -> str:
+    """A report printed as text (the command's own table), as preformatted HTML."""
+    return f"<pre>{html.escape(text)}</pre>"
+
+
 def html_lines(lines: Iterable[str]) -> str:
     """Lines of text as escaped paragraphs-in-a-list (notes, warnings, a verdict)."""
     items = "".join(f"<li>{html.escape(line)}</li>" for line in lines)

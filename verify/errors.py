@@ -7,7 +7,9 @@ prints ``str(error)`` and exits with status 2; no traceback reaches the user.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
+from pathlib import Path
 
 
 class PendverifyError(Exception):
@@ -183,6 +185,62 @@ class FileAccessError(PlaceError):
 
     def __init__(self, path: str, action: str, reason: str):
         super().__init__(path, f"cannot {action} it: {reason}")  # action: "read" or "write"
+
+
+#: the next step for a file that is not there: the worked examples hold every kind of file
+COPY_EXAMPLES = (
+    "`pendverify example` lists the worked examples and `pendverify example NAME DIR` copies one's files "
+    "into DIR"
+)
+
+
+@dataclass
+class UserFileError(PendverifyError):
+    """A file the user named cannot be used as given: it is missing, unreadable, a folder, or a
+    file of another kind.  One sentence: what is wrong, the file (with the folder a relative path
+    was looked up in) and the next step.  Made by ``missing_file``, ``unreadable_file``,
+    ``folder_given`` and ``wrong_kind``."""
+
+    problem: str
+    path: str
+    next_step: str
+    #: the working folder a relative ``path`` was looked up in ("" for an absolute path)
+    folder: str = ""
+
+    def __str__(self) -> str:
+        where = f" (relative to {self.folder})" if self.folder else ""
+        return f"{self.problem}: {self.path}{where}; {self.next_step}"
+
+
+def _folder_of(path: str | Path) -> str:
+    """The working folder a relative path is read from; "" for an absolute one."""
+    return "" if Path(path).is_absolute() else os.getcwd()
+
+
+def missing_file(path: str | Path, what: str = "file", next_step: str = COPY_EXAMPLES) -> UserFileError:
+    """``what`` (a "parameter file", a "scene file", ...) is not at ``path``; ``next_step``: where
+    to get one (by default, the worked examples)."""
+    return UserFileError(f"{what} not found", str(path), f"check the path; {next_step}", _folder_of(path))
+
+
+def unreadable_file(path: str | Path, what: str, reason: str) -> UserFileError:
+    """``path`` exists but the OS refuses to read it (``reason``: its words, "Permission denied")."""
+    return UserFileError(
+        f"cannot read the {what} ({reason})",
+        str(path),
+        "make it readable (ls -l shows its permissions) or give a copy you can read",
+        _folder_of(path),
+    )
+
+
+def folder_given(path: str | Path, what: str) -> UserFileError:
+    """A folder where a ``what`` file was expected."""
+    return UserFileError(f"a folder, not a {what}", str(path), f"give the {what} inside it", _folder_of(path))
+
+
+def wrong_kind(path: str | Path, what: str, found: str, next_step: str) -> UserFileError:
+    """``path`` is a ``found`` (a "text model file", a "robot description") where a ``what`` was expected."""
+    return UserFileError(f"not a {what} but a {found}", str(path), next_step, _folder_of(path))
 
 
 class UserCodeError(PlaceError):

@@ -46,8 +46,8 @@ from meshcat.animation import Animation
 
 from pendverify.analytic import MODELS, PARAMETER_TYPES, ParameterSet
 from pendverify.analytic.plugin import load_model_class
-from pendverify.display import shortened
-from pendverify.errors import TrajectoryError
+from pendverify.display import html_fields, shortened
+from pendverify.errors import TrajectoryError, folder_given, missing_file
 from pendverify.simulation.limits import environment_limit
 from pendverify.viz.geometry import ROOT, UP, VisualSystem
 from pendverify.viz.recorder import SceneRecorder
@@ -87,6 +87,22 @@ class Trajectory:
     #: what reading a saved run noticed (printed by ``render``)
     notes: tuple[str, ...] = ()
 
+    def __repr__(self) -> str:
+        span = f"{len(self.t)} samples over {self.t[-1] - self.t[0]:g} s" if len(self.t) else "no samples"
+        where = shortened(self.source, 80)
+        title = shortened(self.title, 80)
+        return f"<Trajectory {title}: {span}, {self.q.shape[1]} coordinates, from {where}>"
+
+    def _repr_html_(self) -> str:
+        fields = [
+            ("samples", len(self.t)),
+            ("duration [s]", f"{self.t[-1] - self.t[0]:g}"),
+            ("coordinates", self.q.shape[1]),
+            ("source", self.source),
+            *(("note", n) for n in self.notes),
+        ]
+        return html_fields(self.title, fields)
+
     def __post_init__(self) -> None:
         if self.t.ndim != 1 or len(self.t) < 2:
             raise TrajectoryError(self.source, "t", self.t.shape, "expected at least two sample times")
@@ -124,8 +140,10 @@ class Trajectory:
         """
         path = Path(path)
         source = str(path)
+        if path.is_dir():
+            raise folder_given(path, "saved run (.npz)")
         if not path.is_file():
-            raise TrajectoryError(source, "<file>", source, "trajectory file not found")
+            raise missing_file(path, "saved run (.npz)", "`pendverify simulate SCENE -o FILE.npz` saves one")
         t, q, meta = read_saved_arrays(path, source)
         if not isinstance(meta, dict):
             raise TrajectoryError(source, "metadata", type(meta).__name__, "must be a JSON object")

@@ -43,7 +43,7 @@ class SceneReview:
     """One scene's entry: where its animation and plot are, and its invariant results."""
 
     name: str
-    source: str  # the scene file, as given
+    source: str  # the scene file's name, relative to the folder of scenes
     animation: str  # path of the animation, relative to index.html
     plot: str  # path of the energy plot, relative to index.html
     invariants: list  # pendverify.simulation.invariants.InvariantResult

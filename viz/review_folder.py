@@ -37,6 +37,7 @@ from pathlib import Path
 from pendverify.analytic.params import default_parameter_file, load_parameter_file
 from pendverify.atomic import write_atomic
 from pendverify.checks.verification import build_report
+from pendverify.display import REPR_LIMIT, html_table, shortened
 from pendverify.errors import InputError, SceneError
 from pendverify.progress import bar
 from pendverify.robot import erd as erd_data
@@ -66,6 +67,19 @@ class ReviewFolder:
     @property
     def passed(self) -> bool:
         return self.report.passed and all(r.passed for r in self.reviews)
+
+    def __repr__(self) -> str:
+        head = f"<ReviewFolder {'pass' if self.passed else 'FAIL'}: {len(self.reviews)} scene(s), "
+        return (
+            f"{head}checks {self.report.status}; {shortened(str(self.index), REPR_LIMIT - len(head) - 20)}>"
+        )
+
+    def _repr_html_(self) -> str:
+        rows = [(r.name, r.source, r.model, "pass" if r.passed else "FAIL") for r in self.reviews]
+        caption = f"review page {self.index}: checks {self.report.status}"
+        return html_table(
+            ("scene", "file", "model", "invariants"), rows, caption, [not r.passed for r in self.reviews]
+        )
 
 
 def _is_default(scene: Scene) -> bool:
@@ -103,14 +117,6 @@ def scene_targets(scenes: list[Scene], erd: bool = True) -> Selection:
     return selection
 
 
-def _shown(path: Path) -> str:
-    """A scene's path relative to the working directory when it is below it."""
-    try:
-        return str(path.resolve().relative_to(Path.cwd().resolve()))
-    except ValueError:
-        return str(path)
-
-
 def _review(path: Path, scene: Scene, out: Path, trace: bool) -> SceneReview:
     result = run_scene(scene)
     animation, plot = f"scenes/{path.stem}.html", f"plots/{path.stem}.svg"
@@ -119,7 +125,7 @@ def _review(path: Path, scene: Scene, out: Path, trace: bool) -> SceneReview:
     write_atomic(out / plot, energy_plot_svg(result))
     return SceneReview(
         name=scene.name,
-        source=_shown(path),
+        source=path.name,  # relative to the scenes folder: the page is shared, the folder is the author's
         animation=animation,
         plot=plot,
         invariants=[*result.invariants, *([result.engine_comparison] if result.engine_comparison else [])],

@@ -8,7 +8,7 @@ import pytest
 
 from pendverify.analytic import CartDoublePendulumParams, DoublePendulumParams
 from pendverify.analytic.params import default_parameter_file, load_parameter_file
-from pendverify.errors import ParameterError
+from pendverify.errors import ParameterError, UserFileError
 
 from ..conftest import default_params
 
@@ -93,7 +93,7 @@ def test_bad_toml_and_missing_file(tmp_path):
     path.write_text("model = \n")
     with pytest.raises(ParameterError, match=r"broken.toml: key '<file>'.*not valid TOML"):
         load_parameter_file(path)
-    with pytest.raises(ParameterError, match="file not found"):
+    with pytest.raises(UserFileError, match=r"parameter file not found: .*absent\.toml; check the path"):
         load_parameter_file(tmp_path / "absent.toml")
 
 

@@ -152,7 +152,7 @@ def _run_file(tmp_path, capsys, text, extra=()):
         ),
         (
             GOOD.replace('    urdf_joints = ("joint1", "joint2")', "    urdf_joints = ()"),
-            "declares no urdf_joints",
+            "set urdf_joints = (...) in class HangingDoublePendulum",
         ),
         (
             GOOD.replace('    urdf_joints = ("joint1", "joint2")', '    urdf_joints = ("joint1", "elbow")'),
@@ -199,7 +199,7 @@ def test_parameter_file_of_another_model_is_rejected(tmp_path, capsys):
 @pytest.mark.parametrize(
     ("argv", "message"),
     [
-        (["--analytic", "missing.py", "--urdf", "x.urdf"], "missing.py: model file not found"),
+        (["--analytic", "missing.py", "--urdf", "x.urdf"], "model file not found: missing.py (relative to "),
         ([*HANGING[:2], "--params", HANGING[5]], "give --urdf"),
         ([*HANGING, "--model", "double_pendulum"], "not both"),
     ],

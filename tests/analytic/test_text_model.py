@@ -151,10 +151,11 @@ def test_a_certified_text_model_keeps_its_text_as_model_toml_and_rechecks(tmp_pa
         "30",
     ]
     assert main(argv) == 0
-    copy = tmp_path / "double_pendulum.model.toml"
+    name = "minimal_double_pendulum-double_pendulum"  # the model's name, then the URDF's
+    copy = tmp_path / f"{name}.model.toml"
     assert copy.read_text() == (examples / "minimal_double_pendulum_text.toml").read_text()
-    assert not (tmp_path / "double_pendulum.model.py").exists()
-    assert main(["recheck", str(tmp_path / "double_pendulum.cert.json")]) == 0
+    assert not (tmp_path / f"{name}.model.py").exists()
+    assert main(["recheck", str(tmp_path / f"{name}.cert.json")]) == 0
 
 
 def test_a_text_models_module_does_not_claim_its_text_as_python_source():

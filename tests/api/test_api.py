@@ -415,7 +415,7 @@ BAD_INPUTS = {
     ),
     "missing URDF": (
         lambda tmp: pendverify.load_urdf("double_pendulum", tmp / "none.urdf"),
-        "file not found",
+        "robot description not found",
     ),
     "non-finite gravity": (
         lambda tmp: pendverify.load_urdf("double_pendulum", committed_urdf("double_pendulum"), float("nan")),

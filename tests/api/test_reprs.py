@@ -157,7 +157,7 @@ def test_unknown_names_are_key_errors_listing_the_valid_ones(report):
     with pytest.raises(KeyError) as caught:
         report["cart_double_pendulum", "crba"]
     message = str(caught.value)
-    assert "no row for model 'cart_double_pendulum'" in message and "erd:double_pendulum_simple" in message
+    assert "has no model 'cart_double_pendulum'" in message and "erd:double_pendulum_simple" in message
     with pytest.raises(KeyError, match="a check name or"):
         report["double_pendulum", "crba", "x"]
 

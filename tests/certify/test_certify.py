@@ -213,7 +213,7 @@ def _certify_single(tmp_path: Path, source: str = SINGLE_PENDULUM) -> tuple[int,
     files = ["--analytic", "single.py", "--urdf", "single.urdf", "--params", "single.toml"]
     out = tmp_path / "out"
     paths = [str(tmp_path / f) if not f.startswith("--") else f for f in files]
-    return main(["certify", *paths, "-o", str(out), *FAST]), out / "single.cert.json"
+    return main(["certify", *paths, "-o", str(out), *FAST]), out / "single_pendulum-single.cert.json"
 
 
 def test_a_model_written_in_the_test_is_certified(tmp_path, capsys):
@@ -360,9 +360,9 @@ def test_writer_failing_midway_leaves_no_certificate(tmp_path, monkeypatch, caps
 def test_example_robot_data_urdf_is_certified(tmp_path, capsys):
     args = ["certify", "--model", "double_pendulum", "--urdf", "erd:double_pendulum", "-o", str(tmp_path)]
     assert main([*args, *FAST]) == 0
-    cert = json.loads((tmp_path / "erd_double_pendulum.cert.json").read_text())
+    cert = json.loads((tmp_path / "double_pendulum-erd_double_pendulum.cert.json").read_text())
     assert any("off the joint-1→joint-2 line" in note for note in cert["notes"])
-    assert main(["recheck", str(tmp_path / "erd_double_pendulum.cert.json")]) == 0
+    assert main(["recheck", str(tmp_path / "double_pendulum-erd_double_pendulum.cert.json")]) == 0
 
 
 def certificates_by_file(directory: Path) -> dict[str, dict]:

@@ -369,6 +369,7 @@ COMMAND_IMPORTS = {
     "pendverify.commands.simulate",  # urdf_argument, shared with render
     "pendverify.atomic",
     "pendverify.errors",
+    "pendverify.file_kinds",  # which option a file given without one needs (check's stray files)
     "pendverify.jsonio",
     "pendverify.analytic",  # MODELS: --model's names
     "pendverify.simulation.limits",  # --samples' limit

@@ -16,7 +16,9 @@ from pathlib import Path
 
 import pytest
 
+from pendverify.certify.names import set_name
 from pendverify.cli import main
+from pendverify.robot.description import description_stem
 
 REPO = Path(__file__).resolve().parents[2]
 EXAMPLES = REPO / "examples"
@@ -60,7 +62,7 @@ class Model:
 
 def _certify(m: Model) -> list[list[str]]:
     out = m.tmp / "certificates"
-    name = m.urdf.stem  # the URDF's name names the bundle
+    name = set_name(m.stem, description_stem(m.urdf), "test")  # the model's name (its stem), the URDF's
     certify = ["certify", *m.files(), "-o", str(out), "--samples", "100"]
     trusted = ["--run-embedded-code"] if str(m.model).endswith(".py") else []  # a text model is data
     return [certify, ["recheck", str(out / f"{name}.cert.json"), *trusted]]

@@ -65,7 +65,7 @@ def test_show_needs_a_model_or_a_robot(capsys):
 def test_a_missing_robot_file_is_one_line(tmp_path, capsys):
     assert main(["show", "--robot", str(tmp_path / "nope.urdf")]) == 2
     err = capsys.readouterr().err
-    assert "nope.urdf" in err and "file not found" in err and "Traceback" not in err
+    assert "nope.urdf" in err and "robot description not found" in err and "Traceback" not in err
 
 
 def test_an_mjcfs_numbers_say_what_mujoco_made_of_them(capsys):

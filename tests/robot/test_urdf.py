@@ -11,7 +11,7 @@ import pytest
 from pendverify.analytic import DoublePendulum
 from pendverify.checks.catalogue import run_checks
 from pendverify.checks.sampling import sample_states
-from pendverify.errors import UrdfShapeError
+from pendverify.errors import UrdfShapeError, UserFileError
 from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.urdf import load_model
 from pendverify.robot.writer import urdf_for
@@ -78,7 +78,7 @@ def test_vertical_axis_is_a_clear_error():
 
 
 def test_unparsable_and_missing_urdf(tmp_path):
-    with pytest.raises(UrdfShapeError, match=r"nothing\.urdf: file not found"):
+    with pytest.raises(UserFileError, match=r"robot description not found: .*nothing\.urdf; check the path"):
         load_model(tmp_path / "nothing.urdf")
     bad = tmp_path / "bad.urdf"
     bad.write_text("<robot name='x'><link name='a'/><joint name='j' type='revolute'></robot>")

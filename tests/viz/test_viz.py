@@ -205,7 +205,7 @@ def test_render_errors_are_exit_2(tmp_path, capsys):
     assert main(["render", "--trajectory", str(bad), "-o", str(tmp_path / "x.html")]) == 2
     assert "bad.npz" in capsys.readouterr().err
     assert main(["render", "--trajectory", str(tmp_path / "none.npz"), "-o", str(tmp_path / "x.html")]) == 2
-    assert "trajectory file not found" in capsys.readouterr().err
+    assert "saved run (.npz) not found: " in capsys.readouterr().err
     assert main(["render", "-o", str(tmp_path / "x.html")]) == 2
     assert "give a scene file" in capsys.readouterr().err
     params = default_params("double_pendulum")

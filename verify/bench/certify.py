@@ -40,6 +40,7 @@ from pendverify.certify.issue import certification_input
 from pendverify.certify.simulations import invariant_items
 from pendverify.checks.batch import recording_batches
 from pendverify.checks.closed_forms import ClosedForms
+from pendverify.display import html_table, shortened
 from pendverify.robot.batch import configurations
 from pendverify.robot.system import PinocchioSystem
 
@@ -59,6 +60,17 @@ class SetCost:
 
     def as_dict(self) -> dict:
         return dict(self.__dict__)
+
+    def __repr__(self) -> str:
+        parts = ", ".join(f"{k} {v:.3f}" for k, v in self.parts.items())
+        return f"<SetCost {shortened(self.name, 60)}: battery {self.battery:.3f} s ({shortened(parts, 150)})>"
+
+    def _repr_html_(self) -> str:
+        from pendverify.bench.certify_report import rows
+
+        cells = [(r["part"], f"{r['seconds']:.3f}", "—" if r["floor_s"] is None else f"{r['floor_s']:.3f}")
+                 for r in rows(self)]  # fmt: skip
+        return html_table(("part", "seconds", "floor s"), cells, f"the battery's cost on {self.name}")
 
 
 def cpu_once(fn) -> float:

@@ -1,7 +1,11 @@
 """The table and JSON of ``pendverify bench certify`` (``pendverify.bench.certify`` measures).
 
 Targets, on the project's 2-core machine: the battery ≤ 0.1 s per set per core with
-default settings, and within 2.5× of its floor.
+default settings, and within 2.5× of its floor.  They are judged only on a battery of the
+default settings (``BatterySettings()``): ``--quick``'s 100 states and 0.5 s runs are
+another battery, so its target lines give the figures and say that they are not the
+target's measurement.  Met or not, the command's exit status is 0: a benchmark records
+figures, it does not judge a verification.
 """
 
 from __future__ import annotations
@@ -62,15 +66,34 @@ def table(costs, settings, repeats: int, blas: str) -> str:
         "  states; the battery's floor counts the invariants' simulations at their own cost.",
     ]
     for cost in costs:
-        battery = next(r for r in rows(cost) if r["part"] == "battery")
-        met = battery["seconds"] <= BATTERY_TARGET
-        near = battery["over_floor"] is not None and battery["over_floor"] <= FLOOR_TARGET
-        lines.append(
-            f"target {cost.name}: battery {battery['seconds']:.3f} s ≤ {BATTERY_TARGET} s per set per core: "
-            f"{'met' if met else 'NOT met'}; within {FLOOR_TARGET:g}× of the floor "
-            f"({_cell(battery['over_floor'], '.1f')}×): {'met' if near else 'NOT met'}"
-        )
+        lines.append(target_line(cost, settings))
     return "\n".join(lines)
+
+
+def target_line(cost, settings) -> str:
+    """One set's targets: met or NOT met for a battery of the default settings; for another
+    (``--quick``), its figures and why they are not the target's measurement."""
+    from pendverify.certify.battery import BatterySettings
+
+    battery = next(r for r in rows(cost) if r["part"] == "battery")
+    over = _cell(battery["over_floor"], ".1f")
+    default = BatterySettings()
+    if settings != default:
+        return (
+            f"target {cost.name}: not judged: battery {battery['seconds']:.3f} s, {over}× its floor, with "
+            f"{settings.samples} states and {settings.sim_duration:g} s runs; the targets "
+            f"(≤ {BATTERY_TARGET} s per set per core, ≤ {FLOOR_TARGET:g}× the floor) are for the default "
+            f"battery ({default.samples} states, {default.sim_duration:g} s runs): "
+            "run without --quick to judge them"
+        )
+    met = battery["seconds"] <= BATTERY_TARGET
+    near = battery["over_floor"] is not None and battery["over_floor"] <= FLOOR_TARGET
+    missed = "" if met and near else " (recorded, not a failure: a benchmark's exit status is 0)"
+    return (
+        f"target {cost.name}: battery {battery['seconds']:.3f} s ≤ {BATTERY_TARGET} s per set per core: "
+        f"{'met' if met else 'NOT met'}; within {FLOOR_TARGET:g}× of the floor "
+        f"({over}×): {'met' if near else 'NOT met'}{missed}"
+    )
 
 
 def to_json(costs, settings, repeats: int, machine: dict) -> dict:

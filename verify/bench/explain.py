@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from pendverify.diagnosis.corpus import CORPUS_SEED, ModelScores, plants, sample_plants, score_model
+from pendverify.display import REPR_LIMIT, html_table, shortened
 
 QUICK_PER_OPERATOR = 2
 #: the diagnosis's bound on a model of up to 3 degrees of freedom on this project's 2-core machine
@@ -27,6 +28,18 @@ class ExplainBench:
     models: list[ModelScores]
     dof: dict[str, int]
     quick: bool
+
+    def __repr__(self) -> str:
+        totals = ", ".join(f"{k} {v}" for k, v in self.totals().items())
+        head = f"<ExplainBench {'quick' if self.quick else 'full'}: {len(self.models)} model(s), "
+        return f"{head}{shortened(totals, REPR_LIMIT - len(head) - 1)}>"
+
+    def _repr_html_(self) -> str:
+        whats = ("detected", "named", "repaired", "restored")
+        cells = [(m.label, len(m.scores), *(m.count(w) for w in whats)) for m in self.models]
+        return html_table(
+            ("model", "planted", *whats), cells, f"bench explain ({'quick' if self.quick else 'full'})"
+        )
 
     def totals(self) -> dict[str, int]:
         return {

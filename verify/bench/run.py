@@ -33,6 +33,7 @@ from pendverify.bench.workprecision import (
     order_fits,
     scipy_sweep,
 )
+from pendverify.display import html_fields
 from pendverify.numerics import fastpath, fixedstep_runner
 from pendverify.numerics.reference import references
 
@@ -53,6 +54,23 @@ class Results:
     compile_seconds: float = 0.0
     reference_seconds: float = 0.0
     elapsed: float = 0.0
+
+    def __repr__(self) -> str:
+        return (
+            f"<Results {len(self.problems)} problem(s), {len(self.points)} points, {len(self.orders)} order "
+            f"fits, {len(self.engines)} engine rows; smallest error {self.smallest_error():.2e}; "
+            f"{self.elapsed:.1f} s>"
+        )
+
+    def _repr_html_(self) -> str:
+        fields = [
+            ("problems", ", ".join(getattr(p, "key", str(p)) for p in self.problems)),
+            ("points", len(self.points)),
+            ("smallest error", f"{self.smallest_error():.2e}"),
+            ("compile, references, total [s]", f"{self.compile_seconds:.1f}, {self.reference_seconds:.1f}, "
+             f"{self.elapsed:.1f}"),
+        ]  # fmt: skip
+        return html_fields("bench accuracy", fields)
 
     def smallest_error(self) -> float:
         state = [p for p in self.points if p.ok and p.metric == "state"]

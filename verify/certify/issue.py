@@ -12,7 +12,8 @@ re-runs its battery, each invariant item on the engine it records.
 
 Every name that becomes a file name is checked where it is read
 (``pendverify.certify.names``): a parameter file's ``name``, a URDF's stem, a sweep's
-set names.
+set names.  A set certified on a URDF is named after its model, then the URDF
+(``names.set_name``).
 """
 
 from __future__ import annotations
@@ -24,17 +25,17 @@ from pendverify.analytic import ParameterSet
 from pendverify.analytic.params import load_parameter_file
 from pendverify.analytic.plugin import plugin_parameters
 from pendverify.certify.battery import BatteryRun, BatterySettings, run_battery
-from pendverify.certify.battery_item import BatteryItem
+from pendverify.certify.battery_item import BatteryItem, items_html
 from pendverify.certify.bundle import check_files_beside, refuse_existing, verify_signature, write_bundle
 from pendverify.certify.certificate import build_certificate, compare_items, derived_constants, verify_digest
 from pendverify.certify.model_source import ModelSource
-from pendverify.certify.names import check_name
+from pendverify.certify.names import check_name, set_name
 from pendverify.certify.reading import read_certificate
 from pendverify.certify.schema import check_derived, check_schema
 from pendverify.certify.signing import fingerprint
 from pendverify.certify.simulations import recorded_engines
 from pendverify.certify.sweep_task import SetResult
-from pendverify.display import listed, shortened
+from pendverify.display import REPR_LIMIT, html_lines, listed, shortened
 from pendverify.errors import CertificateError, ParameterError, PendverifyError
 from pendverify.robot.description import LoadedDescription, load_description
 from pendverify.robot.erd import resolve_urdf
@@ -75,7 +76,9 @@ def certification_input(
                 raise ParameterError(
                     urdf_params, "model", model_name, f"must be {model!r}, the model named with it"
                 )
-            return CertificationInput(name, ModelSource.of_builtin(model_name), params, text)
+            return CertificationInput(
+                set_name(model_name, name, str(urdf_params)), ModelSource.of_builtin(model_name), params, text
+            )
         if not model:
             raise PendverifyError(f"with a URDF, name the model or give the parameter set ({PARAMS_HINT})")
         params = PinocchioSystem.from_urdf(model, text, source=str(path)).geometry.params
@@ -84,6 +87,7 @@ def certification_input(
                 f"{path}: give the parameter set ({PARAMS_HINT}): "
                 f"a {model} URDF alone does not fix the closed form"
             )
+        name = set_name(model, name, str(path))
         return CertificationInput(name, ModelSource.of_builtin(model), params, text)
     if params_file:
         model_name, name, params = load_parameter_file(params_file)
@@ -114,8 +118,8 @@ def _plugin_input(model_file: str, urdf: str | None, params_file: str | None) ->
             None,
             "certify needs a gravity parameter g: its runs set gravity by it",
         )
-    _, name, text = _urdf_input(urdf)
-    return CertificationInput(name, source, params, text)
+    path, name, text = _urdf_input(urdf)
+    return CertificationInput(set_name(cls.name, name, path), source, params, text)
 
 
 def _urdf_input(urdf: str | LoadedDescription) -> tuple[str, str, str]:
@@ -162,6 +166,10 @@ class Issued:
             return f"<Issued certified: {len(self.items)} items pass; {shortened(str(self.path), 200)}>"
         return f"<Issued not certified: {len(failed)} of {len(self.items)} items fail: {listed(failed, 200)}>"
 
+    def _repr_html_(self) -> str:
+        where = f": {self.path}" if self.certified else ": some items fail, no certificate written"
+        return items_html(self.items, f"{'certified' if self.certified else 'not certified'}{where}")
+
 
 def issue(
     target: CertificationInput, settings: BatterySettings, output, force: bool = False, key=None
@@ -200,7 +208,7 @@ def write_certificate(
     Only what is each run's own differs: ``date`` (the time of certification), ``digest``
     (which covers it) and, when signed, ``signature``'s key.  (A sweep names its sets
     itself, by the model's name and the set's index; a set certified alone is named by its
-    parameter file or URDF.)"""
+    parameter file, or by its model and URDF.)"""
     check_name(name, "<certify>", "name")
     keyid = fingerprint(key.public_key()) if key is not None else None
     cert = build_certificate(name, model, params, urdf, settings, battery, keyid=keyid)
@@ -233,6 +241,19 @@ class Rechecked:
     @property
     def passed(self) -> bool:
         return not self.differences and all(i.passed for i in self.items)
+
+    def __repr__(self) -> str:
+        name = shortened(str(self.certificate.get("name", "?")), 60)
+        failed = [i.name for i in self.items if not i.passed]
+        head = f"<Rechecked {name}: {'passed' if self.passed else 'FAILED'}, {len(self.items)} items"
+        tail = f", {len(failed)} fail ({listed(failed, 80)})" if failed else ""
+        tail += f", {len(self.differences)} difference(s) from the certificate" if self.differences else ""
+        return f"{head}{tail}; {shortened(self.signature, REPR_LIMIT - len(head) - len(tail) - 3)}>"
+
+    def _repr_html_(self) -> str:
+        name = self.certificate.get("name", "?")
+        caption = f"recheck of {name}: {'passed' if self.passed else 'FAILED'}; {self.signature}"
+        return items_html(self.items, caption) + html_lines(self.differences)
 
 
 RUN_EMBEDDED_CODE = "--run-embedded-code"

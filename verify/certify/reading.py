@@ -17,7 +17,7 @@ import stat
 from itertools import accumulate
 from pathlib import Path
 
-from pendverify.errors import CertificateError
+from pendverify.errors import CertificateError, missing_file
 
 MAX_CERTIFICATE_BYTES = 16 * 1024 * 1024  # a certificate embeds its URDF and model text: far below this
 MAX_DEPTH = 32
@@ -28,7 +28,7 @@ def read_limited(path: str | Path, limit: int, what: str, error=CertificateError
     try:
         fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
     except FileNotFoundError:
-        raise error(f"{path}: file not found") from None
+        raise missing_file(path, what, "`pendverify certify ... -o DIR` writes a bundle into DIR") from None
     except IsADirectoryError:
         raise error(f"{path}: is a directory; give the {what} file") from None
     except OSError as exc:

@@ -46,6 +46,7 @@ from pendverify.certify.model_source import ModelSource
 from pendverify.certify.settings_rules import settings_problem
 from pendverify.certify.sweep_limits import DEFAULT_MAX_SETS
 from pendverify.errors import PendverifyError, SweepError
+from pendverify.file_kinds import expect_kind
 from pendverify.robot.description import urdf_text
 from pendverify.robot.rebind import Binding
 
@@ -108,7 +109,8 @@ def load_sweep(path: str | Path, max_sets: int = DEFAULT_MAX_SETS) -> Sweep:
     """A sweep file's sets; more than ``max_sets`` of them is refused before any is made."""
     path = Path(path)
     source = str(path)
-    data = read_toml(path)
+    data = read_toml(path, "sweep file")
+    expect_kind(data, path, "sweep")
     allowed = ("model", "base", "urdf", "mode", "count", "seed", "samples", "duration", "ranges")
     for key, value in data.items():
         if key not in allowed:

@@ -4,8 +4,9 @@
 returns, is the same report printing as the CLI's table (``format_table``).  A report reads
 like a mapping from check name to that check's rows: ``report["crba"]`` is a ``CheckRows``
 (one ``CheckResult`` per model), ``report["crba"]["double_pendulum"]`` or
-``report["double_pendulum", "crba"]`` one result.  In a notebook a report shows as an HTML
-table with the CLI table's rows (``_repr_html_``).
+``report["double_pendulum", "crba"]`` one result; a model is named by its label
+(``cart_pole:cart_pole``) or, when that names one, by the model's name or the URDF's alone.
+In a notebook a report shows as an HTML table with the CLI table's rows (``_repr_html_``).
 """
 
 from __future__ import annotations
@@ -29,6 +30,20 @@ def _ratio(result: CheckResult) -> float:
     """error/tolerance of a row (NaN, a refused row, sorts below every number)."""
     ratio = result.max_error / result.tolerance if result.tolerance else float("inf")
     return ratio if ratio == ratio else -1.0
+
+
+def model_label(labels: tuple[str, ...], key: str, where: str) -> str:
+    """The one label of ``labels`` that ``key`` names: the label itself, or either part of a
+    ``model:name`` label alone (the model's name, or the URDF's or parameter set's name).  A key that
+    names none, or several, is a KeyError that lists the labels (``where``: what holds them)."""
+    if key in labels:
+        return key
+    named = [label for label in labels if key in label.split(":", 1)]
+    if len(named) == 1:
+        return named[0]
+    if named:
+        raise KeyError(f"{key!r} names {len(named)} models of {where}: {', '.join(named)}; give one label")
+    raise KeyError(f"{where} has no model {key!r}; its models: {', '.join(labels) or 'none'}")
 
 
 @dataclass(frozen=True)
@@ -81,12 +96,12 @@ class CheckRows:
         return iter(self.results)
 
     def __getitem__(self, key: str | int) -> CheckResult:
+        """``rows[0]``; ``rows["cart_pole:cart_pole"]`` (a label), or the model's name or the URDF's
+        (parameter set's) name alone when it names one row: ``rows["cart_pole"]``."""
         if isinstance(key, int):
             return self.results[key]
-        for r in self.results:
-            if r.model == key:
-                return r
-        raise KeyError(f"check {self.check!r} has no row for model {key!r}; models: {', '.join(self.models)}")
+        label = model_label(self.models, key, f"check {self.check!r}")
+        return next(r for r in self.results if r.model == label)
 
     def __repr__(self) -> str:
         top = self.worst
@@ -163,7 +178,14 @@ class Report:
             return self[check][model]
         rows = tuple(r for r in self.results if r.check == key)
         if not rows:
-            raise KeyError(f"no check {key!r} in this report; its checks: {', '.join(self.checks) or 'none'}")
+            model = (
+                ""
+                if not any(key in label.split(":", 1) for label in self.models)
+                else (f"; {key!r} is a model: report[CHECK][{key!r}] or report[{key!r}, CHECK] is its result")
+            )
+            raise KeyError(
+                f"no check {key!r} in this report; its checks: {', '.join(self.checks) or 'none'}{model}"
+            )
         return CheckRows(key, rows)
 
     def __contains__(self, key: object) -> bool:

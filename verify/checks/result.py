@@ -68,3 +68,17 @@ class CheckResult:
             f"<CheckResult {self.model[:80]} {self.check}: {self.status}, error {self.max_error:.2e} "
             f"vs tolerance {self.tolerance:.2e} at {where}>"
         )
+
+    def _repr_html_(self) -> str:
+        """The result's row of the check table, its description and notes (a notebook's view)."""
+        from pendverify.display import html_fields
+
+        fields = [
+            ("status", self.status),
+            ("error", f"{self.max_error:.3e}"),
+            ("tolerance", f"{self.tolerance:.3e}"),
+            ("worst state", self.worst_state.get("label", "")),
+            ("states", f"{self.samples} (seed {self.seed})"),
+            *(("note", note) for note in self.notes),
+        ]
+        return html_fields(f"{self.model} {self.check}: {self.description}", fields)

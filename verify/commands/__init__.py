@@ -35,8 +35,10 @@ GLOBAL_HELP = {
 class HelpFormatter(argparse.RawDescriptionHelpFormatter):
     """The help of a pendverify command: the examples kept line by line, every option's default shown.
 
-    An option whose help already says its default is left as written; a flag shows "off", an
-    option without a value "none", any other the value argparse would give it.
+    An option whose help already says its default is left as written; a flag shows whether it is
+    given by default ("off" for ``--no-erd`` as for ``--strict``: the default is not to give it,
+    never the value its ``store_false`` stores), an option without a value "none", any other the
+    value argparse would give it.
     """
 
     def _get_help_string(self, action: argparse.Action) -> str:
@@ -46,7 +48,7 @@ class HelpFormatter(argparse.RawDescriptionHelpFormatter):
         if "default" in text or positional_required or nothing_to_default:
             return text  # said already; a required positional; -h, --version
         if action.nargs == 0 and isinstance(action.const, bool):
-            return f"{text} (default: {'on' if action.default else 'off'})"
+            return f"{text} (default: {'on' if action.default == action.const else 'off'})"
         if action.default is None or action.default is argparse.SUPPRESS:
             return f"{text} (default: none)"
         return f"{text} (default: %(default)s)"

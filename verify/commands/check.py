@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import shlex
 import time
 
 from pendverify.commands import (
@@ -37,12 +38,13 @@ def register(sub) -> None:
     p.add_argument(
         "--analytic",
         metavar="FILE",
-        help="your own closed-form model: a Python file defining one ClosedFormModel subclass "
-        "(`pendverify example cart_pole DIR` copies one); needs --urdf",
+        help="your own model: a Python file (a ClosedFormModel subclass, a SymPy mechanics derivation, "
+        "or the dynamics as code) or a text model (.toml: SymPy text or LaTeX, M, C, H, ... or whole "
+        "equations) (`pendverify example cart_pole DIR` copies one); needs --urdf",
     )
     p.add_argument(
         "--urdf",
-        help="a URDF, xacro or MJCF file to check (with --model, --analytic or --params), "
+        help="a URDF, xacro, MJCF or SDFormat file to check (with --model, --analytic or --params), "
         "or erd:NAME for example-robot-data's",
     )
     p.add_argument("--params", help="a parameter file (TOML) giving the closed form")
@@ -54,7 +56,7 @@ def register(sub) -> None:
         "--no-erd",
         dest="erd",
         action="store_false",
-        help="skip example-robot-data's URDFs (default: checked when installed)",
+        help="skip example-robot-data's URDFs (default: off: they are checked when installed)",
     )
     p.add_argument(
         "--strict",
@@ -65,7 +67,8 @@ def register(sub) -> None:
         "--no-explain",
         dest="explain",
         action="store_false",
-        help="do not diagnose a failing model (which entries differ, how, and a confirmed repair)",
+        help="do not diagnose a failing model (which entries differ, how, and a confirmed repair) "
+        "(default: off: a failing model is diagnosed)",
     )
     p.add_argument(
         "--model-form-rtol",
@@ -76,7 +79,31 @@ def register(sub) -> None:
         "mass off the reference system's joint line (default: 1e-4)",
     )
     add_package_path_option(p)
+    # files given without their option: taken only to say which option each one needs (``stray_files``)
+    p.add_argument("files", nargs="*", help=argparse.SUPPRESS)
     p.set_defaults(func=run)
+
+
+def stray_files(files: list[str]) -> str:
+    """What to type instead of ``pendverify check FILE ...``: each file behind the option its kind
+    takes (``pendverify.file_kinds``), as a message for the usage error."""
+    from pendverify.file_kinds import KINDS, file_kind
+
+    options, unknown = [], []
+    for name in files:
+        kind = file_kind(name)
+        flag = KINDS[kind].flag if kind in ("model", "description", "params") else ""
+        if flag:
+            options.append(f"{flag} {shlex.quote(name)}")
+        else:
+            unknown.append(name)
+    head = f"check takes its files by option, not as {', '.join(files)}"
+    if unknown:
+        return (
+            f"{head}: give each with the option for its kind: --analytic (a model file: .py or a text "
+            "model), --urdf (a robot description), --params (a parameter file)"
+        )
+    return f"{head}: did you mean `pendverify check {' '.join(options)}`?"
 
 
 def run(args: argparse.Namespace) -> int:
@@ -86,6 +113,10 @@ def run(args: argparse.Namespace) -> int:
     from pendverify.atomic import check_output, check_report_output, write_atomic
     from pendverify.checks.junit import to_junit
 
+    if args.files:
+        from pendverify.errors import OptionConflictError
+
+        raise OptionConflictError(stray_files(args.files))
     check_report_output(args.json)
     check_output(args.junit)
     builtin_models(args.model, args.analytic)  # refuses --model with --analytic, and unknown names

@@ -42,7 +42,7 @@ def register(sub) -> None:
         "--no-erd",
         dest="erd",
         action="store_false",
-        help="skip example-robot-data's URDFs (default: checked when installed)",
+        help="skip example-robot-data's URDFs (default: off: they are checked when installed)",
     )
     p.add_argument("--trace", action="store_true", help="draw the tip's path in the animations")
     p.add_argument("--force", action="store_true", help="replace an existing output folder")

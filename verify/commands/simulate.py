@@ -121,11 +121,11 @@ def _json(run) -> str:
 
 
 def urdf_argument(path: str | None) -> str | None:
-    """``--urdf``: an existing file, or an InputError naming it."""
+    """``--urdf``: an existing file, or a UserFileError naming it."""
     from pathlib import Path
 
-    from pendverify.errors import InputError
+    from pendverify.errors import missing_file
 
     if path is not None and not Path(path).is_file():
-        raise InputError("<command line>", "--urdf", path, "URDF file not found")
+        raise missing_file(path, "robot description (--urdf)")
     return path

@@ -53,6 +53,7 @@ import pinocchio as pin
 from pendverify.analytic.interface import BiasOnlyModel
 from pendverify.checks.scaling import mv, total
 from pendverify.checks.trust import EPS
+from pendverify.display import REPR_LIMIT, html_table, listed, shortened
 
 K = 16  # the largest constant of the checks whose quantities the rows are (crba 8, rnea 16, gravity 16)
 PARAMETERS = ("m", "m·c_x", "m·c_y", "m·c_z", "I_xx", "I_xy", "I_yy", "I_xz", "I_yz", "I_zz")
@@ -173,6 +174,14 @@ class Combination:
     def differs(self) -> bool:
         return abs(self.model_value - self.urdf_value) > self.rounding
 
+    def __repr__(self) -> str:
+        values = f"model {self.model_value:.6g}, URDF {self.urdf_value:.6g} [{self.unit}]"
+        return f"<Combination {shortened(self.name, REPR_LIMIT - len(values) - 20)}: {values}>"
+
+    def _repr_html_(self) -> str:
+        row = (f"{self.model_value:.6g}", f"{self.urdf_value:.6g}", self.unit, f"{self.rounding:.2g}")
+        return html_table(("model", "URDF", "unit", "rounding"), [row], self.name, [self.differs])
+
 
 @dataclass
 class ImpliedParameters:
@@ -196,6 +205,37 @@ class ImpliedParameters:
     combinations: list[Combination]
     rank_tolerance: float
     norms: np.ndarray  # each parameter's column norm in the weighted rows
+
+    def __repr__(self) -> str:
+        differ = [c.name for c in self.combinations if c.differs]
+        head = (
+            f"<ImpliedParameters {'exact' if self.exact else 'not exact'}, the URDF's own "
+            f"{'agree' if self.agrees else 'differ'}: {len(self.combinations)} combinations, "
+            f"{len(differ)} differ"
+        )
+        if differ:
+            head += f" ({listed(differ, 120)})"
+        if not self.exact:
+            head += f"; unexplained: {listed(self.unexplained, 60)}"
+        return f"{head}>"
+
+    def _repr_html_(self) -> str:
+        """The identifiable combinations, model against URDF, those that differ in red."""
+        verdict = (
+            "some inertial parameters reproduce the hand model"
+            if self.exact
+            else (
+                f"no inertial parameters reproduce the hand model: unexplained {', '.join(self.unexplained)}"
+            )
+        )
+        caption = f"{verdict}; the URDF's own {'agree' if self.agrees else 'differ'}"
+        rows = [
+            (c.name, c.unit, f"{c.model_value:.6g}", f"{c.urdf_value:.6g}", f"{c.rounding:.2g}",
+             "differs" if c.differs else "agrees")
+            for c in self.combinations
+        ]  # fmt: skip
+        header = ("combination", "unit", "model", "URDF", "rounding", "")
+        return html_table(header, rows, caption, [c.differs for c in self.combinations])
 
     @property
     def tolerance(self) -> float:

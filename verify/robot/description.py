@@ -34,7 +34,7 @@ import numpy as np
 import pinocchio as pin
 
 from pendverify.display import shortened
-from pendverify.errors import UrdfShapeError
+from pendverify.errors import UrdfShapeError, folder_given, missing_file, unreadable_file
 from pendverify.robot.strict import DescriptionFacts
 from pendverify.robot.urdfdom import build_pinocchio_model
 from pendverify.robot.xacro_expand import XACRO_SUFFIXES, expand_xacro, uses_xacro
@@ -123,8 +123,10 @@ def load_description(description: str | Path, source: str | None = None) -> Load
     if not is_description_text(description):
         path = Path(description)
         source = source or str(path)
+        if path.is_dir():
+            raise folder_given(source, "robot description")
         if not path.is_file():
-            raise UrdfShapeError(source, "is a directory, not a file" if path.is_dir() else "file not found")
+            raise missing_file(source, "robot description")
         text = read_text_file(path, source)
     else:
         text, source = str(description), source or TEXT_SOURCE
@@ -208,8 +210,10 @@ def read_text_file(path: Path, source: str) -> str:
             raise UrdfShapeError(source, f"larger than the limit of {limit} bytes for a description")
         return data.decode("utf-8-sig")
     except IsADirectoryError:
-        raise UrdfShapeError(source, "is a directory, not a file") from None
+        raise folder_given(source, "robot description") from None
     except UnicodeDecodeError as exc:
         raise UrdfShapeError(source, f"not UTF-8 text (byte {exc.start}: {exc.reason})") from None
+    except FileNotFoundError:
+        raise missing_file(source, "robot description") from None
     except OSError as exc:
-        raise UrdfShapeError(source, f"cannot be read: {exc.strerror}") from None
+        raise unreadable_file(source, "robot description", exc.strerror or str(exc)) from None

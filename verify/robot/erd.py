@@ -14,7 +14,7 @@ from __future__ import annotations
 import importlib.metadata
 from pathlib import Path
 
-from pendverify.errors import PendverifyError, PlaceError, UrdfShapeError
+from pendverify.errors import PendverifyError, PlaceError, UrdfShapeError, folder_given, missing_file
 from pendverify.robot.description import description_stem
 
 DISTRIBUTION = "example-robot-data"
@@ -76,6 +76,8 @@ def resolve_urdf(spec: str) -> tuple[Path, str]:
         stem, path = erd_urdf(spec)
         return path, f"erd_{stem}"
     path = Path(spec)
+    if path.is_dir():
+        raise folder_given(spec, "robot description")
     if not path.is_file():
-        raise UrdfShapeError(spec, "file not found")
+        raise missing_file(spec, "robot description")
     return path, description_stem(path)

@@ -42,8 +42,8 @@ def declared_geometry(cls, pin_model: pin.Model, source: str) -> UrdfGeometry:
     declared = tuple(cls.urdf_joints)
     if not declared:
         raise PendverifyError(
-            f"{where(cls)}: {cls.__name__} declares no urdf_joints: a plug-in names the URDF joint of each "
-            "coordinate (and gives joint_transform T and joint_offset θ0 of q = T (θ − θ0))"
+            f"{where(cls)}: model {cls.name} does not say which URDF joint each coordinate is: "
+            f"{cls.how_to_name_joints()}"
         )
     if len(declared) != n or len(set(declared)) != n:
         raise PendverifyError(

@@ -52,6 +52,7 @@ from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
 from pendverify.analytic.params import default_parameter_file, load_parameter_file, read_toml
 from pendverify.analytic.plugin import check_model_outputs, load_model_class, plugin_parameters
 from pendverify.errors import InputError, PendverifyError, SceneError
+from pendverify.file_kinds import expect_kind
 from pendverify.simulation.effects import parse_actuation, parse_disturbance
 from pendverify.simulation.laws import Law
 from pendverify.simulation.limits import DEFAULT_MAX_STEPS, check_scene_work
@@ -315,11 +316,9 @@ def parse_scene(data: dict, source: str, base: Path | None = None) -> Scene:
 
 def load_scene(path: str | Path) -> Scene:
     path = Path(path)
-    if not path.is_file():
-        what = "is a directory, not a scene file" if path.is_dir() else "scene file not found"
-        raise SceneError(str(path), "<file>", str(path), what)
     try:
-        data = read_toml(path)
+        data = read_toml(path, "scene file")
     except InputError as exc:
         raise SceneError(exc.source, exc.key, exc.value, exc.rule) from None
+    expect_kind(data, path, "scene")
     return parse_scene(data, str(path), path)

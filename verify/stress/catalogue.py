@@ -55,6 +55,7 @@ import math
 import time
 from dataclasses import dataclass, field
 
+from pendverify.display import html_table, listed
 from pendverify.stress.cases import (
     _aligned_states,
     det_case,
@@ -187,6 +188,27 @@ class StressReport:
     @property
     def passed(self) -> bool:
         return all(r.passed for r in self.results)
+
+    def __repr__(self) -> str:
+        failed = [r.case for r in self.results if not r.passed]
+        head = (
+            f"<StressReport {'pass' if self.passed else 'FAIL'}: {len(self.results)} cases, seed {self.seed}"
+        )
+        return f"{head}{f'; failing: {listed(failed, 150)}' if failed else ''}>"
+
+    def _repr_html_(self) -> str:
+        """One row per case: its quantity, error, tolerance and verdict."""
+        rows = [
+            (r.case, r.quantity, _figure(r.error), _figure(r.tolerance), "pass" if r.passed else "FAIL")
+            for r in self.results
+        ]
+        caption = f"stress: {'pass' if self.passed else 'FAIL'}, seed {self.seed}"
+        header = ("case", "quantity", "error", "tolerance", "result")
+        return html_table(header, rows, caption, [not r.passed for r in self.results])
+
+
+def _figure(value: float | None) -> str:
+    return "—" if value is None else f"{value:.2e}"
 
 
 def run_case(case: Case, ctx: Context) -> StressResult:

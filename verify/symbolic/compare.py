@@ -42,6 +42,7 @@ from pendverify.analytic.forms import entry_position
 from pendverify.analytic.source_file import where
 from pendverify.analytic.symbolic_reading import SymbolicModel, entries, to_sympy
 from pendverify.checks.verdict import CHRISTOFFEL_CONSISTENT, NON_CHRISTOFFEL
+from pendverify.display import html_text, listed, shortened
 from pendverify.errors import PendverifyError
 from pendverify.symbolic.lagrange import Lagrangian, derive, mass_matrix_rate
 from pendverify.symbolic.work import check_symbolic_work
@@ -76,6 +77,15 @@ class SymbolicReport:
     @property
     def passed(self) -> bool:
         return all(c.status != DIFFERS for c in self.comparisons)
+
+    def __repr__(self) -> str:
+        differ = [c.quantity for c in self.comparisons if c.status == DIFFERS]
+        head = f"<SymbolicReport {shortened(self.model, 60)}: {'pass' if self.passed else 'DIFFERS'}"
+        tail = f", {len(self.comparisons)} closed forms compared"
+        return f"{head}{tail}{f' ({listed(differ, 100)} differ)' if differ else ''}>"
+
+    def _repr_html_(self) -> str:
+        return html_text(format_report(self))
 
     def as_dict(self) -> dict:
         return {

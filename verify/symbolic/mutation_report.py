@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from pendverify.checks.catalogue import CHECK_NAMES
+from pendverify.display import html_text, shortened
 
 DETECTED, EQUIVALENT, SURVIVED = "detected", "equivalent", "survived"
 
@@ -54,6 +55,16 @@ class MutationReport:
     @property
     def passed(self) -> bool:
         return self.count(SURVIVED) == 0
+
+    def __repr__(self) -> str:
+        return (
+            f"<MutationReport {shortened(self.model, 60)}: {len(self.outcomes)} mutants, "
+            f"{self.count(DETECTED)} detected, {self.count(EQUIVALENT)} equivalent, "
+            f"{self.count(SURVIVED)} survived (rate {self.rate:.0%}); {self.states} states, seed {self.seed}>"
+        )
+
+    def _repr_html_(self) -> str:
+        return html_text(format_report(self))
 
     def as_dict(self) -> dict:
         return {
