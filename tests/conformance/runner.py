@@ -10,6 +10,7 @@ and returns (exit status, stdout + stderr), an exception escaping ``main`` being
 
 from __future__ import annotations
 
+import signal
 import traceback
 from pathlib import Path
 
@@ -74,7 +75,8 @@ def command_lines(command: str, files: Files, keys: Path) -> list[list[str]]:
         "show": lambda: [["show", str(files.model)]],
         "show --robot": lambda: [["show", "--robot", str(files.robot)]],
         "sympy": lambda: [["sympy", "--analytic", str(files.model)]],
-        "mutate": lambda: [["mutate", *files.analytic(), "--samples", "10", "--method", "mass_matrix"]],
+        # gravity's mutants: H has the fewest terms (M's of the 5-link chain run past CELL_LIMIT)
+        "mutate": lambda: [["mutate", *files.analytic(), "--samples", "10", "--method", "gravity"]],
         "simulate": lambda: [["simulate", str(files.scene())]],
         "render": lambda: [["render", str(files.scene()), "-o", str(tmp / "out.html")]],
         "report": lambda: [
@@ -89,17 +91,38 @@ def command_lines(command: str, files: Files, keys: Path) -> list[list[str]]:
     return table[command]()
 
 
+#: the longest a command line may run [s] before its cell counts as hung: the slowest passing
+#: cell measured was about a minute on a loaded 2-core machine (a first compilation of a model's
+#: generated code, ~20 s, plus the command), so 5 minutes is a hang or unbounded work, not load
+CELL_LIMIT = 300
+
+
+class CellTimeout(BaseException):
+    """Raised by the alarm in ``run``: a BaseException, so a command's ``except Exception`` keeps it."""
+
+
+def _alarm(signum, frame):
+    raise CellTimeout
+
+
 def run(argv: list[str], capsys) -> tuple[int | str, str]:
     """``main(argv)`` in-process, its output captured by pytest's ``capsys`` (the way
-    tests/commands do it): (exit status or "raised", what it printed)."""
+    tests/commands do it): (exit status, "raised" or "timeout", what it printed)."""
     capsys.readouterr()
+    previous = signal.signal(signal.SIGALRM, _alarm)
+    signal.alarm(CELL_LIMIT)
+    trace = ""
     try:
         status: int | str = main(argv)
-        trace = ""
     except SystemExit as exit_:  # argparse's usage errors
-        status, trace = (exit_.code if isinstance(exit_.code, int) else 2), ""
+        status = exit_.code if isinstance(exit_.code, int) else 2
+    except CellTimeout:
+        status, trace = "timeout", f"no exit within {CELL_LIMIT} s"
     except Exception:  # a traceback out of main: a failed cell, kept with its text
         status, trace = "raised", traceback.format_exc()
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)
     captured = capsys.readouterr()
     return status, captured.out + captured.err + trace
 

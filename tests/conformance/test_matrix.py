@@ -11,6 +11,8 @@ product's size and the sample's, and checks the sample covers every (system, com
 
 from __future__ import annotations
 
+import json
+import os
 import shlex
 
 import pytest
@@ -46,6 +48,17 @@ def signing_keys(tmp_path_factory):
     return folder / "keys"
 
 
+def _log(cell: Cell, argv: list[str], got, expected: int, printed: str) -> None:
+    """One JSON line per command line to ``PENDVERIFY_CONFORMANCE_LOG`` when it is set (for a
+    report of every failing cell grouped by its message)."""
+    path = os.environ.get("PENDVERIFY_CONFORMANCE_LOG")
+    if path:
+        lines = [line for line in printed.splitlines() if line.strip()]
+        record = {"cell": cell.id, "argv": argv, "exit": got, "expected": expected, "last": lines[-1:]}
+        with open(path, "a", encoding="utf-8") as f:
+            f.write(json.dumps(record) + "\n")
+
+
 def _tail(text: str, lines: int = 4) -> str:
     return "\n".join(text.strip().splitlines()[-lines:])
 
@@ -62,6 +75,7 @@ def test_cell(cell: Cell, tmp_path, signing_keys, capsys):
     for argv in command_lines(cell.command, files, signing_keys):
         got, printed = run(argv, capsys)
         where = f"{cell.id}: pendverify {shlex.join(argv)} (files in {tmp_path})"
+        _log(cell, argv, got, status, printed)
         assert got == status, f"{where}: exit {got}, expected {status} ({reason}):\n{_tail(printed)}"
         assert "Traceback" not in printed, f"{where}: printed a traceback:\n{_tail(printed, 12)}"
         if status == 2:
