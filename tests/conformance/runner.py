@@ -98,10 +98,15 @@ CELL_LIMIT = 300
 
 
 class CellTimeout(BaseException):
-    """Raised by the alarm in ``run``: a BaseException, so a command's ``except Exception`` keeps it."""
+    """Raised by the alarm in ``run``; a command may still catch it (a model's exception is bad
+    input to pendverify), so ``_fired`` records that the limit was reached whatever it returns."""
+
+
+_fired: list[bool] = []
 
 
 def _alarm(signum, frame):
+    _fired.append(True)
     raise CellTimeout
 
 
@@ -109,6 +114,7 @@ def run(argv: list[str], capsys) -> tuple[int | str, str]:
     """``main(argv)`` in-process, its output captured by pytest's ``capsys`` (the way
     tests/commands do it): (exit status, "raised" or "timeout", what it printed)."""
     capsys.readouterr()
+    _fired.clear()
     previous = signal.signal(signal.SIGALRM, _alarm)
     signal.alarm(CELL_LIMIT)
     trace = ""
@@ -123,6 +129,8 @@ def run(argv: list[str], capsys) -> tuple[int | str, str]:
     finally:
         signal.alarm(0)
         signal.signal(signal.SIGALRM, previous)
+    if _fired:
+        status, trace = "timeout", f"no exit within {CELL_LIMIT} s"
     captured = capsys.readouterr()
     return status, captured.out + captured.err + trace
 
