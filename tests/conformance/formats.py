@@ -7,6 +7,7 @@ description its numbers are checked against, its closed forms and an optional ``
 returns the text of the model file.  The formats follow docs/models.md and docs/text-latex.md:
 
 * ``class``: a ``ClosedFormModel`` subclass and its ``ParameterSet`` (``self.math.cos``);
+  ``class_object_arrays`` the same returning ``dtype=object`` arrays;
 * ``text``: SymPy strings in TOML (M, C, H, V, D, B);
 * ``latex``: ``notation = "latex"``, each matrix a ``bmatrix`` printed by ``sympy.latex``;
 * ``equations``: the equations of motion whole, one per coordinate (accelerations ``ddq<i>``);
@@ -197,14 +198,17 @@ def _class_method(name: str, args: str, body: list[str], unpack: list[str]) -> l
     ]
 
 
-def _array(rows) -> str:
+def _array(rows, dtype: str = "") -> str:
+    tail = f", dtype={dtype})" if dtype else ")"
     if rows and isinstance(rows[0], list):
-        return "np.array([" + ", ".join("[" + ", ".join(r) + "]" for r in rows) + "])"
-    return "np.array([" + ", ".join(rows) + "])"
+        return "np.array([" + ", ".join("[" + ", ".join(r) + "]" for r in rows) + "]" + tail
+    return "np.array([" + ", ".join(rows) + "]" + tail
 
 
-def write_class(model: Model) -> str:
-    """A ``ClosedFormModel`` subclass; every method unpacks q, q̇ and the parameters into locals."""
+def write_class(model: Model, dtype: str = "") -> str:
+    """A ``ClosedFormModel`` subclass; every method unpacks q, q̇ and the parameters into locals.
+    With ``dtype="object"`` every array is built as an object array (a style that keeps SymPy
+    entries as they are, numerically an array of Python floats)."""
     f, system = model.forms, model.system
     n = system.dof
     params = list(model.kinds)
@@ -248,15 +252,22 @@ def write_class(model: Model) -> str:
         f"    urdf_joints = {tuple(system.joint_names)!r}",
         "",
     ]
-    lines += _class_method("mass_matrix", ", q", [f"return {_array(_rows(f.M))}"], unpack_p + trig + unpack_q)
     lines += _class_method(
-        "coriolis_matrix", ", q, v", [f"return {_array(_rows(f.C))}"], unpack_p + trig + unpack_q + unpack_v
+        "mass_matrix", ", q", [f"return {_array(_rows(f.M), dtype)}"], unpack_p + trig + unpack_q
     )
-    lines += _class_method("gravity", ", q", [f"return {_array(_vector(f.H))}"], unpack_p + trig + unpack_q)
+    lines += _class_method(
+        "coriolis_matrix",
+        ", q, v",
+        [f"return {_array(_rows(f.C), dtype)}"],
+        unpack_p + trig + unpack_q + unpack_v,
+    )
+    lines += _class_method(
+        "gravity", ", q", [f"return {_array(_vector(f.H), dtype)}"], unpack_p + trig + unpack_q
+    )
     lines += _class_method("potential_energy", ", q", [f"return {f.V}"], unpack_p + trig + unpack_q)
     if system.damping:
-        lines += _class_method("damping_matrix", "", [f"return {_array(_rows(f.D))}"], unpack_p)
-    lines += _class_method("input_matrix", "", [f"return {_array(_rows(f.B))}"], [])
+        lines += _class_method("damping_matrix", "", [f"return {_array(_rows(f.D), dtype)}"], unpack_p)
+    lines += _class_method("input_matrix", "", [f"return {_array(_rows(f.B), dtype)}"], [])
     lines += _class_method(
         "energies",
         ", q, v, u, w",
@@ -433,6 +444,7 @@ class Format:
 
 FORMATS: dict[str, Format] = {
     "class": Format(write_class, ".py", symbolic=True),
+    "class_object_arrays": Format(lambda m: write_class(m, "object"), ".py", symbolic=True),
     "text": Format(write_text, ".toml", symbolic=True),
     "latex": Format(write_latex, ".toml", symbolic=True),
     "equations": Format(write_equations, ".toml", symbolic=True),
