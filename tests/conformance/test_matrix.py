@@ -71,7 +71,7 @@ def test_cell(cell: Cell, tmp_path, signing_keys, capsys):
     system = SYSTEMS[cell.system]
     plant = plant_for(cell.system) if cell.command == "check planted" else None
     files = Files(tmp_path, system, cell.format, cell.description, Model(system, cell.description, plant))
-    status, reason = expected_exit(cell.format, cell.command)
+    status, reason = expected_exit(cell.format, cell.command, cell.description)
     for argv in command_lines(cell.command, files, signing_keys):
         got, printed = run(argv, capsys)
         where = f"{cell.id}: pendverify {shlex.join(argv)} (files in {tmp_path})"
