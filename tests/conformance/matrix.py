@@ -1,0 +1,161 @@
+"""The conformance matrix: cells (system × model format × command × description), their expected
+outcomes, and the deterministic sample the default run takes.
+
+``EXPECTED`` is the one table of what each (format kind, command) must do, with the reason where
+a command does not apply: a format whose closed forms SymPy cannot read (dynamics as code, NumPy
+functions) is refused by ``show``, ``sympy`` and ``mutate`` in one line with exit 2
+(docs/models.md: "the diagnosis, show, sympy and mutate refuse or say so in one line"), and
+dynamics as code by every scene command (docs/models.md: "a scene (simulate) refuses a model
+without a closed-form M"); ``stress`` refuses an MJCF in one line (it rewrites a URDF's numbers;
+docs/commands/stress.md does not say so).  Every other cell must exit 0 on the true model; ``check planted``
+must exit 1 and name the planted entry in a ``diagnosis`` line (``Plant.names``; where the format
+gives C only as a force — whole equations, a mechanics derivation — the row of C·q̇,
+``Cqdot[i]``; dynamics as code and NumPy functions are judged numerically only and no entry is
+expected).  No cell may exit 3 or raise.
+
+The full product is ``PENDVERIFY_CONFORMANCE=full``; otherwise ``sample()`` takes, per command,
+as many cells as it takes for every system and every format to appear (pairing two seeded
+permutations cyclically), so that every (system, command) and (format, command) pair is run;
+``show --robot`` does not read a model and runs once per system and description.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import random
+
+from tests.conformance.formats import FORMATS, Plant
+from tests.conformance.systems import SEED, SYSTEMS, descriptions
+
+COMMANDS = (
+    "check",
+    "check planted",
+    "show",
+    "show --robot",
+    "sympy",
+    "mutate",
+    "simulate",
+    "render",
+    "report",
+    "certify+recheck",
+    "stress",
+    "bench accuracy",
+)
+#: commands that take no model file (a format is meaningless for them)
+MODEL_FREE = ("show --robot",)
+NUMERIC_ONLY = ("dynamics_f", "dynamics_qddot", "numpy_functions")
+DYNAMICS_CODE = ("dynamics_f", "dynamics_qddot")
+SCENE_COMMANDS = ("simulate", "render", "report", "bench accuracy")
+
+_NOT_SYMBOLIC = "SymPy does not read code: refused in one line (docs/models.md, 'Dynamics as code')"
+_NO_CLOSED_M = "a scene refuses a model without a closed-form M (docs/models.md, 'Dynamics as code')"
+
+_STRESS_URDF = (
+    "stress --analytic rewrites the robot file's numbers for its cases: an MJCF is refused in one line "
+    "('an MJCF description, but stress --analytic rewrites a URDF's numbers: give a URDF or xacro file')"
+)
+
+#: (format, command, description) → (exit status, reason), "*" for any format or description;
+#: a cell not listed must exit 0 (1 for "check planted")
+EXPECTED: dict[tuple[str, str, str], tuple[int, str]] = {
+    **{(f, c, "*"): (2, _NOT_SYMBOLIC) for f in NUMERIC_ONLY for c in ("show", "sympy", "mutate")},
+    **{(f, c, "*"): (2, _NO_CLOSED_M) for f in DYNAMICS_CODE for c in SCENE_COMMANDS},
+    ("*", "stress", "mjcf"): (2, _STRESS_URDF),
+}
+#: formats whose C reaches pendverify as the force C·q̇ only (split from a forcing)
+C_AS_FORCE = ("equations", "mechanics")
+
+
+def expected_exit(format_name: str, command: str, description: str) -> tuple[int, str]:
+    default = (1, "a planted error fails check") if command == "check planted" else (0, "the true model")
+    for key in (
+        (format_name, command, description),
+        (format_name, command, "*"),
+        ("*", command, description),
+    ):
+        if key in EXPECTED:
+            return EXPECTED[key]
+    return default
+
+
+def expected_names(format_name: str, plant: Plant) -> tuple[str, ...]:
+    """The entry names one of which a planted cell's diagnosis must print (empty: none expected)."""
+    if format_name in NUMERIC_ONLY:
+        return ()
+    if plant.matrix == "C" and format_name in C_AS_FORCE:
+        return (f"Cqdot[{plant.i + 1}]",)
+    return plant.names
+
+
+@dataclasses.dataclass(frozen=True)
+class Cell:
+    system: str
+    format: str  # "-" for a model-free command
+    command: str
+    description: str
+
+    @property
+    def id(self) -> str:
+        return f"{self.system}-{self.format}-{self.command.replace(' ', '_')}-{self.description}"
+
+
+def plant_for(system_name: str) -> Plant:
+    """The seeded planted error of a system: M, C or H, at a non-zero entry."""
+    from tests.conformance.closed_forms import closed_forms
+
+    forms = closed_forms(system_name)
+    rng = random.Random(f"{SEED}-{system_name}")
+    matrix = rng.choice("MCH")
+    shape = getattr(forms, matrix).shape
+    entries = [
+        (i, j)
+        for i in range(shape[0])
+        for j in range(shape[1])
+        if getattr(forms, matrix)[i, j] != 0 and (matrix != "M" or i <= j)
+    ]
+    if not entries:  # a system whose C is zero (one joint): plant in M
+        return Plant("M", 0, 0)
+    i, j = rng.choice(entries)
+    return Plant(matrix, i, j)
+
+
+def full_product() -> list[Cell]:
+    cells = []
+    for system in SYSTEMS.values():
+        for description in descriptions(system):
+            for command in COMMANDS:
+                formats = ("-",) if command in MODEL_FREE else tuple(FORMATS)
+                cells += [Cell(system.name, f, command, description) for f in formats]
+    return cells
+
+
+def sample() -> list[Cell]:
+    """The default run's cells (module docstring)."""
+    cells = []
+    systems, formats = list(SYSTEMS), list(FORMATS)
+    for index, command in enumerate(COMMANDS):
+        rng = random.Random(SEED + index)
+        if command in MODEL_FREE:
+            cells += [Cell(s, "-", command, d) for s in systems for d in descriptions(SYSTEMS[s])]
+            continue
+        s_perm, f_perm = rng.sample(systems, len(systems)), rng.sample(formats, len(formats))
+        for k in range(max(len(systems), len(formats))):
+            system = SYSTEMS[s_perm[k % len(systems)]]
+            cells.append(
+                Cell(system.name, f_perm[k % len(formats)], command, rng.choice(descriptions(system)))
+            )
+    return cells
+
+
+def selected() -> list[Cell]:
+    return full_product() if os.environ.get("PENDVERIFY_CONFORMANCE") == "full" else sample()
+
+
+def summary() -> str:
+    full, chosen = full_product(), selected()
+    return (
+        f"conformance: {len(SYSTEMS)} systems × {len(FORMATS)} formats × {len(COMMANDS)} commands "
+        f"(× each system's descriptions; model-free commands once per description) = {len(full)} cells; "
+        f"{'full run' if len(chosen) == len(full) else 'sampled'} {len(chosen)}"
+    )
