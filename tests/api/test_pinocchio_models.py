@@ -118,7 +118,7 @@ def test_a_certificate_embeds_the_urdf_text_only_when_it_builds_the_model(robot,
     target = certification_input(
         urdf=describe_model(api.PinocchioRobot(robot.model, urdf_text=text)), model="double_pendulum"
     )
-    assert target.urdf == text and target.name == robot.model.name
+    assert target.urdf == text and target.name == f"double_pendulum-{robot.model.name}"  # model, then URDF
     inertia = robot.model.inertias[1]
     robot.model.inertias[1] = pin.Inertia(inertia.mass * 1.01, inertia.lever, inertia.inertia)
     with pytest.raises(PendverifyError, match=r"builds another model: joint .*: the inertia of its body"):

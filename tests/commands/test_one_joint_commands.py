@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import pytest
 
+from pendverify.analytic.plugin import load_model_class
+from pendverify.certify.names import set_name
 from pendverify.cli import main
 
 from ..robot.one_joint import OneJoint, dm_control_pendulum, write_one_joint
@@ -21,7 +23,10 @@ ROBOTS = ("pendulum", "cart", "dm_pendulum")
 def _certify(r: OneJoint) -> list[list[str]]:
     out = r.folder / "certificates"
     certify = ["certify", *r.files(), "-o", str(out), "--samples", "30"]
-    return [certify, ["recheck", str(out / f"{r.robot.stem}.cert.json"), "--run-embedded-code"]]
+    bundle = set_name(
+        load_model_class(r.model).name, r.robot.stem, str(r.robot)
+    )  # the model's, then the URDF's
+    return [certify, ["recheck", str(out / f"{bundle}.cert.json"), "--run-embedded-code"]]
 
 
 def _render_saved(r: OneJoint) -> list[list[str]]:
