@@ -83,10 +83,12 @@ def as_floats(model, name: str, value) -> np.ndarray:
         imaginary = np.argwhere(array.imag != 0) if shape else np.argwhere([array.imag != 0])
         index = tuple(int(i) for i in imaginary[0]) if shape and len(imaginary) else ()
         entry = _entry(index) or "its value"
-        raise _refuse(model, name, f"{entry} is complex ({array[index]!r}): must be a real number")
+        raise _refuse(model, name, f"{entry} is complex ({complex(array[index])!r}): must be a real number")
+    if kind in "SU":  # NumPy made every entry text: find the entries that were
+        array = np.asarray(value, dtype=object)
     out = np.empty(shape)
     for index in np.ndindex(*shape):
-        x = array[index] if kind == "O" else array[index].item()
+        x = array[index] if array.dtype.kind == "O" else array[index].item()
         real = _real(x)
         if real is None:
             what = "None" if x is None else f"{type(x).__name__} {shortened(repr(x), 60)}"
@@ -111,15 +113,22 @@ def first_non_finite(value: np.ndarray) -> tuple[str, float] | None:
     return _entry(index) or "its value", float(value[index])
 
 
-def parameters_overflow(model, what: str) -> PendverifyError:
-    """The refusal of a model whose value leaves double's range although its inputs are finite.
+#: a parameter beyond this (or below its inverse) in magnitude squares out of double's range
+#: (√1.8e308 ≈ 1.3e154): a product of two such, as m·l² or I·m in any closed form, overflows
+EXTREME = 1e150
 
-    The parameters' size, not the code, is the likely cause: the parameter furthest from 1 (in
-    orders of magnitude: 1e300 as well as 1e-300 under a division) is named, with ``what`` overflowed.
+
+def parameters_overflow(model, what: str) -> PendverifyError | None:
+    """The refusal of a model whose value leaves double's range, or None when no parameter explains it.
+
+    The parameters' size, not the code, is the cause when a parameter is beyond ``EXTREME``
+    (or below 1/``EXTREME``): the one furthest from 1 in orders of magnitude is named, with
+    ``what`` overflowed.
     """
     values = {k: v for k, v in model.params.as_dict().items() if v != 0 and math.isfinite(v)}
-    if not values:
-        return _refuse(model, what, "its value overflows double precision")
-    key = max(values, key=lambda k: abs(math.log10(abs(values[k]))))
+    extreme = {k: v for k, v in values.items() if not 1 / EXTREME <= abs(v) <= EXTREME}
+    if not extreme:
+        return None
+    key = max(extreme, key=lambda k: abs(math.log10(abs(extreme[k]))))
     rule = f"too large or too small: the model's terms built from it overflow double precision ({what})"
-    return ParameterError(f"<{model.name} parameters>", key, values[key], rule)
+    return ParameterError(f"<{model.name} parameters>", key, extreme[key], rule)

@@ -32,7 +32,6 @@ from __future__ import annotations
 import dataclasses
 import importlib.util
 import inspect
-import math
 import sys
 import traceback
 from pathlib import Path
@@ -238,8 +237,8 @@ def check_model_outputs(model: ClosedFormModel) -> None:
     Each value goes through the model boundary (``pendverify.analytic.numeric_values``), as the
     checks read it.  Raises ``UserCodeError`` naming the file defining the class, the method and
     what it returned (or raised), so that a wrong shape is not met later as a broadcasting
-    error; a value that leaves double's range (an OverflowError, an infinity) is refused as the
-    parameter furthest from 1 (``parameters_overflow``): the parameters' size, not the code.
+    error; a value that leaves double's range (an OverflowError, an infinity, a NaN) is refused
+    as the parameter beyond it when there is one (``parameters_overflow``), as the code's otherwise.
     """
     cls = type(model)
     unused = {"input_matrix": not model.inputs, "disturbance_matrix": not model.disturbances}
@@ -251,8 +250,9 @@ def check_model_outputs(model: ClosedFormModel) -> None:
             value = model_value(model, method, *args)
         except KeyboardInterrupt:
             raise
-        except OverflowError:
-            raise parameters_overflow(model, f"{cls.__name__}.{method} at the zero state") from None
+        except OverflowError as exc:
+            overflow = parameters_overflow(model, f"{cls.__name__}.{method} at the zero state")
+            raise (overflow or UserCodeError(place, f"raised {_described(exc)} at the zero state")) from None
         except ArithmeticError:  # a division by zero at the zero state: the checks meet it at a state
             continue
         except (TypeError, ValueError) as exc:
@@ -265,7 +265,10 @@ def check_model_outputs(model: ClosedFormModel) -> None:
         except BaseException as exc:
             raise (user_code_error(exc) or UserCodeError(place, f"raised {_described(exc)}")) from None
         bad = first_non_finite(value)
-        if bad is not None and math.isinf(bad[1]):
-            raise parameters_overflow(model, f"{cls.__name__}.{method}{bad[0]} = {bad[1]} at the zero state")
         if bad is not None:
-            raise UserCodeError(place, f"{bad[0]} is {bad[1]} at the zero state: must be a finite number")
+            overflow = parameters_overflow(
+                model, f"{cls.__name__}.{method}{bad[0]} = {bad[1]} at the zero state"
+            )
+            raise overflow or UserCodeError(
+                place, f"{bad[0]} is {bad[1]} at the zero state: must be a finite number"
+            )
