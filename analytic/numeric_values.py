@@ -75,7 +75,9 @@ def as_floats(model, name: str, value) -> np.ndarray:
         raise _refuse(model, name, f"must return numbers of shape {shape}; it returned {exc}") from None
     if array.shape != shape:
         got = shortened(repr(value), 80)
-        raise _refuse(model, name, f"returned {got}, of shape {array.shape}; expected shape {shape}")
+        if array.dtype.kind not in "biuf":
+            raise _refuse(model, name, f"must return numbers of shape {shape}; it returned {got}")
+        raise _refuse(model, name, f"returned an array of shape {array.shape}; expected {shape} ({got})")
     kind = array.dtype.kind
     if kind in "biuf":
         return array.astype(float)  # a copy: the caller may keep it

@@ -117,7 +117,7 @@ def test_sympy_numbers_are_read_as_floats(tmp_path, capsys):
         ("np.array([[1.0, 0], [0, complex(1, 2)]], dtype=object)", "[2,2] is complex"),
         ("[[1.0, '0'], [0, 1.0]]", "[1,2] is str '0': must be a real number"),
         ("np.array([[1.0, None], [0, 1.0]], dtype=object)", "[1,2] is None: must be a real number"),
-        ("np.eye(3)", "of shape (3, 3); expected shape (2, 2)"),
+        ("np.eye(3)", "returned an array of shape (3, 3); expected (2, 2)"),
         ("[[1.0, 0.0], [0.0]]", "must return numbers of shape (2, 2)"),
         ("np.array([[np.nan, 0], [0, 1.0]])", "[1,1] is nan at the zero state: must be a finite number"),
     ],
