@@ -13,7 +13,9 @@ e⊥(φ) = (−sin φ, cos φ), and every joint i ≤ k turns it at rate 1.  Hen
     C(q, q̇)·q̇ = Σ_k m·J_kᵀ a_k,   a_k = −Σ_{j<k} l·φ̇_j²·e(φ_j) − r·φ̇_k²·e(φ_k)
 
 (the centre's acceleration at q̈ = 0; the rotation adds none in a plane), H = ∂V/∂q with
-V = Σ_k m·g·z_k.  The model writes C·q̇ only (``BiasOnlyModel``).  ``PLANTED`` names an entry
+V = Σ_k m·g·z_k.  The model writes C·q̇ only (``BiasOnlyModel``).  SymPy can read it (its loops
+expand to sums of products of sines and cosines), slowly beyond ten links; ``numeric`` declares
+it evaluated numerically only.  ``PLANTED`` names an entry
 of M to write wrong; the model class is written as a file, as a user's plug-in is.
 """
 
@@ -68,6 +70,7 @@ class ChainParams(ParameterSet):
 
 class Chain(BiasOnlyModel):
     name = "chain{n}"
+    numeric_only = {numeric_only!r}
     params_type = ChainParams
     coordinates = tuple(f"q{{k + 1}}" for k in range(N))
     angular = (True,) * N
@@ -127,6 +130,16 @@ class Chain(BiasOnlyModel):
                 out[i] = out[i] + p.m * p.g * jz
         return np.array(out)
 
+    def gravity_scale(self):
+        """|H_i| ≤ Σ_{{k ≥ i}} m·g·((k − i)·l + r): each lever arm at its longest."""
+        p = self.params
+        return np.array([sum(p.m * p.g * ((k - i) * p.l + p.r) for k in range(i, N)) for i in range(N)])
+
+    def diagonal_scale(self, q):
+        """M_ii ≤ Σ_{{k ≥ i}} (m·((k − i)·l + r)² + I): each |J_k,i| at its longest."""
+        p = self.params
+        return np.array([sum(p.m * ((k - i) * p.l + p.r) ** 2 + p.I for k in range(i, N)) for i in range(N)])
+
     def potential_energy(self, q):
         p, phi, sin = self.params, self._angles(q), self.math.sin
         height, V = 0, 0
@@ -137,12 +150,15 @@ class Chain(BiasOnlyModel):
 '''
 
 
-def write_chain(folder: Path, n: int, planted=None) -> tuple[str, str, str]:
+def write_chain(folder: Path, n: int, planted=None, numeric: bool = False) -> tuple[str, str, str]:
     """(model file, URDF, parameter file) of an n-link chain in ``folder``; ``planted`` = (i, j, factor)
-    writes M[i][j] (0-based) times factor."""
+    writes M[i][j] (0-based) times factor; ``numeric``: the model is evaluated numerically only
+    (``ClosedFormModel.numeric_only``: SymPy does not expand its loops, which takes minutes beyond
+    ten links)."""
     folder.mkdir(parents=True, exist_ok=True)
     model = folder / f"chain{n}.py"
-    model.write_text(MODEL.format(n=n, planted=planted))
+    why = "its sums over the links are evaluated numerically" if numeric else ""
+    model.write_text(MODEL.format(n=n, planted=planted, numeric_only=why))
     urdf = folder / f"chain{n}.urdf"
     urdf.write_text(chain_urdf(n))
     params = folder / f"chain{n}.toml"
