@@ -25,6 +25,7 @@ entry's size (smaller ones are not fitted: the report gives the entry, not a sha
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 from dataclasses import dataclass
@@ -106,12 +107,18 @@ def _symbol(name: str) -> sp.Symbol:
 
 
 def position_basis(Q, angular, names) -> list[tuple[str, np.ndarray, sp.Expr]]:
-    """(name, values at the states Q, SymPy expression) of 1 and sin, cos of every argument."""
-    basis = [("1", np.ones(len(Q)), sp.S.One)]
+    """(name, values at the states Q, its SymPy expression when called) of 1 and sin, cos of every
+    argument; the expressions are made for the functions a fit keeps only (SymPy's sin of a sum
+    takes milliseconds, and a basis holds thousands)."""
+    basis = [("1", np.ones(len(Q)), _one)]
     for text, values, argument in _arguments(Q, angular, names):
-        basis.append((f"sin({text})", np.sin(values), sp.sin(argument)))
-        basis.append((f"cos({text})", np.cos(values), sp.cos(argument)))
+        basis.append((f"sin({text})", np.sin(values), functools.partial(sp.sin, argument)))
+        basis.append((f"cos({text})", np.cos(values), functools.partial(sp.cos, argument)))
     return basis
+
+
+def _one():
+    return sp.S.One
 
 
 def basis_for(quantity: str, Q, V, angular, names) -> list[tuple[str, np.ndarray, sp.Expr]]:
@@ -121,7 +128,9 @@ def basis_for(quantity: str, Q, V, angular, names) -> list[tuple[str, np.ndarray
         return position
     rates = [(f"d{n}", V[:, k], _symbol(f"d{n}")) for k, n in enumerate(names)]
     linear = [
-        (r if p == "1" else f"{r}·{p}", rv * pv, rs * ps) for r, rv, rs in rates for p, pv, ps in position
+        (r if p == "1" else f"{r}·{p}", rv * pv, functools.partial(_times, (rs,), ps))
+        for r, rv, rs in rates
+        for p, pv, ps in position
     ]
     if quantity == "C":
         return position + linear
@@ -129,8 +138,22 @@ def basis_for(quantity: str, Q, V, angular, names) -> list[tuple[str, np.ndarray
     for (a, av, a_s), (b, bv, b_s) in itertools.combinations_with_replacement(rates, 2):
         product = f"{a}²" if a == b else f"{a}·{b}"
         for p, pv, ps in position:
-            products.append((product if p == "1" else f"{product}·{p}", av * bv * pv, a_s * b_s * ps))
+            products.append(
+                (
+                    product if p == "1" else f"{product}·{p}",
+                    av * bv * pv,
+                    functools.partial(_times, (a_s, b_s), ps),
+                )
+            )
     return linear + products
+
+
+def _times(factors, function):
+    """The product of ``factors`` and ``function()``: a basis function's expression, made when asked."""
+    out = function()
+    for f in factors:
+        out = f * out
+    return out
 
 
 def fit(d, basis) -> Pattern | None:
@@ -159,7 +182,7 @@ def fit(d, basis) -> Pattern | None:
     largest = float(np.max(np.abs(coeff)))
     kept = [(float(c), k) for c, k in sorted(zip(coeff, chosen, strict=True), key=lambda ck: ck[1])]
     kept = [(c, k) for c, k in kept if abs(c) > NEGLIGIBLE * largest]
-    return Pattern(tuple((c, basis[k][0]) for c, k in kept), relative, tuple(basis[k][2] for _, k in kept))
+    return Pattern(tuple((c, basis[k][0]) for c, k in kept), relative, tuple(basis[k][2]() for _, k in kept))
 
 
 def entry_pattern(entry: EntryDifference, batch) -> Pattern | None:
