@@ -64,7 +64,10 @@ Closed forms must call trigonometric functions through ``self.math`` (``self.mat
 ``self.math.sin``, ...), not ``math`` or ``numpy``: numerically ``self.math`` *is*
 Python's ``math``, and the SymPy tools swap in SymPy's functions and symbols to read
 the formulas as expressions.  Build arrays with ``np.array`` (it holds SymPy objects
-too) and keep ``__init__`` free of arithmetic on the parameters.
+too) and keep ``__init__`` free of arithmetic on the parameters.  A method may return any
+container of real numbers (an object array, nested lists, SymPy's numbers): whatever evaluates
+the model numerically reads it through ``pendverify.analytic.numeric_values``, as a float array
+of the method's shape, or refuses it in one line.
 """
 
 from __future__ import annotations
@@ -84,6 +87,7 @@ from pendverify.analytic.forms import (
     ClosedForm,
     Energies,
 )
+from pendverify.analytic.numeric_values import model_value
 from pendverify.analytic.parameter_set import ParameterSet
 from pendverify.display import REPR_LIMIT, listed, shortened
 
@@ -214,12 +218,11 @@ class ClosedFormModel(metaclass=ModelClass):
     # --- derived by default: a model may write them as closed forms -------------------
     def det_mass_matrix(self, q: np.ndarray) -> float:
         """det M(q).  Derived by default (LU of M); a hand-written closed form is checked (``det``)."""
-        return float(np.linalg.det(np.asarray(self.mass_matrix(q), dtype=float)))
+        return float(np.linalg.det(model_value(self, "mass_matrix", q)))
 
     def inverse_mass_matrix(self, q: np.ndarray) -> np.ndarray:
         """M(q)⁻¹.  Derived by default (solving with M); a hand-written one is checked (``minverse``)."""
-        M = np.asarray(self.mass_matrix(q), dtype=float)
-        return np.linalg.solve(M, np.eye(self.nv))
+        return np.linalg.solve(model_value(self, "mass_matrix", q), np.eye(self.nv))
 
     def acceleration(self, q: np.ndarray, v: np.ndarray, u: np.ndarray, w: np.ndarray) -> np.ndarray:
         """q̈.  Derived by default: M⁻¹ (B u + W w − D q̇ − C q̇ − H) from the model's own parts.
@@ -228,14 +231,13 @@ class ClosedFormModel(metaclass=ModelClass):
         here, *not* as a re-assembly of the other methods, so that a typo in any
         single place shows up in some check.
         """
-        M = np.asarray(self.mass_matrix(q), dtype=float)
         force = (
-            self.input_matrix() @ np.asarray(u, dtype=float)
-            + self.disturbance_matrix() @ np.asarray(w, dtype=float)
-            - self.damping_matrix() @ v
-            - self.bias(q, v)
+            model_value(self, "input_matrix") @ np.asarray(u, dtype=float)
+            + model_value(self, "disturbance_matrix") @ np.asarray(w, dtype=float)
+            - model_value(self, "damping_matrix") @ np.asarray(v, dtype=float)
+            - model_value(self, "bias", q, v)
         )
-        return np.linalg.solve(M, force)
+        return np.linalg.solve(model_value(self, "mass_matrix", q), force)
 
     def gravity_scale(self) -> np.ndarray:
         """Σ |coefficients| of each H_i: a bound of |H_i(q)| over all q (units of H).
@@ -252,7 +254,8 @@ class ClosedFormModel(metaclass=ModelClass):
 
     def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> float:
         """T(q, q̇) = ½ q̇ᵀ M(q) q̇."""
-        return 0.5 * float(v @ self.mass_matrix(q) @ v)
+        v = np.asarray(v, dtype=float)
+        return 0.5 * float(v @ model_value(self, "mass_matrix", q) @ v)
 
     def diagonal_scale(self, q: np.ndarray) -> np.ndarray:
         """Per-coordinate inertia scale S_i ≥ |terms of M_ii| (units of M_ii).

@@ -43,6 +43,7 @@ import numpy as np
 from pendverify.analytic import ClosedFormModel, ParameterSet
 from pendverify.analytic.forms import INTERFACE
 from pendverify.analytic.module_names import module_name
+from pendverify.analytic.numeric_values import first_non_finite, model_value, parameters_overflow
 from pendverify.analytic.params import parse_parameter_document, read_parameter_toml
 from pendverify.analytic.source_file import where
 from pendverify.errors import (
@@ -250,33 +251,43 @@ def _expected_shapes(model: ClosedFormModel) -> dict[str, tuple[tuple, tuple[int
 
 
 def check_model_outputs(model: ClosedFormModel) -> None:
-    """Evaluate the model's hand-written methods at the zero state: each returns numbers of its shape.
+    """Evaluate the model's hand-written methods at the zero state: each returns finite numbers of its shape.
 
-    Raises ``UserCodeError`` naming the file defining the class, the method and what it
-    returned (or raised), so that a wrong shape is not met later as a broadcasting error.
+    Each value goes through the model boundary (``pendverify.analytic.numeric_values``), as the
+    checks read it.  Raises ``UserCodeError`` naming the file defining the class, the method and
+    what it returned (or raised), so that a wrong shape is not met later as a broadcasting
+    error; a value that leaves double's range (an OverflowError, an infinity, a NaN) is refused
+    as the parameter beyond it when there is one (``parameters_overflow``), as the code's otherwise.
     """
     cls = type(model)
     unused = {"input_matrix": not model.inputs, "disturbance_matrix": not model.disturbances}
-    for method, (args, shape) in _expected_shapes(model).items():
+    for method, (args, _) in _expected_shapes(model).items():
         if method not in cls.hand_written() or unused.get(method):
             continue
         place = f"{where(cls)}: {cls.__name__}.{method}"
         try:
-            value = np.asarray(getattr(model, method)(*args), dtype=float)
+            value = model_value(model, method, *args)
         except KeyboardInterrupt:
             raise
-        except ArithmeticError:  # the parameters' size, not the code: the checks refuse such states
+        except OverflowError as exc:
+            overflow = parameters_overflow(model, f"{cls.__name__}.{method} at the zero state")
+            raise (overflow or UserCodeError(place, f"raised {_described(exc)} at the zero state")) from None
+        except ArithmeticError:  # a division by zero at the zero state: the checks meet it at a state
             continue
         except (TypeError, ValueError) as exc:
             user = user_code_error(exc)
             if user is not None:
                 raise user from None
             raise UserCodeError(place, f"must return numbers; at the zero state: {exc}") from None
-        except PendverifyError:  # the model's own one-line refusal (a right-hand side's, say)
+        except PendverifyError:  # the boundary's refusal, or the model's own one-line refusal
             raise
         except BaseException as exc:
             raise (user_code_error(exc) or UserCodeError(place, f"raised {_described(exc)}")) from None
-        if value.shape != shape:
-            raise UserCodeError(
-                place, f"returned an array of shape {value.shape} at the zero state; expected {shape}"
+        bad = first_non_finite(value)
+        if bad is not None:
+            overflow = parameters_overflow(
+                model, f"{cls.__name__}.{method}{bad[0]} = {bad[1]} at the zero state"
+            )
+            raise overflow or UserCodeError(
+                place, f"{bad[0]} is {bad[1]} at the zero state: must be a finite number"
             )

@@ -161,7 +161,14 @@ def model_target(
         model = cls(params)
     except Exception as exc:
         raise PendverifyError(f"{cls.name}: building the model failed: {type(exc).__name__}: {exc}") from None
-    check_model_outputs(model)
+    try:
+        check_model_outputs(model)
+    except ParameterError as exc:  # a value beyond double's range: name the file it came from
+        if "parameters read off the URDF" not in notes:
+            raise
+        raise ParameterError(
+            system.source, exc.key, exc.value, f"{exc.rule} (as read off the URDF)"
+        ) from None
     if name is None:
         name = _description_name(urdf)
     return Target(f"{cls.name}:{name}", model, system, system.source, notes)
@@ -189,8 +196,13 @@ def params_target(
     """
     cls = model_cls or _model_class(params.model)
     origin = origin or f"the inline {cls.name} parameters"
+    model = cls(params)
+    try:
+        check_model_outputs(model)
+    except ParameterError as exc:  # a value beyond double's range: name the file it came from
+        raise ParameterError(origin, f"parameters.{exc.key}", exc.value, exc.rule) from None
     system = PinocchioSystem.for_model(cls, urdf_for(params), params.g, f"<URDF of {origin}>")
-    return Target(f"{cls.name}:{name}", cls(params), system, system.source)
+    return Target(f"{cls.name}:{name}", model, system, system.source)
 
 
 def is_builtin(cls: type[ClosedFormModel]) -> bool:
@@ -287,7 +299,12 @@ def select_targets(
                 "with a URDF, name the model (--model or --analytic on the command line, the model "
                 f"argument in the Python API) or give the parameter set ({PARAMS_HINT})"
             )
-        return Selection([model_target(model_cls, urdf, values, name)])
+        try:
+            return Selection([model_target(model_cls, urdf, values, name)])
+        except ParameterError as exc:  # a value of the parameter file beyond double's range: name the file
+            if not isinstance(params, (str, Path)) or not exc.source.startswith("<"):
+                raise
+            raise ParameterError(str(params), f"parameters.{exc.key}", exc.value, exc.rule) from None
     if values is not None:
         if isinstance(params, (str, Path)):
             return Selection([params_target(values, Path(params).stem, str(params), model_cls)])

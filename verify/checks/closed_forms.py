@@ -1,7 +1,9 @@
 """A model's closed forms at a batch of states: each method evaluated once for all states.
 
 ``ClosedForms.value(name)`` is method ``name`` at every state, as a float array with the
-batch axis first (``constant(name)`` for a method without arguments).  How:
+batch axis first (``constant(name)`` for a method without arguments); the model's own code is
+called through the model boundary (``pendverify.analytic.numeric_values``), which returns each
+value as a float array of its shape or refuses it in one line.  How:
 
 * a method the model writes itself is one call of its generated NumPy function
   (``pendverify.numerics.codegen.vectorised``: the model's code read by SymPy and printed
@@ -32,6 +34,7 @@ from __future__ import annotations
 import numpy as np
 
 from pendverify.analytic.interface import BiasOnlyModel
+from pendverify.analytic.numeric_values import model_value
 from pendverify.checks.scaling import mv
 from pendverify.numerics.codegen.vectorised import METHODS, generated
 
@@ -63,7 +66,7 @@ class ClosedForms:
         """A method called once: without state (D, B, W, the gravity scale) or at a fixed state."""
         key = (name, *(np.asarray(a).tobytes() for a in args))
         if key not in self._constants:
-            self._constants[key] = getattr(self.model, name)(*args)
+            self._constants[key] = model_value(self.model, name, *args)
         return self._constants[key]
 
     def replace(self, values: dict[str, np.ndarray]) -> None:
@@ -93,7 +96,7 @@ class ClosedForms:
         return self._python(name)
 
     def _written(self, name: str) -> np.ndarray:
-        own = np.asarray(self._call(name, 0), dtype=float)
+        own = self._call(name, 0)
         if self.model.numeric_only and not self.python_only:
             self.per_state[name] = self.model.numeric_only
         if self.python_only or self.model.numeric_only:
@@ -116,14 +119,14 @@ class ClosedForms:
             return self._python(name, first=own)
         return values
 
-    def _call(self, name: str, i: int):
-        args = METHODS[name]
-        return getattr(self.model, name)(*(self.arrays[a][i] for a in args))
+    def _call(self, name: str, i: int) -> np.ndarray:
+        """Method ``name`` at state i, through the model boundary (``analytic.numeric_values``)."""
+        return model_value(self.model, name, *(self.arrays[a][i] for a in METHODS[name]))
 
     def _python(self, name: str, first=None) -> np.ndarray:
         """The model's own method at each state (once, broadcast, for a method without arguments)."""
         if first is None:
-            first = np.asarray(self._call(name, 0), dtype=float)
+            first = self._call(name, 0)
         out = np.empty((self.n, *first.shape))
         out[0] = first
         if METHODS[name] == "":

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pendverify.analytic import ClosedFormModel
+from pendverify.analytic.numeric_values import model_value
 
 DEFAULT_SEED = 20260301
 DEFAULT_RANDOM_STATES = 400
@@ -51,7 +52,7 @@ def _force_scales(model: ClosedFormModel, columns: np.ndarray, group: str) -> np
         return np.array(
             [ACCEL_RANGE / _acceleration_per_unit(model, group, k) for k in range(columns.shape[1])]
         )
-    inertia = model.diagonal_scale(np.zeros(model.nv))
+    inertia = model_value(model, "diagonal_scale", np.zeros(model.nv))
     return ACCEL_RANGE * np.array([np.max(np.abs(col) * inertia) for col in columns.T])
 
 
@@ -59,9 +60,9 @@ def _acceleration_per_unit(model: ClosedFormModel, group: str, k: int) -> float:
     """max |Δq̈| for a unit of input (``group`` "u") or disturbance ("w") k at the zero state."""
     zero = np.zeros(model.nv)
     u, w = np.zeros(len(model.inputs)), np.zeros(len(model.disturbances))
-    rest = np.asarray(model.acceleration(zero, zero, u, w), dtype=float)
+    rest = model_value(model, "acceleration", zero, zero, u, w)
     (u if group == "u" else w)[k] = 1.0
-    push = np.asarray(model.acceleration(zero, zero, u, w), dtype=float) - rest
+    push = model_value(model, "acceleration", zero, zero, u, w) - rest
     return float(np.max(np.abs(push))) or 1.0
 
 
@@ -77,8 +78,8 @@ def sample_states(model: ClosedFormModel, n_random: int = DEFAULT_RANDOM_STATES,
     nv = model.nv
     angular = np.array(model.angular)
     q_range = np.where(angular, ANGLE_RANGE, POSITION_RANGE)
-    u_scale = _force_scales(model, model.input_matrix(), "u")
-    w_scale = _force_scales(model, model.disturbance_matrix(), "w")
+    u_scale = _force_scales(model, model_value(model, "input_matrix"), "u")
+    w_scale = _force_scales(model, model_value(model, "disturbance_matrix"), "w")
     nu, nw = u_scale.size, w_scale.size
     special = {name: np.asarray(q, dtype=float) for name, q in model.special_states().items()}
     moving = np.concatenate([np.full(nv, RATE_RANGE), np.ones(nu + nw)])  # q̇, u, w of a moving state

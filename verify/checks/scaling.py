@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from pendverify.analytic.numeric_values import model_value
 from pendverify.checks.spectral import norms2
 
 
@@ -29,7 +30,7 @@ def weights_of(S):
 
 
 def weights(model, q):
-    return weights_of(model.diagonal_scale(q))
+    return weights_of(model_value(model, "diagonal_scale", q))
 
 
 def scaled_matrix(A, w):
@@ -63,7 +64,7 @@ def rate_scale(model, q, v) -> float:
     cart's), so they set the size of the intermediate terms too.  The length for
     a linear coordinate i is ℓ_i = √(min S_angular / S_i), a radius of gyration.
     """
-    return float(rates_of(model.diagonal_scale(q), v, model.angular))
+    return float(rates_of(model_value(model, "diagonal_scale", q), v, model.angular))
 
 
 def norm2(A) -> float:

@@ -13,9 +13,14 @@ In order:
    check on every state, or a sentence saying none was found (``pendverify.diagnosis.repair``).
 
 Only a model with a failing check on trusted states is diagnosed (the caller decides).  The
-whole diagnosis is bounded by ``deadline_s``: the repair search gets what the steps before it
-left (they are vectorised and bounded themselves: well under a second for 3 degrees of
-freedom), and says so when it stops at the bound.
+whole diagnosis is bounded by ``deadline_s``: each step starts only while time is left (the
+entries' shapes one entry at a time), the repair search gets what the steps before it left
+(they are vectorised and bounded by counts themselves: well under a second for 3 degrees of
+freedom; the convention search's candidates by ``MAX_CANDIDATES``), and a ``repair`` finding
+that is not one says what was not searched when the bound stops it: the shapes of how many
+entries, the known traps, the inertial parameters, the repairs, or how many of the entries
+that disagree the repair search screened.  A step under way is not interrupted, so the bound
+is exceeded by at most one step (one entry's shape, the traps or the parameters).
 """
 
 from __future__ import annotations
@@ -42,21 +47,47 @@ FINISHING_S = 0.5
 def explain(batch, results, deadline_s: float = REPAIR_DEADLINE_S) -> list[Finding]:
     """The diagnosis of a model whose checks ``results`` on ``batch`` fail (module docstring)."""
     start = time.perf_counter()
+
+    def late() -> bool:
+        return time.perf_counter() - start > deadline_s - FINISHING_S
+
     failing = {r.check for r in results if not r.passed}
     findings: list[Finding] = []
+    skipped: list[str] = []
     # quantities of any size reach here (a damping of 1e300 is valid input): overflow in a fit
     # makes that fit fail, it is not an error
     with np.errstate(all="ignore"):
-        for entry in differing_entries(batch, failing):
+        entries = differing_entries(batch, failing)
+        shaped = 0
+        for entry in entries:
             findings.append(entry_finding(entry, batch))
+            if late():
+                continue
+            shaped += 1
             pattern = entry_pattern(entry, batch)
             if pattern is not None:
                 findings.append(pattern_finding(entry, pattern, batch.model.coordinates))
-        findings += diagnose(batch.model, batch.system, results)
-        findings += identify_parameters(batch)
+        if shaped < len(entries):
+            skipped.append(f"the shape of {len(entries) - shaped} of {len(entries)} differing entries")
+        steps = (
+            ("the known traps", lambda: diagnose(batch.model, batch.system, results)),
+            ("the inertial parameters", lambda: identify_parameters(batch)),
+        )
+        for what, step in steps:
+            if late():
+                skipped.append(what)
+            else:
+                findings += step()
         left = deadline_s - (time.perf_counter() - start) - FINISHING_S
-        repairs, why_not = search_repair(batch, max(0.0, left))
+        if left > 0:
+            repairs, why_not = search_repair(batch, left)
+        else:
+            repairs, why_not = [], ""
+            skipped.append("repairs")
     findings += repairs
+    if skipped:
+        stopped = f"diagnosis stopped at its {deadline_s:g} s bound; not searched: {', '.join(skipped)}"
+        why_not = f"{why_not}; {stopped}" if why_not else stopped
     if why_not:  # said as a repair that is not one: checks_pass false, nothing suggested
         details = {"written": None, "suggested": None, "suggested_source": None, "location": None}
         findings.append(Finding("repair", why_not, details={**details, "checks_pass": False}))

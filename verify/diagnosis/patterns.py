@@ -6,7 +6,8 @@ basis its quantity allows:
 * M, H, V, D, det M: functions of q alone — 1, and sin and cos of each angle, of twice
   each angle, and of the sums and differences of two and of three angles (the arguments
   a closed form of a chain of revolute joints is built from; det M brings the doubled
-  angles through cos²);
+  angles through cos²); for many angles, at most ``MAX_ARGUMENTS`` arguments: those of three
+  angles go first, then those of two (a count bound on the basis, which grows as n³);
 * C: those, and those times each rate q̇k (C is linear in q̇, and a friction inside C
   is a constant);
 * C·q̇: those times each rate q̇k and each product q̇j·q̇k.
@@ -24,7 +25,9 @@ entry's size (smaller ones are not fitted: the report gives the entry, not a sha
 
 from __future__ import annotations
 
+import functools
 import itertools
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -65,23 +68,37 @@ class Pattern:
         return f"{len(self.terms)} term{'s' if len(self.terms) > 1 else ''}"
 
 
+#: the most trigonometric arguments a basis holds: sums and differences of three angles are left
+#: out beyond it, then those of two (n angles give 2n + 2·C(n, 2) + 4·C(n, 3) arguments: 590 for
+#: 10 angles, 42 720 for 40, each a basis column at every state and a SymPy expression)
+MAX_ARGUMENTS = 2500
+
+
+def _group_count(n: int, size: int) -> int:
+    return math.comb(n, size) * 2 ** (size - 1)
+
+
 def _arguments(Q, angular, names):
-    """(name, values) of the trigonometric arguments of the basis."""
+    """(name, values, SymPy expression) of the trigonometric arguments of the basis, at most
+    ``MAX_ARGUMENTS`` of them (module docstring)."""
     idx = [i for i, a in enumerate(angular) if a]
-    out = []
-    for i in idx:
-        out.append((names[i], Q[:, i]))
-    for i in idx:
-        out.append((f"2·{names[i]}", 2 * Q[:, i]))
+    symbols = {i: _symbol(names[i]) for i in idx}
+    out = [(names[i], Q[:, i], symbols[i]) for i in idx]
+    out += [(f"2·{names[i]}", 2 * Q[:, i], 2 * symbols[i]) for i in idx]
+    count = len(out)
     for size in (2, 3):
+        count += _group_count(len(idx), size)
+        if count > MAX_ARGUMENTS:
+            break
         for group in itertools.combinations(idx, size):
             for signs in itertools.product((1, -1), repeat=size - 1):
                 values = Q[:, group[0]].copy()
-                text = names[group[0]]
+                text, expr = names[group[0]], symbols[group[0]]
                 for s, j in zip(signs, group[1:], strict=True):
                     values = values + s * Q[:, j]
                     text += f" {'+' if s > 0 else '−'} {names[j]}"
-                out.append((text, values))
+                    expr = expr + s * symbols[j]
+                out.append((text, values, expr))
     return out
 
 
@@ -90,13 +107,18 @@ def _symbol(name: str) -> sp.Symbol:
 
 
 def position_basis(Q, angular, names) -> list[tuple[str, np.ndarray, sp.Expr]]:
-    """(name, values at the states Q, SymPy expression) of 1 and sin, cos of every argument."""
-    basis = [("1", np.ones(len(Q)), sp.S.One)]
-    for text, values in _arguments(Q, angular, names):
-        argument = sp.sympify(text.replace("·", "*").replace("−", "-"), locals={n: _symbol(n) for n in names})
-        basis.append((f"sin({text})", np.sin(values), sp.sin(argument)))
-        basis.append((f"cos({text})", np.cos(values), sp.cos(argument)))
+    """(name, values at the states Q, its SymPy expression when called) of 1 and sin, cos of every
+    argument; the expressions are made for the functions a fit keeps only (SymPy's sin of a sum
+    takes milliseconds, and a basis holds thousands)."""
+    basis = [("1", np.ones(len(Q)), _one)]
+    for text, values, argument in _arguments(Q, angular, names):
+        basis.append((f"sin({text})", np.sin(values), functools.partial(sp.sin, argument)))
+        basis.append((f"cos({text})", np.cos(values), functools.partial(sp.cos, argument)))
     return basis
+
+
+def _one():
+    return sp.S.One
 
 
 def basis_for(quantity: str, Q, V, angular, names) -> list[tuple[str, np.ndarray, sp.Expr]]:
@@ -106,7 +128,9 @@ def basis_for(quantity: str, Q, V, angular, names) -> list[tuple[str, np.ndarray
         return position
     rates = [(f"d{n}", V[:, k], _symbol(f"d{n}")) for k, n in enumerate(names)]
     linear = [
-        (r if p == "1" else f"{r}·{p}", rv * pv, rs * ps) for r, rv, rs in rates for p, pv, ps in position
+        (r if p == "1" else f"{r}·{p}", rv * pv, functools.partial(_times, (rs,), ps))
+        for r, rv, rs in rates
+        for p, pv, ps in position
     ]
     if quantity == "C":
         return position + linear
@@ -114,8 +138,22 @@ def basis_for(quantity: str, Q, V, angular, names) -> list[tuple[str, np.ndarray
     for (a, av, a_s), (b, bv, b_s) in itertools.combinations_with_replacement(rates, 2):
         product = f"{a}²" if a == b else f"{a}·{b}"
         for p, pv, ps in position:
-            products.append((product if p == "1" else f"{product}·{p}", av * bv * pv, a_s * b_s * ps))
+            products.append(
+                (
+                    product if p == "1" else f"{product}·{p}",
+                    av * bv * pv,
+                    functools.partial(_times, (a_s, b_s), ps),
+                )
+            )
     return linear + products
+
+
+def _times(factors, function):
+    """The product of ``factors`` and ``function()``: a basis function's expression, made when asked."""
+    out = function()
+    for f in factors:
+        out = f * out
+    return out
 
 
 def fit(d, basis) -> Pattern | None:
@@ -144,7 +182,7 @@ def fit(d, basis) -> Pattern | None:
     largest = float(np.max(np.abs(coeff)))
     kept = [(float(c), k) for c, k in sorted(zip(coeff, chosen, strict=True), key=lambda ck: ck[1])]
     kept = [(c, k) for c, k in kept if abs(c) > NEGLIGIBLE * largest]
-    return Pattern(tuple((c, basis[k][0]) for c, k in kept), relative, tuple(basis[k][2] for _, k in kept))
+    return Pattern(tuple((c, basis[k][0]) for c, k in kept), relative, tuple(basis[k][2]() for _, k in kept))
 
 
 def entry_pattern(entry: EntryDifference, batch) -> Pattern | None:

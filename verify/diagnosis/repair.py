@@ -124,7 +124,11 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
             findings += _findings(changes, edit, slot, forms, notation, alternative=True)
         return findings, ""
     where = ", ".join(s.label for s in slots[:6]) + (f" and {len(slots) - 6} more" if len(slots) > 6 else "")
-    bound = " (the search stopped at its time bound)" if time.perf_counter() > deadline else ""
+    bound = (
+        f" (the search stopped at its time bound: searched {len(screened)} of {len(slots)} entries)"
+        if time.perf_counter() > deadline
+        else ""
+    )
     also = " nor two edits of one entry," if pairs else ""
     return [], (
         f"no repair: no single edit of {where} (nor one edit of each, for two entries,{also}) makes every "

@@ -21,6 +21,7 @@ from pendverify.display import listed, shortened
 from pendverify.robot import seed_geometry  # noqa: F401  (registers the reference systems' readers)
 from pendverify.robot.batch import PinocchioBatch, finite_rows
 from pendverify.robot.coordinates import CoordinateMap
+from pendverify.robot.finite_terms import check_finite_terms
 from pendverify.robot.geometry import MODEL_FORM_RTOL, ModelForm, UrdfGeometry, combined, reader
 from pendverify.robot.gravity_tilt import tilt_form
 from pendverify.robot.joint_map import declared_geometry
@@ -106,6 +107,7 @@ class PinocchioSystem:
             loaded = dataclasses.replace(urdf, model=urdf.model.copy(), reading_notes=notes)
         else:
             loaded = load_urdf(urdf, source)
+        check_finite_terms(loaded.model, loaded.source)
         own = loaded.facts.gravity
         if g is not None and own is not None and g != own:
             loaded.reading_notes.append(

@@ -35,6 +35,9 @@ from pendverify.robot.coordinates import CoordinateMap
 
 #: candidates evaluated at once: their arrays, (CHUNK, K, n², nb) for the fit, stay within a few MB
 CHUNK = 2048
+#: the most numbers a chunk's arrays hold (8 bytes each: 256 MB), whatever the model's size: a
+#: 40-link chain's 40 pivot systems at 24 states take 1.5 MB per candidate
+MAX_CHUNK_FLOATS = 32_000_000
 
 
 @dataclass(frozen=True)
@@ -104,8 +107,11 @@ def screen(model, system, candidates, states) -> Screen | None:
     shifts = parallel_axis_systems(joint)
     T = np.array([c.T for c in candidates])  # (C, n, n)
     theta0 = np.array([c.theta0 for c in candidates])  # (C, n)
+    # a chunk holds C·K·n² numbers per pivot system and a few more: at most MAX_CHUNK_FLOATS in all
+    K = len(hand.theta)
+    chunk = max(1, min(CHUNK, MAX_CHUNK_FLOATS // (K * n * n * (len(shifts) + 4))))
     parts = [
-        _errors(hand, joint, shifts, T[i : i + CHUNK], theta0[i : i + CHUNK]) for i in range(0, len(T), CHUNK)
+        _errors(hand, joint, shifts, T[i : i + chunk], theta0[i : i + chunk]) for i in range(0, len(T), chunk)
     ]
     bare, fitted, eH, coefficients = (np.concatenate(x) for x in zip(*parts, strict=True))
     before = float(max(bare[0], eH[0]))

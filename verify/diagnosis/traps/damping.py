@@ -4,13 +4,15 @@ r = M_hand (q̈_hand − q̈_pin) is fitted by X q̇ with a constant matrix X ov
 the moving states.  X = D: the hand q̈ lacks the friction D q̇; X = 2D: the
 friction has the wrong sign; X a part of D: those terms are missing; X not
 in D: the q̈ carries friction that ``damping_matrix`` does not declare.  The fit
-counts only when its relative residual is within ``FIT_RTOL``.
+counts only when its relative residual is within ``FIT_RTOL``.  The model is evaluated through
+the model boundary (``pendverify.analytic.numeric_values``), as the checks evaluate it.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from pendverify.analytic.numeric_values import model_value
 from pendverify.diagnosis.finding import Finding
 
 FIT_RTOL = 1e-6  # relative residual of the damping fit that counts as exact
@@ -29,19 +31,20 @@ def _damping_sentence(model, system, failing, states) -> str | None:
     if len(moving) < model.nv + 1:
         return None
     rows, target = [], []
+    B, W = model_value(model, "input_matrix"), model_value(model, "disturbance_matrix")
+    D = model_value(model, "damping_matrix")
     for s in moving:
-        tau = model.input_matrix() @ s.u + model.disturbance_matrix() @ s.w - model.damping_matrix() @ s.v
-        diff = model.acceleration(s.q, s.v, s.u, s.w) - system.acceleration(s.q, s.v, tau)
-        target.append(model.mass_matrix(s.q) @ diff)
+        tau = B @ s.u + W @ s.w - D @ s.v
+        diff = model_value(model, "acceleration", s.q, s.v, s.u, s.w) - system.acceleration(s.q, s.v, tau)
+        target.append(model_value(model, "mass_matrix", s.q) @ diff)
         rows.append(s.v)
-    V, R = np.array(rows, dtype=float), np.array(target, dtype=float)  # a model may return object arrays
+    V, R = np.array(rows, dtype=float), np.array(target)
     if not np.all(np.isfinite(R)):
         return None  # a q̈ not finite at a state is no damping trap (and LAPACK would refuse it)
     X, *_ = np.linalg.lstsq(V, R, rcond=None)  # R ≈ V Xᵀ: r = X q̇
     X = X.T
     if np.linalg.norm(V @ X.T - R) > FIT_RTOL * np.linalg.norm(R) or np.max(np.abs(X)) == 0:
         return None
-    D = model.damping_matrix()
     scale = max(float(np.max(np.abs(D))), float(np.max(np.abs(X))))
     X[np.abs(X) < FIT_RTOL * scale] = 0.0
     names = model.coordinates
