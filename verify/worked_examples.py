@@ -19,6 +19,7 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 
+from pendverify.display import REPR_LIMIT, html_table, shortened
 from pendverify.errors import FileAccessError, UnknownNameError
 
 if sys.version_info >= (3, 11):
@@ -72,6 +73,16 @@ class WorkedExample:
     def models(self) -> tuple[ShippedFile, ...]:
         """The model files ``check --analytic`` takes: Python first, then the LaTeX or text one."""
         return (self.model, self.written_model) if self.written_model else (self.model,)
+
+    def __repr__(self) -> str:
+        files = f"{len(self.files)} files: {', '.join(str(f.path) for f in self.files)}"
+        head = f"<WorkedExample {self.name!r}, {self.dof} DOF, "
+        return head + shortened(files, REPR_LIMIT - len(head) - 1) + ">"
+
+    def _repr_html_(self) -> str:
+        """Its files, where each is copied to and what it is, under its name and summary."""
+        rows = [(str(f.path), f.role) for f in self.files]
+        return html_table(("file", "what it is"), rows, f"{self.name}: {self.summary}")
 
 
 #: the catalogue's roles of a file, by its key

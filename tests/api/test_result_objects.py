@@ -68,6 +68,7 @@ def objects(tmp_path_factory) -> dict[str, object]:
         "Results": Results(QUICK_BENCH, {}, [], {}),
         "SetCost": SetCost("x" * 200, 0.1, {p: 0.01 for p in PARTS}, {"checks": 0.01, "stress": 0.01}, 10),
         "ExplainBench": ExplainBench([ModelScores(f"model {i}" * 10) for i in range(50)], {}, True),
+        "WorkedExample": api.worked_example("double_pendulum"),  # the most files: its repr is cut
     }
 
 
@@ -91,6 +92,7 @@ RESULTS = (
     "Results",
     "SetCost",
     "ExplainBench",
+    "WorkedExample",
 )
 
 
