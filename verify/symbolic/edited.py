@@ -18,6 +18,7 @@ import numpy as np
 import sympy as sp
 
 from pendverify.analytic.symbolic_reading import SYMBOLIC_MATH, SymbolicModel, to_sympy
+from pendverify.numerics.codegen.vectorised import NUMERIC_EDITS
 
 
 def _edited_method(cls, sm: SymbolicModel, method: str, changes, readable: bool):
@@ -60,12 +61,15 @@ def edited_model(model, sm: SymbolicModel, edits: dict, name: str = "Edited", re
     ``readable=False``: SymPy cannot read the edited methods (they take floats only), so the
     checks evaluate them with their own Python state by state instead of generating NumPy code
     for each edited model (``pendverify mutate``'s hundreds of mutants: generating costs more
-    than it saves there)."""
+    than it saves there); their other methods use the model's generated code
+    (``pendverify.numerics.codegen.vectorised.generated``)."""
     cls = type(model)
     namespace = {
         method: _edited_method(cls, sm, method, changes, readable) for method, changes in edits.items()
     }
     namespace["__module__"] = cls.__module__  # messages name the model's own file
+    if not readable:  # the other methods' generated code is the model's own
+        namespace[NUMERIC_EDITS] = (cls, tuple(edits))
     edited = type(f"{cls.__name__}{name}", (cls,), namespace)(model.params)
     if {"gravity_scale", "diagonal_scale"} - set(cls.hand_written()):
         # derived tolerance scales stay the original's, as hand-written ones would
