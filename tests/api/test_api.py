@@ -37,7 +37,9 @@ FEW = 60  # random states where the test is about the API, not the breadth of th
 TIMING = re.compile(r", \d+\.\d+ s: ")
 #: a repair search that stopped at its time bound (``pendverify.diagnosis.repair``) tried as many
 #: candidates as the time allowed: that count depends on the machine's load, nothing else on the line does
-TIME_BOUNDED = re.compile(r"\d+ (candidate\(s\) tried against every check) (\(the search stopped at its time bound\))")
+TIME_BOUNDED = re.compile(
+    r"\d+ (candidate\(s\) tried against every check) (\(the search stopped at its time bound\))"
+)
 
 
 def default_values(name: str = "double_pendulum") -> dict[str, float]:
