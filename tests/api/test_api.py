@@ -115,6 +115,16 @@ SAME_ARGUMENTS = {
 }
 
 
+def test_comparable_blanks_only_what_a_time_bound_decides():
+    """A repair search's count is blanked only where it stopped at its time bound; the sentence
+    itself, and a count the search reached by exhausting its candidates, are still compared."""
+    bounded = "no repair: …; 4 candidate(s) tried against every check (the search stopped at its time bound)"
+    assert comparable(bounded) == comparable(bounded.replace("4 candidate", "5 candidate"))
+    assert comparable(bounded) != comparable(bounded.replace("every check", "the first check"))
+    whole = "no repair: …; 4 candidate(s) tried against every check"
+    assert comparable(whole) != comparable(whole.replace("4 candidate", "5 candidate"))
+
+
 @pytest.mark.parametrize("case", SAME_ARGUMENTS, ids=list(SAME_ARGUMENTS))
 def test_the_api_and_the_cli_check_the_same_targets_with_the_same_numbers(capsys, tmp_path, case):
     args, kwargs, argv = SAME_ARGUMENTS[case]
