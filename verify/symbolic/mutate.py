@@ -44,6 +44,7 @@ printed report are in ``pendverify.symbolic.mutation_report``.
 
 from __future__ import annotations
 
+import itertools
 import random
 import time
 
@@ -197,7 +198,8 @@ def _controls(model, system, sm, states, seed) -> list[str]:
 
 def sampled(mutants: list[Mutant], limit: int, seed: int) -> tuple[list[Mutant], dict[str, int]]:
     """At most ``limit`` mutants per method, drawn with ``seed`` in their generated order (so spread
-    over the entries and operators), and how many each method had."""
+    over the entries and operators), and how many each method had.  The methods take turns, so
+    that a run stopped at its wall-clock bound has run some mutants of each."""
     generated: dict[str, list[Mutant]] = {}
     for m in mutants:
         generated.setdefault(m.method, []).append(m)
@@ -205,8 +207,9 @@ def sampled(mutants: list[Mutant], limit: int, seed: int) -> tuple[list[Mutant],
     for method, ms in generated.items():
         if len(ms) > limit:
             ms = [ms[i] for i in sorted(random.Random(f"{seed}:{method}").sample(range(len(ms)), limit))]
-        kept += ms
-    return kept, {method: len(ms) for method, ms in generated.items()}
+        kept.append(ms)
+    turns = [m for group in itertools.zip_longest(*kept) for m in group if m is not None]
+    return turns, {method: len(ms) for method, ms in generated.items()}
 
 
 def run_mutation(
