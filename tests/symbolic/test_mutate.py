@@ -226,3 +226,22 @@ def test_a_mutant_uses_its_models_generated_code_except_for_the_mutated_method()
     assert "mass_matrix" not in module.FUNCTIONS and "mass_matrix" in base.FUNCTIONS
     assert "edited numerically" in module.MISSING["mass_matrix"]
     assert module.FUNCTIONS == {m: f for m, f in base.FUNCTIONS.items() if m != "mass_matrix"}
+
+
+def test_a_method_that_reads_the_mutated_one_is_not_taken_from_the_models_generated_code():
+    """The triple pendulum's hand-written q̈ calls its generalized_force: a mutant of that force must
+    reach q̈, so q̈ runs the mutant's own Python (its generated code holds the original force)."""
+    from pathlib import Path
+
+    from pendverify.analytic.params import load_parameter_file
+    from pendverify.api import load_model
+    from pendverify.numerics.codegen.vectorised import generated
+
+    examples = Path(__file__).resolve().parents[2] / "examples"
+    cls = load_model(examples / "triple_pendulum.py")
+    params = load_parameter_file(examples / "triple_pendulum.toml", {cls.name: cls.params_type})[2]
+    sm = SymbolicModel.of(cls)
+    mutant = next(m for m in generate(sm) if m.method == "generalized_force" and m.operator == "scale")
+    module = generated(type(numeric_model(cls(params), sm, mutant.method, mutant.changes)))
+    assert "acceleration" in generated(cls).FUNCTIONS and "acceleration" not in module.FUNCTIONS
+    assert "mass_matrix" in module.FUNCTIONS  # M does not read the force: shared
