@@ -152,9 +152,10 @@ def generated(model_cls) -> types.ModuleType | types.SimpleNamespace:
     or generated.
 
     A class edited numerically (``pendverify.symbolic.edited`` with ``readable=False``: a
-    mutant) shares its base's module less the edited methods, which its own Python evaluates:
-    the other methods are the base's code, so generating them again for each of hundreds of
-    mutants would print the same functions (0.3 s each for a 5-link chain)."""
+    mutant) shares its base's module less the edited methods and the methods that read them
+    (a hand-written q̈ calling M), which its own Python evaluates: the others are the base's
+    code, so generating them again for each of hundreds of mutants would print the same
+    functions (0.3 s each for a 5-link chain)."""
     from pendverify.numerics.codegen.cache import Family, kernel
 
     edited = vars(model_cls).get(NUMERIC_EDITS)
@@ -170,5 +171,5 @@ def generated(model_cls) -> types.ModuleType | types.SimpleNamespace:
     return kernel(model_cls, family=Family("vectorised", render, numba=False)).module
 
 
-#: the class attribute of a class edited numerically: (its base, the edited methods)
+#: the class attribute of a class edited numerically: (its base, the edited methods and their readers)
 NUMERIC_EDITS = "numeric_edits"
