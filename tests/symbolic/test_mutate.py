@@ -156,3 +156,92 @@ def test_a_christoffel_consistent_refactoring_is_an_equivalent_mutant():
     assert outcome.verdict == EQUIVALENT
     assert outcome.reason.startswith(CHRISTOFFEL_CONSISTENT)
     assert "flagged by coriolis (warning)" in outcome.reason  # Pinocchio's C is another one
+
+
+# --- the bounds: mutants per closed form, and the wall-clock backstop ---------------------------
+def test_a_form_above_the_mutant_bound_runs_a_seeded_sample_and_says_what_it_left(monkeypatch, capsys):
+    """The double pendulum's M has 51 mutants; at a bound of 10, ten run (the same ten for the same
+    seed), every one detected, and the report names the 41 not run; exit 0 (none survived)."""
+    monkeypatch.setenv("PENDVERIFY_MAX_MUTANTS", "10")
+    argv = ["mutate", "--model", "double_pendulum", "--method", "mass_matrix", "--samples", "8"]
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert "detection rate 100.0% (10/10 non-equivalent mutants)" in out
+    assert "drawn with the seed: mass_matrix 10 of 51; not run: 41" in out
+    target = _target(DoublePendulum, default_params("double_pendulum"))
+    first, again = (run_mutation(target, 4, methods=("mass_matrix",)) for _ in range(2))
+    assert [o.description for o in first.outcomes] == [o.description for o in again.outcomes]
+    assert first.bounds.as_dict()["sampled"] == {"mass_matrix": 51}
+    other = run_mutation(target, 4, seed=7, methods=("mass_matrix",))
+    assert [o.description for o in other.outcomes] != [o.description for o in first.outcomes]
+
+
+def test_a_sampled_run_still_fails_on_a_gap(monkeypatch, capsys):
+    """The bound does not hide a survivor among the mutants it runs: exit 1."""
+    monkeypatch.setenv("PENDVERIFY_MAX_MUTANTS", "2")
+    report = run_mutation(
+        _target(WithDrawing, default_params("double_pendulum")), 4, methods=("drawing_length",)
+    )
+    assert [o.verdict for o in report.outcomes] == [SURVIVED] * 2 and not report.passed
+    assert report.bounds.sampled() == {"drawing_length": 3}
+
+
+class _Clock:
+    """A clock that advances ``step`` seconds each time it is read: the wall-clock bound is reached
+    after a fixed number of mutants whatever the machine's speed."""
+
+    def __init__(self, step: float):
+        self.now, self.step = 0.0, step
+
+    def perf_counter(self) -> float:
+        self.now += self.step
+        return self.now
+
+
+def test_the_run_stops_at_its_wall_clock_bound_and_names_what_it_did_not_run(monkeypatch):
+    import pendverify.symbolic.mutate as mutate_module
+    from pendverify.symbolic.mutation_report import format_report
+
+    monkeypatch.setenv("PENDVERIFY_MUTATE_SECONDS", "120")
+    # started at 50; 50 s elapsed before the first mutant, 100 s before the second, 150 s: two run
+    monkeypatch.setattr(mutate_module, "time", _Clock(50.0))
+    report = run_mutation(
+        _target(DoublePendulum, default_params("double_pendulum")), 4, methods=("gravity", "mass_matrix")
+    )
+    # the methods take turns: one mutant of each ran
+    assert [o.method for o in report.outcomes] == ["mass_matrix", "gravity"] and report.passed
+    assert report.bounds.not_run == {"mass_matrix": 50, "gravity": 32}
+    text = format_report(report)
+    assert "stopped at its bound of 120 s (PENDVERIFY_MUTATE_SECONDS): 2 of 84 mutants run; not run: " in text
+
+
+def test_a_mutant_uses_its_models_generated_code_except_for_the_mutated_method():
+    from pendverify.numerics.codegen.vectorised import generated
+
+    params = default_params("double_pendulum")
+    sm = SymbolicModel.of(DoublePendulum)
+    drop = next(m for m in generate(sm) if m.description == "mass_matrix[0,0]: drop m1*r1**2")
+    mutated = numeric_model(DoublePendulum(params), sm, drop.method, drop.changes)
+    base, module = generated(DoublePendulum), generated(type(mutated))
+    assert "mass_matrix" not in module.FUNCTIONS and "mass_matrix" in base.FUNCTIONS
+    assert "edited numerically" in module.MISSING["mass_matrix"]
+    assert module.FUNCTIONS == {m: f for m, f in base.FUNCTIONS.items() if m != "mass_matrix"}
+
+
+def test_a_method_that_reads_the_mutated_one_is_not_taken_from_the_models_generated_code():
+    """The triple pendulum's hand-written q̈ calls its generalized_force: a mutant of that force must
+    reach q̈, so q̈ runs the mutant's own Python (its generated code holds the original force)."""
+    from pathlib import Path
+
+    from pendverify.analytic.params import load_parameter_file
+    from pendverify.api import load_model
+    from pendverify.numerics.codegen.vectorised import generated
+
+    examples = Path(__file__).resolve().parents[2] / "examples"
+    cls = load_model(examples / "triple_pendulum.py")
+    params = load_parameter_file(examples / "triple_pendulum.toml", {cls.name: cls.params_type})[2]
+    sm = SymbolicModel.of(cls)
+    mutant = next(m for m in generate(sm) if m.method == "generalized_force" and m.operator == "scale")
+    module = generated(type(numeric_model(cls(params), sm, mutant.method, mutant.changes)))
+    assert "acceleration" in generated(cls).FUNCTIONS and "acceleration" not in module.FUNCTIONS
+    assert "mass_matrix" in module.FUNCTIONS  # M does not read the force: shared

@@ -17,7 +17,9 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
-from pendverify.analytic.symbolic_reading import SYMBOLIC_MATH, SymbolicModel, to_sympy
+from pendverify.analytic.symbolic_reading import SYMBOLIC_MATH, SymbolicModel, entries, to_sympy
+from pendverify.errors import PendverifyError
+from pendverify.numerics.codegen.vectorised import METHODS, NUMERIC_EDITS
 
 
 def _edited_method(cls, sm: SymbolicModel, method: str, changes, readable: bool):
@@ -54,18 +56,54 @@ def _edited_method(cls, sm: SymbolicModel, method: str, changes, readable: bool)
     return edited
 
 
+_READERS: dict[tuple, tuple[str, ...]] = {}
+
+
+def _readers(model, sm: SymbolicModel, methods: tuple[str, ...]) -> tuple[str, ...]:
+    """The model's other methods whose value reads an entry of ``methods`` (a hand-written q̈ that
+    calls M): read by SymPy on the model with every entry of ``methods`` a fresh symbol, once per
+    class and methods.  Every method, if that reading fails: then none shares generated code."""
+    cls = type(model)
+    key = (cls, methods)
+    if key not in _READERS:
+        marks = {
+            m: [(i, e, sp.Dummy(f"edited_{m}_{i}")) for i, e in enumerate(entries(sm.closed_forms[m]))]
+            for m in methods
+        }
+        symbols = {d for changes in marks.values() for _, _, d in changes}
+        others = [m for m in cls.own_methods() if m in METHODS and m not in methods]
+        try:
+            probe = SymbolicModel.of(edited_model(model, sm, marks, "Probe", readable=True).__class__)
+            readers = [
+                m
+                for m in others
+                if symbols & set().union(*map(_free, entries(probe.evaluate(m, METHODS[m]))))
+            ]
+        except PendverifyError:  # a model SymPy reads only in part: share nothing
+            readers = others
+        _READERS[key] = tuple(readers)
+    return _READERS[key]
+
+
+def _free(expr) -> set:
+    return getattr(sp.sympify(expr), "free_symbols", set())
+
+
 def edited_model(model, sm: SymbolicModel, edits: dict, name: str = "Edited", readable: bool = True):
     """``model`` with the entries of ``edits`` ({method: changes}) replaced (module docstring).
 
     ``readable=False``: SymPy cannot read the edited methods (they take floats only), so the
     checks evaluate them with their own Python state by state instead of generating NumPy code
     for each edited model (``pendverify mutate``'s hundreds of mutants: generating costs more
-    than it saves there)."""
+    than it saves there); their other methods use the model's generated code
+    (``pendverify.numerics.codegen.vectorised.generated``)."""
     cls = type(model)
     namespace = {
         method: _edited_method(cls, sm, method, changes, readable) for method, changes in edits.items()
     }
     namespace["__module__"] = cls.__module__  # messages name the model's own file
+    if not readable:  # the generated code of the methods that do not read an edited one is the model's own
+        namespace[NUMERIC_EDITS] = (cls, tuple(edits) + _readers(model, sm, tuple(edits)))
     edited = type(f"{cls.__name__}{name}", (cls,), namespace)(model.params)
     if {"gravity_scale", "diagonal_scale"} - set(cls.hand_written()):
         # derived tolerance scales stay the original's, as hand-written ones would

@@ -101,11 +101,14 @@ def is_coriolis_form(sm: SymbolicModel, method: str, value) -> bool:
     )
 
 
-def generate(sm: SymbolicModel) -> list[Mutant]:
-    """Every mutant of every declared closed form, deduplicated per method."""
+def generate(sm: SymbolicModel, methods=None) -> list[Mutant]:
+    """Every mutant of every declared closed form (of ``methods`` only, if given), deduplicated per
+    method."""
     angles, rates = sm.angles, sm.symbols["v"]
     out: list[Mutant] = []
     for method, value in sm.closed_forms.items():
+        if methods is not None and method not in methods:
+            continue
         seen: set = set()
         candidates: list[Mutant] = []
         for index, expr in enumerate(entries(value)):

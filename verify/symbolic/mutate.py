@@ -25,7 +25,17 @@ equivalent
 survived
     no check fails and no equivalence is proved: a gap in the verification.
 
-Detection rate = detected / (all − equivalent); the target is 100 %.  Before
+Detection rate = detected / (all − equivalent) over the mutants run; the target is 100 %.
+
+The work is bounded before it starts and while it runs.  The number of mutants grows with the
+size of the closed forms (a 5-link chain's M has 2 871, its C 8 339; the reference systems'
+largest form, the cart's M⁻¹, 460), and each costs a lambdification and a run of the checks
+(0.05–0.3 s on a 2-core machine, growing with the degrees of freedom).  So at most
+``PENDVERIFY_MAX_MUTANTS`` (default ``DEFAULT_MAX_MUTANTS``) mutants of each closed form run: a
+larger set is sampled with the seed, evenly over its entries and operators (every reference
+system's forms are below the bound, so they run whole); and the run stops at its wall-clock
+bound ``PENDVERIFY_MUTATE_SECONDS`` (default ``DEFAULT_MUTATE_SECONDS``), a backstop against a
+machine slower than measured.  The report says what was not run in either case.  Before
 any mutant runs, the untouched model and one *control* per method (every
 entry replaced by its own lambdified expression) must pass every check, so that
 a detection is never caused by the lambdified rounding itself.  The verdicts and the
@@ -34,6 +44,8 @@ printed report are in ``pendverify.symbolic.mutation_report``.
 
 from __future__ import annotations
 
+import itertools
+import random
 import time
 
 import numpy as np
@@ -43,10 +55,18 @@ from pendverify.checks.catalogue import CHECKS, applicable_checks, run_check
 from pendverify.checks.sampling import sample_states
 from pendverify.errors import PendverifyError, UnknownNameError
 from pendverify.progress import bar
+from pendverify.simulation.limits import environment_limit
 from pendverify.symbolic.edited import edited_model
 from pendverify.symbolic.equivalence import coriolis_equivalence, differences, equivalence
 from pendverify.symbolic.mutants import Mutant, generate, is_coriolis_form
-from pendverify.symbolic.mutation_report import DETECTED, EQUIVALENT, SURVIVED, MutationReport, Outcome
+from pendverify.symbolic.mutation_report import (
+    DETECTED,
+    EQUIVALENT,
+    SURVIVED,
+    Bounds,
+    MutationReport,
+    Outcome,
+)
 from pendverify.symbolic.zero_test import show
 
 FIRST_RANDOM = 4  # random states in the first round, after the special ones
@@ -62,6 +82,12 @@ AIMED_AT = {
     "coriolis_force": "rnea",
 }
 DEFAULT_MUTATION_STATES = 40
+MAX_MUTANTS_VARIABLE = "PENDVERIFY_MAX_MUTANTS"
+#: above the reference systems' largest form (460 mutants) so that they run whole
+DEFAULT_MAX_MUTANTS = 500
+MUTATE_SECONDS_VARIABLE = "PENDVERIFY_MUTATE_SECONDS"
+#: the backstop: the conformance matrix gives a command 300 s, and a mutant takes well under a second
+DEFAULT_MUTATE_SECONDS = 240
 
 
 # --- numeric mutants ------------------------------------------------------------------------
@@ -170,6 +196,22 @@ def _controls(model, system, sm, states, seed) -> list[str]:
     return done
 
 
+def sampled(mutants: list[Mutant], limit: int, seed: int) -> tuple[list[Mutant], dict[str, int]]:
+    """At most ``limit`` mutants per method, drawn with ``seed`` in their generated order (so spread
+    over the entries and operators), and how many each method had.  The methods take turns, so
+    that a run stopped at its wall-clock bound has run some mutants of each."""
+    generated: dict[str, list[Mutant]] = {}
+    for m in mutants:
+        generated.setdefault(m.method, []).append(m)
+    kept = []
+    for method, ms in generated.items():
+        if len(ms) > limit:
+            ms = [ms[i] for i in sorted(random.Random(f"{seed}:{method}").sample(range(len(ms)), limit))]
+        kept.append(ms)
+    turns = [m for group in itertools.zip_longest(*kept) for m in group if m is not None]
+    return turns, {method: len(ms) for method, ms in generated.items()}
+
+
 def run_mutation(
     target,
     samples: int = DEFAULT_MUTATION_STATES,
@@ -177,8 +219,13 @@ def run_mutation(
     all_checks: bool = False,
     methods: tuple[str, ...] | None = None,
 ) -> MutationReport:
-    """Generate, run and classify every mutant of ``target.model`` (of ``methods`` only, if given)."""
+    """Generate, run and classify the mutants of ``target.model`` (of ``methods`` only, if given),
+    within the bounds of the module docstring."""
     started = time.perf_counter()
+    bounds = Bounds(
+        environment_limit(MAX_MUTANTS_VARIABLE, DEFAULT_MAX_MUTANTS),
+        environment_limit(MUTATE_SECONDS_VARIABLE, DEFAULT_MUTATE_SECONDS),
+    )
     model, system = target.model, target.system
     sm = SymbolicModel.of(type(model))
     written = sm.cls.written_closed_forms()
@@ -190,10 +237,15 @@ def run_mutation(
     rounds = [r for r in (states[:first], states[first:]) if r]
     controls = _controls(model, system, sm, states, seed)
     unseen = unseen_methods(sm.cls)
-    mutants = [m for m in generate(sm) if (methods is None or m.method in methods) and m.method not in unseen]
+    wanted = [m for m in (methods or sm.closed_forms) if m not in unseen]
+    mutants, bounds.generated = sampled(generate(sm, wanted), bounds.max_mutants, seed)
     outcomes = []
     with bar(len(mutants), "mutate", "mutant") as progress:
         for m in mutants:
+            if time.perf_counter() - started > bounds.seconds:
+                for m in mutants[len(outcomes) :]:
+                    bounds.not_run[m.method] = bounds.not_run.get(m.method, 0) + 1
+                break
             outcomes.append(classify(model, system, sm, m, rounds, seed, all_checks))
             progress.update(1)
     return MutationReport(
@@ -207,6 +259,7 @@ def run_mutation(
         all_checks,
         derived_methods(sm.cls),
         unseen,
+        bounds,
     )
 
 

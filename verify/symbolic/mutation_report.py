@@ -30,6 +30,33 @@ class Outcome:
 
 
 @dataclass
+class Bounds:
+    """The bounds of a run (``pendverify.symbolic.mutate``) and what they left out."""
+
+    #: mutants run per closed form at most (a larger set is sampled)
+    max_mutants: int
+    #: the wall-clock bound [s]
+    seconds: int
+    #: mutants generated per method (before sampling)
+    generated: dict[str, int] = field(default_factory=dict)
+    #: mutants sampled but not run per method, the run having stopped at ``seconds``
+    not_run: dict[str, int] = field(default_factory=dict)
+
+    def sampled(self) -> dict[str, int]:
+        """Per method cut by ``max_mutants``: how many it had."""
+        return {m: n for m, n in self.generated.items() if n > self.max_mutants}
+
+    def as_dict(self) -> dict:
+        return {
+            "max_mutants": self.max_mutants,
+            "seconds": self.seconds,
+            "generated": self.generated,
+            "sampled": self.sampled(),
+            "not_run": self.not_run,
+        }
+
+
+@dataclass
 class MutationReport:
     model: str
     source: str
@@ -43,6 +70,7 @@ class MutationReport:
     derived: list[str] = field(default_factory=list)
     #: hand-written methods no Pinocchio check sees (B, W with a derived q̈): not mutated
     unseen: list[str] = field(default_factory=list)
+    bounds: Bounds | None = None
 
     def count(self, verdict: str, method: str | None = None) -> int:
         return sum(o.verdict == verdict and (method is None or o.method == method) for o in self.outcomes)
@@ -81,6 +109,7 @@ class MutationReport:
             "all_checks": self.all_checks,
             "derived": self.derived,
             "unseen": self.unseen,
+            "bounds": self.bounds.as_dict() if self.bounds else None,
             "elapsed_s": round(self.elapsed_s, 3),
             "outcomes": [o.as_dict() for o in self.outcomes],
         }
@@ -131,6 +160,7 @@ def format_report(report: MutationReport) -> str:
             f"not mutated (no Pinocchio check sees them: the URDF has no input map and q̈ is derived; "
             f"compared by pendverify sympy): {', '.join(report.unseen)}"
         )
+    out += bound_lines(report)
     relevant = len(report.outcomes) - report.count(EQUIVALENT)
     out.append(
         f"detection rate {report.rate:.1%} ({report.count(DETECTED)}/{relevant} non-equivalent mutants), "
@@ -138,3 +168,26 @@ def format_report(report: MutationReport) -> str:
         f"controls pass for {len(report.controls)} methods, {report.elapsed_s:.1f} s"
     )
     return "\n".join(out)
+
+
+def bound_lines(report: MutationReport) -> list[str]:
+    """What the run's bounds left out, in words (nothing when every mutant ran)."""
+    b = report.bounds
+    if b is None:
+        return []
+    out = []
+    sampled = b.sampled()
+    if sampled:
+        cut = ", ".join(f"{m} {b.max_mutants} of {n}" for m, n in sampled.items())
+        out.append(
+            f"sampled at the bound of {b.max_mutants} mutants per closed form (PENDVERIFY_MAX_MUTANTS), "
+            f"drawn with the seed: {cut}; not run: {sum(sampled.values()) - b.max_mutants * len(sampled)}"
+        )
+    if b.not_run:
+        total = len(report.outcomes) + sum(b.not_run.values())
+        left = ", ".join(f"{m} {n}" for m, n in b.not_run.items())
+        out.append(
+            f"stopped at its bound of {b.seconds} s (PENDVERIFY_MUTATE_SECONDS): {len(report.outcomes)} of "
+            f"{total} mutants run; not run: {left}"
+        )
+    return out

@@ -146,10 +146,30 @@ def render(model_cls) -> str:
     return "\n".join(header + functions + registry)
 
 
-def generated(model_cls) -> types.ModuleType:
+def generated(model_cls) -> types.ModuleType | types.SimpleNamespace:
     """The generated module of ``model_cls`` (``FUNCTIONS``, ``MISSING``): from memory, from the
     signed on-disk cache (``codegen.cache``, where a second process finds it without SymPy),
-    or generated."""
+    or generated.
+
+    A class edited numerically (``pendverify.symbolic.edited`` with ``readable=False``: a
+    mutant) shares its base's module less the edited methods and the methods that read them
+    (a hand-written q̈ calling M), which its own Python evaluates: the others are the base's
+    code, so generating them again for each of hundreds of mutants would print the same
+    functions (0.3 s each for a 5-link chain)."""
     from pendverify.numerics.codegen.cache import Family, kernel
 
+    edited = vars(model_cls).get(NUMERIC_EDITS)
+    if edited is not None:
+        base, methods = edited
+        module = generated(base)
+        why = "edited numerically (a mutant): evaluated with its own Python"
+        return types.SimpleNamespace(
+            PARAMETERS=module.PARAMETERS,
+            FUNCTIONS={m: f for m, f in module.FUNCTIONS.items() if m not in methods},
+            MISSING={**module.MISSING, **dict.fromkeys(methods, why)},
+        )
     return kernel(model_cls, family=Family("vectorised", render, numba=False)).module
+
+
+#: the class attribute of a class edited numerically: (its base, the edited methods and their readers)
+NUMERIC_EDITS = "numeric_edits"
