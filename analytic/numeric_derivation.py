@@ -78,7 +78,7 @@ K_CODE = 16
 DERIVED = (
     "M = B (∂q̈/∂u)⁻¹, H = −M q̈(q, 0, 0) and C·q̇ + H = −M q̈(q, q̇, 0) − D q̇ are derived from the "
     "code's q̈ at each state (pendverify.analytic.numeric_derivation); crba, gravity and rnea add "
-    "the derivation's rounding bound (∝ κ̃(M)² to κ̃(M)³, Pinocchio's M) to their tolerance"
+    "the derivation's rounding bound (∝ κ̃(M)², from Pinocchio's M and q̈) to their tolerance"
 )
 
 
