@@ -60,7 +60,7 @@ refused, not judged.
 
 Measured (the conformance matrix's triple pendulum of point masses and 5-link chain, 60 states
 each, κ̃ up to 400 and |θ| up to 100 rad): the derived M is within 3·10⁻¹⁴ of Pinocchio's and the
-bound above is at most 1.5·10⁻⁸ (triple) and 1.6·10⁻⁷ (chain): pessimistic by 10⁶, but below
+bound above is at most 1.5·10⁻⁸ (triple) and 1.6·10⁻⁷ (chain): pessimistic by 10⁵ to 10⁶, but below
 the trust limit; a worst case of step 1 at every call, with γ = 1 + |θ| in it, would reach
 1.3·10⁻³ and 0.19 and refuse these true models.
 """
