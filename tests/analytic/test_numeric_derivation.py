@@ -130,11 +130,15 @@ def test_code_not_affine_in_the_inputs_is_refused_naming_the_state(tmp_path):
 
 
 def test_stress_counts_the_derived_checks_refusals_as_refusals_not_failures(tmp_path):
-    """Extreme cases (|θ| ≈ 1e6 rad, r2 × 1e3) widen the derivation's bound past the trust limit
-    at some states: those checks are refused there, and every case still passes."""
+    """Extreme conditioning (r2 × 1e3, m2 × 1e6) widens the derivation's bound past the trust limit
+    at some states: those checks are refused there, and every case still passes.  |θ| ≈ 1e6 rad
+    does not: the angles' rounding is the same in every call of the derivation at a state, so it
+    reaches the derived M as a hand-written M's (the check's own tolerance), not amplified."""
     report = stress(_code(tmp_path), URDF, MINIMAL_PARAMS, quick=True)
     assert all(r.passed for r in report.results), [(r.case, r.note) for r in report.results if not r.passed]
+    extreme = next(r for r in report.results if r.case == "r2 ×1e3")
+    assert "crba, rnea, gravity refused at some states" in extreme.note, extreme.note
     large = next(r for r in report.results if r.case.startswith("|θ| ≈ 1e+06"))
-    assert "crba, rnea, gravity refused at some states" in large.note, large.note
+    assert "refused" not in large.note, large.note
     nominal = next(r for r in report.results if r.case == "nominal")
     assert not nominal.refused and "refused" not in nominal.note, nominal.note

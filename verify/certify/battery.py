@@ -27,7 +27,7 @@ import numpy as np
 
 from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
 from pendverify.certify.battery_item import BatteryItem
-from pendverify.certify.simulations import invariant_items
+from pendverify.certify.simulations import invariant_items, invariants_not_run
 from pendverify.checks.sampling import sample_states
 from pendverify.checks.verdict import REFUSED
 from pendverify.checks.verification import guarded_checks
@@ -50,10 +50,13 @@ class BatterySettings:
 @dataclass(frozen=True)
 class BatteryRun:
     """The battery's evidence on one set: every item, and what reading the URDF being
-    certified noticed (``PinocchioSystem.notes``), which its certificate records as ``notes``."""
+    certified noticed (``PinocchioSystem.notes``), which its certificate records as ``notes``;
+    ``not_run``: one sentence per part of the battery that does not apply to the model, why
+    (``invariants_not_run``), also among ``notes``."""
 
     items: list[BatteryItem]
     notes: list[str]
+    not_run: tuple[str, ...] = ()
 
     @property
     def passed(self) -> bool:
@@ -142,20 +145,23 @@ def run_battery(
     model, params: ParameterSet, urdf: str, settings: BatterySettings, engines: dict | None = None
 ) -> BatteryRun:
     """The battery for a model (a class, or a built-in model's name), its parameters and URDF:
-    its items, and the notes of the URDF read once for all of them.
+    its items, and the notes of the URDF read once for all of them, with a sentence per part
+    that does not apply to the model (``invariants_not_run``).
 
     ``engines``: effect → the engine its invariant items ran on (``recheck``: the certificate's)."""
     cls = model_class(model)
     loaded = load_urdf(urdf, f"<URDF being certified: {cls.name}>")  # read once for every part
     system = PinocchioSystem.for_model(cls, loaded, params.g)
+    not_run = invariants_not_run(cls)
     parts = (
         lambda: check_items(cls(params), system, settings),
         lambda: stress_items(cls, params, settings, loaded),
-        lambda: invariant_items(cls, params, urdf, settings, engines, system),
+        (lambda: []) if not_run else (lambda: invariant_items(cls, params, urdf, settings, engines, system)),
     )
     items = []
     with bar(len(parts), "battery", "part") as progress:  # checks, stress cases, simulations
         for part in parts:
             items += part()
             progress.update(1)
-    return BatteryRun(items, system.notes)
+    skipped = (not_run,) if not_run else ()
+    return BatteryRun(items, [*system.notes, *skipped], skipped)

@@ -33,7 +33,9 @@ checks             every battery item: name, kind (check | stress | invariant);
 summary            derived from ``checks``: items, passed, failed (names),
                    result (PASSED | FAILED), worst_item, worst_ratio
 notes              what the URDF reader noticed (angle offsets, a centre of mass
-                   off the closed form's family and the allowance it implies)
+                   off the closed form's family and the allowance it implies), and
+                   why a part of the battery does not apply to the model (a model
+                   giving q̈ alone runs no simulation: ``simulations.invariants_not_run``)
 date               UTC time of certification, ISO 8601
 signature          signed certificates only (``certify --key``): envelope (the
                    NAME.intoto.jsonl beside it), keyid (the key's fingerprint),

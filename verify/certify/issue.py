@@ -149,11 +149,13 @@ def check_sweep_names(sweep, source: str) -> None:
 @dataclass(frozen=True)
 class Issued:
     """What ``issue`` (``pendverify.certify_set``) did: every battery item's evidence and, when all
-    of them pass, the certificate written and its path."""
+    of them pass, the certificate written and its path; ``not_run``: why a part of the battery
+    did not apply to the model (``BatteryRun.not_run``)."""
 
     items: list[BatteryItem]
     certificate: dict | None = None
     path: Path | None = None
+    not_run: tuple[str, ...] = ()
 
     @property
     def certified(self) -> bool:
@@ -181,11 +183,11 @@ def issue(
     refuse_existing(output, target.name, force)
     battery = run_battery(target.model.load(), target.params, target.urdf, settings)
     if not battery.passed:
-        return Issued(battery.items)
+        return Issued(battery.items, not_run=battery.not_run)
     cert, path = write_certificate(
         target.name, target.model, target.params, target.urdf, settings, battery, output, force, key
     )
-    return Issued(battery.items, cert, path)
+    return Issued(battery.items, cert, path, battery.not_run)
 
 
 def write_certificate(

@@ -54,6 +54,25 @@ UNRECORDED = ABA  # the engine of an invariant item that records none
 CROSS_CHECK_STATES = 8
 
 
+def invariants_not_run(model_cls) -> str:
+    """Why the battery's invariant items are not run for the model; "" when its simulations apply.
+
+    A model that gives q̈ alone (``has_mass_matrix`` False: dynamics as code, a q̈ with fewer
+    inputs than coordinates) has no closed-form M, H or V: a scene refuses it
+    (``pendverify.simulation.scene.parse_scene``), the compiled path has nothing to generate, and
+    the invariants judge the model's energy, which it does not give.  On ABA alone they would judge
+    Pinocchio, not the model.  Its q̈ is judged by the core checks (``aba``; ``crba``, ``gravity``
+    and ``rnea`` on a derived M).
+    """
+    if model_cls.has_mass_matrix:
+        return ""
+    return (
+        f"invariant items not run: {model_cls.__name__} gives q̈ alone, without the closed-form M, H "
+        "and V that the battery's simulations (energy drift and balances) judge; its q̈ is judged "
+        "by the core checks"
+    )
+
+
 def invariant_items(model_cls, params, urdf: str, settings, engines=None, system=None) -> list:
     """One simulation per effect the model has, on the fast path where it compiles, else ABA on ``urdf``.
 

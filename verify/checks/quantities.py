@@ -110,13 +110,23 @@ class Terms:
 
     @cached_property
     def derivation(self):
-        """(crba's, gravity's and rnea's) relative rounding bounds of forms the model derives from its
-        q̈ (``pendverify.analytic.numeric_derivation``), from Pinocchio's M; zeros for any other model."""
+        """(crba's, gravity's, rnea's) relative rounding bounds of forms the model derives from its q̈
+        (``pendverify.analytic.numeric_derivation``), from Pinocchio's M, H and forces; zeros for any
+        other model."""
         if not self.batch.model.mass_from_acceleration:
-            return 0.0, 0.0
+            return 0.0, 0.0, 0.0
         model = self.batch.model
         steps = np.array([model.derivation_steps(q) for q in self.q])
-        return rounding_bounds(self.M_pin, self.S, self.B, self.g_scale, self.batch.angle, steps)
+        force = -(self.bias_pin + self.v @ np.asarray(self.D, dtype=float).T)  # M q̈(q, q̇, 0), Pinocchio's
+        return rounding_bounds(
+            self.M_pin, self.S, self.B, self.g_scale, steps, self.H_pin, force, self.rnea_scale
+        )
+
+    @cached_property
+    def rnea_scale(self):
+        """The size of the terms rnea compares at each state: rates times Σ|q̇ᵢ/wᵢ|, plus gravity's."""
+        gravity = np.max(self.w * self.g_scale, axis=-1)
+        return (self.rate + self.d_rate) * total(np.abs(self.v / self.w)) + gravity
 
     @cached_property
     def D_urdf(self):
@@ -251,13 +261,12 @@ def measure_crba(t):
 def measure_rnea(t):
     w = t.w
     entries = w * np.abs(t.bias_pin - t.bias_hand)
-    scale = (t.rate + t.d_rate) * total(np.abs(t.v / w)) + np.max(w * t.g_scale, axis=-1)
     return Measure(
         np.max(entries, axis=-1),
-        scale,
+        t.rnea_scale,
         np.max(w * t.allowance, axis=-1),
         entries=entries,
-        derived=t.derivation[1],
+        derived=t.derivation[2],
     )
 
 

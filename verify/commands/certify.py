@@ -145,6 +145,8 @@ def run_certify(args: argparse.Namespace) -> int:
     issued = issue(target, settings, args.output, args.force, _key(args))
     if not args.quiet:
         _print_items(issued.items)
+        for sentence in issued.not_run:
+            print(sentence)
     if args.json:
         write_json_report(args, _certify_json(issued))
     if not issued.certified:

@@ -23,7 +23,7 @@ from pendverify.stress.framework import (
     Context,
     StressResult,
     compare,
-    error_ratio,
+    judged_ratio,
     model_of,
     refusals_as_expected,
     sampled_states,
@@ -98,7 +98,7 @@ def large_angle_case(
             invariant = f"2πk invariance: no state could be verified; |θ| up to {angle:.3g} rad"
             note = "" if inv_ok else "FAIL invariance: every state refused"
             return stress_result(name, direct, expect, invariant, inv_ok, note)
-        inv_worst = max(invariance.results, key=error_ratio)
+        inv_worst = max(invariance.results, key=judged_ratio)
         invariant = (
             f"2πk invariance (closed form at θ vs Pinocchio at θ mod 2π): {inv_worst.max_error:.2g} "
             f"≤ {inv_worst.tolerance:.2g} ({inv_worst.check}); |θ| up to {angle:.3g} rad"
