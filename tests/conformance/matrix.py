@@ -23,6 +23,7 @@ The full product is ``PENDVERIFY_CONFORMANCE=full``; otherwise ``sample()`` take
   outside ``LIGHT_FORMATS``, or running one twice, is drawn again (seeded), since those cells cost
   the most (measured on a loaded 2-core machine: ``sympy`` on chain5's text model 39 s, ``check``
   on its whole equations 37 s, where a light pairing takes 0.1–3 s);
+* ``bench accuracy``: the cells of ``certify+recheck`` (``SAME_CELLS``), whose compiled code it reuses;
 * ``show --robot``, which reads no model: once per system and description.
 """
 
@@ -56,6 +57,10 @@ CORE = ("check", "check planted")
 #: the systems with the longest closed forms (5 and 3 joints): SymPy reading their text models,
 #: and ``sympy``'s derivation, dominate a run
 HEAVY_SYSTEMS = ("chain5", "triple_pendulum")
+#: command → the command whose cells it takes (same system, format and description): both compile
+#: the model's generated code with numba (~20–100 s a model, the run's largest cost), which the
+#: code cache keeps for the second (it keys on the model file's name and contents)
+SAME_CELLS = {"bench accuracy": "certify+recheck"}
 #: the formats a heavy system is paired with outside ``CORE``: Python code, which pendverify imports
 #: rather than parses with SymPy
 LIGHT_FORMATS = ("class", "class_object_arrays", "dynamics_f", "dynamics_qddot", "numpy_functions")
@@ -170,6 +175,10 @@ def sample() -> list[Cell]:
         rng = random.Random(SEED + index)
         if command in MODEL_FREE:
             cells += [Cell(s, "-", command, d) for s in systems for d in descriptions(SYSTEMS[s])]
+            continue
+        if command in SAME_CELLS:
+            same = [c for c in cells if c.command == SAME_CELLS[command]]
+            cells += [dataclasses.replace(c, command=command) for c in same]
             continue
         pairs = (
             [(s, f) for s in systems for f in formats] if command in CORE else _pairing(rng, systems, formats)
