@@ -14,7 +14,8 @@ evaluates it at seeded numbers: the Christoffel C and the Kane forcing are indep
 Symbols are plain: q1…qn, their rates dq1…dqn, the parameters by name, inputs tau1….  Entries
 are rewritten by ``_tidy`` so that the files written from them stay short.  ``closed_forms(name)`` is cached
 in-process and on disk (a pickle keyed by the digest of this module, ``derivation.py`` and
-``systems.py``) so the derivation runs once per session, and once per edit across sessions.
+``systems.py``, in a folder private to the user: ``_private_folder``) so the derivation runs once
+per session, and once per edit across sessions.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ import functools
 import hashlib
 import os
 import pickle
+import stat
 import tempfile
 from pathlib import Path
 
@@ -105,17 +107,38 @@ def _digest() -> str:
     return h.hexdigest()[:16]
 
 
+def _private_folder() -> Path | None:
+    """The folder of the pickles: ``pendverify-conformance-<uid>`` in the temporary folder, mode
+    0700.  A pickle runs code when loaded, so one is read only from a folder this user owns and
+    nobody else can write (else None: derive without a cache); the shared temporary folder
+    itself is writable by every user."""
+    uid = os.getuid()
+    folder = Path(tempfile.gettempdir()) / f"pendverify-conformance-{uid}"
+    try:
+        folder.mkdir(mode=0o700, exist_ok=True)
+        info = folder.lstat()
+    except OSError:
+        return None
+    private = stat.S_ISDIR(info.st_mode) and info.st_uid == uid and not info.st_mode & 0o077
+    return folder if private else None
+
+
 @functools.cache
 def closed_forms(name: str) -> ClosedForms:
-    """The closed forms of system ``name``, derived once (module docstring)."""
-    path = Path(tempfile.gettempdir()) / f"pendverify-conformance-{_digest()}-{name}.pickle"
+    """The closed forms of system ``name``, derived once (module docstring).  Written atomically
+    (a temporary file renamed into place), so xdist workers deriving the same system at once
+    each read a whole pickle or none."""
+    folder = _private_folder()
+    if folder is None:
+        return _derive(name)
+    path = folder / f"{_digest()}-{name}.pickle"
     if path.is_file():
         try:
             return pickle.loads(path.read_bytes())
         except Exception:  # a torn or stale pickle: derive again
             pass
     forms = _derive(name)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp")
+    fd, tmp = tempfile.mkstemp(dir=folder, prefix=path.name, suffix=".tmp")
     with os.fdopen(fd, "wb") as f:
         f.write(pickle.dumps(forms))
     os.replace(tmp, path)

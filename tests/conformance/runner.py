@@ -80,7 +80,16 @@ def command_lines(command: str, files: Files, keys: Path) -> list[list[str]]:
         "simulate": lambda: [["simulate", str(files.scene())]],
         "render": lambda: [["render", str(files.scene()), "-o", str(tmp / "out.html")]],
         "report": lambda: [
-            ["report", "-o", str(tmp / "review"), "--scenes", str(files.scene().parent), "--samples", "20"]
+            [
+                "report",
+                "-o",
+                str(tmp / "review"),
+                "--scenes",
+                str(files.scene().parent),
+                "--samples",
+                "20",
+                "--no-erd",
+            ]
         ],
         "certify+recheck": lambda: _certify(files, keys),
         "stress": lambda: [["stress", *files.analytic(), "--quick"]],

@@ -108,3 +108,16 @@ def test_a_planted_entry_is_caught_by_the_generator_check():
     q = np.array([0.3, -0.7])
     with pytest.raises(AssertionError):
         _close(M(q), pin.crba(model, model.createData(), _pinocchio_q(model, q)), "planted")
+
+
+def test_pickles_are_read_only_from_a_private_folder(tmp_path, monkeypatch):
+    """A folder others can write (a planted pickle would run its code when loaded) is not used."""
+    import tempfile
+
+    from tests.conformance import closed_forms as module
+
+    monkeypatch.setattr(tempfile, "gettempdir", lambda: str(tmp_path))
+    folder = module._private_folder()
+    assert folder is not None and (folder.stat().st_mode & 0o777) == 0o700
+    folder.chmod(0o777)
+    assert module._private_folder() is None
