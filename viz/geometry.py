@@ -190,12 +190,15 @@ class VisualSystem:
 
         For a cart, the rail's direction points to the right of the screen; for a
         fixed-base chain, the horizontal h = up × a of ``pendverify.robot.system`` does.
+        The first joint that fixes a plane decides: a hinge (its axis), or a slider whose rail
+        is not vertical; a vertical slider (a lift) moves in every vertical plane, so the
+        joints after it decide, and a robot of vertical sliders alone is seen along −y.
         """
         model, data = self.system.model, self.system.data
-        # joint 1's motion: linear part for a slider, angular for a hinge
-        motion = joint_jacobians(model, data, pin.neutral(model))[:, 0]
-        if np.linalg.norm(motion[3:]) == 0.0:
-            normal = np.cross(motion[:3], UP)  # then up × normal = the rail's direction
-        else:
-            normal = motion[3:]  # then up × normal = h
-        return normal / np.linalg.norm(normal)
+        motions = joint_jacobians(model, data, pin.neutral(model))
+        for motion in motions.T:  # each joint's motion: linear part for a slider, angular for a hinge
+            normal = np.cross(motion[:3], UP) if np.linalg.norm(motion[3:]) == 0.0 else motion[3:]
+            size = np.linalg.norm(normal)  # then up × normal = the rail's direction, or h
+            if size > 1e-9 * max(np.linalg.norm(motion), 1.0):
+                return normal / size
+        return np.array([0.0, -1.0, 0.0])
