@@ -33,6 +33,8 @@ import dataclasses
 import os
 import random
 
+import sympy as sp
+
 from tests.conformance.formats import FORMATS, Plant
 from tests.conformance.systems import SEED, SYSTEMS, descriptions
 
@@ -71,6 +73,11 @@ SCENE_COMMANDS = ("simulate", "render", "report", "bench accuracy")
 _NOT_SYMBOLIC = "SymPy does not read code: refused in one line (docs/models.md, 'Dynamics as code')"
 _NO_CLOSED_M = "a scene refuses a model without a closed-form M (docs/models.md, 'Dynamics as code')"
 
+_NO_CODE_FROM_FUNCTIONS = (
+    "bench accuracy --scene generates code from SymPy's reading of the model; NumPy functions are not "
+    "read by SymPy: refused in one line (docs/models.md, 'NumPy functions')"
+)
+
 _STRESS_URDF = (
     "stress --analytic rewrites the robot file's numbers for its cases: an MJCF is refused in one line "
     "('an MJCF description, but stress --analytic rewrites a URDF's numbers: give a URDF or xacro file')"
@@ -81,8 +88,15 @@ _STRESS_URDF = (
 EXPECTED: dict[tuple[str, str, str], tuple[int, str]] = {
     **{(f, c, "*"): (2, _NOT_SYMBOLIC) for f in NUMERIC_ONLY for c in ("show", "sympy", "mutate")},
     **{(f, c, "*"): (2, _NO_CLOSED_M) for f in DYNAMICS_CODE for c in SCENE_COMMANDS},
+    ("numpy_functions", "bench accuracy", "*"): (2, _NO_CODE_FROM_FUNCTIONS),
     ("*", "stress", "mjcf"): (2, _STRESS_URDF),
 }
+#: formats that give no V: pendverify integrates V from H when it reads the file
+V_FROM_H = ("equations", "matrix_equation", "mechanics")
+_NOT_A_GRADIENT = (
+    "a planted H that is not the gradient of any potential, in a format whose V is integrated from H, "
+    "is refused at reading in one line naming H ('is not the gradient of any potential … give V as well')"
+)
 #: formats whose C reaches pendverify as the force C·q̇ only (split from a forcing)
 C_AS_FORCE = ("equations", "mechanics")
 
@@ -97,6 +111,22 @@ def expected_exit(format_name: str, command: str, description: str) -> tuple[int
         if key in EXPECTED:
             return EXPECTED[key]
     return default
+
+
+def planted_refusal(format_name: str, plant: Plant, system_name: str) -> tuple[int, str] | None:
+    """(2, reason) where a planted H can have no potential and the format's V comes from H, else None.
+
+    Whether the planted H is still a gradient (∂H_i/∂q_j = ∂H_j/∂q_i) is decided from the derived
+    closed forms, not assumed: scaling an entry that depends on its own coordinate alone keeps it one."""
+    if plant.matrix != "H" or format_name not in V_FROM_H:
+        return None
+    from tests.conformance.closed_forms import closed_forms
+
+    forms = plant.apply(closed_forms(system_name))
+    jacobian = forms.H.jacobian(list(forms.q))
+    if all(sp.simplify(jacobian[i, j] - jacobian[j, i]) == 0 for i in range(len(forms.q)) for j in range(i)):
+        return None
+    return 2, _NOT_A_GRADIENT
 
 
 def expected_names(format_name: str, plant: Plant) -> tuple[str, ...]:

@@ -26,6 +26,7 @@ from tests.conformance.matrix import (
     expected_names,
     full_product,
     plant_for,
+    planted_refusal,
     sample,
     selected,
     summary,
@@ -72,6 +73,9 @@ def test_cell(cell: Cell, tmp_path, signing_keys, capsys):
     plant = plant_for(cell.system) if cell.command == "check planted" else None
     files = Files(tmp_path, system, cell.format, cell.description, Model(system, cell.description, plant))
     status, reason = expected_exit(cell.format, cell.command, cell.description)
+    refusal = plant and planted_refusal(cell.format, plant, cell.system)
+    if refusal:
+        status, reason = refusal
     for argv in command_lines(cell.command, files, signing_keys):
         got, printed = run(argv, capsys)
         where = f"{cell.id}: pendverify {shlex.join(argv)} (files in {tmp_path})"
@@ -81,7 +85,8 @@ def test_cell(cell: Cell, tmp_path, signing_keys, capsys):
         if status == 2:
             errors = [line for line in printed.splitlines() if line.startswith("pendverify: error:")]
             assert len(errors) == 1, f"{where}: a refusal is one 'pendverify: error:' line:\n{_tail(printed)}"
-        if plant is not None:
+            assert not refusal or "key 'H'" in errors[0], f"{where}: the refusal names H:\n{errors[0]}"
+        if plant is not None and not refusal:
             names = expected_names(cell.format, plant)
             diagnosis = [line for line in printed.splitlines() if line.startswith("diagnosis")]
             assert not names or any(n in line for line in diagnosis for n in names), (
