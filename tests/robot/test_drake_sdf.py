@@ -196,7 +196,8 @@ def test_drakes_example_is_certified_and_rechecked(tmp_path, case):
         tmp_path / "out", urdf=path, urdf_params=params_file(params, "right"), analytic=model_file, samples=20
     )
     assert issued.certified, f"{case}: {[(i.name, i.status) for i in issued.items]}"
-    assert (issued.path.parent / Path(path).name).read_text() == Path(path).read_text()
+    bundle = issued.path.name.removesuffix(".cert.json")  # the set's name: the model's, then the file's
+    assert issued.path.with_name(bundle + Path(path).suffix).read_text() == Path(path).read_text()
     assert api.recheck(issued.path, run_embedded_code=True).passed
     wrong = {**params, mass: params[mass] * 1.01}
     refused = api.certify_set(
