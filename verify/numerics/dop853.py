@@ -37,7 +37,13 @@ SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
 ERROR_EXPONENT = -1.0 / 8.0  # error estimator of order 7
 
 # status codes of the stepper
-OK, STEP_TOO_SMALL, NOT_FINITE = 0, -1, -2
+OK, STEP_TOO_SMALL, NOT_FINITE, TOO_MANY_STEPS = 0, -1, -2, -3
+#: accepted steps after which a run stops (TOO_MANY_STEPS): a work bound, not an accuracy one.  A
+#: step is 12 evaluations of the right-hand side (about 1 µs each for these models), so this is
+#: about a minute of work; a stiff run near t = 0, where 10 ulp of t is ~1e-323 and the step-size
+#: floor never bites, would otherwise creep towards t_end forever (a certificate with a damping of
+#: 1e300 did).
+MAX_STEPS = 5_000_000
 
 
 # --- DOP853 ------------------------------------------------------------------------------
@@ -214,4 +220,7 @@ def _dop853(P, y, t_end, rtol, atol, t_out, out, st, sx):
             st[nrec] = t
             sx[nrec] = y
         nrec += 1
+        if steps >= MAX_STEPS and t < t_end:
+            status = TOO_MANY_STEPS
+            break
     return nfev, steps, rejected, status, nrec

@@ -58,7 +58,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pendverify.numerics.codegen.cache import record_compiled
-from pendverify.numerics.dop853 import OK, STEP_TOO_SMALL
+from pendverify.numerics.dop853 import MAX_STEPS, OK, STEP_TOO_SMALL, TOO_MANY_STEPS
 from pendverify.numerics.generate import GeneratedSystem, distinct_modules
 
 __all__ = ["FastResult", "integrate", "integrate_ensemble", "warm_up"]
@@ -98,7 +98,10 @@ def integrate(system: GeneratedSystem, x0, t_end, rtol, atol, t_out=None, record
         cap = rows  # the run is deterministic: the second pass fits exactly
     record_compiled()  # numba's files of a first call go into the cache's signed record
     if status != OK:
-        why = "step size fell below 10 ulp" if status == STEP_TOO_SMALL else "non-finite error estimate"
+        why = {
+            STEP_TOO_SMALL: "step size fell below 10 ulp",
+            TOO_MANY_STEPS: f"stopped at its bound of {MAX_STEPS} steps before t_end",
+        }.get(status, "non-finite error estimate")
         raise RuntimeError(f"fast-path DOP853 failed: {why} (rtol {rtol:g}, atol {atol:g})")
     rows = rows if record else 1
     st, sx = (st[:rows], sx[:rows]) if record else (np.zeros(1), x0[None, :].copy())
