@@ -41,8 +41,8 @@ OK, STEP_TOO_SMALL, NOT_FINITE, TOO_MANY_STEPS = 0, -1, -2, -3
 #: accepted steps after which a run stops (TOO_MANY_STEPS): a work bound, not an accuracy one.  A
 #: step is 12 evaluations of the right-hand side (about 1 µs each for these models), so this is
 #: about a minute of work; a stiff run near t = 0, where 10 ulp of t is ~1e-323 and the step-size
-#: floor never bites, would otherwise creep towards t_end forever (a certificate with a damping of
-#: 1e300 did).
+#: floor never bites, would otherwise creep towards t_end for ever (the recheck of a forged
+#: certificate in the fuzz tests ran for over 15 minutes in this loop).
 MAX_STEPS = 5_000_000
 
 
