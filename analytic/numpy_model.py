@@ -283,7 +283,7 @@ def numpy_model(
     """
     # deferred on purpose: SymPy (the declaration's reader) loads only for such a model file
     from pendverify.analytic.python_dynamics import require_gravity_named_g
-    from pendverify.analytic.text_model import class_name_of, parameter_type
+    from pendverify.analytic.text_model import class_name_of, declared_attributes, parameter_type
     from pendverify.analytic.text_parse import DECLARATION_KEYS, Reader, read_text_document
 
     path = Path(str(source))
@@ -332,15 +332,7 @@ def numpy_model(
     class_name = class_name_of(spec)
     params_type = parameter_type(spec, class_name)
     namespace: dict[str, Any] = {
-        "name": spec.name,
-        "params_type": params_type,
-        "coordinates": spec.coordinates,
-        "angular": spec.angular,
-        "inputs": spec.inputs,
-        "disturbances": spec.disturbances,
-        "urdf_joints": spec.urdf_joints,
-        "joint_transform": spec.joint_transform,
-        "joint_offset": spec.joint_offset,
+        **declared_attributes(spec, params_type),
         "functions": dict(functions),
         "source": _resolved(str(path)),
     }

@@ -302,6 +302,22 @@ def class_name_of(spec: TextModelSpec) -> str:
     return "".join(part.capitalize() for part in spec.name.split("_")) or "TextModel"
 
 
+def declared_attributes(spec: TextModelSpec, params_type: type[ParameterSet]) -> dict[str, object]:
+    """The class attributes a declaration gives every model built from it: its name, parameter set,
+    coordinates, inputs, disturbances and map to the URDF's joints."""
+    return {
+        "name": spec.name,
+        "params_type": params_type,
+        "coordinates": spec.coordinates,
+        "angular": spec.angular,
+        "inputs": spec.inputs,
+        "disturbances": spec.disturbances,
+        "urdf_joints": spec.urdf_joints,
+        "joint_transform": spec.joint_transform,
+        "joint_offset": spec.joint_offset,
+    }
+
+
 def build_model_class(
     spec: TextModelSpec, module: types.ModuleType | None = None, base: type[ClosedFormModel] | None = None
 ) -> type[ClosedFormModel]:
@@ -319,15 +335,7 @@ def build_model_class(
         sys.modules[module.__name__] = module
     params_type = parameter_type(spec, class_name)
     namespace = {
-        "name": spec.name,
-        "params_type": params_type,
-        "coordinates": spec.coordinates,
-        "angular": spec.angular,
-        "inputs": spec.inputs,
-        "disturbances": spec.disturbances,
-        "urdf_joints": spec.urdf_joints,
-        "joint_transform": spec.joint_transform,
-        "joint_offset": spec.joint_offset,
+        **declared_attributes(spec, params_type),
         "text_spec": spec,
         "how_to_name_joints": _how_to_name_joints(spec),
         "energies": _energies,
