@@ -11,7 +11,7 @@ search or a parameter identification run on it anyway must find nothing.
 
 from __future__ import annotations
 
-from pendverify.bench.explain import run_explain_bench, shipped_targets
+from pendverify.bench.explain import corpus_targets, run_explain_bench
 from pendverify.bench.explain_report import table
 from pendverify.checks.batch import CheckBatch
 from pendverify.checks.sampling import sample_states
@@ -36,7 +36,7 @@ def test_planted_errors_are_named_and_repaired(capsys):
 
 
 def test_untouched_models_get_no_repair_and_no_parameter_claim():
-    for label, model, system, _ in shipped_targets():
+    for label, model, system, _ in corpus_targets():
         batch = CheckBatch(model, system, sample_states(model, CORPUS_SAMPLES, CORPUS_SEED))
         repairs, why = search_repair(batch, 10.0)
         assert repairs == [] and "no single entry" in why, label

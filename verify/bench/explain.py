@@ -1,7 +1,8 @@
 """``pendverify bench explain``: how well the diagnosis names and repairs planted errors, and its cost.
 
 The corpus of ``pendverify.diagnosis.corpus`` on every model file the worked examples ship
-(the Python class, and the same model as LaTeX or text where one is shipped), each against
+(the Python class, and the same model as LaTeX or text where one is shipped) and on the models
+of ``examples/diagnosis_corpus.toml`` (one per class of model the examples do not cover), each against
 its URDF and parameter set: per model, how many planted errors the checks detect, how many
 the diagnosis names at the right entry, repairs (confirmed by every check) and restores (the
 planted edit or an equivalent one), whether the untouched model is clean, and the time a
@@ -11,6 +12,7 @@ diagnosis takes (mean and largest, per planted error, on one core).  ``quick`` d
 
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass
 
 from pendverify.diagnosis.corpus import CORPUS_SEED, ModelScores, plants, sample_plants, score_model
@@ -48,19 +50,55 @@ class ExplainBench:
         } | {"planted": sum(len(m.scores) for m in self.models)}
 
 
-def shipped_targets():
-    """(label, model, system, degrees of freedom) of every model file the worked examples ship."""
+#: the shipped list of the corpus's models besides the worked examples, one per class of model
+CORPUS_CATALOGUE = "diagnosis_corpus.toml"
+
+
+def _target(model_file, urdf, params_file):
+    """(model, system) of a model file checked against ``urdf`` with the parameters of ``params_file``."""
     from pendverify.analytic.plugin import load_model_class
     from pendverify.robot.system import PinocchioSystem
     from pendverify.targets import parameter_values
+
+    cls = load_model_class(str(model_file))
+    params = parameter_values(cls, params_file)
+    return cls(params), PinocchioSystem.for_model(cls, urdf, getattr(params, "g", None))
+
+
+def shipped_targets():
+    """(label, model, system, degrees of freedom) of every model file the worked examples ship."""
     from pendverify.worked_examples import EXAMPLES
 
     for example in EXAMPLES:
         for file in example.models:
-            cls = load_model_class(str(file.source))
-            params = parameter_values(cls, example.params.source)
-            system = PinocchioSystem.for_model(cls, example.urdf.source, getattr(params, "g", None))
-            yield f"{example.name}, {file.role}", cls(params), system, example.dof
+            model, system = _target(file.source, example.urdf.source, example.params.source)
+            yield f"{example.name}, {file.role}", model, system, example.dof
+
+
+def class_targets():
+    """(label, model, system, degrees of freedom) of every model of ``CORPUS_CATALOGUE``; the label
+    names its class: ``"acrobot_tedrake (non-Christoffel C)"``."""
+    from pendverify.shipped import shipped_file
+
+    if sys.version_info >= (3, 11):
+        import tomllib
+    else:  # pragma: no cover - exercised on Python 3.10 only
+        import tomli as tomllib
+
+    def shipped(spec: str):
+        kind, _, name = spec.partition("/")
+        return shipped_file(kind, name)
+
+    catalogue = tomllib.loads(shipped("examples/" + CORPUS_CATALOGUE).read_text(encoding="utf-8"))
+    for entry in catalogue.get("model", ()):
+        model, system = _target(shipped(entry["model"]), shipped(entry["urdf"]), shipped(entry["params"]))
+        yield f"{entry['name']} ({entry['class']})", model, system, entry["dof"]
+
+
+def corpus_targets():
+    """Every model the corpus plants errors in: the worked examples' files, then the classes'."""
+    yield from shipped_targets()
+    yield from class_targets()
 
 
 def run_explain_bench(quick: bool = False) -> ExplainBench:
@@ -68,7 +106,7 @@ def run_explain_bench(quick: bool = False) -> ExplainBench:
     from pendverify.analytic.symbolic_reading import SymbolicModel
     from pendverify.progress import bar
 
-    targets = list(shipped_targets())
+    targets = list(corpus_targets())
     chosen = {}
     for label, model, _, _ in targets:
         sm = SymbolicModel.of(type(model))
