@@ -43,7 +43,7 @@ from pendverify.analytic.parameter_set import check_value
 from pendverify.analytic.plugin import load_model_class, validate_model_class
 from pendverify.checks.report import CheckReport
 from pendverify.checks.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
-from pendverify.checks.verification import build_report
+from pendverify.checks.verification import build_report, model_report
 from pendverify.display import REPR_LIMIT, html_table, shortened
 from pendverify.errors import InputError, PendverifyError, UnknownNameError, missing_file
 from pendverify.robot import erd as erd_data
@@ -314,7 +314,11 @@ def check(
       (``--params``); ``check(params="file.toml")`` takes the model the file names;
     * ``check(model, urdf, params)``: the URDF against the closed form of the parameters
       (``--model``/``--analytic`` with ``--urdf`` and ``--params``); without ``params``, a
-      built-in model reads its parameters off the URDF.  A model file or class needs ``urdf``.
+      built-in model reads its parameters off the URDF;
+    * ``check(model)``, a model file or class without ``urdf``: its ``units`` check alone (one
+      dimension per entry, from the parameters' kinds: ``pendverify.checks.units``), which needs
+      no robot; a model SymPy cannot read needs ``urdf``.  Every report with a model SymPy reads
+      has its ``units`` row first.
 
     ``model``, ``params`` and ``urdf`` are taken as ``load_model``, ``load_params`` and
     ``load_urdf`` take them (``urdf`` may also be ``erd:NAME``).  ``samples`` random states are
@@ -344,6 +348,14 @@ def check(
             )
         model, urdf = None, model
     model_cls = None if model is None else load_model(model, declaration)
+    if urdf is None and model_cls is not None and not is_builtin(model_cls):
+        # a model alone: what its own expressions can show, the units (checks.verification.model_report)
+        if params is not None:
+            parameter_values(model_cls, params)  # a parameter file given is read, and refused if bad
+        report = model_report(model_cls, seed)
+        report.strict, report.explain = strict, explain
+        report.elapsed_s = time.perf_counter() - started
+        return CheckReport.from_report(report)
     if urdf is not None and not erd_data.is_erd_spec(urdf):
         urdf = _urdf_arg(urdf)
     selection = select_targets(model_cls, urdf, params, erd_urdfs=erd)

@@ -125,7 +125,9 @@ class System:
                     kinds[c] = "inertia"
             if joint["damping"]:
                 kinds[joint["damping"]] = "damping"
-        kinds.update(dict.fromkeys(self.armatures(description), "inertia"))
+        # an armature adds to M's diagonal: a rotor inertia (kg·m²) on a hinge, a mass (kg) on a slide
+        for a, (kind, _) in zip(self.armatures(description), self.joints, strict=False):
+            kinds[a] = "mass" if kind == "prismatic" else "inertia"
         kinds["g"] = "gravity"
         return kinds
 
@@ -156,7 +158,7 @@ SYSTEMS = {
 def _draw(rng: np.random.Generator, name: str, values: dict[str, float]) -> float:
     """One parameter's value: masses 0.3–2 kg, lengths 0.3–1 m, offsets 30–70 % of the link,
     inertias 0.8–1.2 × m l²/12 (an axial one a tenth of
-    that, K 0.9–1 × I: the triangle inequality MuJoCo asks), dampers 0.01–0.1, armatures 0.005–0.02 kg·m²."""
+    that, K 0.9–1 × I: the triangle inequality MuJoCo asks), dampers 0.01–0.1, armatures 0.005–0.02 kg·m² (kg on a slide)."""
     kind, index = name[0], name[1:]
     if kind == "m":
         return rng.uniform(0.3, 2.0)

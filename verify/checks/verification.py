@@ -2,6 +2,9 @@
 
 For each target (a closed-form model and a URDF in Pinocchio):
 
+0. the ``units`` check reads the model alone (``pendverify.checks.units``): one dimension per
+   entry, its place's; it needs no robot file, and ``model_report`` runs it alone for a model
+   given without one;
 1. the sampled states are guarded by the trust rule of ``pendverify.checks.trust``
    (the one ``pendverify stress`` uses); a state beyond it is not compared, and
    every check that could have been judged only there is ``refused``;
@@ -21,6 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from pendverify.analytic.source_file import where
 from pendverify.checks.applicability import derived_notes
 from pendverify.checks.batch import CheckBatch
 from pendverify.checks.catalogue import applicable_checks, run_checks, skipped_notes
@@ -28,8 +32,10 @@ from pendverify.checks.report import Report
 from pendverify.checks.result import CheckResult
 from pendverify.checks.sampling import sample_states
 from pendverify.checks.trust import REFUSE_REL, Verdicts, check_conditioning
+from pendverify.checks.units import NAME as UNITS
+from pendverify.checks.units import units_check
 from pendverify.checks.verdict import FAIL, REFUSED, WARN, apply_strict, non_christoffel_c
-from pendverify.errors import IllConditionedError
+from pendverify.errors import IllConditionedError, PendverifyError
 from pendverify.progress import bar
 from pendverify.robot.geometry import MODEL_FORM_RTOL
 
@@ -136,16 +142,20 @@ def per_state_note(per_state: dict[str, str]) -> list[str]:
 def verify_target(report: Report, target, samples: int, seed: int) -> None:
     """Verify one target and add its results, notes, warnings and diagnoses to ``report``."""
     label = target.label
+    units, units_notes = units_check(label, type(target.model), seed)  # the model alone, first
     states = sample_states(target.model, samples, seed)
     report.states[label] = len(states)
     report.sources[label] = target.source
     notes = (
-        target.system.notes
+        units_notes
+        + target.system.notes
         + target.notes
         + skipped_notes(target.model, target.system)
         + derived_notes(target.model)
     )
     results, refused, per_state, batch = guarded_checks(label, target.model, target.system, states, seed)
+    if units is not None:
+        results.insert(0, units)
     notes += per_state_note(per_state)
     kept = len(refused) < len(states)
     if refused:
@@ -164,7 +174,8 @@ def verify_target(report: Report, target, samples: int, seed: int) -> None:
         warnings.append(sentence)
     if report.strict:
         apply_strict(results)
-    failing = [r for r in results if r.status == FAIL and r.check != "model-form"]
+    # the diagnosis compares values with Pinocchio's: the URDF's own terms and the units are not values
+    failing = [r for r in results if r.status == FAIL and r.check not in ("model-form", UNITS)]
     if failing and kept and report.explain and not target.model.has_mass_matrix:
         notes.append("not explained: the diagnosis compares M, C·q̇ and H, which q̈ alone does not give")
     elif failing and kept and report.explain:
@@ -179,6 +190,28 @@ def verify_target(report: Report, target, samples: int, seed: int) -> None:
     if warnings:
         report.warnings[label] = warnings
     report.results += results
+
+
+def model_report(model_cls, seed: int) -> Report:
+    """The report of a model given without a robot description: its ``units`` row alone (what the
+    model's own expressions can show), labelled with the model's name, and a sentence naming the
+    checks that need a robot description."""
+    label = model_cls.name
+    report = Report(seed=seed, states={label: 0}, results=[])
+    units, notes = units_check(label, model_cls, seed)
+    if units is None:  # nothing the model alone can show: as before, a robot description is needed
+        raise PendverifyError(
+            f"{where(model_cls)}: give --urdf (urdf= in the Python API): the URDF to verify "
+            f"{model_cls.name} against ({'; '.join(notes)})"
+        )
+    report.results.append(units)
+    if notes:
+        report.notes[label] = notes
+    report.skipped.append(
+        "the checks against Pinocchio (crba, rnea, gravity, ...) need a robot description: "
+        "give --urdf FILE (urdf= in the Python API)"
+    )
+    return report
 
 
 def build_report(

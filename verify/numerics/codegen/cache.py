@@ -9,7 +9,8 @@ copied templates), never on parameter values.  Its numba functions are
 index (``codegen.signed``) maps a *model key* — the SHA-256 of the source files that
 define the model class, its bases and its parameter set (and of the modules they use
 from outside the standard library and site-packages), of the generator package, of the
-symbolic reader and of the template modules, and of pendverify's and SymPy's versions —
+symbolic reader, of the template modules and of the units reading (``SOURCES``), and of
+pendverify's and SymPy's versions —
 to that digest, so that a second process neither reads the model with SymPy nor
 compiles again.  A model whose formulas depend on code the key does not see may pass
 ``fresh=True``.
@@ -51,6 +52,11 @@ SOURCES = (
     "pendverify.symbolic.zero_test",
     "pendverify.numerics.dop853",
     "pendverify.numerics.fixedstep",
+    # the units reading (family ``units``) and the notation and entry labels its messages use
+    "pendverify.checks.dimensions",
+    "pendverify.checks.units",
+    "pendverify.diagnosis.notation",
+    "pendverify.diagnosis.slots",
 )
 
 
