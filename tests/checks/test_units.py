@@ -148,7 +148,7 @@ def test_each_place_of_a_cart_pole_has_its_mixed_units():
 
 
 # --- what is decided and what is not ---------------------------------------------------------------
-m, l, g, b, k, theta = sp.symbols("m l g b k theta", positive=True)
+m, l, g, b, k, theta = sp.symbols("m l g b k theta", positive=True)  # noqa: E741 (l: a length)
 DIMS = {m: KIND_DIMENSIONS["mass"], l: KIND_DIMENSIONS["length"], g: KIND_DIMENSIONS["gravity"]}
 DIMS.update({b: KIND_DIMENSIONS["damping"], theta: _kg()})  # k: no declared kind
 
@@ -245,9 +245,8 @@ def test_the_row_comes_first_fails_and_is_carried_by_json_and_junit(tmp_path):
     (entry,) = [r for r in json.loads(report.to_json())["results"] if r["check"] == "units"]
     assert entry["status"] == "fail" and entry["notes"] == [note]
     junit = to_junit(report)
-    assert (
-        'name="units"' in junit and "units: error 1.000e+00, tolerance 0.000e+00, worst state M[2,2]" in junit
-    )
+    assert 'name="units"' in junit
+    assert "units: error 1.000e+00, tolerance 0.000e+00, worst state M[2,2]" in junit
 
 
 def test_a_dimension_error_fails_where_every_value_agrees(tmp_path):

@@ -158,7 +158,8 @@ SYSTEMS = {
 def _draw(rng: np.random.Generator, name: str, values: dict[str, float]) -> float:
     """One parameter's value: masses 0.3–2 kg, lengths 0.3–1 m, offsets 30–70 % of the link,
     inertias 0.8–1.2 × m l²/12 (an axial one a tenth of
-    that, K 0.9–1 × I: the triangle inequality MuJoCo asks), dampers 0.01–0.1, armatures 0.005–0.02 kg·m² (kg on a slide)."""
+    that, K 0.9–1 × I: the triangle inequality MuJoCo asks), dampers 0.01–0.1, armatures
+    0.005–0.02 kg·m² (kg on a slide)."""
     kind, index = name[0], name[1:]
     if kind == "m":
         return rng.uniform(0.3, 2.0)
