@@ -117,7 +117,7 @@ def _check(files):
 def test_gymnasiums_accelerations_verify_by_aba_and_say_what_did_not_run(files, tmp_path):
     report = _check(files(tmp_path))
     assert report.status == "pass", report
-    assert report.checks == ("aba",)
+    assert report.checks == ("units", "aba")
     notes = " ".join(n for ns in report.notes.values() for n in ns)
     for check in ("crba", "rnea", "gravity", "energy"):
         assert check in notes
@@ -191,5 +191,5 @@ def test_q_ddot_alone_in_latex_verifies_and_a_planted_error_fails(planted, tmp_p
     model = tmp_path / "gym_cart_pole_latex.toml"
     model.write_text(text)
     report = pendverify.check(model, urdf, params, samples=SAMPLES, explain=False)
-    assert report.checks == ("aba",)
+    assert report.checks == ("units", "aba")
     assert report["aba"].status == ("fail" if planted else "pass"), report

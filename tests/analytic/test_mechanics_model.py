@@ -22,7 +22,7 @@ REPO = Path(__file__).resolve().parents[2]
 URDF = REPO / "urdf" / "double_pendulum.urdf"
 PARAMS = REPO / "examples" / "minimal_double_pendulum.toml"
 SAMPLES = 60  # the special states plus 60 random ones
-CHECKS = {"crba", "rnea", "gravity", "aba", "energy", "damping"}
+CHECKS = {"units", "crba", "rnea", "gravity", "aba", "energy", "damping"}
 
 
 def _check(model, declaration=DECLARATION):

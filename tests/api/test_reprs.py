@@ -77,7 +77,7 @@ def test_report_repr_is_short_and_says_verdict_size_and_models(report):
     text = short(repr(report))
     # erd's mesh URDFs put link 1's centre of mass 2 µm off the joint line: a model-form term
     # within its threshold, which passes with a warning (the verdict "warn")
-    assert text.startswith("<CheckReport warn: 42 checks on 4 model(s), ")
+    assert text.startswith("<CheckReport warn: 46 checks on 4 model(s), ")
     assert {r.status for r in report.results if r.check == "model-form"} == {"warn"}
     assert f"{sum(report.states.values())} states, seed 20260301" in text
     assert "erd:double_pendulum_simple" in text
@@ -91,17 +91,17 @@ def test_report_repr_stays_short_with_many_long_model_labels(report):
         results=list(report.results),
     )
     text = short(repr(many))
-    assert "…" in text and text.startswith("<Report warn: 42 checks on 44 model(s), 400 states, seed 1")
+    assert "…" in text and text.startswith("<Report warn: 46 checks on 44 model(s), 400 states, seed 1")
 
 
 def test_report_html_shows_the_rows_of_the_cli_table(report, capsys):
     assert main(["check", "--model", "double_pendulum", "--samples", str(FEW)]) == 0
     lines = capsys.readouterr().out.splitlines()
-    assert set(lines[1]) == {"-"} and lines[2 + 42] == ""  # the header's rule; 42 rows; a blank line
-    cli_rows = [re.split(r"\s{2,}", line) for line in lines[2 : 2 + 42]]
+    assert set(lines[1]) == {"-"} and lines[2 + 46] == ""  # the header's rule; 46 rows; a blank line
+    cli_rows = [re.split(r"\s{2,}", line) for line in lines[2 : 2 + 46]]
     parsed = cells(report._repr_html_())
     assert parsed.rows[0] == re.split(r"\s{2,}", lines[0].strip())
-    assert parsed.rows[1:] == cli_rows and len(report.results) == 42
+    assert parsed.rows[1:] == cli_rows and len(report.results) == 46
     # the notes and the verdict line are those under the CLI's table (the timing aside)
     kept = ("note", "warning", "largest")
     under = [TIMING.sub(", … s: ", line) for line in lines if line.startswith(kept)]
@@ -153,7 +153,7 @@ def test_report_item_access_by_check_name(report):
 def test_unknown_names_are_key_errors_listing_the_valid_ones(report):
     with pytest.raises(KeyError) as caught:
         report["crbaa"]
-    assert "no check 'crbaa' in this report; its checks: crba, rnea, gravity, coriolis" in str(caught.value)
+    assert "no check 'crbaa' in this report; its checks: units, crba, rnea, gravity, coriolis" in str(caught.value)
     with pytest.raises(KeyError) as caught:
         report["cart_double_pendulum", "crba"]
     message = str(caught.value)

@@ -214,4 +214,4 @@ def test_every_python_block_of_the_guide_runs_as_written(tmp_path, monkeypatch, 
     for test in tests:
         test()
     assert namespace["cart"].passed and namespace["implied"].exact and namespace["run"].passed
-    assert "9 checks on 1 model(s)" in capsys.readouterr().out
+    assert "10 checks on 1 model(s)" in capsys.readouterr().out  # units, and 9 against Pinocchio
