@@ -377,7 +377,7 @@ BAD_INPUTS = {
     # a model SymPy reads runs its units check alone; one it cannot read has nothing to check
     "plug-in without a URDF": (
         lambda tmp: pendverify.check(REPO / "tests" / "analytic" / "data" / "pendulum_functions.py"),
-        "pendulum_functions.py: give --urdf (urdf= in the Python API): the URDF to verify pendulum_functions against",
+        "pendulum_functions.py: give --urdf (urdf= in the Python API): the URDF to verify pendulum_functions",
     ),
     "unknown example-robot-data URDF": (
         lambda tmp: pendverify.check("erd:double_pendulum_triple"),
