@@ -218,12 +218,14 @@ def test_a_cart_pole_planted_in_m_is_named_with_both_units(tmp_path):
     findings = _findings(_planted(tmp_path, ("p.mc + p.mp", "p.mc + p.mp * p.r**2")))
     assert set(findings) == {"M[1,1]"}, findings
     assert findings["M[1,1]"] == (
-        "M[1,1]: the term mp*r**2 has kg·m² but mc has kg (an entry of M for two positions is kg)"
+        "M[1,1]: the term mp*r**2 has kg·m² but mc has kg (an entry of M for the position x alone is kg)"
     )
     # mass_matrix's k (inverse_mass_matrix has its own): the entries agree with each other, not their place
     findings = _findings(_planted(tmp_path, ("k = p.mp * p.r * self", "k = p.mp * p.r**2 * self")))
     assert set(findings) == {"M[1,2]", "M[2,1]"}, findings
-    assert findings["M[1,2]"].endswith("has kg·m² but an entry of M for a position and an angle is kg·m")
+    assert findings["M[1,2]"].endswith(
+        "has kg·m² but an entry of M for the position x and the angle theta is kg·m"
+    )
 
 
 def _cart_pole_check(model: Path, **kwargs):
@@ -238,7 +240,7 @@ def test_the_row_comes_first_fails_and_is_carried_by_json_and_junit(tmp_path):
     assert row.status == "fail" and row.max_error == 1.0 and row.worst_state["label"] == "M[2,2]"
     (note,) = row.notes
     assert note == (
-        "M[2,2]: the term mp*r has kg·m but I has kg·m² (an entry of M for two angles is kg·m²) "
+        "M[2,2]: the term mp*r has kg·m but I has kg·m² (an entry of M for the angle theta alone is kg·m²) "
         f"({model}, CartPole.mass_matrix, entry M[2,2])"
     )
     assert f"fail [cart_pole:cart_pole units]: {note}" in report.table()
@@ -292,7 +294,7 @@ def test_a_model_alone_runs_the_units_check(tmp_path, capsys):
     assert main(["check", "--analytic", str(path)]) == 1
     out = capsys.readouterr().out
     assert (
-        "fail [pend units]: M[1,1]: l m has kg·m but an entry of M for two angles is kg·m² "
+        "fail [pend units]: M[1,1]: l m has kg·m but an entry of M for the angle \\theta alone is kg·m² "
         f"({path}, key M, entry M[1,1])"
     ) in out, out
 
@@ -327,3 +329,24 @@ def test_a_warm_code_cache_answers_without_sympy(tmp_path):
         ["units", "15", "of", "20", "entries", "True"],
         ["units", "15", "of", "20", "entries", "False"],
     ], [r.stdout + r.stderr for r in runs]
+
+
+def test_a_term_m_g_added_to_h_of_a_hinge_is_named(tmp_path):
+    """The shipped text double pendulum with g·m1 (kg·m/s², a force) added to H[1] (a torque)."""
+    text = (REPO / "examples" / "minimal_double_pendulum_text.toml").read_text()
+    old = '"g*((m1*r1 + m2*l1)*cos(theta1) + m2*r2*cos(theta1 + theta2))",'
+    path = tmp_path / "minimal_double_pendulum_text.toml"
+    path.write_text(text.replace(old, old[:-2] + ' + g*m1",'))
+    findings = _findings(path)
+    assert set(findings) == {"H[1]"}, findings
+    assert findings["H[1]"].startswith("H[1]: the term g*m1 has kg·m/s² but ")
+    assert findings["H[1]"].endswith("has kg·m²/s² (an entry of H for the angle theta1 is kg·m²/s²)")
+
+
+def test_a_model_alone_still_reads_its_parameter_file(tmp_path, capsys):
+    """--params with a model alone is read and refused when bad, not ignored."""
+    bad = tmp_path / "bad.toml"
+    bad.write_text(CART_POLE_PARAMS.read_text().replace("mc = ", "mc = -"))
+    assert main(["check", "--analytic", str(CART_POLE), "--params", str(bad)]) == 2
+    assert "parameters.mc" in capsys.readouterr().err
+    assert main(["check", "--analytic", str(CART_POLE), "--params", str(CART_POLE_PARAMS)]) == 0

@@ -263,16 +263,22 @@ class Reader:
         return None
 
 
-def _coordinate_names(angular: tuple[bool, ...], indices) -> str:
-    kinds = ["an angle" if angular[i] else "a position" for i in indices]
-    if len(kinds) == 2 and kinds[0] == kinds[1]:
-        return "two angles" if angular[indices[0]] else "two positions"
-    return " and ".join(kinds)
+def _coordinates(angular: tuple[bool, ...], names: tuple[str, ...], indices) -> str:
+    """The coordinates an entry belongs to, with their kinds: ``the angle theta``, ``the position x
+    and the angle theta``, ``the angle theta alone`` (a diagonal entry)."""
+    said = [f"the {'angle' if angular[i] else 'position'} {names[i]}" for i in indices]
+    if len(said) == 2 and indices[0] == indices[1]:
+        return f"{said[0]} alone"
+    return " and ".join(said)
 
 
-def required(method: str, position: tuple[int, ...], angular: tuple[bool, ...]) -> tuple[Dim | None, str]:
-    """(the dimension entry ``position`` of ``method`` must have, the rule in words), or (None, "")
-    where the interface does not fix it (module docstring)."""
+def required(
+    method: str, position: tuple[int, ...], angular: tuple[bool, ...], names: tuple[str, ...] = ()
+) -> tuple[Dim | None, str]:
+    """(the dimension entry ``position`` of ``method`` must have, the rule in words naming the
+    coordinates ``names``, q1, q2, … if not given), or (None, "") where the interface does not fix
+    it (module docstring)."""
+    names = names or tuple(f"q{i + 1}" for i in range(len(angular)))
     q = [NONE if a else LENGTH for a in angular]
     tau = [mul(ENERGY, inverse(d)) for d in q]
     name = QUANTITY.get(method, method)
@@ -293,11 +299,11 @@ def required(method: str, position: tuple[int, ...], angular: tuple[bool, ...]) 
             "inverse_mass_matrix": mul(q[i], inverse(mul(tau[j], power(SECOND, Fraction(2))))),
         }
         d = rules[method]
-        return d, f"an entry of {name} for {_coordinate_names(angular, (i, j))} is {unit_text(d)}"
+        return d, f"an entry of {name} for {_coordinates(angular, names, (i, j))} is {unit_text(d)}"
     if len(position) == 1 and method in ("gravity", "coriolis_force", "acceleration"):
         i = position[0]
         d = tau[i] if method != "acceleration" else mul(q[i], power(SECOND, Fraction(-2)))
-        return d, f"an entry of {name} for {_coordinate_names(angular, (i,))} is {unit_text(d)}"
+        return d, f"an entry of {name} for {_coordinates(angular, names, (i,))} is {unit_text(d)}"
     return None, ""
 
 
@@ -343,6 +349,7 @@ def read_units(model_cls) -> dict:
         return {"not_run": f"SymPy cannot read the model ({_without_file(model_cls, exc)})"}
     notation = Notation.of(model_cls)
     reader = Reader(symbol_dimensions(sm), notation.render, dict(sm.kinds))
+    names = tuple(reader.term(q) for q in sm.symbols["q"])  # in the model's notation
     out: dict = {"entries": 0, "decided": 0, "unread": {}, "findings": []}
     for method, form in model_cls.written_closed_forms().items():
         try:
@@ -356,7 +363,7 @@ def read_units(model_cls) -> dict:
                 continue
             position = entry_position(method, shape, index) if shape else ()
             label = entry_label(method, value, index)
-            need, place = required(method, position, model_cls.angular)
+            need, place = required(method, position, model_cls.angular, names)
             reader.clashes = []
             terms = sp.Add.make_args(expr)
             d = reader.agree(expr, terms, top=True, required=need, place=place)
