@@ -25,7 +25,19 @@ from ..conftest import example_module
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 STEMS = ("triple_pendulum", "furuta_pendulum")
 #: every check of ``pendverify check``; ``damping`` runs because both URDFs declare <dynamics damping>
-ALL_CHECKS = {"crba", "rnea", "gravity", "coriolis", "skew", "det", "minverse", "aba", "energy", "damping"}
+ALL_CHECKS = {
+    "units",
+    "crba",
+    "rnea",
+    "gravity",
+    "coriolis",
+    "skew",
+    "det",
+    "minverse",
+    "aba",
+    "energy",
+    "damping",
+}
 
 
 def _files(stem: str) -> tuple[str, str, str]:
@@ -65,7 +77,8 @@ def test_check_passes_every_check(tmp_path, capsys, stem):
     for r in report["results"]:
         assert r["status"] == "pass", r
         assert r["max_error"] <= r["tolerance"] < 1e-11, r  # ε-level, not a loose tolerance
-        assert r["samples"] == 110  # 100 random states, 5 special configurations at rest and moving
+        # 100 random states, 5 special configurations at rest and moving; the units row reads none
+        assert r["samples"] == (0 if r["check"] == "units" else 110)
 
 
 @pytest.mark.parametrize(("stem", "entries"), [("triple_pendulum", 58), ("furuta_pendulum", 29)])
