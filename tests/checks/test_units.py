@@ -350,3 +350,37 @@ def test_a_model_alone_still_reads_its_parameter_file(tmp_path, capsys):
     assert main(["check", "--analytic", str(CART_POLE), "--params", str(bad)]) == 2
     assert "parameters.mc" in capsys.readouterr().err
     assert main(["check", "--analytic", str(CART_POLE), "--params", str(CART_POLE_PARAMS)]) == 0
+
+
+#: the corpus's operators that keep every term's dimension
+KEEPS = ("sign", "drop", "duplicate", "factor 2", "factor ½", "parameter", "sin↔cos", "pivot", "swap θ")
+
+
+def test_no_claim_on_the_explain_corpus_but_where_a_plant_changes_a_dimension():
+    """``bench explain``'s planted errors in every shipped model: every operator but a rate swap keeps
+    each term's dimension (a sign, a dropped or doubled term, a factor, a parameter of the same kind,
+    sin ↔ cos, an angle swap, ± m·r² in M) and gets no claim; a swap of a position's rate with an
+    angle's (ẋ ↔ θ̇) changes it, and only there is a claim made (not where the rate multiplies an
+    undecided damping coefficient: ẋ·b_x → θ̇·b_x); 9 of the 1750 plants are named."""
+    from pendverify.analytic.forms import entry_position
+    from pendverify.analytic.symbolic_reading import SymbolicModel
+    from pendverify.bench.explain import shipped_targets
+    from pendverify.checks.dimensions import entry_dimension, symbol_dimensions
+    from pendverify.diagnosis.corpus import plants
+
+    caught, planted = 0, 0
+    for label, model, _, _ in shipped_targets():
+        sm = SymbolicModel.of(type(model))
+        reader, forms = Reader(symbol_dimensions(sm), kinds=dict(sm.kinds)), sm.closed_forms
+        position_rates = {f"d{c}" for c, a in zip(model.coordinates, model.angular, strict=True) if not a}
+        for plant in plants(sm):
+            shape = getattr(forms[plant.method], "shape", None)
+            position = entry_position(plant.method, shape, plant.index) if shape else ()
+            _, clashes = entry_dimension(reader, plant.new, *required(plant.method, position, model.angular))
+            if plant.operator not in KEEPS and plant.operator != "swap θ̇":
+                continue  # an operator added to the corpus since: its dimensions are not known here
+            swapped = set(plant.what.split(" in ", 1)[0].split(" ↔ "))
+            changes = plant.operator == "swap θ̇" and len(swapped & position_rates) == 1
+            assert changes or not clashes, f"{label=} {plant.operator=} {plant.what=} {clashes=}"
+            caught, planted = caught + bool(clashes), planted + 1
+    assert planted >= 1750 and caught >= 9, (planted, caught)  # measured: 1750 and 9

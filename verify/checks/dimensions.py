@@ -363,25 +363,30 @@ def read_units(model_cls) -> dict:
                 continue
             position = entry_position(method, shape, index) if shape else ()
             label = entry_label(method, value, index)
-            need, place = required(method, position, model_cls.angular, names)
-            reader.clashes = []
-            terms = sp.Add.make_args(expr)
-            d = reader.agree(expr, terms, top=True, required=need, place=place)
-            if d is not None and need is not None and d != need:
-                reader.clashes.append(f"{reader.named(expr)} has {unit_text(d)} but {place}")
+            d, clashes = entry_dimension(reader, expr, *required(method, position, model_cls.angular, names))
             out["entries"] += 1
             out["decided"] += d is not None
-            if reader.clashes:
+            if clashes:
                 out["findings"].append(
                     {
                         "quantity": QUANTITY.get(method),
                         "index": [p + 1 for p in position],
                         "label": label,
                         "location": _location(model_cls, method),
-                        "message": f"{label}: {'; '.join(reader.clashes)}",
+                        "message": f"{label}: {'; '.join(clashes)}",
                     }
                 )
     return out
 
 
-__all__ = ["KIND_DIMENSIONS", "Reader", "read_units", "required", "unit_text"]
+def entry_dimension(reader: Reader, expr, need: Dim | None, place: str) -> tuple[Dim | None, list[str]]:
+    """(the dimension of one entry, or None where undecided; its clashes: terms that disagree, and a
+    decided dimension other than ``need``, the entry's place's as ``required`` gives it with ``place``)."""
+    reader.clashes = []
+    d = reader.agree(expr, sp.Add.make_args(expr), top=True, required=need, place=place)
+    if d is not None and need is not None and d != need:
+        reader.clashes.append(f"{reader.named(expr)} has {unit_text(d)} but {place}")
+    return d, reader.clashes
+
+
+__all__ = ["KIND_DIMENSIONS", "Reader", "entry_dimension", "read_units", "required", "unit_text"]
