@@ -61,7 +61,7 @@ def test_the_minimal_model_passes_and_the_report_says_what_was_derived(capsys):
     report = pendverify.check(MODEL, URDF, PARAMS, samples=60)
     assert report.passed
     checks = {r.check for r in report.results}
-    assert {"crba", "rnea", "gravity", "coriolis", "skew", "aba", "energy", "damping"} == checks
+    assert {"units", "crba", "rnea", "gravity", "coriolis", "skew", "aba", "energy", "damping"} == checks
 
 
 def test_sympy_and_mutate_pass_on_the_minimal_model(capsys):
