@@ -40,7 +40,8 @@ def register(sub) -> None:
         metavar="FILE",
         help="your own model: a Python file (a ClosedFormModel subclass, a SymPy mechanics derivation, "
         "or the dynamics as code) or a text model (.toml: SymPy text or LaTeX, M, C, H, ... or whole "
-        "equations) (`pendverify example cart_pole DIR` copies one); needs --urdf",
+        "equations) (`pendverify example cart_pole DIR` copies one); with --urdf, or alone for its units "
+        "check (one dimension per entry, from the parameters' kinds)",
     )
     p.add_argument(
         "--urdf",
