@@ -163,6 +163,7 @@ def _clashes(expr, symbols=DIMS) -> list[str]:
     ("expr", "named"),
     [
         (m * l**2 + m * l, ("l*m has kg·m", "l**2*m has kg·m²")),
+        (m * l**2 / 12 + 2 * m * l, ("2*l*m has kg·m", "l**2*m/12 has kg·m²")),  # pure coefficients
         (m * g * l * sp.sin(theta) + m * g, ("g*m has kg·m/s²", "g*l*m*sin(theta) has kg·m²/s²")),
         (m * (l**2 + l), ("in l**2 + l, the term ", "l has m", "l**2 has m²")),
         (m * g * l * sp.sin(l * theta), ("the argument of sin, l*theta, has m: it must be dimensionless",)),
@@ -183,6 +184,7 @@ def test_terms_of_other_dimensions_are_named_with_both(expr, named):
     [
         m * l**2 + k * l,  # k has no declared kind
         m * l**2 + sp.Float(9.81) * m * l,  # a decimal may be a quantity written by its value
+        m * l**2 + 10 * m * l,  # so may an integer beyond a derivation's coefficients (g = 10 m/s²)
         m * l**2 + b * l,  # a damping coefficient's unit depends on its joint
         m * l**2 + sp.Float(0.01),  # a number standing alone as a term
         m * l**2 + 1,

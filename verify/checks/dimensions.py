@@ -35,9 +35,10 @@ Recursively, with a *wildcard* (None) wherever the dimension cannot be decided:
   coefficient is N·m·s/rad on a revolute joint and N·s/m on a prismatic one, which the kind
   does not say: a wildcard, as is a symbol whose kind is not declared;
 * q_j, q̇_j: [q_j], [q_j]/s; an input u or a disturbance w: a wildcard (its unit is not declared);
-* an integer or a fraction: a pure number (a derivation's 2, 1/2, 1/12); π likewise; a decimal
-  (9.81, 0.5) may be a quantity written by its value (g, a length): a wildcard, and so is a
-  number standing alone as a term of a sum (``m*l**2 + 0.01``, ``1 + cos(θ)``), whatever it is;
+* an integer or a fraction up to 9 over 12: a pure number (a derivation's 2, 1/2, 4/3, 1/12); π
+  likewise; a decimal (9.81, 0.5) or a larger integer (10) may be a quantity written by its value
+  (g, a length): a wildcard, and so is a number standing alone as a term of a sum
+  (``m*l**2 + 0.01``, ``1 + cos(θ)``), whatever it is;
 * a product: the product of its factors' dimensions (a wildcard if one is); x**r for a number
   r: [x]^r (a square root is r = 1/2); a power with a symbolic exponent needs a dimensionless
   base and exponent, and is dimensionless;
@@ -106,6 +107,9 @@ PURE_FUNCTIONS = (
     sp.sin, sp.cos, sp.tan, sp.cot, sp.sec, sp.csc, sp.asin, sp.acos, sp.atan, sp.acot,
     sp.sinh, sp.cosh, sp.tanh, sp.asinh, sp.acosh, sp.atanh, sp.exp, sp.log,
 )  # fmt: skip
+#: the largest numerator and denominator of an integer or fraction read as a pure number: a
+#: derivation's coefficients (2, 1/2, 4/3, 1/12, 9 cos² θ); 10 may be g written by its value
+PURE_NUMERATOR, PURE_DENOMINATOR = 9, 12
 #: the largest denominator of a decimal exponent read as a fraction (x**0.5 is a square root)
 EXPONENT_DENOMINATOR = 12
 #: the widest a term is printed in a message
@@ -172,9 +176,11 @@ class Reader:
         """[expr], or None where it cannot be decided; clashes inside are appended to ``clashes``."""
         if isinstance(expr, sp.Symbol):
             return self.symbols.get(expr)
-        if isinstance(expr, (sp.Integer, sp.Rational, sp.NumberSymbol)):
+        if isinstance(expr, sp.NumberSymbol):
             return NONE
-        if isinstance(expr, sp.Number):  # a decimal: maybe a quantity written by its value
+        if isinstance(expr, sp.Rational) and abs(expr.p) <= PURE_NUMERATOR and expr.q <= PURE_DENOMINATOR:
+            return NONE
+        if isinstance(expr, sp.Number):  # a decimal, g = 10: maybe a quantity written by its value
             return None
         if isinstance(expr, sp.Add):
             return self.agree(expr, expr.args, top=False)
