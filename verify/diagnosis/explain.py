@@ -34,6 +34,7 @@ from pendverify.diagnosis.entries import differing_entries, entry_finding
 from pendverify.diagnosis.finding import Finding
 from pendverify.diagnosis.parameters import identify_parameters
 from pendverify.diagnosis.patterns import entry_pattern, pattern_finding
+from pendverify.diagnosis.ranking import ranked
 from pendverify.diagnosis.repair import search_repair
 
 #: the whole diagnosis's bound, 10 s for up to 3 degrees of freedom on a 2-core machine; most
@@ -91,4 +92,4 @@ def explain(batch, results, deadline_s: float = REPAIR_DEADLINE_S) -> list[Findi
     if why_not:  # said as a repair that is not one: checks_pass false, nothing suggested
         details = {"written": None, "suggested": None, "suggested_source": None, "location": None}
         findings.append(Finding("repair", why_not, details={**details, "checks_pass": False}))
-    return findings
+    return ranked(findings)
