@@ -93,7 +93,5 @@ def test_the_rule_exact_first_then_by_how_much_changes_statements_last():
     given = [two, rough, entry, none, structural, one, mass, pattern, combos, pivot, found]
     order = ranked(given)
     assert order == [entry, pattern, found, mass, one, pivot, two, rough, none, structural, combos]
-    assert explanations_first(given) == [found, mass, one, pivot, two, rough, none, structural, combos] + [
-        entry,
-        pattern,
-    ]
+    explanations = [found, mass, one, pivot, two, rough, none, structural, combos]
+    assert explanations_first(given) == [*explanations, entry, pattern]
