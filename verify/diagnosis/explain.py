@@ -3,7 +3,8 @@
 In order:
 
 1. the entries that differ, each with the shape of its difference over the states
-   (``pendverify.diagnosis.entries``, ``pendverify.diagnosis.patterns``);
+   (``pendverify.diagnosis.entries``, ``pendverify.diagnosis.patterns``), its coefficients
+   written as products of the parameters where one fits (``pendverify.diagnosis.monomials``);
 2. the known traps (``pendverify.diagnosis.diagnose``: coordinate conventions, an inertia
    about the pivot, friction missing from q̈);
 3. the inertial parameters the model implies: whether it is this robot's dynamics with other
@@ -32,6 +33,7 @@ import numpy as np
 from pendverify.diagnosis.diagnose import diagnose
 from pendverify.diagnosis.entries import differing_entries, entry_finding
 from pendverify.diagnosis.finding import Finding
+from pendverify.diagnosis.monomials import coefficient_words
 from pendverify.diagnosis.parameters import identify_parameters
 from pendverify.diagnosis.patterns import entry_pattern, pattern_finding
 from pendverify.diagnosis.ranking import ranked
@@ -67,7 +69,8 @@ def explain(batch, results, deadline_s: float = REPAIR_DEADLINE_S) -> list[Findi
             shaped += 1
             pattern = entry_pattern(entry, batch)
             if pattern is not None:
-                findings.append(pattern_finding(entry, pattern, batch.model.coordinates))
+                written = coefficient_words(pattern, entry, batch.model)
+                findings.append(pattern_finding(entry, pattern, batch.model.coordinates, written))
         if shaped < len(entries):
             skipped.append(f"the shape of {len(entries) - shaped} of {len(entries)} differing entries")
         steps = (
