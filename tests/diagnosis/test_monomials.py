@@ -16,7 +16,7 @@ from pendverify.checks.batch import CheckBatch
 from pendverify.checks.catalogue import applicable_checks, run_checks
 from pendverify.checks.sampling import sample_states
 from pendverify.diagnosis.explain import explain
-from pendverify.diagnosis.monomials import coefficient_dimension
+from pendverify.diagnosis.monomials import coefficient_dimension, written_coefficient
 from pendverify.robot.system import PinocchioSystem
 
 from ..conftest import SEED, default_params
@@ -94,3 +94,12 @@ def test_the_coefficients_units_follow_the_coordinates():
     assert coefficient_dimension("Cqdot", (0,), dx, model) is None  # friction: no fixed unit
     assert coefficient_dimension("C", (0, 1), dt1, model) == (1, 1, 0)
     assert coefficient_dimension("C", (0, 0), 1, model) is None
+
+
+def test_a_coefficient_is_matched_in_its_units_only_and_exactly():
+    mass, length = ("m", 1.0, (1, 0, 0)), ("l", 2.0, (0, 1, 0))
+    assert written_coefficient(4.0, 0.0, (1, 2, 0), (mass, length)) == "l²·m"  # not 4·m: kg, not kg·m²
+    assert written_coefficient(4.0 * (1 + 1e-9), 0.0, (1, 2, 0), (mass, length)) is None  # beyond rounding
+    assert written_coefficient(4.0 * (1 + 1e-9), 1e-8, (1, 2, 0), (mass, length)) == "l²·m"  # a looser fit
+    assert written_coefficient(1e300, 0.0, (1, 2, 0), (mass, length)) is None  # no product, no overflow
+    assert written_coefficient(3.0, 0.0, (1, 2, 0), (mass, length)) == "3·l²·m/4"

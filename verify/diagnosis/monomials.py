@@ -43,6 +43,8 @@ METRE = np.array([0, 1, 0])
 def _fixed_parameters(params) -> tuple[tuple[str, float, tuple], ...]:
     """(name, value, dimension) of each parameter whose kind has a fixed unit and whose value is > 0."""
     out = []
+    if not dataclasses.is_dataclass(params):  # a parameter set without declared kinds: no units to go by
+        return ()
     for f in dataclasses.fields(params):
         kind = f.metadata.get("kind", "")
         value = getattr(params, f.name, None)
@@ -100,12 +102,18 @@ def written_coefficient(c: float, uncertainty: float, dimension: tuple, paramete
     window = max(uncertainty, FLOOR * abs(c))
     fits = set()
     for value, expr in _products(parameters, dimension):
-        ratio = Fraction(abs(c) / value).limit_denominator(12)
+        quotient = abs(c) / value
+        if not np.isfinite(quotient):  # (a coefficient of 1e300: no product of these values)
+            continue
+        ratio = Fraction(quotient).limit_denominator(12)
         if ratio in FRACTIONS and abs(float(ratio) * value - abs(c)) <= window:
             fits.add(sp.Rational(ratio.numerator, ratio.denominator) * expr)
     if len(fits) != 1:
         return None
-    return str(fits.pop()).replace("**", "^").replace("*", "·")
+    text = str(fits.pop())
+    for power, superscript in (("**2", "²"), ("**3", "³"), ("**4", "⁴")):
+        text = text.replace(power, superscript)
+    return text.replace("*", "·")
 
 
 def coefficient_words(pattern, entry, model) -> list[str | None]:
