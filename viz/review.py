@@ -15,6 +15,7 @@ import html
 from dataclasses import dataclass, field
 from urllib.parse import quote
 
+from pendverify.diagnosis.ranking import explanations_first
 from pendverify.jsonio import versions
 
 _STYLE = """
@@ -104,13 +105,13 @@ def check_matrix(report) -> str:
 
 def diagnosis_block(report) -> str:
     """What is wrong in each failing model and how to fix it, under the check matrix: the
-    diagnosis's findings (``pendverify.diagnosis.explain``), the repair first."""
-    order = {"repair": 0, "parameters": 1, "convention": 2, "structural": 3, "entry": 4, "pattern": 5}
+    diagnosis's findings (``pendverify.diagnosis.explain``), the most likely fix first
+    (``pendverify.diagnosis.ranking``)."""
     out = []
     for model, findings in report.diagnoses.items():
         items = "".join(
             f'<li class="{_e(f.kind)}"><strong>{_e(f.kind)}</strong> {_e(f.message)}</li>'
-            for f in sorted(findings, key=lambda f: order[f.kind])
+            for f in explanations_first(findings)
         )
         out.append(
             f'<div class="diagnosis"><p class="fail">what is wrong in {_e(model)}, and how to fix it:</p>'

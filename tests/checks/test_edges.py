@@ -324,8 +324,8 @@ def test_pivot_inertia_is_named_with_its_residual_despite_a_rounded_pi(tmp_path,
     status, out, _ = _check(capsys, *args, str(tmp_path / "x.json"))
     assert status == 1
     match = re.search(
-        r"M_urdf − M_hand is up to a relative residual of ([0-9.e+-]+) \(a smaller difference remains as "
-        r"well\) the parallel-axis term m·r² of pole \(joint pole_hinge\)",
+        r"the parallel-axis term m·r² = [0-9.]+ kg·m² of pole \(joint pole_hinge\) \(M_urdf − M_hand is up "
+        r"to a relative residual of ([0-9.e+-]+) \(a smaller difference remains as well\) that term\)",
         out,
     )
     assert match, out

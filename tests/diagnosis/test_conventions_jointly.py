@@ -137,7 +137,10 @@ def test_a_map_trap_with_an_inertia_about_the_pivot_is_named_with_both():
     finding = _finding(model, system)
     assert set(finding.details["traps"]) == {ABSOLUTE_RELATIVE, PIVOT}
     assert finding.details["links"] == {"link3 (joint joint3)": 1}
-    assert "the URDF's inertia of link3 (joint joint3) is about the pivot" in finding.message
+    assert (
+        "the URDF's inertia of link3 (joint joint3) is about the pivot instead of the centre of mass, "
+        "or your M misses the parallel-axis term"
+    ) in finding.message
     assert finding.details["residual"] <= EXACT_RESIDUAL
     assert _every_check_passes(model, system, finding.details)
     # the pivot trap alone does not explain it: the joint finding is the only one
@@ -243,7 +246,7 @@ def test_an_inertia_about_the_pivot_alone_is_left_to_the_inertia_trap():
     results = run_checks("pivot", model, system, sample_states(model, 30, SEED), SEED)
     (finding,) = diagnose(model, system, results)
     assert finding.quantity == "M" and finding.kind == "convention"
-    assert finding.message.startswith("M_urdf − M_hand is exactly the parallel-axis term m·r² of link3")
+    assert finding.message.startswith("M[3,3] lacks the parallel-axis term m·r² = 0.009 kg·m² of link3")
 
 
 # --- bounded work --------------------------------------------------------------------------------------

@@ -19,6 +19,7 @@ from pendverify.checks.catalogue import run_checks
 from pendverify.checks.sampling import sample_states
 from pendverify.cli import main
 from pendverify.diagnosis.diagnose import diagnose
+from pendverify.diagnosis.traps.inertia import SIDE_MARGIN, turning_axes
 from pendverify.robot.coordinates import CoordinateMap
 from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
@@ -52,15 +53,88 @@ def test_urdf_inertia_about_the_pivot_is_named_in_the_report(tmp_path, capsys):
         == 1
     )
     out = capsys.readouterr().out
+    both = "your M misses the parallel-axis term, or the URDF's <inertia> of {} is about the pivot"
     sentence = (
-        "diagnosis [double_pendulum:pivot]: M_urdf − M_hand is exactly the parallel-axis term m·r² of "
-        "link1 (joint joint1), link2 (joint joint2) (m·r² = 0.0625 kg·m², 0.03872 kg·m²): inertia given "
-        "about the pivot instead of the centre of mass"
+        "diagnosis [double_pendulum:pivot]: M[1,1] lacks the parallel-axis term m·r² = 0.0625 kg·m² of "
+        "link1 (joint joint1) (M_urdf − M_hand is exactly that term): " + both.format("link1")
     )
     assert sentence in out
+    link2 = "M[1,1], M[1,2], M[2,2] lack the parallel-axis term m·r² = 0.03872 kg·m² of link2 (joint joint2)"
+    assert link2 in out
+    assert both.format("link2") in out
     report = json.loads(out_json.read_text())
     (trap,) = [d for d in report["diagnoses"]["double_pendulum:pivot"] if d["kind"] == "convention"]
-    assert "inertia given about the pivot" in trap["message"]
+    assert both.format("link1") in trap["message"]
+
+
+class ParallelAxisMissing(DoublePendulum):
+    """M without link 2's m2·r2²: I2 used where the inertia about joint 2 is due."""
+
+    @property
+    def alpha(self):
+        return super().alpha - self.params.m2 * self.params.r2**2
+
+    @property
+    def delta(self):
+        return super().delta - self.params.m2 * self.params.r2**2
+
+
+BOTH_SIDES = "your M misses the parallel-axis term, or the URDF's <inertia> of link2 is about the pivot"
+
+
+def test_a_missing_parallel_axis_term_and_a_urdf_inertia_about_the_pivot_get_the_same_two_sided_words():
+    """The two situations M cannot tell apart: the hand's M lacks m2·r2² against a right URDF, and a
+    right hand model against a URDF whose <inertia> of link 2 is about the pivot.  Link 2 is wide
+    (I2 = 0.05 kg·m² > m2·r2² = 0.0387 kg·m²), so the URDF's inertia can be about the pivot."""
+    params = default_params("double_pendulum").replace(I2=0.05)
+    (hand_wrong,) = _diagnoses(ParallelAxisMissing(params), _dp_system(params))
+    pivot = params.replace(I2=params.I2 + params.m2 * params.r2**2)
+    (urdf_wrong,) = _diagnoses(DoublePendulum(params), _dp_system(pivot))
+    assert hand_wrong == urdf_wrong
+    assert hand_wrong.startswith(
+        "M[1,1], M[1,2], M[2,2] lack the parallel-axis term m·r² = 0.03872 kg·m² of link2 (joint joint2) "
+        "(M_urdf − M_hand is exactly that term): " + BOTH_SIDES
+    )
+
+
+def test_a_urdf_inertia_about_the_pivot_of_a_rod_keeps_both_sides():
+    """The reference rods (I2 = 0.0135 < m2·r2²): with the pivot inertia really in the URDF, the
+    centre-of-mass inertia it implies is I2 itself, a possible one: both sides are named."""
+    params = default_params("double_pendulum")
+    pivot = params.replace(I2=params.I2 + params.m2 * params.r2**2)
+    (sentence,) = _diagnoses(DoublePendulum(params), _dp_system(pivot))
+    assert BOTH_SIDES in sentence
+
+
+def test_a_rod_whose_urdf_inertia_cannot_be_about_the_pivot_names_the_hand_model_alone():
+    """The reference rods against their right URDF: read as about the pivot, link 2's <inertia>
+    (0.0135 kg·m²) would leave it 0.0135 − 0.03872 = −0.02522 kg·m² about its centre of mass, which
+    no body has: only the hand model can be wrong."""
+    params = default_params("double_pendulum")
+    (sentence,) = _diagnoses(ParallelAxisMissing(params), _dp_system(params))
+    assert sentence.endswith(
+        ": your M misses the parallel-axis term (the URDF's <inertia> of link2 cannot be about the pivot: "
+        "about the centre of mass it would leave link2 a moment of inertia of -0.02522 kg·m² about the axis "
+        "it turns about, and no body has one below zero)"
+    )
+    assert "or the URDF" not in sentence
+
+
+@pytest.mark.parametrize("ratio", [1.0, 1.0 - SIDE_MARGIN / 2])
+def test_a_body_on_the_boundary_keeps_both_sides(ratio):
+    """A hoop hung from its rim: I_c = m·r², so the URDF's inertia read about the pivot leaves zero
+    about the centre of mass, a limit a body reaches; within the rounding margin below it too."""
+    params = default_params("double_pendulum")
+    params = params.replace(I2=ratio * params.m2 * params.r2**2)
+    (sentence,) = _diagnoses(ParallelAxisMissing(params), _dp_system(params))
+    assert BOTH_SIDES in sentence
+
+
+def test_a_planar_link_turns_about_its_joint_axis_alone():
+    system = _dp_system(default_params("double_pendulum"))
+    axes = turning_axes(system.model, 2)
+    assert axes.shape == (3, 1)
+    assert np.allclose(np.abs(axes[:, 0]), [1.0, 0.0, 0.0])  # the URDF's joint axis: x
 
 
 class PivotCountedTwice(DoublePendulum):
@@ -75,13 +149,15 @@ class PivotCountedTwice(DoublePendulum):
         return super().delta + self.params.m2 * self.params.r2**2
 
 
-def test_hand_model_adding_m_r2_twice_is_named():
+def test_hand_model_adding_m_r2_twice_is_named_with_both_sides():
     params = default_params("double_pendulum")
     (sentence,) = _diagnoses(PivotCountedTwice(params), _dp_system(params))
-    assert sentence.startswith(
-        "M_hand − M_urdf is exactly the parallel-axis term m·r² of link2 (joint joint2)"
+    assert sentence == (
+        "M[1,1], M[1,2], M[2,2] have the parallel-axis term m·r² = 0.03872 kg·m² of link2 (joint joint2) "
+        "too many (M_hand − M_urdf is exactly that term): your M adds the parallel-axis term to an inertia "
+        "already about the pivot (counted twice), or the URDF's <inertia> of link2 is m·r² short (the term "
+        "taken off an inertia already about the centre of mass)"
     )
-    assert "counted twice" in sentence
 
 
 # --- absolute vs relative angles -------------------------------------------------------------

@@ -64,7 +64,7 @@ def test_a_latex_typo_is_named_shaped_and_repaired_in_latex(tmp_path, capsys):
     assert status == 1
     assert "M[2,2] (theta2, theta2): hand 0.10444, Pinocchio 0.05222" in out
     assert "hand − Pinocchio = 0.05222 (constant, residual" in out
-    assert "M[2,2]: 2 \\delta → \\delta makes every check pass on every state" in out
+    assert "M[2,2]: 2\\delta → \\delta makes every check pass on every state" in out
     (findings,) = report["diagnoses"].values()
     assert {f["kind"] for f in findings} <= set(KINDS)
     assert {f["quantity"] for f in findings} - {None} <= set(QUANTITIES)
@@ -173,11 +173,11 @@ def test_the_diagnosis_reaches_junit_the_review_page_and_assert_verified(tmp_pat
     assert main([*args, "--junit", str(junit)]) == 1
     capsys.readouterr()
     xml = junit.read_text()
-    assert "diagnosis: M[2,2]: 2 \\delta → \\delta makes every check pass" in xml
+    assert "diagnosis: M[2,2]: 2\\delta → \\delta makes every check pass" in xml
     report = api.check(typo, DP_URDF, DP_PARAMS)
     page = diagnosis_block(report)
-    assert "<strong>repair</strong> M[2,2]: 2 \\delta → \\delta" in page
-    with pytest.raises(AssertionError, match=r"M\[2,2\]: 2 \\delta → \\delta makes every check pass"):
+    assert "<strong>repair</strong> M[2,2]: 2\\delta → \\delta" in page
+    with pytest.raises(AssertionError, match=r"M\[2,2\]: 2\\delta → \\delta makes every check pass"):
         assert_verified(typo, DP_URDF, DP_PARAMS)
 
 
@@ -223,3 +223,64 @@ def test_which_inertial_parameters_a_model_assumes(tmp_path):
     assert differing and all("link2" in name for name in differing), differing
     own = api.implied_parameters("double_pendulum", DP_URDF, DP_PARAMS, samples=20)
     assert own.exact and own.agrees and not any(c.differs for c in own.combinations)
+
+
+# --- the repair in the user's own text ------------------------------------------------------------
+def _latex_planted(tmp_path, good: str, bad: str) -> Path:
+    """The reference double pendulum's LaTeX with ``good`` typed as ``bad`` in both of its displays
+    (θ and x notation: ``good`` is written with θ, and x_k stands for θ_k in the second)."""
+    text = (REPO / "examples" / "double_pendulum_latex.toml").read_text()
+    for old, new in ((good, bad), (good.replace("\\theta_", "x_"), bad.replace("\\theta_", "x_"))):
+        assert text.count(old) == 1, old
+        text = text.replace(old, new)
+    path = tmp_path / "planted.toml"
+    path.write_text(text)
+    return path
+
+
+def _repair_of(tmp_path, capsys, path, urdf=DP_URDF, params=DP_PARAMS) -> dict:
+    status, _, report = _check(
+        tmp_path, capsys, "--analytic", str(path), "--urdf", str(urdf), "--params", str(params)
+    )
+    assert status == 1
+    repair = next(f for f in next(iter(report["diagnoses"].values())) if f["kind"] == "repair")
+    assert repair["checks_pass"] is True, repair["message"]
+    return repair
+
+
+def test_a_latex_sign_error_is_repaired_as_the_users_string_with_one_sign_changed(tmp_path, capsys):
+    good = "\\alpha + 2\\beta\\cos(\\theta_2) & "
+    path = _latex_planted(tmp_path, good, good.replace("+", "-"))
+    repair = _repair_of(tmp_path, capsys, path)
+    assert repair["index"] == [1, 1]
+    assert repair["suggested_source"] == "\\alpha + 2\\beta\\cos(\\theta_2)"  # the user's own text
+    assert (
+        "M[1,1]: \\alpha - 2\\beta\\cos(\\theta_2) → \\alpha + 2\\beta\\cos(\\theta_2) makes"
+        in repair["message"]
+    )
+
+
+def test_a_latex_term_rewritten_keeps_every_other_term_as_the_user_wrote_it(tmp_path, capsys):
+    """sin typed for cos in H[1]'s first term: that term is printed anew (``\\cos\\theta_1``, not
+    SymPy's ``\\cos{\\left(\\theta_{1} \\right)}``), the rest of the entry is the user's text."""
+    good = "m_1gr_1\\cos(\\theta_1) + m_2g(l_1\\cos(\\theta_1)"
+    path = _latex_planted(tmp_path, good, good.replace("\\cos", "\\sin", 1))
+    repair = _repair_of(tmp_path, capsys, path)
+    rest = " + m_2g(l_1\\cos(\\theta_1) + r_2\\cos(\\theta_1 + \\theta_2))"
+    source = repair["suggested_source"]
+    assert source.endswith(rest) and "\\left" not in source, source
+    first = source[: -len(rest)]
+    assert first != "m_1gr_1\\sin(\\theta_1)" and "\\cos\\theta_1" in first, source
+    assert repair["message"].startswith(f"H[1]: m_1gr_1\\sin(\\theta_1){rest} → {source} makes")
+
+
+def test_a_text_model_repair_is_the_users_text_as_written(tmp_path, capsys):
+    """The user's order of terms and factors is kept (SymPy would print 2*l1*m2*r2*cos(theta2) first)."""
+    text = (REPO / "examples" / "minimal_double_pendulum_text.toml").read_text()
+    good = "I1 + I2 + m1*r1**2 + m2*(l1**2 + r2**2) + 2*m2*l1*r2*cos(theta2)"
+    path = tmp_path / "sign.toml"
+    path.write_text(text.replace(good, good.replace("+ 2*m2", "- 2*m2")))
+    params = REPO / "examples" / "minimal_double_pendulum.toml"
+    repair = _repair_of(tmp_path, capsys, path, params=params)
+    assert repair["suggested_source"] == good
+    assert repair["suggested"] == "I1 + I2 + 2*l1*m2*r2*cos(theta2) + m1*r1**2 + m2*(l1**2 + r2**2)"

@@ -354,8 +354,32 @@ def test_a_urdf_inertia_about_the_pivot_is_named():
     (finding,) = identify_parameters(batch)
     d = finding.details
     assert (d["link"], d["parameter"]) == ("link1", "inertia about the pivot")
-    assert "link1's inertia about the centre of mass where the URDF has it about the pivot" in finding.message
+    assert (
+        "link1's inertia smaller than the URDF's by the parallel-axis term m·|c|² = 0.0625 kg·m²: your M "
+        "misses the parallel-axis term, or the URDF's <inertia> of link1 is about the pivot"
+    ) in finding.message
     assert _close(d["model_value"][0][0], params.I1) and _close(d["urdf_value"][0][0], pivot)
+
+
+def test_a_rod_missing_its_parallel_axis_term_is_blamed_on_the_hand_model_alone():
+    """Against a right URDF, link 1's <inertia> (0.0208 kg·m² < m1·r1² = 0.0625 kg·m²) cannot be
+    about the pivot: the parameters finding names the hand model's side only."""
+    cls, params, system = _builtin("double_pendulum")
+
+    class Missing(cls):
+        @property
+        def alpha(self):
+            return super().alpha - self.params.m1 * self.params.r1**2
+
+    model = Missing(params)
+    batch = _batch(model, system)
+    assert _failing(model, system, batch)
+    (finding,) = identify_parameters(batch)
+    assert finding.details["parameter"] == "inertia about the pivot"
+    assert "link1's inertia smaller than the URDF's by the parallel-axis term" in finding.message
+    one_side = "your M misses the parallel-axis term (the URDF's <inertia> of link1 cannot be about"
+    assert one_side in finding.message
+    assert "or the URDF" not in finding.message
 
 
 def test_the_identifiable_combinations_of_a_planar_chain():

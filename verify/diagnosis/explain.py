@@ -3,7 +3,8 @@
 In order:
 
 1. the entries that differ, each with the shape of its difference over the states
-   (``pendverify.diagnosis.entries``, ``pendverify.diagnosis.patterns``);
+   (``pendverify.diagnosis.entries``, ``pendverify.diagnosis.patterns``), its coefficients
+   written as products of the parameters where one fits (``pendverify.diagnosis.monomials``);
 2. the known traps (``pendverify.diagnosis.diagnose``: coordinate conventions, an inertia
    about the pivot, friction missing from q̈);
 3. the inertial parameters the model implies: whether it is this robot's dynamics with other
@@ -32,8 +33,10 @@ import numpy as np
 from pendverify.diagnosis.diagnose import diagnose
 from pendverify.diagnosis.entries import differing_entries, entry_finding
 from pendverify.diagnosis.finding import Finding
+from pendverify.diagnosis.monomials import coefficient_words
 from pendverify.diagnosis.parameters import identify_parameters
 from pendverify.diagnosis.patterns import entry_pattern, pattern_finding
+from pendverify.diagnosis.ranking import ranked
 from pendverify.diagnosis.repair import search_repair
 
 #: the whole diagnosis's bound, 10 s for up to 3 degrees of freedom on a 2-core machine; most
@@ -66,7 +69,8 @@ def explain(batch, results, deadline_s: float = REPAIR_DEADLINE_S) -> list[Findi
             shaped += 1
             pattern = entry_pattern(entry, batch)
             if pattern is not None:
-                findings.append(pattern_finding(entry, pattern, batch.model.coordinates))
+                written = coefficient_words(pattern, entry, batch.model)
+                findings.append(pattern_finding(entry, pattern, batch.model.coordinates, written))
         if shaped < len(entries):
             skipped.append(f"the shape of {len(entries) - shaped} of {len(entries)} differing entries")
         steps = (
@@ -91,4 +95,4 @@ def explain(batch, results, deadline_s: float = REPAIR_DEADLINE_S) -> list[Findi
     if why_not:  # said as a repair that is not one: checks_pass false, nothing suggested
         details = {"written": None, "suggested": None, "suggested_source": None, "location": None}
         findings.append(Finding("repair", why_not, details={**details, "checks_pass": False}))
-    return findings
+    return ranked(findings)

@@ -6,6 +6,8 @@
   put back where its expression stands (SymPy's ``subs``, which also finds 2·I2 + 2·m2·r2²
   as 2·δ); the location is the file and the equation's key;
 * a text model file in SymPy syntax: SymPy's own printing over the file's names;
+* a repaired entry of either kind of file is the user's own text of the entry with the fewest
+  terms changed, each changed term printed as above (``pendverify.diagnosis.source_edit``);
 * a Python class: the same printing, which is a Python expression over the class's names;
   the location is the source file and ``Class.method``.
 """
@@ -16,8 +18,10 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
+from pendverify.analytic.forms import entry_position
 from pendverify.analytic.source_file import where
 from pendverify.analytic.text_model import METHODS
+from pendverify.diagnosis.source_edit import UNREADABLE, SourceText, minimal_edit
 
 #: method → the key of a text model file that gives it
 TEXT_KEYS = {method: key for key, (method, _) in METHODS.items()}
@@ -33,13 +37,15 @@ class Notation:
     derived: dict = field(default_factory=dict)  # text file: key → how it was computed from others
     names: dict = field(default_factory=dict)  # LaTeX: symbol → its LaTeX
     shorthands: list = field(default_factory=list)  # LaTeX: (expression, its symbol), largest first
+    spec: object = None  # a text model file's spec (``TextModelSpec``), None for a class
+    _source: list = field(default_factory=list, repr=False)  # the file's SourceText, once read
 
     @classmethod
     def of(cls, model_cls) -> Notation:
         spec = getattr(model_cls, "text_spec", None)
         if spec is None:
             return cls("python", where(model_cls), model_cls.__name__)
-        notation = cls(spec.notation, str(spec.path), model_cls.__name__, dict(spec.derived))
+        notation = cls(spec.notation, str(spec.path), model_cls.__name__, dict(spec.derived), spec=spec)
         for key, value in spec.latex_symbols.items():
             value = sp.sympify(value)
             if isinstance(value, sp.Symbol):
@@ -61,6 +67,30 @@ class Notation:
                 form = form.subs(value, stand_in)
             forms.append(form)
         return sp.latex(min(forms, key=sp.count_ops), symbol_names=self.names)
+
+    def entry_edit(self, method: str, index: int, old, new) -> tuple[str, str]:
+        """(the entry as the source writes it, the repaired entry): for a text model file, the file's
+        own text of the entry and that text with the fewest terms changed (``source_edit``); for a
+        class, a key derived from others, or when the text is not found, both printed whole."""
+        whole = self.render(old), self.render(new)
+        key = TEXT_KEYS.get(method, method)
+        if self.spec is None or key in self.derived or key not in self.spec.equations:
+            return whole
+        if not self._source:
+            try:
+                self._source.append(SourceText(self.spec))
+            except UNREADABLE:  # the file is gone or changed since it was read
+                self._source.append(None)
+        source = self._source[0]
+        if source is None:
+            return whole
+        value = self.spec.equations[key]
+        position = entry_position(method, value.shape, index) if isinstance(value, sp.MatrixBase) else ()
+        written = source.entry_text(key, position, old)
+        if written is None:
+            return whole
+        edited = minimal_edit(source, written, old, new, self.render)
+        return written, edited if edited is not None else whole[1]
 
     def location(self, method: str, label: str) -> str:
         """Where the entry sits: the file, the key (or Class.method) and the entry."""

@@ -26,6 +26,7 @@ import pinocchio as pin
 from pendverify.diagnosis.finding import Finding
 from pendverify.diagnosis.hypotheses import Explanation, Hypothesis, explanations
 from pendverify.diagnosis.implied import AXES, COMPONENTS, ImpliedParameters, implied_parameters
+from pendverify.diagnosis.traps.inertia import sides
 
 
 # --- the findings ------------------------------------------------------------------------------
@@ -57,19 +58,18 @@ def _values(h: Hypothesis, x: float, model: pin.Model):
     return I_c + sign * (body.matrix()[3:, 3:] - I_c), I_c
 
 
-def _phrase(h: Hypothesis, model_value, urdf_value, body: pin.Inertia) -> str:
-    """The change in words, as "your equations are this URDF with ..." continues."""
+def _phrase(h: Hypothesis, model_value, urdf_value, model: pin.Model) -> str:
+    """The change in words, as "your equations are this URDF with ..." continues.  An inertia about
+    the pivot names both sides it may be wrong on, or the hand model's alone when the URDF rules
+    the other out (``pendverify.diagnosis.traps.inertia.sides``)."""
+    body = model.inertias[h.joint + 1]
     if h.parameter == "inertia about the pivot":
         c = np.array(body.lever)
         term = f"{body.mass * float(c @ c):.6g} kg·m²"
-        if h.label == "+":
-            return (
-                f"{h.link}'s inertia about its pivot where the URDF has it about the centre of mass "
-                f"(the parallel-axis term m·|c|² = {term} counted twice)"
-            )
+        larger = h.label == "+"  # the model's inertia is the URDF's plus m·r²
         return (
-            f"{h.link}'s inertia about the centre of mass where the URDF has it about the pivot "
-            f"(the URDF's is larger by the parallel-axis term m·|c|² = {term})"
+            f"{h.link}'s inertia {'larger' if larger else 'smaller'} than the URDF's by the parallel-axis "
+            f"term m·|c|² = {term}: {sides(model, h.joint + 1, -1 if larger else 1)}"
         )
     ours, theirs = _distinct(model_value, urdf_value)
     if h.parameter == "mass":
@@ -112,7 +112,7 @@ def _findings(found: list[Explanation], implied: ImpliedParameters, model: pin.M
                 explanation.hypotheses, explanation.values, explanation.roundings, strict=True
             )
         ]
-        phrases = [_phrase(h, ours, theirs, model.inertias[h.joint + 1]) for h, ours, theirs, _ in changes]
+        phrases = [_phrase(h, ours, theirs, model) for h, ours, theirs, _ in changes]
         sentence = "your equations are this URDF with " + " and ".join(phrases)
         if len(found) > 1:
             sentence += (

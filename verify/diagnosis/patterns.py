@@ -38,6 +38,11 @@ from pendverify.diagnosis.finding import Finding
 
 MAX_TERMS = 6
 PATTERN_RESIDUAL = 1e-9
+#: a coefficient's uncertainty is this many times what the fit's residual moves it by: the noise of
+#: d in the fitted functions' span is of the size of the residual (the part outside it), per
+#: dimension, so the coefficient of function k moves by about ‖r‖·‖row k of A_S⁺‖; 10 covers
+#: the few chosen dimensions and a residual below its mean
+COEFFICIENT_SAFETY = 10.0
 #: a fitted coefficient below this fraction of the largest is rounding, not a term
 NEGLIGIBLE = 1e-9
 FITTED = ("M", "H", "V", "D", "detM", "C", "Cqdot")
@@ -51,14 +56,20 @@ class Pattern:
     residual: float
     #: each term's basis function as a SymPy expression over the model's names
     functions: tuple = ()
+    #: each coefficient's uncertainty (absolute): how far it may be from the exact coefficient of
+    #: the difference (``COEFFICIENT_SAFETY`` times the residual through the fit's pseudo-inverse)
+    uncertainties: tuple = ()
 
-    def formula(self) -> str:
+    def formula(self, written=None) -> str:
+        """The fit as a formula; ``written``: per term, its coefficient's magnitude in words (a product
+        of parameters, ``pendverify.diagnosis.monomials``) or None to print the number."""
         if not self.terms:
             return "0"
         out = ""
-        for c, name in self.terms:
+        for k, (c, name) in enumerate(self.terms):
             sign = "−" if c < 0 else "+"
-            magnitude = f"{abs(c):.6g}" if name == "1" else f"{abs(c):.6g}·{name}"
+            number = written[k] if written and written[k] else f"{abs(c):.6g}"
+            magnitude = number if name == "1" else f"{number}·{name}"
             out += f" {sign} {magnitude}" if out else (f"−{magnitude}" if c < 0 else magnitude)
         return out
 
@@ -180,9 +191,19 @@ def fit(d, basis) -> Pattern | None:
     if relative > PATTERN_RESIDUAL:
         return None
     largest = float(np.max(np.abs(coeff)))
-    kept = [(float(c), k) for c, k in sorted(zip(coeff, chosen, strict=True), key=lambda ck: ck[1])]
-    kept = [(c, k) for c, k in kept if abs(c) > NEGLIGIBLE * largest]
-    return Pattern(tuple((c, basis[k][0]) for c, k in kept), relative, tuple(basis[k][2]() for _, k in kept))
+    moved = (
+        COEFFICIENT_SAFETY
+        * float(np.linalg.norm(residual))
+        * np.linalg.norm(np.linalg.pinv(A[:, chosen]), axis=1)
+    )
+    found = sorted(zip(coeff, chosen, moved, strict=True), key=lambda ckm: ckm[1])
+    kept = [(float(c), k, float(m)) for c, k, m in found if abs(c) > NEGLIGIBLE * largest]
+    return Pattern(
+        tuple((c, basis[k][0]) for c, k, _ in kept),
+        relative,
+        tuple(basis[k][2]() for _, k, _ in kept),
+        tuple(m for _, _, m in kept),
+    )
 
 
 def entry_pattern(entry: EntryDifference, batch) -> Pattern | None:
@@ -196,16 +217,15 @@ def entry_pattern(entry: EntryDifference, batch) -> Pattern | None:
         return fit(entry.hand - entry.pin, basis)
 
 
-def pattern_finding(entry: EntryDifference, pattern: Pattern, coordinates) -> Finding:
-    """The ``pattern`` finding: ``M[2,2]: hand − Pinocchio = 0.0416 (constant, residual 3e-16)``."""
+def pattern_finding(entry: EntryDifference, pattern: Pattern, coordinates, written=None) -> Finding:
+    """The ``pattern`` finding: ``M[2,2]: hand − Pinocchio = 0.0416 (constant, residual 3e-16)``;
+    ``written``: per term, its coefficient as a product of parameters, or None (``Pattern.formula``)."""
     label = entry.label(coordinates).split(" (")[0]
     message = (
-        f"{label}: hand − Pinocchio = {pattern.formula()} ({pattern.kind()}, residual {pattern.residual:.1g})"
+        f"{label}: hand − Pinocchio = {pattern.formula(written)} ({pattern.kind()}, "
+        f"residual {pattern.residual:.1g})"
     )
-    return Finding(
-        "pattern",
-        message,
-        entry.quantity,
-        tuple(i + 1 for i in entry.index),
-        {"terms": [[c, name] for c, name in pattern.terms], "residual": pattern.residual},
-    )
+    details = {"terms": [[c, name] for c, name in pattern.terms], "residual": pattern.residual}
+    if written and any(written):
+        details["coefficients"] = list(written)
+    return Finding("pattern", message, entry.quantity, tuple(i + 1 for i in entry.index), details)

@@ -176,7 +176,7 @@ def _findings(changes: dict, edit: Edit, slot: Slot, forms: dict, notation, alte
     out = []
     for (method, index), (old, new) in changes.items():
         label = entry_label(method, forms[method], index)
-        written, suggested = notation.render(old), notation.render(new)
+        written, suggested = notation.entry_edit(method, index, old, new)
         location = notation.location(method, label)
         shown = (
             f"{written} → {suggested}"

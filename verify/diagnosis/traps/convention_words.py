@@ -101,18 +101,21 @@ def _sign_clause(model, c: Candidate) -> str:
 
 
 def pivot_clause(links: dict[str, int], mr2: dict[str, float]) -> str:
-    """The pivot fit's clause: which links' inertias are about the pivot, or counted twice."""
+    """The pivot fit's clause: which links' inertias are about the pivot, or counted twice; each with the
+    other side M cannot tell from it (``pendverify.diagnosis.traps.inertia``, "Which side is wrong")."""
     plus = [n for n, k in links.items() if k > 0]
     minus = [n for n, k in links.items() if k < 0]
     parts = []
     if plus:
         parts.append(
-            f"the URDF's inertia of {', '.join(plus)} is about the pivot instead of the centre of mass "
+            f"the URDF's inertia of {', '.join(plus)} is about the pivot instead of the centre of mass, "
+            "or your M misses the parallel-axis term "
             f"(m·r² = {', '.join(f'{mr2[n]:.6g} kg·m²' for n in plus)})"
         )
     if minus:
         parts.append(
-            f"the hand model adds m·r² to the inertia of {', '.join(minus)}, already about the pivot "
+            f"the hand model adds m·r² to the inertia of {', '.join(minus)}, already about the pivot, "
+            "or the URDF's <inertia> is m·r² short "
             f"(m·r² = {', '.join(f'{mr2[n]:.6g} kg·m²' for n in minus)})"
         )
     return f"{PIVOT}: " + " and ".join(parts)

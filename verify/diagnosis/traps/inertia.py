@@ -14,6 +14,30 @@ term, a rotational inertia of zero mass at the joint origin: M is linear in the
 bodies' spatial inertias, and that one contributes J_ωᵀ R (m (|c|² 𝟙 − c cᵀ)) Rᵀ J_ω.
 The same copy with c_b·K_b taken off the body's own inertia is the URDF the fit
 says was meant (``corrected_system``).
+
+Which side is wrong
+-------------------
+M alone sees only M_urdf − M_hand, so each sign has two readings that give the same numbers:
+
+* c_b = +1 (the hand's M lacks m·r²): your M misses the parallel-axis term (the URDF is right),
+  or the URDF's <inertia> is about the pivot (your M is right);
+* c_b = −1 (the hand's M has m·r² too many): your M adds it to an inertia already about the
+  pivot, or the URDF's <inertia> is m·r² short (the term taken off an inertia already about
+  the centre of mass).
+
+Both are named unless the URDF itself rules one out.  The only reading that asks something of
+the URDF's numbers is "the URDF's <inertia> is about the pivot": the body's inertia about its
+centre of mass is then I_c − m(|c|²𝟙 − ccᵀ), and every body's moment of inertia about any axis
+through its centre of mass is ∫ d² dm ≥ 0.  When that moment is negative about an axis the
+body turns about, that reading is impossible and the hand model's side is named alone (a
+uniform rod hung from its end: I_c = m·L²/12 < m·r² = m·L²/4; a point mass: I_c = 0).  Only
+the axes the body turns about are asked (``turning_axes``): M depends on the inertia through
+them alone, and a URDF's other moments are often placeholders.  The other readings are always
+possible: the URDF's own inertia is a physical one (Pinocchio refuses any other), and adding
+m·r² keeps it one.  A body on the boundary (a hoop hung from its rim: I_c = m·r²) is not ruled
+out: the reading is decided only when the moment is below −``SIDE_MARGIN``·m·r², a margin that
+covers the rounding of a URDF written with three significant digits (5e-3 of each of m, c and
+I, so at most ~1.5e-2 of m·r² and of I_c).
 """
 
 from __future__ import annotations
@@ -30,6 +54,11 @@ from pendverify.robot.coordinates import CoordinateMap
 from pendverify.robot.system import PinocchioSystem
 
 COEFF_TOL = 1e-3  # how close a fitted coefficient must be to an integer
+#: how far below zero (relative to m·r²) the implied moment must be to rule a reading out (docstring)
+SIDE_MARGIN = 2e-2
+#: configurations the axes a body turns about are gathered at (random, seeded)
+AXIS_CONFIGURATIONS = 4
+AXIS_SEED = 4242
 
 
 def _shift(inertia: pin.Inertia) -> np.ndarray:
@@ -51,6 +80,73 @@ def _with_model(system: PinocchioSystem, model: pin.Model, cmap: CoordinateMap |
     geometry = system.geometry if cmap is None else dataclasses.replace(system.geometry, cmap=cmap)
     g = -float(system.model.gravity.linear[2])
     return PinocchioSystem(model, geometry, g, system.source, system.urdf, system.model_form_rtol)
+
+
+def turning_axes(model: pin.Model, joint: int) -> np.ndarray:
+    """An orthonormal basis (3, k) of the directions body ``joint`` turns about, in its joint frame:
+    the span of its angular velocity's Jacobian (local frame) at ``AXIS_CONFIGURATIONS`` random
+    configurations (a planar chain's body: its joint axis; a body on a spherical joint: all three)."""
+    rng = np.random.default_rng(AXIS_SEED)
+    data = model.createData()
+    columns = []
+    for _ in range(AXIS_CONFIGURATIONS):
+        q = pin.integrate(model, pin.neutral(model), rng.uniform(-np.pi, np.pi, model.nv))
+        pin.computeJointJacobians(model, data, q)
+        columns.append(pin.getJointJacobian(model, data, joint, pin.ReferenceFrame.LOCAL)[3:, :])
+    u, s, _ = np.linalg.svd(np.hstack(columns))
+    # the columns are unit axes or cross products of them: rank at rounding level of 1
+    return u[:, : int(np.sum(s > 1e-9 * max(float(s[0]), 1.0)))] if s.size else np.zeros((3, 0))
+
+
+def pivot_reading_moment(model: pin.Model, joint: int) -> tuple[float, float]:
+    """(the smallest moment of inertia about an axis body ``joint`` turns about, through its centre of
+    mass, if the URDF's <inertia> were about the pivot; m·r² about that axis) in kg·m² (module
+    docstring, "Which side is wrong")."""
+    inertia = model.inertias[joint]
+    P = turning_axes(model, joint)
+    if P.shape[1] == 0:
+        return 0.0, 0.0
+    shift = P.T @ _shift(inertia) @ P
+    implied = P.T @ np.asarray(inertia.inertia) @ P - shift
+    smallest = np.linalg.eigvalsh(implied)
+    k = int(np.argmin(smallest))
+    return float(smallest[k]), float(np.max(np.linalg.eigvalsh(shift)))
+
+
+def pivot_reading_possible(model: pin.Model, joint: int) -> bool:
+    """Whether the URDF's <inertia> of body ``joint`` can be an inertia about the pivot: the moment
+    about the centre of mass it implies is not below −``SIDE_MARGIN``·m·r² (module docstring)."""
+    moment, mr2 = pivot_reading_moment(model, joint)
+    return moment >= -SIDE_MARGIN * mr2
+
+
+def sides(model: pin.Model, joint: int, sign: int) -> str:
+    """Which side the parallel-axis term of body ``joint`` is wrong on, in words: both readings, or
+    the hand model's alone when the URDF rules its reading out (module docstring); ``sign`` +1 when
+    the hand's M lacks m·r², −1 when it has it too many."""
+    link = _link_name(model, joint).split(" (")[0]
+    if sign < 0:
+        return (
+            "your M adds the parallel-axis term to an inertia already about the pivot (counted twice), "
+            f"or the URDF's <inertia> of {link} is m·r² short (the term taken off an inertia already "
+            "about the centre of mass)"
+        )
+    if pivot_reading_possible(model, joint):
+        return (
+            f"your M misses the parallel-axis term, or the URDF's <inertia> of {link} is about the pivot "
+            "(a URDF <inertia> is about the centre of mass: I_com = I_pivot − m·r²)"
+        )
+    moment, _ = pivot_reading_moment(model, joint)
+    return (
+        f"your M misses the parallel-axis term (the URDF's <inertia> of {link} cannot be about the "
+        f"pivot: about the centre of mass it would leave {link} a moment of inertia of {moment:.6g} "
+        "kg·m² about the axis it turns about, and no body has one below zero)"
+    )
+
+
+def _joint_of(model: pin.Model, name: str) -> int:
+    """The joint whose link ``_link_name`` names ``name``."""
+    return next(j for j in range(1, model.njoints) if _link_name(model, j) == name)
 
 
 def parallel_axis_systems(system: PinocchioSystem) -> list[tuple[str, PinocchioSystem]]:
@@ -128,22 +224,22 @@ def pivot_inertia(model, system, failing, states) -> Finding | None:
         return None
     fit = fit_words(residual)
     _, at_zero = parallel_axis_terms(system, np.zeros((1, model.nv)))
-    mr2 = {n: float(np.max(np.abs(k))) for n, k in zip(names, at_zero, strict=True)}
-    plus = [n for n, c in zip(names, rounded, strict=True) if c > 0]
-    minus = [n for n, c in zip(names, rounded, strict=True) if c < 0]
     parts = []
-    if plus:
+    for name, c, k, seen in zip(names, rounded, at_zero, np.max(np.abs(K), axis=1), strict=True):
+        if not c:
+            continue
+        mr2 = float(np.max(np.abs(k)))
+        n = seen.shape[0]
+        # the entries the term reaches at some state (rounding of the CRBA aside)
+        where = [
+            f"M[{i + 1},{j + 1}]" for i in range(n) for j in range(i, n) if seen[i, j] > 1e-12 * np.max(seen)
+        ]
+        verb = ("lacks" if len(where) == 1 else "lack") if c > 0 else ("has" if len(where) == 1 else "have")
+        extra = "" if c > 0 else " too many"
+        difference = "M_urdf − M_hand" if c > 0 else "M_hand − M_urdf"
         parts.append(
-            f"M_urdf − M_hand is {fit} the parallel-axis term m·r² of {', '.join(plus)} "
-            f"(m·r² = {', '.join(f'{mr2[n]:.6g} kg·m²' for n in plus)}): inertia given about the pivot "
-            "instead of the centre of mass — a URDF <inertia> is about the centre of mass, "
-            "I_com = I_pivot − m·r²"
-        )
-    if minus:
-        parts.append(
-            f"M_hand − M_urdf is {fit} the parallel-axis term m·r² of {', '.join(minus)} "
-            f"(m·r² = {', '.join(f'{mr2[n]:.6g} kg·m²' for n in minus)}): the hand model adds m·r² to an "
-            "inertia that is already about the pivot (I_pivot = I_com + m·r², counted twice)"
+            f"{', '.join(where)} {verb} the parallel-axis term m·r² = {mr2:.6g} kg·m² of {name}{extra} "
+            f"({difference} is {fit} that term): {sides(system.model, _joint_of(system.model, name), int(c))}"
         )
     details = {"links": {n: int(c) for n, c in zip(names, rounded, strict=True) if c}, "residual": residual}
     return Finding(kind="convention", message="; ".join(parts), quantity="M", details=details)

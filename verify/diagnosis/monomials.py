@@ -1,0 +1,129 @@
+"""A fitted coefficient written as a product of the parameters: −7.848 as −2·g·l1·m2.
+
+The shape of a difference (``pendverify.diagnosis.patterns``) has numeric coefficients.  Each is
+matched against q·p1^a1·…·pk^ak, a small fraction q (``candidates.FRACTIONS``: 1, 2, 3, 4, ½, ⅓,
+…, 1/12) times a product of at most ``DEGREE`` parameter values, and written so when exactly one
+such product fits:
+
+* **Units first.** Only products with the coefficient's physical dimension are tried, so that a
+  parameter worth 1 (m1 = 1 kg) or two lengths in ratio 2 do not make every product fit.  With
+  L_i = m for a prismatic coordinate and 1 for an angle, and E = kg·m²/s² an energy:
+  M[i,j] is E·s²/(L_i·L_j), H[i] is E/L_i, V is E, det M is Π_i E·s²/L_i²; a C[i,j] term
+  c·q̇_k·f(q) has c = E·s²/(L_i·L_j·L_k), a C·q̇[i] term c·q̇_j·q̇_k·f(q) has
+  c = E·s²/(L_i·L_j·L_k).  Parameters of a kind without a fixed unit (damping, or none
+  declared) are not used; neither is a term that has no fixed-unit reading (a constant in C, a
+  friction term of C·q̇): it keeps its number.
+* **Exactly.** A product fits when |q·v − |c|| is within the coefficient's uncertainty
+  (``Pattern.uncertainties``: the residual of the fit carried through its pseudo-inverse, so a
+  badly conditioned fit gets a wide window) or ``FLOOR`` relative (the rounding of a product of
+  ``DEGREE`` floats and of the fitted number, a few ε, with margin).
+* **Unambiguous.** When two different products fit (l1 = 2·r1 makes 2·g·l1·m2 and 4·g·m2·r1
+  the same number), the number is kept: the values cannot say which one the model holds.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import itertools
+from fractions import Fraction
+
+import numpy as np
+import sympy as sp
+
+from pendverify.diagnosis.candidates import DIMENSIONS, FRACTIONS
+
+DEGREE = 4
+FLOOR = 1e-12
+ENERGY = np.array([1, 2, -2])  # kg·m²/s² in (kg, m, s)
+SECOND = np.array([0, 0, 1])
+METRE = np.array([0, 1, 0])
+
+
+def _fixed_parameters(params) -> tuple[tuple[str, float, tuple], ...]:
+    """(name, value, dimension) of each parameter whose kind has a fixed unit and whose value is > 0."""
+    out = []
+    if not dataclasses.is_dataclass(params):  # a parameter set without declared kinds: no units to go by
+        return ()
+    for f in dataclasses.fields(params):
+        kind = f.metadata.get("kind", "")
+        value = getattr(params, f.name, None)
+        if kind in DIMENSIONS and isinstance(value, (int, float)) and np.isfinite(value) and value > 0:
+            out.append((f.name, float(value), DIMENSIONS[kind]))
+    return tuple(out)
+
+
+@functools.lru_cache(maxsize=64)
+def _products(parameters: tuple, dimension: tuple) -> tuple[tuple[float, sp.Expr], ...]:
+    """(value, expression) of every product of at most ``DEGREE`` parameters with ``dimension``."""
+    out = []
+    for degree in range(1, DEGREE + 1):
+        for combo in itertools.combinations_with_replacement(range(len(parameters)), degree):
+            total = tuple(int(x) for x in np.sum([parameters[i][2] for i in combo], axis=0))
+            if total == dimension:
+                value = float(np.prod([parameters[i][1] for i in combo]))
+                out.append((value, sp.Mul(*[sp.Symbol(parameters[i][0]) for i in combo])))
+    return tuple(out)
+
+
+def coefficient_dimension(quantity: str, index: tuple[int, ...], function, model) -> tuple | None:
+    """The physical dimension (kg, m, s) of the coefficient of basis ``function`` in an entry of
+    ``quantity`` at ``index`` (0-based), or None when it has no fixed unit (module docstring)."""
+    angular = list(model.angular)
+    length = [np.zeros(3, int) if a else METRE for a in angular]
+    rates = {f"d{c}": k for k, c in enumerate(model.coordinates)}
+    function = sp.sympify(function)
+    powers = function.as_powers_dict()  # a rate's exponent in the basis function (dθ1² → 2)
+    count = [(rates[s.name], int(powers.get(s, 1))) for s in function.free_symbols if s.name in rates]
+    rate_length = sum((p * length[k] for k, p in count), np.zeros(3, int))
+    n_rates = sum(p for _, p in count)
+    inertia = ENERGY + 2 * SECOND
+    if quantity == "M" and not n_rates:
+        i, j = index
+        out = inertia - length[i] - length[j]
+    elif quantity == "H" and not n_rates:
+        out = ENERGY - length[index[0]]
+    elif quantity == "V" and not n_rates:
+        out = ENERGY
+    elif quantity == "detM" and not n_rates:
+        out = sum((inertia - 2 * L for L in length), np.zeros(3, int))
+    elif quantity == "C" and n_rates == 1:
+        i, j = index
+        out = inertia - length[i] - length[j] - rate_length
+    elif quantity == "Cqdot" and n_rates == 2:
+        out = ENERGY - length[index[0]] - rate_length + n_rates * SECOND
+    else:
+        return None
+    return tuple(int(x) for x in out)
+
+
+def written_coefficient(c: float, uncertainty: float, dimension: tuple, parameters: tuple) -> str | None:
+    """|c| as "q·p1·p2…" when exactly one product of the parameters fits it (module docstring)."""
+    window = max(uncertainty, FLOOR * abs(c))
+    fits = set()
+    for value, expr in _products(parameters, dimension):
+        quotient = abs(c) / value
+        if not np.isfinite(quotient):  # (a coefficient of 1e300: no product of these values)
+            continue
+        ratio = Fraction(quotient).limit_denominator(12)
+        if ratio in FRACTIONS and abs(float(ratio) * value - abs(c)) <= window:
+            fits.add(sp.Rational(ratio.numerator, ratio.denominator) * expr)
+    if len(fits) != 1:
+        return None
+    text = str(fits.pop())
+    for power, superscript in (("**2", "²"), ("**3", "³"), ("**4", "⁴")):
+        text = text.replace(power, superscript)
+    return text.replace("*", "·")
+
+
+def coefficient_words(pattern, entry, model) -> list[str | None]:
+    """Per term of ``pattern`` (the difference of ``entry``), its coefficient's magnitude as a product of
+    ``model``'s parameters, or None to keep the number (module docstring)."""
+    parameters = _fixed_parameters(model.params)
+    out = []
+    for (c, _), function, uncertainty in zip(
+        pattern.terms, pattern.functions, pattern.uncertainties, strict=True
+    ):
+        dimension = coefficient_dimension(entry.quantity, entry.index, function, model)
+        out.append(None if dimension is None else written_coefficient(c, uncertainty, dimension, parameters))
+    return out
