@@ -37,6 +37,18 @@ KIND_RULES: dict[str, tuple[str, str]] = {
 }
 
 
+#: kind → its dimension, the exponents of (kg, m, s); a damping coefficient's depends on its joint
+#: (N·m·s/rad on a hinge, N·s/m on a slide), which the kind does not say: None
+KIND_DIMENSIONS: dict[str, tuple[int, int, int] | None] = {
+    "mass": (1, 0, 0),
+    "length": (0, 1, 0),
+    "offset": (0, 1, 0),
+    "inertia": (1, 2, 0),
+    "damping": None,
+    "gravity": (0, 1, -2),
+}
+
+
 def quantity(kind: str, doc: str) -> Any:
     """A dataclass field holding one physical quantity of the given kind."""
     if kind not in KIND_RULES:

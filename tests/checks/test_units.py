@@ -386,3 +386,14 @@ def test_no_claim_on_the_explain_corpus_but_where_a_plant_changes_a_dimension():
             assert changes or not clashes, f"{label=} {plant.operator=} {plant.what=} {clashes=}"
             caught, planted = caught + bool(clashes), planted + 1
     assert planted >= 1750 and caught >= 9, (planted, caught)  # measured: 1750 and 9
+
+
+def test_every_kind_has_the_dimension_of_its_declared_unit():
+    """One table of kinds' dimensions (``parameter_set.KIND_DIMENSIONS``) agrees with the units the
+    kinds declare (``KIND_RULES``); damping's two units leave its dimension undecided."""
+    from pendverify.analytic.parameter_set import KIND_RULES
+
+    assert set(KIND_DIMENSIONS) == set(KIND_RULES)
+    for kind, (_, unit) in KIND_RULES.items():
+        d = KIND_DIMENSIONS[kind]
+        assert (unit_text(d) if d is not None else None) == (None if kind == "damping" else unit), kind

@@ -72,6 +72,7 @@ from fractions import Fraction
 
 import sympy as sp
 
+from pendverify.analytic import parameter_set
 from pendverify.analytic.forms import entry_position
 from pendverify.analytic.source_file import where
 from pendverify.analytic.symbolic_reading import SymbolicModel, entries
@@ -93,14 +94,10 @@ NONE = _dim()
 LENGTH = _dim(m=1)
 SECOND = _dim(s=1)
 ENERGY = _dim(1, 2, -2)
-#: each parameter kind's dimension; damping's depends on its joint: not decided (module docstring)
+#: each parameter kind's dimension (``parameter_set.KIND_DIMENSIONS``); damping's depends on its
+#: joint: not decided (module docstring)
 KIND_DIMENSIONS: dict[str, Dim | None] = {
-    "mass": _dim(kg=1),
-    "length": LENGTH,
-    "offset": LENGTH,
-    "inertia": _dim(1, 2),
-    "gravity": _dim(m=1, s=-2),
-    "damping": None,
+    kind: None if d is None else _dim(*d) for kind, d in parameter_set.KIND_DIMENSIONS.items()
 }
 #: the functions whose argument must be dimensionless and whose value is
 PURE_FUNCTIONS = (

@@ -34,6 +34,7 @@ from fractions import Fraction
 import numpy as np
 import sympy as sp
 
+from pendverify.analytic.parameter_set import KIND_DIMENSIONS
 from pendverify.analytic.symbolic_reading import SymbolicModel, entries
 from pendverify.diagnosis.patterns import basis_for, fit
 from pendverify.diagnosis.slots import QUANTITY, SCREEN_RTOL, Slot
@@ -183,8 +184,7 @@ def _matched(coefficient: float, monomials) -> sp.Expr | None:
 
 
 #: the physical dimension (kg, m, s) of each kind of parameter whose unit is fixed
-DIMENSIONS = {"mass": (1, 0, 0), "length": (0, 1, 0), "offset": (0, 1, 0), "inertia": (1, 2, 0)}
-DIMENSIONS["gravity"] = (0, 1, -2)
+DIMENSIONS = {kind: d for kind, d in KIND_DIMENSIONS.items() if d is not None}
 
 
 def _dimension(expr, kinds: dict) -> tuple | None:
