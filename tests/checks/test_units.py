@@ -288,10 +288,12 @@ def _pendulum_files(tmp_path: Path, form: str, planted: bool) -> Path:
 
 def test_a_model_alone_runs_the_units_check(tmp_path, capsys):
     form = "LaTeX, every key as a bmatrix"
-    assert main(["check", "--analytic", str(_pendulum_files(tmp_path, form, planted=False))]) == 0
+    # units that agree verify nothing against a robot: exit status 2, so a script that forgot --urdf fails
+    assert main(["check", "--analytic", str(_pendulum_files(tmp_path, form, planted=False))]) == 2
     out = capsys.readouterr().out
     assert "pend   units  0.00e+00  0.00e+00   5 of 7 entries  pass" in out, out
     assert "give --urdf FILE (urdf= in the Python API)" in out
+    assert out.rstrip().endswith("nothing was compared with a robot: NOT verified (give --urdf FILE)"), out
     path = _pendulum_files(tmp_path, form, planted=True)
     assert main(["check", "--analytic", str(path)]) == 1
     out = capsys.readouterr().out
@@ -351,7 +353,9 @@ def test_a_model_alone_still_reads_its_parameter_file(tmp_path, capsys):
     bad.write_text(CART_POLE_PARAMS.read_text().replace("mc = ", "mc = -"))
     assert main(["check", "--analytic", str(CART_POLE), "--params", str(bad)]) == 2
     assert "parameters.mc" in capsys.readouterr().err
-    assert main(["check", "--analytic", str(CART_POLE), "--params", str(CART_POLE_PARAMS)]) == 0
+    assert main(["check", "--analytic", str(CART_POLE), "--params", str(CART_POLE_PARAMS)]) == 2
+    captured = capsys.readouterr()
+    assert "parameters.mc" not in captured.err and "NOT verified (give --urdf FILE)" in captured.out
 
 
 #: the corpus's operators that keep every term's dimension

@@ -149,6 +149,11 @@ class Report:
         """True for pass and pass with warnings (without ``strict``)."""
         return self.status in (PASS, WARN)
 
+    @property
+    def robot_compared(self) -> bool:
+        """Whether any check compared the model with a robot (a model alone gets its ``units`` row only)."""
+        return any(r.check != "units" for r in self.results)
+
     def failures(self) -> list[CheckResult]:
         """The results that fail."""
         return [r for r in self.results if r.status == FAIL]
@@ -328,6 +333,8 @@ def verdict_sentence(report: Report) -> str:
         if report.strict:
             return f"FAIL: {warned} warning(s), which --strict counts as failures"
         return f"pass with {warned} warning(s)"
+    if report.results and not report.robot_compared:
+        return "the units agree; nothing was compared with a robot: NOT verified (give --urdf FILE)"
     return "all checks pass"
 
 
