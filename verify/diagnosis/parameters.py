@@ -168,34 +168,40 @@ def _combinations_finding(implied: ImpliedParameters) -> Finding:
     )
 
 
-def _structural_finding(implied: ImpliedParameters) -> Finding:
-    """No parameters reproduce all rows: which quantities are this robot's on their own, which entries not."""
+def _written(label: str, model) -> str:
+    """A row's entry or quantity (``H[2]``, ``H``) in the model's own name of the quantity (``G[2]``)."""
+    quantity, bracket, rest = label.partition("[")
+    return model.written_name(quantity) + bracket + rest
+
+
+def _structural_finding(implied: ImpliedParameters, model) -> Finding:
+    """No parameters reproduce all rows: which quantities are this robot's on their own, which entries
+    not; named in the model's own names of the quantities (``ClosedFormModel.written_names``)."""
     quantities = implied.quantities
     alone = {q: implied.fits(implied.rows_of(q)) for q in quantities}
     not_alone = [q for q in quantities if not alone[q]]
     if not_alone:
-        what = " and ".join(not_alone)
+        what = " and ".join(_written(q, model) for q in not_alone)
         where = (
             f"{what} on its own is" if len(not_alone) == 1 else f"{what} are, each on its own,"
         ) + " not this robot's for any inertial parameters"
     else:
         together = [
-            f"{a} and {b}"
+            f"{_written(a, model)} and {_written(b, model)}"
             for a, b in itertools.combinations(quantities, 2)
             if implied.fits(implied.rows_of(a, b))
         ]
-        where = (
-            f"{', '.join(quantities)} are each this robot's with some inertial parameters, "
-            "but not all with the same ones"
-        )
+        named = ", ".join(_written(q, model) for q in quantities)
+        where = f"{named} are each this robot's with some inertial parameters, but not all with the same ones"
         if together:
             where += f" ({'; '.join(together)} together are)"
     entries = implied.unexplained
+    left = ", ".join(_written(e, model) for e in entries)
     relative = implied.residual / float(np.linalg.norm(implied.rows.b))
     return Finding(
         "structural",
         "no mass distribution of this robot produces your equations: the difference is structural: "
-        f"{where}; leaving out {', '.join(entries)}, parameters reproduce the rest "
+        f"{where}; leaving out {left}, parameters reproduce the rest "
         f"(relative residual of the best fit to all of them {relative:.3g})",
         details={"residual": relative, "entries": entries, "not_alone": not_alone},
     )
@@ -232,7 +238,7 @@ def identify_parameters(batch, unsearched: list | None = None) -> list[Finding]:
         if implied.agrees:
             return []
         if not implied.exact:
-            return [_structural_finding(implied)]
+            return [_structural_finding(implied, batch.model)]
         count = len(all_hypotheses(implied, batch.system.model))
         pairs = count * (count - 1) // 2
         most = 2 if count + pairs <= MAX_GROUPS else 1
