@@ -162,6 +162,10 @@ class ClosedFormModel(metaclass=ModelClass):
     default_params: ClassVar[ParameterSet | None] = None
     #: The motion ``pendverify certify`` simulates; None: derived from the model's scales.
     battery_motion: ClassVar[BatteryMotion | None] = None
+    #: The model's own names of the quantities where its source names them otherwise than the
+    #: interface (quantity as a diagnosis names it → the model's name): ``{"H": "G"}`` for a model
+    #: file whose gravity vector is ``G(q, p)``.  A diagnosis names entries by them.
+    written_names: ClassVar[dict[str, str]] = {}
 
     def __init__(self, params: ParameterSet):
         if not isinstance(params, self.params_type):
@@ -282,6 +286,11 @@ class ClosedFormModel(metaclass=ModelClass):
             f"({', '.join(cls.coordinates)}) in order, with joint_transform T and joint_offset θ0 when "
             "q = T (θ − θ0) is not the identity"
         )
+
+    @classmethod
+    def written_name(cls, quantity: str) -> str:
+        """The model's own name of ``quantity`` (``written_names``), else the quantity's."""
+        return cls.written_names.get(quantity, quantity)
 
     # --- which quantities are hand-written --------------------------------------------------
     @classmethod

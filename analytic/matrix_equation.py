@@ -47,10 +47,14 @@ from pendverify.analytic.matrix_equation_parse import (
 STANDARD = "M q̈ + C q̇ + D q̇ + H = B u + W w"
 
 
-def assemble(terms: list[Term], given: dict, n: int, inputs: int, disturbances: int) -> tuple[dict, dict]:
+def assemble(
+    terms: list[Term], given: dict, n: int, inputs: int, disturbances: int
+) -> tuple[dict, dict, dict]:
     """The model's parts and how each was derived from the file's keys ``given`` (module docstring).
 
-    Returns (parts, derived); a part ``"h"`` is the bias s_h·h, split by the caller.  Raises
+    Returns (parts, derived, written): ``written`` maps a part to the file's key that is it as it
+    stands (H → G), the model's ``written_names``; a part ``"h"`` is the bias s_h·h, split by the
+    caller.  Raises
     ``MatrixEquationError`` at the term at fault.
     """
     seen: dict[str, Name] = {}
@@ -82,7 +86,7 @@ def assemble(terms: list[Term], given: dict, n: int, inputs: int, disturbances: 
     if not mass:
         raise MatrixEquationError("no M q̈ term: a matrix equation is M q̈ + … = …", 0)
     flip = mass[0].sign
-    parts, derived = {"M": given["M"]}, {}
+    parts, derived, written = {"M": given["M"]}, {}, {}
     for t in terms:
         s = t.sign * flip
         if t.key is not None and t.key.name == "M":
@@ -101,7 +105,9 @@ def assemble(terms: list[Term], given: dict, n: int, inputs: int, disturbances: 
             derived[target] = (
                 f"{minus}{name}: the matrix equation puts {name} where {STANDARD} has {minus}{target}"
             )
-    return parts, derived
+        if sign > 0 and name != target:
+            written[target] = name
+    return parts, derived, written
 
 
 def matrix_text(value) -> str | None:
@@ -121,7 +127,7 @@ def read_matrix_equation(reader, spec, key: str, text: str) -> None:
     given = {k: eq[k] for k in KEYS if k in eq}
     try:
         terms = read_terms(text, spec.notation == "latex")
-        parts, derived = assemble(terms, given, n, len(spec.inputs), len(spec.disturbances))
+        parts, derived, written = assemble(terms, given, n, len(spec.inputs), len(spec.disturbances))
     except MatrixEquationError as exc:
         reader.fail_at(key, exc.why, text, exc.at)
     used = {t.key.name for t in terms if t.key is not None}
@@ -136,6 +142,7 @@ def read_matrix_equation(reader, spec, key: str, text: str) -> None:
         del eq[k]
     eq.update(parts)
     spec.derived.update(derived)
+    spec.written_names.update(written)
     if "h" in eq:  # the bias: f = B u + W w − h − C q̇ − D q̇, split as every f is
         v = sp.Matrix(sym["v"])
         f = -eq.pop("h") - sum((eq.pop(k) * v for k in ("C", "D") if k in eq), sp.zeros(n, 1))

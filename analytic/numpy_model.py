@@ -80,6 +80,8 @@ FUNCTIONS: dict[str, tuple[str, str, str]] = {
     "B": ("", "nu", "input_matrix"),
     "W": ("", "nw", "disturbance_matrix"),
 }
+#: the diagnosis's quantities this form names otherwise: the gravity vector is G (given, or h(q, 0))
+WRITTEN_NAMES = {"H": "G"}
 #: the functions that give the bias, exactly one of which a model file defines
 BIAS = ("C", "Cqdot", "h")
 #: the grid points per angle, and the most angles gridded (``GRID ** GRID_ANGLES`` points)
@@ -335,6 +337,7 @@ def numpy_model(
         **declared_attributes(spec, params_type),
         "functions": dict(functions),
         "source": _resolved(str(path)),
+        "written_names": WRITTEN_NAMES,
     }
     for key in functions:
         namespace[FUNCTIONS[key][2]] = _method(key)

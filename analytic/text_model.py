@@ -337,6 +337,7 @@ def build_model_class(
     namespace = {
         **declared_attributes(spec, params_type),
         "text_spec": spec,
+        "written_names": dict(spec.written_names),
         "how_to_name_joints": _how_to_name_joints(spec),
         "energies": _energies,
     }

@@ -79,6 +79,8 @@ class TextModelSpec:
     symbols: dict[str, tuple[sp.Symbol, ...]]  # "q", "v", "u", "w", "p"
     equations: dict[str, object] = field(default_factory=dict)  # key → sp.Matrix or scalar
     derived: dict[str, str] = field(default_factory=dict)  # key → how it was computed from others
+    #: quantity → the file's own key for it where they differ (H → G of a matrix equation)
+    written_names: dict[str, str] = field(default_factory=dict)
     notation: str = "sympy"
     #: with notation = "latex": the file's [symbols] table, each LaTeX key with what it reads as
     latex_symbols: dict[str, object] = field(default_factory=dict)

@@ -185,7 +185,7 @@ D = [["b"]]
 G = ["m*g*l*sin(theta)"]
 B = [["1"]]
 equations = ["M*ddq + D*dq + G = B*u"]
-"""), ('G = ["m*g*l*sin(theta)"]', 'G = ["m*g*l*cos(theta)"]', "gravity", "H[1]")),
+"""), ('G = ["m*g*l*sin(theta)"]', 'G = ["m*g*l*cos(theta)"]', "gravity", "G[1]")),
     "text, matrix equation with h": (".toml", _text("""
 M = [["m*l**2"]]
 h = ["b*dtheta + m*g*l*sin(theta)"]
@@ -239,6 +239,7 @@ f = '\begin{bmatrix} \tau - b\dot\theta - m g l \sin\theta \end{bmatrix}'
     "LaTeX, whole equations": (".toml", _latex(r"""
 equations = 'm l^2 \ddot\theta + b\dot\theta + m g l\sin\theta = \tau'
 """), (r"m l^2 \ddot", r"m l \ddot", "crba", "M[1,1]")),
+    # planted: − G, so the hand's H is −G, no longer the file's G as it stands: named H (with + G, G)
     "LaTeX, matrix equation": (".toml", _latex(r"""
 M = '\begin{bmatrix} m l^2 \end{bmatrix}'
 D = '\begin{bmatrix} b \end{bmatrix}'

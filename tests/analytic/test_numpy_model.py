@@ -172,7 +172,7 @@ def test_h_gives_g_and_the_bias(tmp_path):
     [
         ("[delta + beta * c2, delta]])", "[delta + beta * c2, 1.05 * delta]])", "M[2,2]", "crba"),
         ("[h * v[0], 0.0]", "[1.1 * h * v[0], 0.0]", "C[2,1]", "coriolis"),
-        ("p.m2 * p.r2 * c12])", "1.02 * p.m2 * p.r2 * c12])", "H[2]", "gravity"),
+        ("p.m2 * p.r2 * c12])", "1.02 * p.m2 * p.r2 * c12])", "G[2]", "gravity"),
     ],
     ids=["M", "C", "G"],
 )
@@ -180,7 +180,8 @@ def test_a_planted_wrong_entry_fails_naming_it(old, new, entry, check, tmp_path,
     assert main(["check", *_double(tmp_path, _changed(DOUBLE_PENDULUM, old, new)), *SAMPLES]) == 1
     out = capsys.readouterr().out
     assert any(line.split()[1:2] == [check] and line.endswith("FAIL") for line in out.splitlines()), out
-    assert f"]: {entry} (" in out, out  # the diagnosis names the entry
+    assert f"]: {entry} (" in out, out  # the diagnosis names the entry, by the file's own name (G)
+    assert "H[" not in out, out  # the interface's name of G appears nowhere
 
 
 @pytest.mark.parametrize(("factor", "status"), [("", "pass"), (" * 1.01", "fail")], ids=["right", "wrong"])

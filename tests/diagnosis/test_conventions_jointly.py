@@ -23,6 +23,7 @@ from pendverify.analytic.params import load_parameter_file
 from pendverify.checks.catalogue import run_checks
 from pendverify.checks.sampling import sample_states
 from pendverify.diagnosis.diagnose import diagnose
+from pendverify.diagnosis.traps import convention_screen
 from pendverify.diagnosis.traps.convention_maps import (
     ABSOLUTE_RELATIVE,
     DEGREES,
@@ -32,8 +33,10 @@ from pendverify.diagnosis.traps.convention_maps import (
     QUARTER,
     SIGN,
     candidates,
+    left_out,
+    most_touched,
 )
-from pendverify.diagnosis.traps.conventions import coordinate_conventions
+from pendverify.diagnosis.traps.conventions import SCREEN_STATES, coordinate_conventions
 from pendverify.diagnosis.traps.fit import EXACT_RESIDUAL, diagnosis_states
 from pendverify.diagnosis.traps.inertia import corrected_system
 from pendverify.robot.coordinates import CoordinateMap
@@ -146,6 +149,20 @@ def test_a_map_trap_with_an_inertia_about_the_pivot_is_named_with_both():
     # the pivot trap alone does not explain it: the joint finding is the only one
     results = run_checks("planted", model, system, sample_states(model, 30, SEED), SEED)
     assert [f.details["traps"] for f in diagnose(model, system, results)] == [[ABSOLUTE_RELATIVE, PIVOT]]
+
+
+def test_the_pivot_fits_beyond_the_work_bound_are_not_run_and_said_so(monkeypatch):
+    """The case above with room for the declared map's fit alone: the candidate that explains it is
+    not fitted, so nothing is named, and what was left out is said."""
+    model, right = _setup("triple_pendulum", lambda p: p.replace(I3=p.I3 + p.m3 * p.r3**2))
+    system = _planted(right, np.eye(3), (0, 0, 0))
+    failing, states = _failing(model, system), diagnosis_states(model)
+    monkeypatch.setattr(convention_screen, "MAX_FIT_WORK", convention_screen.fit_work(SCREEN_STATES, 3, 3))
+    unsearched = []
+    assert coordinate_conventions(model, system, failing, states, unsearched) is None
+    (said,) = unsearched
+    found = re.fullmatch(r"the pivot-inertia fit of (\d+) coordinate convention maps whose H agrees", said)
+    assert found and int(found.group(1)) >= 1, said
 
 
 def test_a_joint_fit_that_leaves_a_small_difference_says_so():
@@ -263,6 +280,21 @@ def test_the_candidates_stay_within_the_budget_and_keep_every_single_trap(n):
     if n <= 3:  # every combination: each non-empty set of flips, each pattern of k ∈ {0, 1, 3} but none
         assert len(flips) == 2**n - 1
         assert len(shifts) == 3**n - 1
+
+
+def test_forty_coordinates_are_screened_only_alike_and_said_so():
+    n = 40
+    model = SimpleNamespace(nv=n, angular=(True,) * n)
+    assert most_touched(model, np.zeros(n)) == 0  # even one coordinate at a time is beyond the budget
+    found = candidates(model, np.eye(n), np.zeros(n), [True] * n)
+    assert len(found) <= MAX_CANDIDATES * 3 / n
+    assert {c.flips for c in found} == {(), tuple(range(n))}
+    assert {len(set(c.shifts)) for c in found} == {1}  # every angle shifted alike (or none)
+    assert (
+        left_out(model, 0)
+        == "coordinate conventions on some of the 40 coordinates (only on all of them alike)"
+    )
+    assert left_out(model, n) == ""
 
 
 # --- how long the search takes -------------------------------------------------------------------------

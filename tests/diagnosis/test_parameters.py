@@ -29,6 +29,7 @@ from pendverify.analytic.plugin import load_model_class, plugin_parameters
 from pendverify.checks.batch import CheckBatch
 from pendverify.checks.catalogue import run_checks
 from pendverify.checks.sampling import sample_states
+from pendverify.diagnosis import parameters
 from pendverify.diagnosis.implied import implied_parameters
 from pendverify.diagnosis.parameters import identify_parameters
 from pendverify.robot.system import PinocchioSystem
@@ -283,6 +284,34 @@ def test_two_changes_are_named_together():
         assert _close(finding.details["model_value"], value, finding.details["rounding"])
     assert findings[0].message == findings[1].message
     assert " and link2's centre of mass at y = 0.3 m instead of 0.22 m" in findings[0].message
+
+
+def test_pairs_beyond_the_bound_are_not_tried_and_said_so(monkeypatch):
+    """With fewer groups allowed than a double pendulum's singles and pairs, the pair of changes
+    named above is not searched: the combinations are listed instead, and ``unsearched`` says so."""
+    cls, params, system = _builtin("double_pendulum")
+    monkeypatch.setattr(parameters, "MAX_GROUPS", 10)
+    unsearched = []
+    (finding,) = identify_parameters(_batch(cls(params.replace(m1=1.2, r2=0.3)), system), unsearched)
+    assert finding.details["parameter"] == "identifiable combinations"
+    (said,) = unsearched
+    assert said.startswith("pairs of changes of the inertial parameters (") and said.endswith(
+        " pairs, beyond 10)"
+    )
+
+
+def test_a_fit_beyond_its_work_bound_is_not_run_and_said_so(monkeypatch):
+    cls, params, system = _builtin("double_pendulum")
+    batch = _batch(cls(params.replace(m1=1.2)), system)
+    assert identify_parameters(batch)  # within the bound: the heavier link is named
+    rows = len(batch) * (2 * 2 + 2 * 2)
+    monkeypatch.setattr(parameters, "MAX_FIT_WORK", rows * 20**2 - 1)
+    unsearched = []
+    assert identify_parameters(batch, unsearched) == []
+    assert unsearched == [
+        f"the inertial parameters (a fit of 20 parameters to {rows} rows, beyond the bound of "
+        f"{rows * 400 - 1:.0e} on its work)"
+    ]
 
 
 def test_three_changes_list_the_identifiable_combinations():

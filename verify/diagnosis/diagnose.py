@@ -44,10 +44,13 @@ def _largest_failure(results) -> float:
 
 
 HYPOTHESES = (pivot_inertia, missing_damping, coordinate_conventions)
+#: the hypotheses whose search is bounded by its work: each says what it left out (``unsearched``)
+BOUNDED = (coordinate_conventions,)
 
 
-def diagnose(model, system, results) -> list[Finding]:
-    """One finding per known trap that explains the failing checks; its message says how well it fits."""
+def diagnose(model, system, results, unsearched: list | None = None) -> list[Finding]:
+    """One finding per known trap that explains the failing checks; its message says how well it fits.
+    What a bounded search left out is added to ``unsearched``, in words."""
     failing = {r.check for r in results if not r.passed}
     if not failing:
         return []
@@ -57,7 +60,10 @@ def diagnose(model, system, results) -> list[Finding]:
     out = []
     with np.errstate(all="ignore"):
         for hypothesis in hypotheses:
-            finding = hypothesis(model, system, failing, states)
+            if hypothesis in BOUNDED:
+                finding = hypothesis(model, system, failing, states, unsearched)
+            else:
+                finding = hypothesis(model, system, failing, states)
             if finding is not None:
                 out.append(finding)
     return out

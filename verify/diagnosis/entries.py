@@ -7,8 +7,10 @@ An entry differs at a state when its own error, scaled as the check's measure sc
 (``Measure.entries``, ``pendverify.checks.quantities``), exceeds the check's tolerance there
 (relative tolerance × the measure's scale, ``pendverify.checks.judge.collect``): the entry
 alone would fail the check at that state.  Entries are named 1-based as a derivation writes
-them, with the coordinates they pair (``M[2,2] (theta2, theta2)``), the hand value and
-Pinocchio's at the state where the entry is worst, and on how many states it differs.
+them, by the model's own name of the quantity (``ClosedFormModel.written_names``: G where a
+model file writes the gravity vector G), with the coordinates they pair (``M[2,2] (theta2,
+theta2)``), the hand value and Pinocchio's at the state where the entry is worst, and on how many
+states it differs.
 """
 
 from __future__ import annotations
@@ -83,14 +85,18 @@ class EntryDifference:
     pin: np.ndarray
     differs: np.ndarray  # bool per judged state
     worst: int  # position in ``states`` where the entry is furthest beyond its tolerance
+    #: the quantity as the model's source names it (``ClosedFormModel.written_names``: G for H)
+    written: str = ""
 
     def label(self, coordinates) -> str:
-        """``M[2,2] (theta2, theta2)``: 1-based, with the coordinates the entry pairs."""
+        """``M[2,2] (theta2, theta2)``: 1-based, in the model's own name of the quantity, with the
+        coordinates the entry pairs."""
+        name = self.written or self.quantity
         if not self.index:
-            return self.quantity
+            return name
         one_based = ",".join(str(i + 1) for i in self.index)
         names = ", ".join(coordinates[i] for i in self.index)
-        return f"{self.quantity}[{one_based}] ({names})"
+        return f"{name}[{one_based}] ({names})"
 
 
 def differing_entries(batch, failing: set[str]) -> list[EntryDifference]:
@@ -132,6 +138,7 @@ def differing_entries(batch, failing: set[str]) -> list[EntryDifference]:
                     pin[(judged, *index)],
                     differs,
                     int(np.argmax(column)),
+                    batch.model.written_name(compared.quantity),
                 )
             )
     return out

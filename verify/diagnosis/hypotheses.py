@@ -163,10 +163,16 @@ def _solve(implied: ImpliedParameters, hypotheses) -> Explanation | None:
     return Explanation(tuple(hypotheses), tuple(map(float, x)), residual, tuple(map(float, rounding)))
 
 
-def explanations(implied: ImpliedParameters, model: pin.Model) -> list[Explanation]:
-    """The sparsest explanations that reproduce the equations to rounding (module docstring)."""
-    hypotheses = [h for j, link in enumerate(implied.links) for h in link_hypotheses(model, j, link)]
-    for size in (1, 2):
+def all_hypotheses(implied: ImpliedParameters, model: pin.Model) -> list[Hypothesis]:
+    """Every link's hypotheses, in joint order."""
+    return [h for j, link in enumerate(implied.links) for h in link_hypotheses(model, j, link)]
+
+
+def explanations(implied: ImpliedParameters, model: pin.Model, most: int = 2) -> list[Explanation]:
+    """The sparsest explanations of at most ``most`` hypotheses that reproduce the equations to
+    rounding (module docstring)."""
+    hypotheses = all_hypotheses(implied, model)
+    for size in range(1, most + 1):
         found = []
         for group in itertools.combinations(hypotheses, size):
             explanation = _solve(implied, group)

@@ -223,6 +223,22 @@ def entry_label(method: str, value, index: int) -> str:
     return f"{name}[{','.join(str(i + 1) for i in entry_position(method, value.shape, index))}]"
 
 
+def _entry_values(batch, evaluate, method: str, form, flat: list) -> np.ndarray | None:
+    """Each entry of ``method``'s written form at the batch's states, (N, entries): as the checks
+    evaluate the model's own method (its generated code, built once for the checks) where the model
+    writes it, else each entry lambdified.  Printing every entry of a large model for SymPy's
+    ``lambdify`` took minutes (a 20-link chain's 400 entries of M: 110 s); the entries that disagree
+    are lambdified later all the same, for their edits."""
+    if not flat:
+        return None
+    if method in batch.forms.written:
+        with np.errstate(all="ignore"):
+            own = np.asarray(batch.forms.value(method), dtype=float)
+        if own.size == len(batch) * len(flat):
+            return own.reshape(len(batch), len(flat))
+    return np.stack([evaluate(e, form.args) for e in flat], axis=-1)
+
+
 def find_slots(batch, sm: SymbolicModel) -> list[Slot]:
     """Every entry of a written closed form that disagrees with Pinocchio at the screening states."""
     model = batch.model
@@ -239,7 +255,7 @@ def find_slots(batch, sm: SymbolicModel) -> list[Slot]:
         if target is None:
             continue
         flat = entries(value)
-        current = np.stack([evaluate(e, form.args) for e in flat], axis=-1) if flat else None
+        current = _entry_values(batch, evaluate, method, form, flat)
         if row:
             cols = shape[1]
             X = current.reshape(len(batch), shape[0], cols)

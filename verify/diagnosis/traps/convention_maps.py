@@ -35,9 +35,10 @@ description, after the declared map itself (no trap).
 For n coordinates, a of them angles, that is (5·2ⁿ − 2)·2·4ᵃ maps before duplicates go
 (with θ0 = 0; 2ⁿ flips, and the 2ⁿ + 2ⁿ − 1 distinct orders of each of A and A⁻¹ with them,
 each with and without degrees, times the shifts): 4 864 for the triple pendulum.  The work
-grows as 8ⁿ, so a larger model flips, and shifts, at most ``touched`` coordinates at a time
+grows as 8ⁿ, so a larger model flips, and shifts, at most ``most_touched`` coordinates at a time
 (besides all of them at once, flipped or shifted alike), the largest number that keeps the
-count within ``MAX_CANDIDATES``.
+count within ``MAX_CANDIDATES`` (3/n of it beyond three coordinates); none one at a time when even
+one exceeds it (from 15 coordinates on), and ``left_out`` says what that leaves out.
 """
 
 from __future__ import annotations
@@ -157,12 +158,16 @@ def _subset_count(size: int, most: int, choices: int = 1, whole: int = 1) -> int
     return count + (whole if size > most else 0)
 
 
-def _most_touched(model, readings: int, sides: int) -> int:
-    """The largest number of coordinates flipped or shifted at a time that keeps the count in budget.
+def most_touched(model, theta0) -> int:
+    """The largest number of coordinates flipped or shifted at a time that keeps the count of
+    candidates within budget (module docstring); 0 when even one at a time does not: then only all
+    of them at once, flipped or shifted alike (64 maps, times the offsets' readings and sides).
 
     The counts are computed, not enumerated: the grid for all n coordinates of a 40-link chain
     has 4⁴⁰ rows."""
     n, angular = model.nv, np.array(model.angular, dtype=bool)
+    theta0 = np.asarray(theta0, float)
+    readings, sides = len(_offset_readings(model, theta0)), 2 if np.any(theta0) else 1
     budget = MAX_CANDIDATES * min(1.0, 3 / n)
     relative = 2 if angular.sum() >= 2 else 0
     a = int(angular.sum())
@@ -171,7 +176,20 @@ def _most_touched(model, readings: int, sides: int) -> int:
         linear = (flips + relative * (2 * flips - 1)) * (2 if angular.any() else 1)
         if linear * _subset_count(a, most, 3, 3) * readings * sides <= budget:
             return most
-    return 1
+    return 0
+
+
+def left_out(model, most: int) -> str:
+    """The traps ``candidates`` leaves out when it touches at most ``most`` coordinates, in words
+    ("" when it leaves none out)."""
+    n = model.nv
+    if most >= n:
+        return ""
+    if most == 0:
+        return f"coordinate conventions on some of the {n} coordinates (only on all of them alike)"
+    return (
+        f"coordinate conventions on more than {most} of the {n} coordinates at a time (unless on all alike)"
+    )
 
 
 def _linear_parts(model, most: int):
@@ -217,7 +235,7 @@ def candidates(model, T, theta0, revolute) -> list[Candidate]:
     T, theta0 = np.asarray(T, float), np.asarray(theta0, float)
     angular = np.array(model.angular, dtype=bool)
     readings = _offset_readings(model, theta0)
-    most = _most_touched(model, len(readings), 2 if np.any(theta0) else 1)
+    most = most_touched(model, theta0)
     grid = _shift_grid(angular, most)
     s = np.array(SHIFTS)[grid]  # (G, n)
     found = []

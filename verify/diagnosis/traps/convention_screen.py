@@ -21,6 +21,12 @@ A candidate's error is the one the ``crba`` and ``gravity`` checks measure
 entry of (M' − Σ_b c_b K'_b − M_hand)·(w wᵀ), w = S^{-½} the scaled coordinates' weights,
 and max_i w_i |H'_i − H_hand,i| over max_i w_i·(gravity scale)_i.  Its residual is that
 error over the declared map's (the first candidate, without a fit).
+
+Bounded work: H is compared first, for every candidate (K gravity evaluations each, no fit);
+a candidate whose H alone leaves a residual beyond the caller's cutoff fails the screen whatever
+its fit, so only the others are fitted, and of those only as many, in the candidates' order
+(simplest first), as the fits' work counted before they start allows (``MAX_FIT_WORK``).  On a
+model with gravity that is a handful; the decisions are those of fitting every candidate.
 """
 
 from __future__ import annotations
@@ -38,6 +44,13 @@ CHUNK = 2048
 #: the most numbers a chunk's arrays hold (8 bytes each: 256 MB), whatever the model's size: a
 #: 40-link chain's 40 pivot systems at 24 states take 1.5 MB per candidate
 MAX_CHUNK_FLOATS = 32_000_000
+#: the most pivot-fit work one screen does, counted by ``fit_work`` before the fits start: the SVD
+#: dominates, ~2.5 ns per unit (measured: one candidate of a 40-link chain, K = 4 states and 40
+#: pivot systems, 1.1e7 units, in 25 ms on one core of an idle 2-core machine), so 2e8 units are
+#: about half a second, ten times that on a loaded one.  A triple pendulum's whole budget of
+#: candidates (``convention_maps.MAX_CANDIDATES``: 40 000 × 576 units) stays well inside it: up to
+#: three coordinates every candidate is fitted
+MAX_FIT_WORK = 200_000_000
 
 
 @dataclass(frozen=True)
@@ -52,6 +65,8 @@ class Screen:
     links: list[str]
     #: the declared map's error (the denominator of ``residual``)
     before: float
+    #: candidates whose H passed but that were not fitted: beyond ``MAX_FIT_WORK`` (residual inf)
+    unfitted: int = 0
 
 
 def _congruence(T, A):
@@ -72,28 +87,51 @@ class _Hand:
     g_scale: np.ndarray
 
 
-def _errors(hand: _Hand, joint, shifts, T, theta0):
-    """(error of M without the fit, error of M with it, error of H, the fit's c) of candidates (T, θ0')."""
+def _configurations(hand: _Hand, T, theta0) -> np.ndarray:
+    """q = T'(θ − θ0') of candidates (T, θ0') at the hand's states, (C·K, n)."""
+    n = hand.theta.shape[1]
+    return ((hand.theta[None] - theta0[:, None]) @ np.swapaxes(T, -1, -2)).reshape(-1, n)
+
+
+def _gravity_errors(hand: _Hand, joint, T, theta0) -> np.ndarray:
+    """The error of H of candidates (T, θ0') (C,)."""
     C, (K, n) = len(T), hand.theta.shape
-    q = ((hand.theta[None] - theta0[:, None]) @ np.swapaxes(T, -1, -2)).reshape(-1, n)  # q = T'(θ − θ0')
-    pin = joint.at(q)
-    M = _congruence(T, pin.mass_matrix().reshape(C, K, n, n))
-    H = (np.swapaxes(T, -1, -2)[:, None] @ pin.gravity().reshape(C, K, n, 1))[..., 0]
+    H = np.swapaxes(T, -1, -2)[:, None] @ joint.at(_configurations(hand, T, theta0)).gravity().reshape(
+        C, K, n, 1
+    )
+    return np.max(np.max(hand.w * np.abs(H[..., 0] - hand.H), axis=-1) / hand.g_scale, axis=-1)
+
+
+def _mass_errors(hand: _Hand, joint, shifts, T, theta0):
+    """(error of M without the fit, error of M with it, the fit's c) of candidates (T, θ0')."""
+    C, (K, n) = len(T), hand.theta.shape
+    q = _configurations(hand, T, theta0)
+    M = _congruence(T, joint.at(q).mass_matrix().reshape(C, K, n, n))
     dM = ((M - hand.M) * hand.ww).reshape(C, K * n * n)  # scaled
-    eH = np.max(np.max(hand.w * np.abs(H - hand.H), axis=-1) / hand.g_scale, axis=-1)
+    bare = np.max(np.abs(dM), axis=-1)
     if not shifts:
-        return np.max(np.abs(dM), axis=-1), np.max(np.abs(dM), axis=-1), eH, np.zeros((C, 0))
+        return bare, bare, np.zeros((C, 0))
     terms = [_congruence(T, only.at(q).mass_matrix().reshape(C, K, n, n)) * hand.ww for _, only in shifts]
     A = np.stack(terms, axis=-1).reshape(C, K * n * n, len(shifts))  # (C, K n², nb)
     coefficients = integer_coefficients((np.linalg.pinv(A) @ dM[..., None])[..., 0])
     left = dM - (A @ coefficients[..., None])[..., 0]
-    return np.max(np.abs(dM), axis=-1), np.max(np.abs(left), axis=-1), eH, coefficients
+    return bare, np.max(np.abs(left), axis=-1), coefficients
 
 
-def screen(model, system, candidates, states) -> Screen | None:
+def _chunks(count: int, size: int):
+    return [slice(i, min(i + size, count)) for i in range(0, count, size)]
+
+
+def screen(model, system, candidates, states, cutoff: float = np.inf) -> Screen | None:
     """Each candidate's residual and pivot fit at ``states`` (module docstring); None where the hand
-    model's M or H is not finite there (nothing to compare).  The candidates go through in chunks of
-    ``CHUNK``, which bounds the memory the batched fit takes."""
+    model's M or H is not finite there (nothing to compare).
+
+    H first, for every candidate (K gravity evaluations each); a candidate whose H alone leaves a
+    residual beyond ``cutoff`` fails whatever its fit, and is not fitted: its residual is H's alone.
+    The others are fitted in the candidates' order (simplest first) while the fits' work, counted
+    before they start (``fit_work``), stays within ``MAX_FIT_WORK``; the rest are ``unfitted``
+    (residual infinite).  The candidates go through in chunks whose arrays hold at most
+    ``MAX_CHUNK_FLOATS`` numbers, which bounds the memory the batched fit takes."""
     n = model.nv
     terms = CheckBatch(model, system, states).terms
     if not (np.all(np.isfinite(terms.M_hand)) and np.all(np.isfinite(terms.H_hand))):
@@ -107,14 +145,31 @@ def screen(model, system, candidates, states) -> Screen | None:
     shifts = parallel_axis_systems(joint)
     T = np.array([c.T for c in candidates])  # (C, n, n)
     theta0 = np.array([c.theta0 for c in candidates])  # (C, n)
-    # a chunk holds C·K·n² numbers per pivot system and a few more: at most MAX_CHUNK_FLOATS in all
     K = len(hand.theta)
+    # a chunk holds C·K·n² numbers per pivot system and a few more: at most MAX_CHUNK_FLOATS in all
     chunk = max(1, min(CHUNK, MAX_CHUNK_FLOATS // (K * n * n * (len(shifts) + 4))))
-    parts = [
-        _errors(hand, joint, shifts, T[i : i + chunk], theta0[i : i + chunk]) for i in range(0, len(T), chunk)
-    ]
-    bare, fitted, eH, coefficients = (np.concatenate(x) for x in zip(*parts, strict=True))
-    before = float(max(bare[0], eH[0]))
+    eH = np.concatenate([_gravity_errors(hand, joint, T[s], theta0[s]) for s in _chunks(len(T), CHUNK)])
+    bare0, _, _ = _mass_errors(hand, joint, shifts, T[:1], theta0[:1])
+    before = float(max(bare0[0], eH[0]))
     with np.errstate(divide="ignore", invalid="ignore"):
-        residual = np.maximum(fitted, eH) / before
-    return Screen(residual, coefficients, [name for name, _ in shifts], before)
+        residual = eH / before
+    todo = np.flatnonzero(~(residual > cutoff))
+    todo = np.union1d([0], todo)  # the declared map is always fitted (its pivot fit is a finding)
+    fits = max(1, min(len(todo), MAX_FIT_WORK // fit_work(K, n, len(shifts))))
+    unfitted = len(todo) - fits
+    residual[todo[fits:]] = np.inf
+    todo = todo[:fits]
+    coefficients = np.zeros((len(T), len(shifts)))
+    for s in _chunks(len(todo), chunk):
+        at = todo[s]
+        _, fitted, c = _mass_errors(hand, joint, shifts, T[at], theta0[at])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            residual[at] = np.maximum(fitted, eH[at]) / before
+        coefficients[at] = c
+    return Screen(residual, coefficients, [name for name, _ in shifts], before, unfitted)
+
+
+def fit_work(states: int, n: int, pivots: int) -> int:
+    """The work of one candidate's pivot fit, counted as K·n²·(nb + 1)² (the SVD of its K·n² × nb
+    system and the M evaluations before it, in numbers)."""
+    return states * n * n * (pivots + 1) ** 2

@@ -46,7 +46,7 @@ import numpy as np
 from pendverify.checks.catalogue import applicable_checks, run_checks
 from pendverify.diagnosis.finding import Finding
 from pendverify.diagnosis.traps import convention_words as words
-from pendverify.diagnosis.traps.convention_maps import PIVOT, Candidate, candidates
+from pendverify.diagnosis.traps.convention_maps import PIVOT, Candidate, candidates, left_out, most_touched
 from pendverify.diagnosis.traps.convention_screen import screen
 from pendverify.diagnosis.traps.fit import DIAGNOSIS_SEED, EXACT_RESIDUAL, FIT_RESIDUAL
 from pendverify.diagnosis.traps.inertia import corrected_system, parallel_axis_terms
@@ -146,13 +146,20 @@ def _alternatives(model, system, maps, found, order, named: int, states, before)
     return out
 
 
-def coordinate_conventions(model, system, failing, states) -> Finding | None:
+def coordinate_conventions(model, system, failing, states, unsearched: list | None = None) -> Finding | None:
     """The simplest combination of convention traps that explains the failure, confirmed by every
-    check on ``states`` (module docstring), or None."""
+    check on ``states`` (module docstring), or None.  What the search's bounds leave out
+    (``convention_maps.left_out``, the candidates the screen did not fit) is added to ``unsearched``."""
     if not {"crba", "gravity"} & set(failing):
         return None
     maps = candidates(model, system.cmap.T, system.cmap.theta0, _revolute(system))
-    found = screen(model, system, maps, states[-SCREEN_STATES:])
+    found = screen(model, system, maps, states[-SCREEN_STATES:], SCREEN_RESIDUAL)
+    if unsearched is not None:
+        unsearched += [w for w in (left_out(model, most_touched(model, system.cmap.theta0)),) if w]
+        if found is not None and found.unfitted:
+            unsearched.append(
+                f"the pivot-inertia fit of {found.unfitted} coordinate convention maps whose H agrees"
+            )
     if found is None or not found.before > 0:
         return None
     order = _ranked(maps, found)
