@@ -84,15 +84,16 @@ def page_steps(path: Path) -> list[Step]:
     return steps(path.read_text(encoding="utf-8"), page_name(path, ROOT))
 
 
+def names(start: str, first: str) -> bool:
+    """Whether a table's entry names a block by its first line: the line starts with the entry's text
+    (is it, for a text ending in ``$``: a command that is the start of another's first line)."""
+    return first == start[:-1] if start.endswith("$") else first.startswith(start)
+
+
 def entry(table: dict[tuple[str, str], object], step: Step) -> object | None:
-    """The table's value for ``step``: the entry of its page whose text its first line starts with (is,
-    for a text ending in ``$``: a command that is the start of another's first line)."""
+    """The table's value for ``step``: the entry of its page that names it (``names``)."""
     page, first = step.key
-
-    def matches(start: str) -> bool:
-        return first == start[:-1] if start.endswith("$") else first.startswith(start)
-
-    return next((v for (p, start), v in table.items() if p == page and matches(start)), None)
+    return next((v for (p, start), v in table.items() if p == page and names(start, first)), None)
 
 
 def runs(step: Step) -> bool:
@@ -175,7 +176,7 @@ def test_every_table_names_a_block_there_is():
     blocks = [s for p in PAGES for s in page_steps(p) if s.file is None]
     for table in (NOT_RUN, EXIT_STATUS):
         for (page, start), value in table.items():
-            named = [s for s in blocks if s.page == page and s.key[1].startswith(start)]
+            named = [s for s in blocks if s.page == page and names(start, s.key[1])]
             assert len(named) == 1, f"{page}: {len(named)} shell blocks start with {start!r} ({value})"
     assert SLOW <= {page_name(p, ROOT) for p in RUN_PAGES}
 
