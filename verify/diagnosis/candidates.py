@@ -335,6 +335,8 @@ def screen_slot(slot: Slot, batch, sm, evaluate, monomials, pool, deadline: floa
     edits = _coefficient_edits(slot, evaluate) + _added_term_edits(slot, batch, monomials, sm.kinds)
     edits += _restored_term_edits(slot, pool) + _constant_edits(slot, monomials)
     edits += list(structural_edits(slot.expr, sm.angles, sm.symbols["v"], sm.kinds))
+    # simplest first: an added term that SymPy folds into a swapped angle is kept as the swap
+    edits.sort(key=lambda e: RANK.get(e.operator, 9))
     slot.matches += [
         e for e, _, mismatch in _evaluated(slot, edits, sm, evaluate, deadline) if mismatch <= SCREEN_RTOL
     ]

@@ -5,7 +5,9 @@ class, and the same model as LaTeX or text where there is one) and every non-zer
 its written closed forms, one error per operator (``OPERATORS``) is planted where the
 operator applies — the first place in the entry's tree where it changes the entry — with
 ``pendverify.symbolic.edited.edited_model``.  A planted model that passes every check is
-*not detected* and left out (an equivalent edit, or a gap ``pendverify mutate`` reports).
+*not detected* and left out (an equivalent edit, or a gap ``pendverify mutate`` reports); a
+model passes as ``pendverify check`` judges it, a C that is a valid C·q̇ but not the Christoffel
+C warning (``pendverify.diagnosis.acceptance``).
 For each detected one the diagnosis (``pendverify.diagnosis.explain``) is run and scored:
 
 named
@@ -19,7 +21,8 @@ restored
 seconds
     how long the diagnosis took (``explain``, after the checks, as ``check`` runs it).
 
-The untouched models must pass every check (``ModelScores.clean``), so get no diagnosis.
+The untouched models must pass every check (``ModelScores.clean``; warnings pass, as in
+``pendverify check``), so get no diagnosis.
 """
 
 from __future__ import annotations
@@ -39,6 +42,7 @@ from pendverify.analytic.text_parse import CONSTANTS, FUNCTIONS
 from pendverify.checks.batch import CheckBatch
 from pendverify.checks.catalogue import applicable_checks, run_checks
 from pendverify.checks.sampling import sample_states
+from pendverify.diagnosis.acceptance import accepted
 from pendverify.diagnosis.explain import explain
 from pendverify.diagnosis.slots import QUANTITY
 from pendverify.symbolic.edited import edited_model
@@ -187,7 +191,7 @@ def score_model(
     out = ModelScores(label)
     batch = CheckBatch(model, system, states)
     results = run_checks(label, model, system, states, CORPUS_SEED, applicable_checks(model, system), batch)
-    out.clean = all(r.passed for r in results)
+    out.clean = accepted(results)
     for plant in plants(sm) if chosen is None else chosen:
         score = Score(plant)
         planted = edited_model(
@@ -201,7 +205,7 @@ def score_model(
                 )
             except (ArithmeticError, ValueError, np.linalg.LinAlgError):
                 results = None
-        if results is not None and not all(r.passed for r in results):
+        if results is not None and not accepted(results):
             score.detected = True
             start = time.perf_counter()  # the diagnosis alone, as check runs it after the checks
             findings = explain(batch, results, deadline_s)

@@ -22,6 +22,7 @@ The repair is printed in the model's own notation, where it sits
 
 from __future__ import annotations
 
+import dataclasses
 import time
 
 import numpy as np
@@ -30,6 +31,7 @@ import sympy as sp
 from pendverify.analytic.forms import entry_position
 from pendverify.analytic.symbolic_reading import SymbolicModel
 from pendverify.checks.catalogue import applicable_checks, run_checks
+from pendverify.diagnosis.acceptance import accepted, matrix_c_note
 from pendverify.diagnosis.candidates import (
     RANK,
     candidates,
@@ -70,7 +72,20 @@ def _confirmed(batch, sm, changes: dict) -> bool:
             results = run_checks("repair", repaired, batch.system, batch.states, 0, names)
         except (ArithmeticError, ValueError, np.linalg.LinAlgError):
             return False
-    return all(r.passed for r in results)
+    return accepted(results)
+
+
+def _groups(slots: list[Slot], n: int) -> list[list[Slot]]:
+    """The slots in the order they are screened, shortest first, each alone but for the entries of
+    one row of a Coriolis-type matrix: those are screened together and their candidates confirmed
+    simplest first, since only the row's product with q̇ is compared and an added term in one
+    entry can make up for a swapped angle in the other (a C that is not the Christoffel one,
+    ``pendverify.diagnosis.acceptance``, passes either way)."""
+    groups: dict = {}
+    for slot in sorted(slots, key=lambda s: sp.count_ops(s.expr)):
+        row = slot.index // n if slot.row is not None else slot.index  # a Coriolis row form is n × n
+        groups.setdefault((slot.method, slot.row is not None, row), []).append(slot)
+    return list(groups.values())
 
 
 def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
@@ -99,15 +114,18 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
     monomials: dict[str, tuple] = {}
     confirm = _Confirmation(batch, sm, deadline)
     screened = []
-    for slot in sorted(slots, key=lambda s: sp.count_ops(s.expr)):
+    for group in _groups(slots, batch.model.nv):
+        for slot in group:
+            if time.perf_counter() > min(deadline, confirm.alternatives_until):
+                break
+            quantity = QUANTITY.get(slot.method, "")
+            if quantity not in monomials:
+                monomials[quantity] = monomials_for(sm, params, quantity)
+            screen_slot(slot, screening, sm, evaluate, monomials[quantity], pool, deadline)
+            screened.append(slot)
+        confirm.run(candidates(slots, [s for s in group if any(s is x for x in screened)]))
         if time.perf_counter() > min(deadline, confirm.alternatives_until):
             break
-        quantity = QUANTITY.get(slot.method, "")
-        if quantity not in monomials:
-            monomials[quantity] = monomials_for(sm, params, quantity)
-        screen_slot(slot, screening, sm, evaluate, monomials[quantity], pool, deadline)
-        screened.append(slot)
-        confirm.run(candidates(slots, [slot]))
     if not confirm.found and len(slots) == 2 and len(screened) == 2:  # one edit of each entry
         confirm.run(slot_pairs(*slots))
     pairs = not confirm.found and batch.model.nv <= PAIRS_UP_TO_DOF and len(slots) <= 2
@@ -119,9 +137,18 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
         )
     notation = Notation.of(type(batch.model))
     if confirm.found:
-        findings = _findings(*confirm.found[0], forms, notation)
-        for changes, edit, slot in confirm.found[1:]:
-            findings += _findings(changes, edit, slot, forms, notation, alternative=True)
+        findings = []
+        for k, (changes, edit, slot) in enumerate(confirm.found):
+            found = _findings(changes, edit, slot, forms, notation, alternative=k > 0)
+            note = matrix_c_note(screening, sm, evaluate, changes)
+            if note:  # coriolis and skew warn after the repair, as before the error
+                found = [
+                    dataclasses.replace(
+                        f, message=f"{f.message}; {note}", details={**f.details, "warns": note}
+                    )
+                    for f in found
+                ]
+            findings += found
         return findings, ""
     where = ", ".join(s.label for s in slots[:6]) + (f" and {len(slots) - 6} more" if len(slots) > 6 else "")
     bound = (

@@ -1,0 +1,60 @@
+"""When an edited model counts as repaired: the checks' own verdict, against the model's baseline.
+
+A repair is confirmed when the edited model passes every applicable check on every state
+(``pendverify.diagnosis.repair``) — *passes* as ``pendverify check`` judges it, warnings
+included.  One warning concerns the written closed forms themselves: a matrix C whose product
+C·q̇ is right but which is not the Christoffel C (Tedrake's acrobot, many textbooks) fails
+``coriolis`` and, when Ṁ − 2C is not skew-symmetric, ``skew`` — the two checks that compare C
+itself — and ``pendverify.checks.verdict.non_christoffel_c`` demotes them to warnings when every
+other check passes.  Such a model's untouched form is therefore a pass with that warning, and
+an edit of it is repaired when the edited model is back there: those two checks warn, nothing
+worse (``accepted``).  Requiring ``coriolis`` and ``skew`` to pass outright would leave every
+error planted in such a model without a repair, as no edit of one entry makes its C the
+Christoffel one.
+
+``matrix_c_note`` says so next to a repair: whether the repaired model's C still differs from
+Pinocchio's Coriolis matrix at the screening states.  The comparison is relative to the size
+of the two matrices, with ``SCREEN_RTOL`` (``pendverify.diagnosis.slots``: far above rounding,
+far below any edit).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from pendverify.analytic.symbolic_reading import entries
+from pendverify.checks.verdict import MATRIX_C_CHECKS, non_christoffel_c
+from pendverify.diagnosis.slots import SCREEN_RTOL
+
+
+def accepted(results) -> bool:
+    """Whether an edited model's check results make it a repair: every check passes, the checks
+    that compare C itself demoted to warnings first when C·q̇ is right (module docstring).
+
+    ``results`` are the confirmation's own and are judged in place, as ``pendverify check``
+    judges its rows."""
+    non_christoffel_c(results)
+    return all(r.passed for r in results)
+
+
+def matrix_c_note(screening, sm, evaluate, changes: dict) -> str:
+    """The note a repair carries when the repaired model's matrix C is not Pinocchio's
+    (``coriolis`` and ``skew`` warn, as they do for the model as written), else ""."""
+    if (
+        "coriolis_matrix" not in sm.closed_forms
+        or type(screening.model).closed_forms["coriolis_matrix"].equals
+    ):
+        return ""
+    written = entries(sm.closed_forms["coriolis_matrix"])
+    edited = [changes.get(("coriolis_matrix", i), (None, e))[1] for i, e in enumerate(written)]
+    args = type(screening.model).closed_forms["coriolis_matrix"].args
+    with np.errstate(all="ignore"):
+        hand = np.stack([evaluate(e, args) for e in edited], axis=-1)
+    pin = np.asarray(screening.terms.C_pin, dtype=float).reshape(hand.shape)
+    size = float(np.max(np.abs(pin), initial=0.0) + np.max(np.abs(hand), initial=0.0)) or 1.0
+    if not np.all(np.isfinite(hand)) or np.max(np.abs(hand - pin)) <= SCREEN_RTOL * size:
+        return ""
+    return (
+        f"{' and '.join(MATRIX_C_CHECKS)} still warn, as for the model as written: its C is a valid C·q̇, "
+        "not the Christoffel C"
+    )
