@@ -165,9 +165,7 @@ def verify_target(report: Report, target, samples: int, seed: int) -> None:
     if report.strict:
         apply_strict(results)
     failing = [r for r in results if r.status == FAIL and r.check != "model-form"]
-    if failing and kept and report.explain and not target.model.has_mass_matrix:
-        notes.append("not explained: the diagnosis compares M, C·q̇ and H, which q̈ alone does not give")
-    elif failing and kept and report.explain:
+    if failing and kept and report.explain:
         # SymPy and the searches are loaded only when a model fails (a passing run starts faster)
         from pendverify.diagnosis.explain import explain
 

@@ -29,6 +29,7 @@ import dataclasses
 import functools
 import itertools
 import time
+from collections.abc import Iterator
 from fractions import Fraction
 
 import numpy as np
@@ -260,19 +261,26 @@ def sum_pool(sm: SymbolicModel) -> list[frozenset]:
 
 def _restored_term_edits(slot: Slot, pool) -> list[Edit]:
     """A sum (or a lone term) completed by the one term it lacks, as the same sum stands elsewhere
-    in the model: the inverse of a term dropped inside a factor (det M, M⁻¹)."""
+    in the model: the inverse of a term dropped inside a factor (det M, M⁻¹).  A sum written inside
+    another sum is one sum to SymPy (q̈'s −(d2·θ̈2 + φ1)/d1, where φ1 stands alone in θ̈2): a sum
+    that holds all but one term of a sum written elsewhere, two at least, gets that one too."""
     out = []
     for node, path in walk(slot.expr):
         terms = frozenset(node.args) if node.is_Add else frozenset([node])
         if node.is_Number:
             continue
         for other in pool:
+            missing = other - terms
+            if len(missing) != 1:
+                continue
             if len(other) == len(terms) + 1 and terms < other:
                 new = sp.Add(*other)
-                added = next(iter(other - terms))
-                out.append(
-                    Edit("drop", node, new, replace_at(slot.expr, path, new), f"add {added} to {node}")
-                )
+            elif node.is_Add and len(other) > 2 and other - missing < terms:
+                new = sp.Add(node, *missing)
+            else:
+                continue
+            added = next(iter(missing))
+            out.append(Edit("drop", node, new, replace_at(slot.expr, path, new), f"add {added} to {node}"))
     return out
 
 
@@ -346,20 +354,18 @@ def screen_slot(slot: Slot, batch, sm, evaluate, monomials, pool, deadline: floa
 FIRST_EDITS = 15
 
 
-def _enumerated(slot: Slot, sm, pool) -> list[Edit]:
+def _enumerated(slot: Slot, sm, pool) -> Iterator[Edit]:
     """The edits of an entry that need no fit: a sign, a drop, a factor 2 or ½ on each term, the
     structural edits and the restored terms (a pair's two edits are each of these, or the
-    second a solved coefficient: never an added term, which would fit anything)."""
-    out = []
+    second a solved coefficient: never an added term, which would fit anything).  One at a
+    time, as they are evaluated: the time bound stops a long entry's (a q̈ written out) early."""
     for path, terms in sums(slot.expr):
         for i, term in enumerate(terms):
             for k in COEFFICIENTS[:4]:
                 new = sp.Rational(k.numerator, k.denominator) * term
-                out.append(
-                    Edit("scale", term, new, with_term(slot.expr, path, terms, i, new), f"{term} → {new}")
-                )
-    out += list(structural_edits(slot.expr, sm.angles, sm.symbols["v"], sm.kinds))
-    return out + _restored_term_edits(slot, pool)
+                yield Edit("scale", term, new, with_term(slot.expr, path, terms, i, new), f"{term} → {new}")
+    yield from structural_edits(slot.expr, sm.angles, sm.symbols["v"], sm.kinds)
+    yield from _restored_term_edits(slot, pool)
 
 
 def pairs_within(slot: Slot, sm, evaluate, pool, deadline: float) -> list[Edit]:
@@ -371,8 +377,10 @@ def pairs_within(slot: Slot, sm, evaluate, pool, deadline: float) -> list[Edit]:
     firsts = sorted(closer, key=lambda x: (x[0], x[1]))[:FIRST_EDITS]
     out = []
     for _, _, first, values in firsts:
+        if time.perf_counter() > deadline:
+            break
         inner = dataclasses.replace(slot, expr=first.expr, values=values, matches=[])
-        seconds = _coefficient_edits(inner, evaluate) + _enumerated(inner, sm, pool)
+        seconds = itertools.chain(_coefficient_edits(inner, evaluate), _enumerated(inner, sm, pool))
         for second, _, mismatch in _evaluated(inner, seconds, sm, evaluate, deadline):
             if mismatch <= SCREEN_RTOL and second.expr != slot.expr:
                 out.append(

@@ -196,8 +196,11 @@ def identify_parameters(batch) -> list[Finding]:
 
     [] when the URDF's own parameters reproduce them; one ``structural`` finding when no
     parameters do; otherwise one ``parameters`` finding per changed parameter of the
-    sparsest explanation (module docstring), or one listing the combinations that differ.
+    sparsest explanation (module docstring), or one listing the combinations that differ; [] for
+    a model that gives q̈ alone (no M, C·q̇, H to compare).
     """
+    if not batch.model.has_mass_matrix:
+        return []
     with np.errstate(all="ignore"):
         implied = implied_parameters(batch)
         if implied.agrees:
