@@ -5,6 +5,9 @@ of the corpus file and the exact repair is asserted; the untouched model gets no
 * **A C that is a valid C·q̇ but not the Christoffel C** (Tedrake's acrobot,
   ``examples/corpus_acrobot_tedrake.toml``): ``coriolis`` and ``skew`` warn on the untouched
   model; a repair brings the edited model back there (``pendverify.diagnosis.acceptance``).
+* **A model given by q̈ alone** (gymnasium's book acrobot written out,
+  ``examples/corpus_acrobot_gym_qddot.toml``, one torque for two coordinates: only ``aba``
+  runs): repairs are searched in the ``qddot`` entries, compared with Pinocchio's ABA.
 """
 
 from __future__ import annotations
@@ -14,6 +17,7 @@ from pathlib import Path
 
 import pytest
 
+from pendverify.analytic.symbolic_reading import SymbolicModel
 from pendverify.bench.explain import _target as load_target
 from pendverify.bench.explain import class_targets
 from pendverify.checks.batch import CheckBatch
@@ -28,6 +32,13 @@ from ..conftest import SEED
 REPO = Path(__file__).resolve().parents[2]
 EXAMPLES = REPO / "examples"
 TEDRAKE = EXAMPLES / "corpus_acrobot_tedrake.toml"
+GYM = EXAMPLES / "corpus_acrobot_gym_qddot.toml"
+GYM_ARGS = (
+    "--urdf",
+    str(EXAMPLES / "corpus_acrobot_tedrake.urdf"),
+    "--params",
+    str(EXAMPLES / "corpus_acrobot_gym_qddot_params.toml"),
+)
 TEDRAKE_ARGS = (
     "--urdf",
     str(EXAMPLES / "corpus_acrobot_tedrake.urdf"),
@@ -108,3 +119,63 @@ def test_a_wrong_c_qdot_is_not_accepted_as_the_non_christoffel_warning(tmp_path)
     _, results = _results(model, system)
     assert not accepted(results)
     assert {r.check for r in results if not r.passed} >= {"rnea", "coriolis", "skew"}
+
+
+# --- q̈ alone -----------------------------------------------------------------------------------
+def _qddot_planted(tmp_path, entry: int, right: str, wrong: str, last: bool = False) -> Path:
+    """The q̈ file with ``right`` made ``wrong`` once in q̈'s ``entry`` (0-based; its first
+    occurrence there, or its ``last``)."""
+    lines = GYM.read_text().split("\n")
+    k = [i for i, line in enumerate(lines) if line.startswith("  '''")][entry]
+    at = lines[k].rfind(right) if last else lines[k].find(right)
+    assert at >= 0, right
+    lines[k] = lines[k][:at] + wrong + lines[k][at + len(right) :]
+    path = tmp_path / "planted_qddot.toml"
+    path.write_text("\n".join(lines))
+    return path
+
+
+PHI1_TERM = " - 2*m2*l1*lc2*dtheta2*dtheta1*sin(theta2)"
+
+
+@pytest.mark.parametrize(
+    ("entry", "right", "wrong", "last", "repair"),
+    [
+        (1, "((a + ", "((2*a + ", False, "qddot[2]: 2*a → a in qddot[2]"),
+        # I1 → I2 in d1 reads as 2*I2: the parameter edit SymPy folded is undone
+        (1, "+ I1 + I2)", "+ I2 + I2)", False, "qddot[2]: 2*I2 → I1 + I2 in qddot[2]"),
+        # a term of φ1 dropped where φ1 is a part of a longer sum (−(d2·θ̈2 + φ1)/d1): restored
+        # from φ1 as it stands alone inside θ̈2
+        (
+            0,
+            PHI1_TERM,
+            "",
+            True,
+            "qddot[1]: -dtheta2**2*l1*lc2*m2*sin(theta2) + g*lc2*m2*sin(theta1 + theta2)",
+        ),
+    ],
+)
+def test_an_error_in_a_model_given_by_qddot_is_repaired_in_its_qddot(
+    tmp_path, capsys, entry, right, wrong, last, repair
+):
+    planted = _qddot_planted(tmp_path, entry, right, wrong, last)
+    out, (found,) = _repairs(tmp_path, capsys, planted, *GYM_ARGS)
+    assert found["checks_pass"] and found["message"].startswith(repair), found["message"]
+    assert "key qddot" in found["location"]
+    assert "not explained" not in out
+
+
+def test_a_dropped_phi1_term_is_restored_exactly(tmp_path, capsys):
+    """The repaired entry is the one written, term for term."""
+    planted = _qddot_planted(tmp_path, 0, PHI1_TERM, "", last=True)
+    _, (found,) = _repairs(tmp_path, capsys, planted, *GYM_ARGS)
+    model, _ = _target("acrobot_gym_qddot")
+    assert found["suggested"] == str(SymbolicModel.of(type(model)).closed_forms["acceleration"][0])
+
+
+def test_the_untouched_qddot_model_passes_and_gets_no_repair():
+    model, system = _target("acrobot_gym_qddot")
+    batch, results = _results(model, system)
+    assert [r.check for r in results] == ["aba"] and accepted(results)
+    repairs, why = search_repair(batch, 10.0)
+    assert repairs == [] and "no single entry" in why
