@@ -8,6 +8,9 @@ of the corpus file and the exact repair is asserted; the untouched model gets no
 * **A model given by q̈ alone** (gymnasium's book acrobot written out,
   ``examples/corpus_acrobot_gym_qddot.toml``, one torque for two coordinates: only ``aba``
   runs): repairs are searched in the ``qddot`` entries, compared with Pinocchio's ABA.
+* **det M** (``examples/corpus_acrobot_detm.toml``, det M and M⁻¹ written out; the shipped
+  cart-pole): a term missing from det M is restored from the determinant of the written M, in
+  M⁻¹ too where it is written over the same det M.
 """
 
 from __future__ import annotations
@@ -24,7 +27,7 @@ from pendverify.checks.batch import CheckBatch
 from pendverify.checks.catalogue import applicable_checks, run_checks
 from pendverify.checks.sampling import sample_states
 from pendverify.cli import main
-from pendverify.diagnosis.acceptance import accepted
+from pendverify.diagnosis.acceptance import passes
 from pendverify.diagnosis.repair import search_repair
 
 from ..conftest import SEED
@@ -32,6 +35,13 @@ from ..conftest import SEED
 REPO = Path(__file__).resolve().parents[2]
 EXAMPLES = REPO / "examples"
 TEDRAKE = EXAMPLES / "corpus_acrobot_tedrake.toml"
+DETM = EXAMPLES / "corpus_acrobot_detm.toml"
+DETM_ARGS = (
+    "--urdf",
+    str(EXAMPLES / "corpus_acrobot_tedrake.urdf"),
+    "--params",
+    str(EXAMPLES / "corpus_acrobot_detm_params.toml"),
+)
 GYM = EXAMPLES / "corpus_acrobot_gym_qddot.toml"
 GYM_ARGS = (
     "--urdf",
@@ -102,11 +112,20 @@ def test_an_error_in_a_model_whose_c_is_not_christoffel_is_repaired(tmp_path, ca
     assert f"{repair}" in out
 
 
+def test_a_christoffel_c_with_an_error_is_repaired_back_to_the_christoffel_c(tmp_path, capsys):
+    """C[1,1] dropped from a Christoffel C: doubling q̇1 in C[1,2] would give a valid C·q̇ too (and
+    pass with the warning); the edit that makes every check pass is the one printed."""
+    planted = _planted(tmp_path, DETM, '["-m2*l1*lc2*sin(q2)*dq2", ', '["0", ')
+    _, (found,) = _repairs(tmp_path, capsys, planted, *DETM_ARGS)
+    assert found["message"].startswith("C[1,1]: 0 → -dq2*l1*lc2*m2*sin(q2) makes every check pass")
+    assert "warns" not in found
+
+
 def test_the_untouched_non_christoffel_model_passes_with_its_warning_and_gets_no_repair():
     model, system = _target("acrobot_tedrake")
     batch, results = _results(model, system)
     assert {r.check for r in results if not r.passed} == {"coriolis", "skew"}  # before the verdict
-    assert accepted(results)
+    assert passes(results)
     assert {r.check: r.status for r in results}["coriolis"] == "warn"
     repairs, why = search_repair(batch, 10.0)
     assert repairs == [] and "no single entry" in why
@@ -117,7 +136,7 @@ def test_a_wrong_c_qdot_is_not_accepted_as_the_non_christoffel_warning(tmp_path)
     planted = _planted(tmp_path, TEDRAKE, '["m2*l1*lc2*sin(q2)*dq1", "0"]', '["m2*l1*lc2*sin(q2)*dq2", "0"]')
     model, system = load_target(planted, *TEDRAKE_ARGS[1::2])
     _, results = _results(model, system)
-    assert not accepted(results)
+    assert not passes(results)
     assert {r.check for r in results if not r.passed} >= {"rnea", "coriolis", "skew"}
 
 
@@ -176,6 +195,45 @@ def test_a_dropped_phi1_term_is_restored_exactly(tmp_path, capsys):
 def test_the_untouched_qddot_model_passes_and_gets_no_repair():
     model, system = _target("acrobot_gym_qddot")
     batch, results = _results(model, system)
-    assert [r.check for r in results] == ["aba"] and accepted(results)
+    assert [r.check for r in results] == ["aba"] and passes(results)
     repairs, why = search_repair(batch, 10.0)
     assert repairs == [] and "no single entry" in why
+
+
+# --- det M -----------------------------------------------------------------------------------------
+DET = "I1*I2 + m2*l1**2*I2 - m2**2*l1**2*lc2**2*cos(q2)**2"
+
+
+def test_a_term_missing_from_det_m_is_restored_in_det_m_and_in_m_inverse(tmp_path, capsys):
+    text = DETM.read_text()
+    assert text.count(DET) == 5  # det_M and the four entries of M_inv over it
+    planted = tmp_path / "planted_detm.toml"
+    planted.write_text(text.replace(DET, DET.replace("I1*I2 + ", "")))
+    _, found = _repairs(tmp_path, capsys, planted, *DETM_ARGS)
+    assert [f["location"].split(", ", 1)[1] for f in found] == [
+        "key det_M, entry detM",
+        "key M_inv, entry Minv[1,1]",
+        "key M_inv, entry Minv[1,2]",
+        "key M_inv, entry Minv[2,1]",
+        "key M_inv, entry Minv[2,2]",
+    ]
+    assert found[0]["suggested"] == "I1*I2 + I2*l1**2*m2 - l1**2*lc2**2*m2**2*cos(q2)**2"
+    assert all(f["checks_pass"] for f in found)
+
+
+def test_a_product_dropped_from_a_python_det_m_is_restored():
+    """The shipped cart-pole's det M = (I + mp·r²)(mc + mp) − mp²·r²·cos²θ without its product."""
+    from pendverify.bench.explain import shipped_targets
+    from pendverify.symbolic.edited import edited_model
+
+    model, system = next(
+        (m, s) for label, m, s, _ in shipped_targets() if label == "cart_pole, model (Python)"
+    )
+    sm = SymbolicModel.of(type(model))
+    written = sm.closed_forms["det_mass_matrix"]
+    (product,) = [t for t in written.args if t.is_Mul and t.args[0] != -1]
+    planted = edited_model(model, sm, {"det_mass_matrix": [(0, written, written - product)]}, "Planted")
+    batch, results = _results(planted, system)
+    assert not passes(results)
+    repairs, _ = search_repair(batch, 10.0)
+    assert repairs and repairs[0].details["suggested"] == str(written), [f.message for f in repairs]

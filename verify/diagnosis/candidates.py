@@ -14,7 +14,8 @@ are found from the numbers rather than enumerated blindly:
   product of at most ``DEGREE`` parameters of the kinds the quantity allows (the model's own
   products first) — this undoes a dropped term and an inertia about the pivot (± m·r²);
 * a restored term: a sum completed by the one term it lacks, as the same sum stands elsewhere
-  in the model (a term dropped inside det M or M⁻¹).
+  in the model (a term dropped inside det M or M⁻¹);
+* a det M completed by what it lacks of the determinant of the written M.
 
 ``candidates`` orders what passed the screen for confirmation, simplest first (``RANK``): each
 edit alone, then the same edit wherever the same expression stands in other slots (a shared
@@ -284,6 +285,31 @@ def _restored_term_edits(slot: Slot, pool) -> list[Edit]:
     return out
 
 
+#: det M is expanded symbolically from the written M for models of up to this many coordinates
+DETERMINANT_UP_TO_DOF = 3
+
+
+def _determinant_edits(slot: Slot, sm) -> list[Edit]:
+    """A written det M completed by what it lacks of the determinant of the written M: the
+    difference of the two, expanded and factored, added as one term when it is a part of the
+    determinant (fewer terms, expanded), or all of it where the entry is 0 (a product of sums
+    dropped from the expansion: (I2 + m2·r2²)(I1 + l1²·m2 + m1·r1²)).
+    Where the written M is right, as its own checks say, its determinant is Pinocchio's."""
+    M = sm.closed_forms.get("mass_matrix")
+    if slot.method != "det_mass_matrix" or M is None or M.shape[0] > DETERMINANT_UP_TO_DOF:
+        return []
+    determinant = sp.expand(M.det(method="berkowitz"))
+    difference = determinant - sp.expand(slot.expr)
+    whole = len(sp.Add.make_args(difference)) >= len(sp.Add.make_args(determinant))
+    if difference == 0 or (whole and slot.expr != 0):
+        return []  # not a part of det M missing (a factor on all of it is a coefficient edit)
+    term = sp.factor(sp.trigsimp(difference))
+    # the whole entry is what is edited: where M⁻¹'s entries are written over the same det M,
+    # the edit is made there too (``candidates``)
+    new = slot.expr + term
+    return [Edit("drop", slot.expr, new, new, f"add {term} (a term of det M from the written M)")]
+
+
 def _evaluated(slot: Slot, edits, sm, evaluate, deadline: float):
     """(edit, its values at the screening states, the slot's mismatch with them) of each new edit."""
     seen = set()
@@ -342,6 +368,7 @@ def screen_slot(slot: Slot, batch, sm, evaluate, monomials, pool, deadline: floa
     """The edits of one slot that make it agree at the screening states, in ``slot.matches``."""
     edits = _coefficient_edits(slot, evaluate) + _added_term_edits(slot, batch, monomials, sm.kinds)
     edits += _restored_term_edits(slot, pool) + _constant_edits(slot, monomials)
+    edits += _determinant_edits(slot, sm)
     edits += list(structural_edits(slot.expr, sm.angles, sm.symbols["v"], sm.kinds))
     # simplest first: an added term that SymPy folds into a swapped angle is kept as the swap
     edits.sort(key=lambda e: RANK.get(e.operator, 9))

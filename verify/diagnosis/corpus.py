@@ -42,7 +42,7 @@ from pendverify.analytic.text_parse import CONSTANTS, FUNCTIONS
 from pendverify.checks.batch import CheckBatch
 from pendverify.checks.catalogue import applicable_checks, run_checks
 from pendverify.checks.sampling import sample_states
-from pendverify.diagnosis.acceptance import accepted
+from pendverify.diagnosis.acceptance import passes
 from pendverify.diagnosis.explain import explain
 from pendverify.diagnosis.slots import QUANTITY
 from pendverify.symbolic.edited import edited_model
@@ -191,7 +191,7 @@ def score_model(
     out = ModelScores(label)
     batch = CheckBatch(model, system, states)
     results = run_checks(label, model, system, states, CORPUS_SEED, applicable_checks(model, system), batch)
-    out.clean = accepted(results)
+    out.clean = passes(results)
     for plant in plants(sm) if chosen is None else chosen:
         score = Score(plant)
         planted = edited_model(
@@ -205,7 +205,7 @@ def score_model(
                 )
             except (ArithmeticError, ValueError, np.linalg.LinAlgError):
                 results = None
-        if results is not None and not accepted(results):
+        if results is not None and not passes(results):
             score.detected = True
             start = time.perf_counter()  # the diagnosis alone, as check runs it after the checks
             findings = explain(batch, results, deadline_s)

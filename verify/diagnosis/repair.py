@@ -15,6 +15,9 @@
    in B shows as well in a hand-written q̈ that uses it; the checks cannot tell which one the
    derivation meant.  When no single edit
    passes, pairs of edits of one entry are tried for models of up to three degrees of freedom.
+   When still none passes and the written C is not Pinocchio's, the screened edits are confirmed
+   again against the model's own baseline: the warning of a C that is a valid C·q̇ but not the
+   Christoffel C, nothing worse (``pendverify.diagnosis.acceptance``).
 
 The repair is printed in the model's own notation, where it sits
 (``pendverify.diagnosis.notation``).
@@ -31,7 +34,7 @@ import sympy as sp
 from pendverify.analytic.forms import entry_position
 from pendverify.analytic.symbolic_reading import SymbolicModel
 from pendverify.checks.catalogue import applicable_checks, run_checks
-from pendverify.diagnosis.acceptance import accepted, matrix_c_note
+from pendverify.diagnosis.acceptance import accepted, matrix_c_note, written_c_differs
 from pendverify.diagnosis.candidates import (
     RANK,
     candidates,
@@ -60,8 +63,9 @@ ALTERNATIVE_TRIES = 4
 ALTERNATIVE_SECONDS = 2.0
 
 
-def _confirmed(batch, sm, changes: dict) -> bool:
-    """Whether the model with ``changes`` passes every applicable check on every state of ``batch``."""
+def _confirmed(batch, sm, changes: dict, baseline: bool = False) -> bool:
+    """Whether the model with ``changes`` passes every applicable check on every state of ``batch``
+    (``baseline``: or is back to the model's own warning, ``pendverify.diagnosis.acceptance``)."""
     edits: dict[str, list] = {}
     for (method, index), (old, new) in changes.items():
         edits.setdefault(method, []).append((index, old, new))
@@ -72,15 +76,14 @@ def _confirmed(batch, sm, changes: dict) -> bool:
             results = run_checks("repair", repaired, batch.system, batch.states, 0, names)
         except (ArithmeticError, ValueError, np.linalg.LinAlgError):
             return False
-    return accepted(results)
+    return accepted(results, batch, sm, changes, baseline)
 
 
 def _groups(slots: list[Slot], n: int) -> list[list[Slot]]:
     """The slots in the order they are screened, shortest first, each alone but for the entries of
     one row of a Coriolis-type matrix: those are screened together and their candidates confirmed
     simplest first, since only the row's product with q̇ is compared and an added term in one
-    entry can make up for a swapped angle in the other (a C that is not the Christoffel one,
-    ``pendverify.diagnosis.acceptance``, passes either way)."""
+    entry can make up for a swapped angle in the other."""
     groups: dict = {}
     for slot in sorted(slots, key=lambda s: sp.count_ops(s.expr)):
         row = slot.index // n if slot.row is not None else slot.index  # a Coriolis row form is n × n
@@ -135,6 +138,14 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
             for slot in slots
             for edit in pairs_within(slot, sm, evaluate, pool, deadline)
         )
+    tried = 0  # by a first pass
+    if not confirm.found and time.perf_counter() < deadline and written_c_differs(batch, sm):
+        # no edit makes every check pass; the written C is not Pinocchio's: the screened edits
+        # again, a repair now one that is back to that C's warning (acceptance)
+        tried, confirm = confirm.tried, _Confirmation(batch, sm, deadline, baseline=True)
+        confirm.run(candidates(slots, screened))
+        if not confirm.found and len(slots) == 2 and len(screened) == 2:
+            confirm.run(slot_pairs(*slots))
     notation = Notation.of(type(batch.model))
     if confirm.found:
         findings = []
@@ -159,7 +170,7 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
     also = " nor two edits of one entry," if pairs else ""
     return [], (
         f"no repair: no single edit of {where} (nor one edit of each, for two entries,{also}) makes every "
-        f"check pass; {confirm.tried} candidate(s) tried against every check{bound}"
+        f"check pass; {tried + confirm.tried} candidate(s) tried against every check{bound}"
     )
 
 
@@ -167,8 +178,8 @@ class _Confirmation:
     """The candidates every check confirms, in the order they come: the first, then alternatives
     (module docstring); how many were tried; when the search for alternatives ends."""
 
-    def __init__(self, batch, sm, deadline: float):
-        self.batch, self.sm, self.deadline = batch, sm, deadline
+    def __init__(self, batch, sm, deadline: float, baseline: bool = False):
+        self.batch, self.sm, self.deadline, self.baseline = batch, sm, deadline, baseline
         self.found: list = []
         self.tried, self.tried_at_first, self.longest = 0, 0, 0.0
         self.seen: set = set()
@@ -190,7 +201,7 @@ class _Confirmation:
             self.seen.add(key)
             self.tried += 1
             started = time.perf_counter()
-            if _confirmed(self.batch, self.sm, changes):
+            if _confirmed(self.batch, self.sm, changes, self.baseline):
                 self.found.append((changes, edit, slot))
                 if len(self.found) == 1:
                     self.tried_at_first = self.tried
