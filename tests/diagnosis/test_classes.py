@@ -11,6 +11,8 @@ of the corpus file and the exact repair is asserted; the untouched model gets no
 * **det M** (``examples/corpus_acrobot_detm.toml``, det M and M⁻¹ written out; the shipped
   cart-pole): a term missing from det M is restored from the determinant of the written M, in
   M⁻¹ too where it is written over the same det M.
+* **Two errors in different keys** (``examples/corpus_acrobot_two_keys.toml``): one edit of each
+  of two entries, one in M and one in C.
 """
 
 from __future__ import annotations
@@ -28,6 +30,7 @@ from pendverify.checks.catalogue import applicable_checks, run_checks
 from pendverify.checks.sampling import sample_states
 from pendverify.cli import main
 from pendverify.diagnosis.acceptance import passes
+from pendverify.diagnosis.corpus import pair_plants
 from pendverify.diagnosis.repair import search_repair
 
 from ..conftest import SEED
@@ -237,3 +240,43 @@ def test_a_product_dropped_from_a_python_det_m_is_restored():
     assert not passes(results)
     repairs, _ = search_repair(batch, 10.0)
     assert repairs and repairs[0].details["suggested"] == str(written), [f.message for f in repairs]
+
+
+# --- two errors in different keys ------------------------------------------------------------------
+TWO_KEYS = EXAMPLES / "corpus_acrobot_two_keys.toml"
+TWO_KEYS_ARGS = (
+    "--urdf",
+    str(EXAMPLES / "corpus_acrobot_tedrake.urdf"),
+    "--params",
+    str(EXAMPLES / "corpus_acrobot_two_keys_params.toml"),
+)
+M22, M22_WRONG = '"I2"],\n]', '"2*I2"],\n]'
+C21, C21_WRONG = '["m2*l1*lc2*sin(q2)*dq1", "0"]', '["-m2*l1*lc2*sin(q2)*dq1", "0"]'
+
+
+@pytest.mark.parametrize(
+    ("source", "args", "warns"), [(TWO_KEYS, TWO_KEYS_ARGS, False), (TEDRAKE, TEDRAKE_ARGS, True)]
+)
+def test_one_error_in_m_and_one_in_c_are_repaired_together(tmp_path, capsys, source, args, warns):
+    """Neither edit alone makes the checks pass; the two together do (the non-Christoffel model:
+    back to its warning)."""
+    text = source.read_text()
+    assert text.count(M22) == 1 and text.count(C21) == 1
+    planted = tmp_path / "planted_two.toml"
+    planted.write_text(text.replace(M22, M22_WRONG).replace(C21, C21_WRONG))
+    _, found = _repairs(tmp_path, capsys, planted, *args)
+    assert sorted(f["message"].split(" makes")[0] for f in found) == [
+        "C[2,1]: -dq1*l1*lc2*m2*sin(q2) → dq1*l1*lc2*m2*sin(q2)",
+        "M[2,2]: 2*I2 → I2",
+    ]
+    assert all(("warns" in f) is warns for f in found)
+
+
+def test_the_untouched_two_key_model_passes_and_its_pairs_are_drawn_from_two_keys():
+    model, system = _target("acrobot_two_keys")
+    batch, results = _results(model, system)
+    assert all(r.status == "pass" for r in results)
+    repairs, why = search_repair(batch, 10.0)
+    assert repairs == [] and "no single entry" in why
+    pairs = pair_plants(SymbolicModel.of(type(model)), 30)
+    assert len(pairs) == 30 and all(a.method != b.method for a, b in pairs)

@@ -19,7 +19,8 @@ are found from the numbers rather than enumerated blindly:
 
 ``candidates`` orders what passed the screen for confirmation, simplest first (``RANK``): each
 edit alone, then the same edit wherever the same expression stands in other slots (a shared
-sub-expression in code, a shorthand in a LaTeX file), then pairs of two slots' edits.
+sub-expression in code, a shorthand in a LaTeX file), then pairs of two slots' edits
+(``slot_pairs``; ``cross_pairs`` for two errors in different keys or entries).
 ``pairs_within`` tries two edits of one entry, for models of up to three degrees of freedom.
 """
 
@@ -452,6 +453,24 @@ def candidates(slots: list[Slot], among: list[Slot]) -> list[tuple[int, dict, Ed
             if len(shared) > 1:
                 out.append((10 + RANK.get(edit.operator, 9), shared, edit, slot))
     return sorted(out, key=lambda c: c[0])
+
+
+#: pairs of edits of two entries (in different keys, or different rows of one) confirmed at most
+MAX_CROSS_PAIRS = 60
+
+
+def cross_pairs(slots: list[Slot]) -> list[tuple[int, dict, Edit, Slot]]:
+    """One edit of each of two slots, each of which passed its own screen, for every two slots
+    that are not one Coriolis row (whose entries share one comparison): two errors in different
+    keys (one in M, one in C) or entries; simplest first, at most ``MAX_CROSS_PAIRS``."""
+    screened = [s for s in slots if s.matches]
+    out = []
+    for a, b in itertools.combinations(screened, 2):
+        same_row = a.row is not None and b.row is not None and np.array_equal(a.row[0], b.row[0])
+        if a.method == b.method and same_row:
+            continue  # one row of C·q̇ (the same residual): not two separate comparisons
+        out += slot_pairs(a, b)
+    return sorted(out, key=lambda c: c[0])[:MAX_CROSS_PAIRS]
 
 
 def slot_pairs(a: Slot, b: Slot) -> list[tuple[int, dict, Edit, Slot]]:

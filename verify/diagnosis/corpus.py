@@ -22,7 +22,8 @@ seconds
     how long the diagnosis took (``explain``, after the checks, as ``check`` runs it).
 
 The untouched models must pass every check (``ModelScores.clean``; warnings pass, as in
-``pendverify check``), so get no diagnosis.
+``pendverify check``), so get no diagnosis.  A corpus of pairs (``pair_plants``: two errors at
+once, in different keys) is scored the same way, each of the two named and restored.
 """
 
 from __future__ import annotations
@@ -130,6 +131,8 @@ class Score:
     """What the diagnosis did with one planted error."""
 
     plant: Plant
+    #: the other errors planted with it (a pair: ``pair_plants``)
+    also: tuple = ()
     detected: bool = False
     named: bool = False
     repaired: bool = False
@@ -192,11 +195,14 @@ def score_model(
     batch = CheckBatch(model, system, states)
     results = run_checks(label, model, system, states, CORPUS_SEED, applicable_checks(model, system), batch)
     out.clean = passes(results)
-    for plant in plants(sm) if chosen is None else chosen:
-        score = Score(plant)
-        planted = edited_model(
-            model, sm, {plant.method: [(plant.index, plant.original, plant.new)]}, "Planted"
-        )
+    for item in plants(sm) if chosen is None else chosen:
+        group = item if isinstance(item, tuple) else (item,)  # a pair: two errors at once
+        plant = group[0]
+        score = Score(plant, also=group[1:])
+        edits: dict[str, list] = {}
+        for p in group:
+            edits.setdefault(p.method, []).append((p.index, p.original, p.new))
+        planted = edited_model(model, sm, edits, "Planted")
         with np.errstate(all="ignore"):
             batch = CheckBatch(planted, system, states)
             try:
@@ -210,9 +216,9 @@ def score_model(
             start = time.perf_counter()  # the diagnosis alone, as check runs it after the checks
             findings = explain(batch, results, deadline_s)
             score.seconds = time.perf_counter() - start
-            score.named = _named(plant, findings, forms)
+            score.named = all(_named(p, findings, forms) for p in group)
             score.repaired = any(f.kind == "repair" and f.details.get("checks_pass") for f in findings)
-            score.restored = _restored(findings, plant, sm)
+            score.restored = all(_restored(findings, p, sm) for p in group)
             score.message = next((f.message for f in findings if f.kind == "repair"), "")
         out.scores.append(score)
         if progress is not None:
@@ -231,3 +237,20 @@ def sample_plants(sm: SymbolicModel, per_operator: int, seed: int = CORPUS_SEED)
         group = by_operator.get(operator, [])
         chosen += rng.sample(group, min(per_operator, len(group)))
     return chosen
+
+
+#: the keys a pair of planted errors is drawn from, one error in each of two of them
+PAIR_KEYS = ("mass_matrix", "coriolis_matrix", "coriolis_force", "gravity")
+
+
+def pair_plants(sm: SymbolicModel, count: int, seed: int = CORPUS_SEED) -> list[tuple[Plant, Plant]]:
+    """``count`` pairs of planted errors in two different keys of ``PAIR_KEYS`` (one in M and one
+    in C, ...), drawn with ``seed`` from every such pair of the corpus's single plants."""
+    by_key: dict[str, list[Plant]] = {}
+    for plant in plants(sm):
+        if plant.method in PAIR_KEYS:
+            by_key.setdefault(plant.method, []).append(plant)
+    pairs = [
+        (a, b) for k1, k2 in itertools.combinations(sorted(by_key), 2) for a in by_key[k1] for b in by_key[k2]
+    ]
+    return random.Random(seed).sample(pairs, min(count, len(pairs)))

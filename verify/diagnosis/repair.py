@@ -17,7 +17,9 @@
    passes, pairs of edits of one entry are tried for models of up to three degrees of freedom.
    When still none passes and the written C is not Pinocchio's, the screened edits are confirmed
    again against the model's own baseline: the warning of a C that is a valid C·q̇ but not the
-   Christoffel C, nothing worse (``pendverify.diagnosis.acceptance``).
+   Christoffel C, nothing worse (``pendverify.diagnosis.acceptance``).  Then, for models of up
+   to three degrees of freedom, one edit of each of two entries that each passed their own
+   screen (``cross_pairs``): two errors in different keys, one in M and one in C.
 
 The repair is printed in the model's own notation, where it sits
 (``pendverify.diagnosis.notation``).
@@ -38,6 +40,7 @@ from pendverify.diagnosis.acceptance import accepted, matrix_c_note, written_c_d
 from pendverify.diagnosis.candidates import (
     RANK,
     candidates,
+    cross_pairs,
     monomials_for,
     pairs_within,
     screen_slot,
@@ -138,7 +141,7 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
             for slot in slots
             for edit in pairs_within(slot, sm, evaluate, pool, deadline)
         )
-    tried = 0  # by a first pass
+    tried = 0  # by the passes before
     if not confirm.found and time.perf_counter() < deadline and written_c_differs(batch, sm):
         # no edit makes every check pass; the written C is not Pinocchio's: the screened edits
         # again, a repair now one that is back to that C's warning (acceptance)
@@ -146,6 +149,14 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
         confirm.run(candidates(slots, screened))
         if not confirm.found and len(slots) == 2 and len(screened) == 2:
             confirm.run(slot_pairs(*slots))
+    crossed = not confirm.found and batch.model.nv <= PAIRS_UP_TO_DOF and len(screened) > 2
+    if crossed:  # two errors in two entries (of different keys: one in M, one in C)
+        for baseline in (False, True) if written_c_differs(batch, sm) else (False,):
+            if confirm.found or time.perf_counter() > deadline:
+                break
+            tried += confirm.tried
+            confirm = _Confirmation(batch, sm, deadline, baseline=baseline)
+            confirm.run(cross_pairs(screened))
     notation = Notation.of(type(batch.model))
     if confirm.found:
         findings = []
@@ -168,6 +179,7 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
         else ""
     )
     also = " nor two edits of one entry," if pairs else ""
+    also += " nor one edit of each of two entries," if crossed else ""
     return [], (
         f"no repair: no single edit of {where} (nor one edit of each, for two entries,{also}) makes every "
         f"check pass; {tried + confirm.tried} candidate(s) tried against every check{bound}"
