@@ -13,6 +13,8 @@ of the corpus file and the exact repair is asserted; the untouched model gets no
   M⁻¹ too where it is written over the same det M.
 * **Two errors in different keys** (``examples/corpus_acrobot_two_keys.toml``): one edit of each
   of two entries, one in M and one in C.
+* **Conventions named with the file key that fixes them**: joints listed in the other order,
+  and absolute vs relative angles, each as the ``[urdf]`` key to write.
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from pendverify.analytic.symbolic_reading import SymbolicModel
@@ -33,7 +36,7 @@ from pendverify.diagnosis.acceptance import passes
 from pendverify.diagnosis.corpus import pair_plants
 from pendverify.diagnosis.repair import search_repair
 
-from ..conftest import SEED
+from ..conftest import SEED, default_params
 
 REPO = Path(__file__).resolve().parents[2]
 EXAMPLES = REPO / "examples"
@@ -280,3 +283,51 @@ def test_the_untouched_two_key_model_passes_and_its_pairs_are_drawn_from_two_key
     assert repairs == [] and "no single entry" in why
     pairs = pair_plants(SymbolicModel.of(type(model)), 30)
     assert len(pairs) == 30 and all(a.method != b.method for a, b in pairs)
+
+
+# --- conventions, named with the key that declares them ---------------------------------------------
+JOINTS = 'joints = ["shoulder", "elbow"]'
+
+
+def _convention(tmp_path, capsys, declared: str) -> str:
+    text = TWO_KEYS.read_text()
+    assert text.count(JOINTS) == 1
+    planted = tmp_path / "planted_map.toml"
+    planted.write_text(text.replace(JOINTS, declared))
+    out_json = tmp_path / "report.json"
+    assert main(["check", "--analytic", str(planted), *TWO_KEYS_ARGS, "--json", str(out_json)]) == 1
+    capsys.readouterr()
+    (findings,) = json.loads(out_json.read_text())["diagnoses"].values()
+    (convention,) = [f for f in findings if f["kind"] == "convention"]
+    return convention["message"]
+
+
+def test_joints_listed_in_the_other_order_are_named_with_the_joints_key(tmp_path, capsys):
+    message = _convention(tmp_path, capsys, 'joints = ["elbow", "shoulder"]')
+    assert message.startswith(
+        "joint order: the hand model's coordinates are the joints in another order than the map's "
+        "(q1 is shoulder's coordinate, q2 is elbow's coordinate); with the joints in that order every "
+        "check passes"
+    )
+    where = tmp_path / "planted_map.toml"
+    assert message.endswith(f"; declare it as joints = ['shoulder', 'elbow'] under [urdf] in {where}")
+
+
+def test_relative_angles_declared_absolute_are_named_with_the_transform_key(tmp_path, capsys):
+    message = _convention(tmp_path, capsys, JOINTS + "\ntransform = [[1, 0], [-1, 1]]")
+    assert message.startswith("absolute vs relative angles: the hand model's angles are relative")
+    where = tmp_path / "planted_map.toml"
+    assert message.endswith(f"; declare it as transform = [[1, 0], [0, 1]] under [urdf] in {where}")
+
+
+def test_a_python_class_is_told_its_class_attribute():
+    """The same trap in a Python class: the attribute ``joint_transform`` of the class."""
+    from pendverify.analytic import DoublePendulum
+    from pendverify.diagnosis.traps.convention_maps import Candidate
+    from pendverify.diagnosis.traps.convention_words import declared_as
+
+    model = DoublePendulum(default_params("double_pendulum"))
+    c = Candidate(relative=1, shifts=(0, 0), T=np.array([[1.0, 0.0], [-1.0, 1.0]]), theta0=np.zeros(2))
+    words = declared_as(model, c, np.zeros(2))
+    assert words.startswith("declare it as DoublePendulum.joint_transform = [[1, 0], [-1, 1]] in ")
+    assert words.endswith("double_pendulum.py")
