@@ -104,8 +104,11 @@ class _NodeValues:
         found = self.values.get(node)
         if found is not None:
             return found
-        if node.is_Number or node.is_NumberSymbol:
-            value = np.full(self.n, float(node))
+        if not node.free_symbols:  # a number; one that is not real (zoo from an edit's 1/0) is nan
+            try:
+                value = np.full(self.n, float(node))
+            except TypeError:
+                value = np.full(self.n, np.nan)
         elif node.is_Add:
             value = functools.reduce(np.add, map(self, node.args))
         elif node.is_Mul:
