@@ -15,6 +15,9 @@ of the corpus file and the exact repair is asserted; the untouched model gets no
   of two entries, one in M and one in C.
 * **Conventions named with the file key that fixes them**: joints listed in the other order,
   and absolute vs relative angles, each as the ``[urdf]`` key to write.
+* **A key the model derives** (H = ∂V/∂q of a file that writes V, or V integrated from H): the
+  repair is of the key written, confirmed with the other derived again; the derived key is
+  never repaired.
 """
 
 from __future__ import annotations
@@ -331,3 +334,44 @@ def test_a_python_class_is_told_its_class_attribute():
     words = declared_as(model, c, np.zeros(2))
     assert words.startswith("declare it as DoublePendulum.joint_transform = [[1, 0], [-1, 1]] in ")
     assert words.endswith("double_pendulum.py")
+
+
+# --- a key derived from another -----------------------------------------------------------------------
+V_LINE = 'V = "-m1*g*lc1*cos(q1) - m2*g*(l1*cos(q1) + lc2*cos(q1 + q2))"\n'
+H_BLOCK = """H = [
+  "m1*g*lc1*sin(q1) + m2*g*(l1*sin(q1) + lc2*sin(q1 + q2))",
+  "m2*g*lc2*sin(q1 + q2)",
+]
+"""
+
+
+@pytest.mark.parametrize(
+    ("dropped", "right", "wrong", "repair"),
+    [
+        # V written, H = ∂V/∂q derived: lc1 typed for lc2 in V
+        (
+            H_BLOCK,
+            "l1*cos(q1) + lc2*cos(q1 + q2)",
+            "l1*cos(q1) + lc1*cos(q1 + q2)",
+            "V: -g*lc1*m1*cos(q1) - g*m2*(l1*cos(q1) + lc1*cos(q1 + q2)) → "
+            "-g*lc1*m1*cos(q1) - g*m2*(l1*cos(q1) + lc2*cos(q1 + q2))",
+        ),
+        # H written, V integrated from H: m2 typed for m1 in H[1] (still a gradient)
+        (
+            V_LINE,
+            '"m1*g*lc1*sin(q1) + m2*g*',
+            '"m2*g*lc1*sin(q1) + m2*g*',
+            "H[1]: g*lc1*m2*sin(q1) + g*m2*(l1*sin(q1) + lc2*sin(q1 + q2)) → "
+            "g*lc1*m1*sin(q1) + g*m2*(l1*sin(q1) + lc2*sin(q1 + q2))",
+        ),
+    ],
+)
+def test_the_written_key_is_repaired_never_the_one_derived_from_it(
+    tmp_path, capsys, dropped, right, wrong, repair
+):
+    text = TWO_KEYS.read_text()
+    assert text.count(dropped) == 1 and text.count(right) == 1
+    planted = tmp_path / "planted_derived.toml"
+    planted.write_text(text.replace(dropped, "").replace(right, wrong))
+    _, (found,) = _repairs(tmp_path, capsys, planted, *TWO_KEYS_ARGS)
+    assert found["checks_pass"] and found["message"].startswith(repair + " makes every check pass")

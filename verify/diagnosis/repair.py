@@ -22,7 +22,9 @@
    screen (``cross_pairs``): two errors in different keys, one in M and one in C.
 
 The repair is printed in the model's own notation, where it sits
-(``pendverify.diagnosis.notation``).
+(``pendverify.diagnosis.notation``).  A key the model derives from another (H = ∂V/∂q of a text
+model that writes V) is not repaired: an edit of its source is confirmed with it derived again
+(``pendverify.diagnosis.derived``), and only the source's edit is printed.
 """
 
 from __future__ import annotations
@@ -47,8 +49,9 @@ from pendverify.diagnosis.candidates import (
     slot_pairs,
     sum_pool,
 )
+from pendverify.diagnosis.derived import derived_methods, with_derived
 from pendverify.diagnosis.finding import Finding
-from pendverify.diagnosis.notation import Notation
+from pendverify.diagnosis.notation import TEXT_KEYS, Notation
 from pendverify.diagnosis.slots import QUANTITY, SCREEN_STATES, Slot, entry_label, evaluator, find_slots
 from pendverify.symbolic.edited import edited_model
 from pendverify.symbolic.edits import Edit
@@ -116,6 +119,18 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
     slots = find_slots(screening, sm)
     if not slots:
         return [], "no single entry of the written closed forms disagrees with Pinocchio: no repair searched"
+    derived = derived_methods(type(batch.model))  # never repaired: derived again from their source
+    if derived and all(s.method in derived for s in slots):
+        sources = sorted({TEXT_KEYS.get(derived[s.method], derived[s.method]) for s in slots})
+        return [], (
+            f"no repair: the entries that disagree ({', '.join(s.label for s in slots)}) are derived "
+            f"from {', '.join(sources)}, which agrees with Pinocchio"
+        )
+    slots = [s for s in slots if s.method not in derived]
+
+    def run(confirmation, ordered) -> None:  # each candidate with its derived keys derived again
+        confirmation.run((r, with_derived(c, sm, derived), e, s) for r, c, e, s in ordered)
+
     pool = sum_pool(sm)
     monomials: dict[str, tuple] = {}
     confirm = _Confirmation(batch, sm, deadline)
@@ -129,26 +144,29 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
                 monomials[quantity] = monomials_for(sm, params, quantity)
             screen_slot(slot, screening, sm, evaluate, monomials[quantity], pool, deadline)
             screened.append(slot)
-        confirm.run(candidates(slots, [s for s in group if any(s is x for x in screened)]))
+        run(confirm, candidates(slots, [s for s in group if any(s is x for x in screened)]))
         if time.perf_counter() > min(deadline, confirm.alternatives_until):
             break
     if not confirm.found and len(slots) == 2 and len(screened) == 2:  # one edit of each entry
-        confirm.run(slot_pairs(*slots))
+        run(confirm, slot_pairs(*slots))
     pairs = not confirm.found and batch.model.nv <= PAIRS_UP_TO_DOF and len(slots) <= 2
     if pairs:  # two edits of one entry
-        confirm.run(
-            (RANK["pair"], {(slot.method, slot.index): (slot.expr, edit.expr)}, edit, slot)
-            for slot in slots
-            for edit in pairs_within(slot, sm, evaluate, pool, deadline)
+        run(
+            confirm,
+            (
+                (RANK["pair"], {(slot.method, slot.index): (slot.expr, edit.expr)}, edit, slot)
+                for slot in slots
+                for edit in pairs_within(slot, sm, evaluate, pool, deadline)
+            ),
         )
     tried = 0  # by the passes before
     if not confirm.found and time.perf_counter() < deadline and written_c_differs(batch, sm):
         # no edit makes every check pass; the written C is not Pinocchio's: the screened edits
         # again, a repair now one that is back to that C's warning (acceptance)
         tried, confirm = confirm.tried, _Confirmation(batch, sm, deadline, baseline=True)
-        confirm.run(candidates(slots, screened))
+        run(confirm, candidates(slots, screened))
         if not confirm.found and len(slots) == 2 and len(screened) == 2:
-            confirm.run(slot_pairs(*slots))
+            run(confirm, slot_pairs(*slots))
     crossed = not confirm.found and batch.model.nv <= PAIRS_UP_TO_DOF and len(screened) > 2
     if crossed:  # two errors in two entries (of different keys: one in M, one in C)
         for baseline in (False, True) if written_c_differs(batch, sm) else (False,):
@@ -156,12 +174,13 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
                 break
             tried += confirm.tried
             confirm = _Confirmation(batch, sm, deadline, baseline=baseline)
-            confirm.run(cross_pairs(screened))
+            run(confirm, cross_pairs(screened))
     notation = Notation.of(type(batch.model))
     if confirm.found:
         findings = []
         for k, (changes, edit, slot) in enumerate(confirm.found):
-            found = _findings(changes, edit, slot, forms, notation, alternative=k > 0)
+            written = {key: change for key, change in changes.items() if key[0] not in derived}
+            found = _findings(written, edit, slot, forms, notation, alternative=k > 0)
             note = matrix_c_note(screening, sm, evaluate, changes)
             if note:  # coriolis and skew warn after the repair, as before the error
                 found = [
