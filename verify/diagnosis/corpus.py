@@ -44,6 +44,7 @@ from pendverify.checks.batch import CheckBatch
 from pendverify.checks.catalogue import applicable_checks, run_checks
 from pendverify.checks.sampling import sample_states
 from pendverify.diagnosis.acceptance import passes
+from pendverify.diagnosis.derived import derived_methods
 from pendverify.diagnosis.explain import explain
 from pendverify.diagnosis.slots import QUANTITY
 from pendverify.symbolic.edited import edited_model
@@ -116,10 +117,14 @@ def entry_plants(method: str, index: int, expr, sm: SymbolicModel, kinds: dict) 
 
 
 def plants(sm: SymbolicModel) -> list[Plant]:
-    """Every planted error of the corpus for one model."""
+    """Every planted error of the corpus for one model, in the keys it writes (not in one it derives
+    from another, ``pendverify.diagnosis.derived``: a user cannot type an error there)."""
     kinds = sm.kinds
+    derived = derived_methods(sm.cls)
     out = []
     for method, value in sm.closed_forms.items():
+        if method in derived:
+            continue
         for index, expr in enumerate(entries(value)):
             if expr != 0:
                 out += entry_plants(method, index, expr, sm, kinds)
