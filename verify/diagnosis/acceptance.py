@@ -54,44 +54,35 @@ def written_c_differs(batch, sm) -> bool:
     return bool(_differing_c_entries(batch, sm, {}))
 
 
-def _differing_c_entries(batch, sm, changes: dict) -> list[int]:
-    """The entries of the written C (row-major) left alone by ``changes`` that differ from
-    Pinocchio's Coriolis matrix at the states of ``batch`` (relative to the size of the two)."""
+def _differing_c_entries(batch, sm, changes: dict, edited: bool = False) -> list[int]:
+    """The entries of the written C (row-major) that differ from Pinocchio's Coriolis matrix at the
+    states of ``batch``, relative to the size of the two: those ``changes`` leaves alone, or
+    (``edited``) every entry of the C ``changes`` makes."""
     forms = type(batch.model).closed_forms
     if "coriolis_matrix" not in sm.closed_forms or forms["coriolis_matrix"].equals:
         return []
     params = [float(getattr(batch.model.params, p)) for p in sm.parameters]
     evaluate = evaluator(sm, {"q": batch.Q, "v": batch.V, "u": batch.U, "w": batch.W}, params)
-    args = forms["coriolis_matrix"].args
     written = entries(sm.closed_forms["coriolis_matrix"])
+    if edited:
+        written = [changes.get(("coriolis_matrix", i), (None, e))[1] for i, e in enumerate(written)]
     pin = np.asarray(batch.terms.C_pin, dtype=float).reshape(len(batch), len(written))
     with np.errstate(all="ignore"):
-        hand = np.stack([evaluate(e, args) for e in written], axis=-1)
+        hand = np.stack([evaluate(e, forms["coriolis_matrix"].args) for e in written], axis=-1)
     size = float(np.max(np.abs(pin), initial=0.0) + np.max(np.abs(hand), initial=0.0)) or 1.0
     return [
         i
         for i in range(len(written))
-        if ("coriolis_matrix", i) not in changes
-        and np.max(np.abs(hand[:, i] - pin[:, i]), initial=0.0) > SCREEN_RTOL * size
+        if (edited or ("coriolis_matrix", i) not in changes)
+        and not np.max(np.abs(hand[:, i] - pin[:, i]), initial=0.0) <= SCREEN_RTOL * size  # nan differs
     ]
 
 
-def matrix_c_note(screening, sm, evaluate, changes: dict) -> str:
-    """The note a repair carries when the repaired model's matrix C is not Pinocchio's
-    (``coriolis`` and ``skew`` warn, as they do for the model as written), else ""."""
-    if (
-        "coriolis_matrix" not in sm.closed_forms
-        or type(screening.model).closed_forms["coriolis_matrix"].equals
-    ):
-        return ""
-    written = entries(sm.closed_forms["coriolis_matrix"])
-    edited = [changes.get(("coriolis_matrix", i), (None, e))[1] for i, e in enumerate(written)]
-    args = type(screening.model).closed_forms["coriolis_matrix"].args
-    with np.errstate(all="ignore"):
-        hand = np.stack([evaluate(e, args) for e in edited], axis=-1)
-    pin = np.asarray(screening.terms.C_pin, dtype=float).reshape(hand.shape)
-    size = float(np.max(np.abs(pin), initial=0.0) + np.max(np.abs(hand), initial=0.0)) or 1.0
-    if not np.all(np.isfinite(hand)) or np.max(np.abs(hand - pin)) <= SCREEN_RTOL * size:
+def matrix_c_note(screening, sm, changes: dict) -> str:
+    """The note a repair carries when the repaired model's matrix C is not Pinocchio's at the
+    ``screening`` states (``coriolis`` and ``skew`` warn, as they do for the model as written),
+    else ""."""
+    if not _differing_c_entries(screening, sm, changes, edited=True):
         return ""
     return (
         f"{' and '.join(MATRIX_C_CHECKS)} still warn, as for the model as written: its C is a valid C·q̇, "

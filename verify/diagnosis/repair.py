@@ -181,7 +181,7 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
         for k, (changes, edit, slot) in enumerate(confirm.found):
             written = {key: change for key, change in changes.items() if key[0] not in derived}
             found = _findings(written, edit, slot, forms, notation, alternative=k > 0)
-            note = matrix_c_note(screening, sm, evaluate, changes)
+            note = matrix_c_note(screening, sm, changes)
             if note:  # coriolis and skew warn after the repair, as before the error
                 found = [
                     dataclasses.replace(
