@@ -276,6 +276,9 @@ def test_one_error_in_m_and_one_in_c_are_repaired_together(tmp_path, capsys, sou
         "M[2,2]: 2*I2 → I2",
     ]
     assert all(("warns" in f) is warns for f in found)
+    by_entry = {f["message"].split(":", 1)[0]: f["message"] for f in found}
+    assert "; together with the edit of M[2,2]" in by_entry["C[2,1]"]
+    assert "; together with the edit of C[2,1]" in by_entry["M[2,2]"]
 
 
 def test_the_untouched_two_key_model_passes_and_its_pairs_are_drawn_from_two_keys():

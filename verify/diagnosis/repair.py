@@ -181,6 +181,16 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
         for k, (changes, edit, slot) in enumerate(confirm.found):
             written = {key: change for key, change in changes.items() if key[0] not in derived}
             found = _findings(written, edit, slot, forms, notation, alternative=k > 0)
+            if len(found) > 1:  # one repair in several entries: each finding names the others
+                labels = [
+                    f"{f.quantity}[{','.join(map(str, f.index))}]" if f.index else f.quantity for f in found
+                ]
+                found = [
+                    dataclasses.replace(
+                        f, message=f"{f.message}; together with the edit of {', '.join(others)}"
+                    )
+                    for f, others in ((f, labels[:i] + labels[i + 1 :]) for i, f in enumerate(found))
+                ]
             note = matrix_c_note(screening, sm, changes)
             if note:  # coriolis and skew warn after the repair, as before the error
                 found = [
