@@ -7,7 +7,9 @@ its URDF and parameter set: per model, how many planted errors the checks detect
 the diagnosis names at the right entry, repairs (confirmed by every check) and restores (the
 planted edit or an equivalent one), whether the untouched model is clean, and the time a
 diagnosis takes (mean and largest, per planted error, on one core).  ``quick`` draws up to
-``QUICK_PER_OPERATOR`` planted errors of each operator per model (seeded) instead of all.
+``QUICK_PER_OPERATOR`` planted errors of each operator per model (seeded) instead of all.  A
+catalogue entry with ``pairs = N`` is planted N pairs of errors in two different keys instead
+(``QUICK_PAIRS`` with ``quick``): the class of two errors at once.
 """
 
 from __future__ import annotations
@@ -15,10 +17,19 @@ from __future__ import annotations
 import sys
 from dataclasses import dataclass
 
-from pendverify.diagnosis.corpus import CORPUS_SEED, ModelScores, plants, sample_plants, score_model
+from pendverify.diagnosis.corpus import (
+    CORPUS_SEED,
+    ModelScores,
+    pair_plants,
+    plants,
+    sample_plants,
+    score_model,
+)
 from pendverify.display import REPR_LIMIT, html_table, shortened
 
 QUICK_PER_OPERATOR = 2
+#: pairs of planted errors drawn per paired model with ``quick`` (``paired_classes``)
+QUICK_PAIRS = 6
 #: the diagnosis's bound on a model of up to 3 degrees of freedom on this project's 2-core machine
 BOUND_S = 10.0
 
@@ -75,24 +86,37 @@ def shipped_targets():
             yield f"{example.name}, {file.role}", model, system, example.dof
 
 
-def class_targets():
-    """(label, model, system, degrees of freedom) of every model of ``CORPUS_CATALOGUE``; the label
-    names its class: ``"acrobot_tedrake (non-Christoffel C)"``."""
+def _shipped(spec: str):
     from pendverify.shipped import shipped_file
 
+    kind, _, name = spec.partition("/")
+    return shipped_file(kind, name)
+
+
+def _catalogue() -> list[dict]:
+    """The entries of ``CORPUS_CATALOGUE``, each with its ``label``: ``"acrobot_tedrake
+    (non-Christoffel C)"``."""
     if sys.version_info >= (3, 11):
         import tomllib
     else:  # pragma: no cover - exercised on Python 3.10 only
         import tomli as tomllib
 
-    def shipped(spec: str):
-        kind, _, name = spec.partition("/")
-        return shipped_file(kind, name)
+    catalogue = tomllib.loads(_shipped("examples/" + CORPUS_CATALOGUE).read_text(encoding="utf-8"))
+    return [entry | {"label": f"{entry['name']} ({entry['class']})"} for entry in catalogue.get("model", ())]
 
-    catalogue = tomllib.loads(shipped("examples/" + CORPUS_CATALOGUE).read_text(encoding="utf-8"))
-    for entry in catalogue.get("model", ()):
-        model, system = _target(shipped(entry["model"]), shipped(entry["urdf"]), shipped(entry["params"]))
-        yield f"{entry['name']} ({entry['class']})", model, system, entry["dof"]
+
+def class_targets():
+    """(label, model, system, degrees of freedom) of every model of ``CORPUS_CATALOGUE``; the label
+    names its class: ``"acrobot_tedrake (non-Christoffel C)"``."""
+    for entry in _catalogue():
+        model, system = _target(_shipped(entry["model"]), _shipped(entry["urdf"]), _shipped(entry["params"]))
+        yield entry["label"], model, system, entry["dof"]
+
+
+def paired_classes() -> dict[str, int]:
+    """{label: how many pairs} of the catalogue's models whose corpus is pairs of planted errors in
+    two different keys (``pairs = N``: the class of two errors at once), not single errors."""
+    return {entry["label"]: entry["pairs"] for entry in _catalogue() if "pairs" in entry}
 
 
 def corpus_targets():
@@ -107,10 +131,14 @@ def run_explain_bench(quick: bool = False) -> ExplainBench:
     from pendverify.progress import bar
 
     targets = list(corpus_targets())
+    paired = paired_classes()
     chosen = {}
     for label, model, _, _ in targets:
         sm = SymbolicModel.of(type(model))
-        chosen[label] = sample_plants(sm, QUICK_PER_OPERATOR, CORPUS_SEED) if quick else plants(sm)
+        if label in paired:
+            chosen[label] = pair_plants(sm, min(paired[label], QUICK_PAIRS) if quick else paired[label])
+        else:
+            chosen[label] = sample_plants(sm, QUICK_PER_OPERATOR, CORPUS_SEED) if quick else plants(sm)
     out = ExplainBench([], {}, quick)
     with bar(sum(len(c) for c in chosen.values()), "explain", "error") as progress:
         for label, model, system, dof in targets:

@@ -176,9 +176,7 @@ def verify_target(report: Report, target, samples: int, seed: int) -> None:
         apply_strict(results)
     # the diagnosis compares values with Pinocchio's: the URDF's own terms and the units are not values
     failing = [r for r in results if r.status == FAIL and r.check not in ("model-form", UNITS)]
-    if failing and kept and report.explain and not target.model.has_mass_matrix:
-        notes.append("not explained: the diagnosis compares M, C·q̇ and H, which q̈ alone does not give")
-    elif failing and kept and report.explain:
+    if failing and kept and report.explain:
         # SymPy and the searches are loaded only when a model fails (a passing run starts faster)
         from pendverify.diagnosis.explain import explain
 

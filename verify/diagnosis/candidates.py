@@ -14,11 +14,13 @@ are found from the numbers rather than enumerated blindly:
   product of at most ``DEGREE`` parameters of the kinds the quantity allows (the model's own
   products first) — this undoes a dropped term and an inertia about the pivot (± m·r²);
 * a restored term: a sum completed by the one term it lacks, as the same sum stands elsewhere
-  in the model (a term dropped inside det M or M⁻¹).
+  in the model (a term dropped inside det M or M⁻¹);
+* a det M completed by what it lacks of the determinant of the written M.
 
 ``candidates`` orders what passed the screen for confirmation, simplest first (``RANK``): each
 edit alone, then the same edit wherever the same expression stands in other slots (a shared
-sub-expression in code, a shorthand in a LaTeX file), then pairs of two slots' edits.
+sub-expression in code, a shorthand in a LaTeX file), then pairs of two slots' edits
+(``slot_pairs``; ``cross_pairs`` for two errors in different keys or entries).
 ``pairs_within`` tries two edits of one entry, for models of up to three degrees of freedom.
 """
 
@@ -29,6 +31,7 @@ import dataclasses
 import functools
 import itertools
 import time
+from collections.abc import Iterator
 from fractions import Fraction
 
 import numpy as np
@@ -260,20 +263,52 @@ def sum_pool(sm: SymbolicModel) -> list[frozenset]:
 
 def _restored_term_edits(slot: Slot, pool) -> list[Edit]:
     """A sum (or a lone term) completed by the one term it lacks, as the same sum stands elsewhere
-    in the model: the inverse of a term dropped inside a factor (det M, M⁻¹)."""
+    in the model: the inverse of a term dropped inside a factor (det M, M⁻¹).  A sum written inside
+    another sum is one sum to SymPy (q̈'s −(d2·θ̈2 + φ1)/d1, where φ1 stands alone in θ̈2): a sum
+    that holds all but one term of a sum written elsewhere, two at least, gets that one too."""
     out = []
     for node, path in walk(slot.expr):
         terms = frozenset(node.args) if node.is_Add else frozenset([node])
         if node.is_Number:
             continue
         for other in pool:
+            missing = other - terms
+            if len(missing) != 1:
+                continue
             if len(other) == len(terms) + 1 and terms < other:
                 new = sp.Add(*other)
-                added = next(iter(other - terms))
-                out.append(
-                    Edit("drop", node, new, replace_at(slot.expr, path, new), f"add {added} to {node}")
-                )
+            elif node.is_Add and len(other) > 2 and other - missing < terms:
+                new = sp.Add(node, *missing)
+            else:
+                continue
+            added = next(iter(missing))
+            out.append(Edit("drop", node, new, replace_at(slot.expr, path, new), f"add {added} to {node}"))
     return out
+
+
+#: det M is expanded symbolically from the written M for models of up to this many coordinates
+DETERMINANT_UP_TO_DOF = 3
+
+
+def _determinant_edits(slot: Slot, sm) -> list[Edit]:
+    """A written det M completed by what it lacks of the determinant of the written M: the
+    difference of the two, expanded and factored, added as one term when it is a part of the
+    determinant (fewer terms, expanded), or all of it where the entry is 0 (a product of sums
+    dropped from the expansion: (I2 + m2·r2²)(I1 + l1²·m2 + m1·r1²)).
+    Where the written M is right, as its own checks say, its determinant is Pinocchio's."""
+    M = sm.closed_forms.get("mass_matrix")
+    if slot.method != "det_mass_matrix" or M is None or M.shape[0] > DETERMINANT_UP_TO_DOF:
+        return []
+    determinant = sp.expand(M.det(method="berkowitz"))
+    difference = determinant - sp.expand(slot.expr)
+    whole = len(sp.Add.make_args(difference)) >= len(sp.Add.make_args(determinant))
+    if difference == 0 or (whole and slot.expr != 0):
+        return []  # not a part of det M missing (a factor on all of it is a coefficient edit)
+    term = sp.factor(sp.trigsimp(difference))
+    # the whole entry is what is edited: where M⁻¹'s entries are written over the same det M,
+    # the edit is made there too (``candidates``)
+    new = slot.expr + term
+    return [Edit("drop", slot.expr, new, new, f"add {term} (a term of det M from the written M)")]
 
 
 def _evaluated(slot: Slot, edits, sm, evaluate, deadline: float):
@@ -334,7 +369,10 @@ def screen_slot(slot: Slot, batch, sm, evaluate, monomials, pool, deadline: floa
     """The edits of one slot that make it agree at the screening states, in ``slot.matches``."""
     edits = _coefficient_edits(slot, evaluate) + _added_term_edits(slot, batch, monomials, sm.kinds)
     edits += _restored_term_edits(slot, pool) + _constant_edits(slot, monomials)
+    edits += _determinant_edits(slot, sm)
     edits += list(structural_edits(slot.expr, sm.angles, sm.symbols["v"], sm.kinds))
+    # simplest first: an added term that SymPy folds into a swapped angle is kept as the swap
+    edits.sort(key=lambda e: RANK.get(e.operator, 9))
     slot.matches += [
         e for e, _, mismatch in _evaluated(slot, edits, sm, evaluate, deadline) if mismatch <= SCREEN_RTOL
     ]
@@ -344,20 +382,18 @@ def screen_slot(slot: Slot, batch, sm, evaluate, monomials, pool, deadline: floa
 FIRST_EDITS = 15
 
 
-def _enumerated(slot: Slot, sm, pool) -> list[Edit]:
+def _enumerated(slot: Slot, sm, pool) -> Iterator[Edit]:
     """The edits of an entry that need no fit: a sign, a drop, a factor 2 or ½ on each term, the
     structural edits and the restored terms (a pair's two edits are each of these, or the
-    second a solved coefficient: never an added term, which would fit anything)."""
-    out = []
+    second a solved coefficient: never an added term, which would fit anything).  One at a
+    time, as they are evaluated: the time bound stops a long entry's (a q̈ written out) early."""
     for path, terms in sums(slot.expr):
         for i, term in enumerate(terms):
             for k in COEFFICIENTS[:4]:
                 new = sp.Rational(k.numerator, k.denominator) * term
-                out.append(
-                    Edit("scale", term, new, with_term(slot.expr, path, terms, i, new), f"{term} → {new}")
-                )
-    out += list(structural_edits(slot.expr, sm.angles, sm.symbols["v"], sm.kinds))
-    return out + _restored_term_edits(slot, pool)
+                yield Edit("scale", term, new, with_term(slot.expr, path, terms, i, new), f"{term} → {new}")
+    yield from structural_edits(slot.expr, sm.angles, sm.symbols["v"], sm.kinds)
+    yield from _restored_term_edits(slot, pool)
 
 
 def pairs_within(slot: Slot, sm, evaluate, pool, deadline: float) -> list[Edit]:
@@ -369,8 +405,10 @@ def pairs_within(slot: Slot, sm, evaluate, pool, deadline: float) -> list[Edit]:
     firsts = sorted(closer, key=lambda x: (x[0], x[1]))[:FIRST_EDITS]
     out = []
     for _, _, first, values in firsts:
+        if time.perf_counter() > deadline:
+            break
         inner = dataclasses.replace(slot, expr=first.expr, values=values, matches=[])
-        seconds = _coefficient_edits(inner, evaluate) + _enumerated(inner, sm, pool)
+        seconds = itertools.chain(_coefficient_edits(inner, evaluate), _enumerated(inner, sm, pool))
         for second, _, mismatch in _evaluated(inner, seconds, sm, evaluate, deadline):
             if mismatch <= SCREEN_RTOL and second.expr != slot.expr:
                 out.append(
@@ -415,6 +453,24 @@ def candidates(slots: list[Slot], among: list[Slot]) -> list[tuple[int, dict, Ed
             if len(shared) > 1:
                 out.append((10 + RANK.get(edit.operator, 9), shared, edit, slot))
     return sorted(out, key=lambda c: c[0])
+
+
+#: pairs of edits of two entries (in different keys, or different rows of one) confirmed at most
+MAX_CROSS_PAIRS = 60
+
+
+def cross_pairs(slots: list[Slot]) -> list[tuple[int, dict, Edit, Slot]]:
+    """One edit of each of two slots, each of which passed its own screen, for every two slots
+    that are not one Coriolis row (whose entries share one comparison): two errors in different
+    keys (one in M, one in C) or entries; simplest first, at most ``MAX_CROSS_PAIRS``."""
+    screened = [s for s in slots if s.matches]
+    out = []
+    for a, b in itertools.combinations(screened, 2):
+        same_row = a.row is not None and b.row is not None and np.array_equal(a.row[0], b.row[0])
+        if a.method == b.method and same_row:
+            continue  # one row of C·q̇ (the same residual): not two separate comparisons
+        out += slot_pairs(a, b)
+    return sorted(out, key=lambda c: c[0])[:MAX_CROSS_PAIRS]
 
 
 def slot_pairs(a: Slot, b: Slot) -> list[tuple[int, dict, Edit, Slot]]:

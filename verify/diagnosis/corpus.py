@@ -5,7 +5,9 @@ class, and the same model as LaTeX or text where there is one) and every non-zer
 its written closed forms, one error per operator (``OPERATORS``) is planted where the
 operator applies — the first place in the entry's tree where it changes the entry — with
 ``pendverify.symbolic.edited.edited_model``.  A planted model that passes every check is
-*not detected* and left out (an equivalent edit, or a gap ``pendverify mutate`` reports).
+*not detected* and left out (an equivalent edit, or a gap ``pendverify mutate`` reports); a
+model passes as ``pendverify check`` judges it, a C that is a valid C·q̇ but not the Christoffel
+C warning (``pendverify.diagnosis.acceptance``).
 For each detected one the diagnosis (``pendverify.diagnosis.explain``) is run and scored:
 
 named
@@ -19,7 +21,9 @@ restored
 seconds
     how long the diagnosis took (``explain``, after the checks, as ``check`` runs it).
 
-The untouched models must pass every check (``ModelScores.clean``), so get no diagnosis.
+The untouched models must pass every check (``ModelScores.clean``; warnings pass, as in
+``pendverify check``), so get no diagnosis.  A corpus of pairs (``pair_plants``: two errors at
+once, in different keys) is scored the same way, each of the two named and restored.
 """
 
 from __future__ import annotations
@@ -39,6 +43,8 @@ from pendverify.analytic.text_parse import CONSTANTS, FUNCTIONS
 from pendverify.checks.batch import CheckBatch
 from pendverify.checks.catalogue import applicable_checks, run_checks
 from pendverify.checks.sampling import sample_states
+from pendverify.diagnosis.acceptance import passes
+from pendverify.diagnosis.derived import derived_methods
 from pendverify.diagnosis.explain import explain
 from pendverify.diagnosis.slots import QUANTITY
 from pendverify.symbolic.edited import edited_model
@@ -111,10 +117,14 @@ def entry_plants(method: str, index: int, expr, sm: SymbolicModel, kinds: dict) 
 
 
 def plants(sm: SymbolicModel) -> list[Plant]:
-    """Every planted error of the corpus for one model."""
+    """Every planted error of the corpus for one model, in the keys it writes (not in one it derives
+    from another, ``pendverify.diagnosis.derived``: a user cannot type an error there)."""
     kinds = sm.kinds
+    derived = derived_methods(sm.cls)
     out = []
     for method, value in sm.closed_forms.items():
+        if method in derived:
+            continue
         for index, expr in enumerate(entries(value)):
             if expr != 0:
                 out += entry_plants(method, index, expr, sm, kinds)
@@ -126,6 +136,8 @@ class Score:
     """What the diagnosis did with one planted error."""
 
     plant: Plant
+    #: the other errors planted with it (a pair: ``pair_plants``)
+    also: tuple = ()
     detected: bool = False
     named: bool = False
     repaired: bool = False
@@ -187,12 +199,15 @@ def score_model(
     out = ModelScores(label)
     batch = CheckBatch(model, system, states)
     results = run_checks(label, model, system, states, CORPUS_SEED, applicable_checks(model, system), batch)
-    out.clean = all(r.passed for r in results)
-    for plant in plants(sm) if chosen is None else chosen:
-        score = Score(plant)
-        planted = edited_model(
-            model, sm, {plant.method: [(plant.index, plant.original, plant.new)]}, "Planted"
-        )
+    out.clean = passes(results)
+    for item in plants(sm) if chosen is None else chosen:
+        group = item if isinstance(item, tuple) else (item,)  # a pair: two errors at once
+        plant = group[0]
+        score = Score(plant, also=group[1:])
+        edits: dict[str, list] = {}
+        for p in group:
+            edits.setdefault(p.method, []).append((p.index, p.original, p.new))
+        planted = edited_model(model, sm, edits, "Planted")
         with np.errstate(all="ignore"):
             batch = CheckBatch(planted, system, states)
             try:
@@ -201,14 +216,14 @@ def score_model(
                 )
             except (ArithmeticError, ValueError, np.linalg.LinAlgError):
                 results = None
-        if results is not None and not all(r.passed for r in results):
+        if results is not None and not passes(results):
             score.detected = True
             start = time.perf_counter()  # the diagnosis alone, as check runs it after the checks
             findings = explain(batch, results, deadline_s)
             score.seconds = time.perf_counter() - start
-            score.named = _named(plant, findings, forms)
+            score.named = all(_named(p, findings, forms) for p in group)
             score.repaired = any(f.kind == "repair" and f.details.get("checks_pass") for f in findings)
-            score.restored = _restored(findings, plant, sm)
+            score.restored = all(_restored(findings, p, sm) for p in group)
             score.message = next((f.message for f in findings if f.kind == "repair"), "")
         out.scores.append(score)
         if progress is not None:
@@ -227,3 +242,20 @@ def sample_plants(sm: SymbolicModel, per_operator: int, seed: int = CORPUS_SEED)
         group = by_operator.get(operator, [])
         chosen += rng.sample(group, min(per_operator, len(group)))
     return chosen
+
+
+#: the keys a pair of planted errors is drawn from, one error in each of two of them
+PAIR_KEYS = ("mass_matrix", "coriolis_matrix", "coriolis_force", "gravity")
+
+
+def pair_plants(sm: SymbolicModel, count: int, seed: int = CORPUS_SEED) -> list[tuple[Plant, Plant]]:
+    """``count`` pairs of planted errors in two different keys of ``PAIR_KEYS`` (one in M and one
+    in C, ...), drawn with ``seed`` from every such pair of the corpus's single plants."""
+    by_key: dict[str, list[Plant]] = {}
+    for plant in plants(sm):
+        if plant.method in PAIR_KEYS:
+            by_key.setdefault(plant.method, []).append(plant)
+    pairs = [
+        (a, b) for k1, k2 in itertools.combinations(sorted(by_key), 2) for a in by_key[k1] for b in by_key[k2]
+    ]
+    return random.Random(seed).sample(pairs, min(count, len(pairs)))

@@ -52,7 +52,7 @@ def diagnose(model, system, results, unsearched: list | None = None) -> list[Fin
     """One finding per known trap that explains the failing checks; its message says how well it fits.
     What a bounded search left out is added to ``unsearched``, in words."""
     failing = {r.check for r in results if not r.passed}
-    if not failing:
+    if not failing or not model.has_mass_matrix:  # every trap compares M or H: q̈ alone gives neither
         return []
     # a convention or inertia trap changes M or H by O(1): never blame one for a rounding-size failure
     hypotheses = HYPOTHESES if _largest_failure(results) >= TRAP_MIN_ERROR else (missing_damping,)

@@ -218,13 +218,16 @@ def identify_parameters(batch, unsearched: list | None = None) -> list[Finding]:
 
     [] when the URDF's own parameters reproduce them; one ``structural`` finding when no
     parameters do; otherwise one ``parameters`` finding per changed parameter of the
-    sparsest explanation (module docstring), or one listing the combinations that differ.
+    sparsest explanation (module docstring), or one listing the combinations that differ; [] for
+    a model that gives q̈ alone (no M, C·q̇, H to compare).
 
     Bounded by its work, counted before it starts: a fit of P parameters to R rows costs R·P²
     (its QR); beyond ``MAX_FIT_WORK`` nothing is fitted.  Pairs of hypotheses are tried only while
     the groups tried (singles and pairs) stay within ``MAX_GROUPS``.  What is left out is added to
     ``unsearched``, in words.
     """
+    if not batch.model.has_mass_matrix:
+        return []
     rows, parameters = _fit_work(batch)
     if rows * parameters**2 > MAX_FIT_WORK:
         if unsearched is not None:

@@ -85,14 +85,61 @@ def compiled(symbols: tuple, expr):
     return sp.lambdify(symbols, expr, modules="numpy", docstring_limit=0)
 
 
+_FUNCTIONS = {sp.sin: np.sin, sp.cos: np.cos, sp.tan: np.tan, sp.exp: np.exp, sp.Abs: np.abs}
+
+
+class _NodeValues:
+    """An expression's values at the screening states, computed node by node with each node's
+    values kept: the edits a repair tries change one node of an entry, so an edited entry costs
+    the nodes on the path from that node to the root, where compiling it again (``compiled``)
+    costs the printing of the whole entry — tens of milliseconds for a q̈ written out in full,
+    for each of hundreds of edits.  Sums and products are taken in the order of the node's
+    arguments; the values differ from the compiled function's by rounding only."""
+
+    def __init__(self, values: dict, n: int):
+        self.values = dict(values)  # symbol → its values at the states
+        self.n = n
+
+    def __call__(self, node) -> np.ndarray:
+        found = self.values.get(node)
+        if found is not None:
+            return found
+        if not node.free_symbols:  # a number; one that is not real (zoo from an edit's 1/0) is nan
+            try:
+                value = np.full(self.n, float(node))
+            except TypeError:
+                value = np.full(self.n, np.nan)
+        elif node.is_Add:
+            value = functools.reduce(np.add, map(self, node.args))
+        elif node.is_Mul:
+            value = functools.reduce(np.multiply, map(self, node.args))
+        elif node.is_Pow:
+            value = np.power(self(node.base), self(node.exp))
+        elif node.func in _FUNCTIONS:
+            value = _FUNCTIONS[node.func](self(node.args[0]))
+        else:  # anything else as SymPy prints it
+            symbols = tuple(sorted(node.free_symbols, key=str))
+            value = compiled(symbols, node)(*(self(s) for s in symbols))
+        value = np.broadcast_to(np.asarray(value, dtype=float), (self.n,))
+        self.values[node] = value
+        return value
+
+
 def evaluator(sm: SymbolicModel, arrays: dict, params: list):
-    """f(expr, args) → the expression's values at the screening states (vectorised)."""
+    """f(expr, args) → the expression's values at the screening states (vectorised, node by node:
+    ``_NodeValues``)."""
     n = len(arrays["q"])
+    nodes: dict[str, _NodeValues] = {}
 
     def evaluate(expr, args: str) -> np.ndarray:
         symbols = tuple(sm.flat_arguments(args) + list(sm.parameters.values()))
         columns = [arrays[a][:, k] for a in args for k in range(arrays[a].shape[1])]
         with np.errstate(all="ignore"):
+            if expr.free_symbols <= set(symbols):
+                if args not in nodes:
+                    values = [*columns, *(np.full(n, float(p)) for p in params)]
+                    nodes[args] = _NodeValues(dict(zip(symbols, values, strict=True)), n)
+                return nodes[args](expr)
             value = compiled(symbols, expr)(*columns, *params)
         return np.broadcast_to(np.asarray(value, dtype=float), (n,))
 

@@ -134,6 +134,21 @@ def parameter_edits(expr, kinds: dict) -> Iterator[Edit]:
                 yield Edit("parameter", node, new, replace_at(expr, path, new), f"{node} → {new}")
 
 
+def folded_parameter_edits(expr, kinds: dict) -> Iterator[Edit]:
+    """The inverse of a parameter edit that SymPy folded: p' → p in p' + p' + … is written k·p', so
+    one of the k becomes another parameter of its kind (k·p' → (k − 1)·p' + p)."""
+    for node, path in walk(expr):
+        if not (node.is_Mul and len(node.args) == 2 and node.args[0].is_Integer and node.args[1] in kinds):
+            continue
+        k, p = node.args
+        if k < 2:
+            continue
+        for other in sorted(kinds, key=str):
+            if other != p and kinds[other] == kinds[p]:
+                new = (k - 1) * p + other
+                yield Edit("parameter", node, new, replace_at(expr, path, new), f"{node} → {new}")
+
+
 def structural_edits(expr, angles, rates, kinds: dict) -> Iterator[Edit]:
     """The enumerated edits a repair tries (module docstring): all but the solved-for ones."""
     for edit in term_edits(expr, rates):
@@ -141,3 +156,4 @@ def structural_edits(expr, angles, rates, kinds: dict) -> Iterator[Edit]:
             yield edit
     yield from trig_edits(expr, angles, offsets=True)
     yield from parameter_edits(expr, kinds)
+    yield from folded_parameter_edits(expr, kinds)

@@ -15,7 +15,9 @@ coordinates θ may differ from φ by a trap of each kind at once,
 * s_i ∈ {+π/2, +π, −π/2} on angle i (``SHIFTS``): its zero from the vertical instead of
   the horizontal or the reverse (±π/2), from hanging instead of upright (π);
 * the offsets θ0 written in degrees: θ0v is θ0 with all its non-zero angle entries, or
-  one of them among radians, read as degrees (×π/180).
+  one of them among radians, read as degrees (×π/180);
+* alone, P a permutation of coordinates of the same kinds: the hand lists the joints in another
+  order (``_orders``, up to ``ORDER_UP_TO_DOF`` coordinates), T' = T·P, θ0' = P⁻¹θ0.
 
 The map the traps lead to is
 
@@ -54,6 +56,7 @@ ABSOLUTE_RELATIVE = "absolute vs relative angles"
 DEGREES = "degrees vs radians"
 QUARTER = "vertical vs horizontal zero"
 HALF = "upright vs hanging zero"
+ORDER = "joint order"
 PIVOT = "pivot inertia"
 
 #: the zero shift s of k quarter turns, k = 0..3 (the map's θ0 moves by s)
@@ -88,11 +91,14 @@ class Candidate:
     shifts: tuple[int, ...] = ()
     T: np.ndarray = field(default=None, compare=False, repr=False)
     theta0: np.ndarray = field(default=None, compare=False, repr=False)
+    #: the hand's coordinates in the map's order: the map's coordinate i is the hand's
+    #: ``order[i]`` (() for the declared order)
+    order: tuple[int, ...] = ()
 
     @property
     def traps(self) -> tuple[str, ...]:
         """The short names of its traps (without the pivot inertia, which the screen fits)."""
-        out = []
+        out = [ORDER] if self.order else []
         if self.flips:
             out.append(SIGN)
         if self.relative:
@@ -109,7 +115,8 @@ class Candidate:
     def touched(self) -> int:
         shifted = sum(1 for k in self.shifts if k)
         degrees = len(self.offsets_in_degrees) + int(self.angles_in_degrees)
-        return len(self.flips) + int(self.relative != 0) + shifted + degrees
+        moved = sum(1 for i, j in enumerate(self.order) if i != j)
+        return len(self.flips) + int(self.relative != 0) + shifted + degrees + moved
 
     @property
     def factors(self) -> str:
@@ -117,6 +124,7 @@ class Candidate:
         R = {1: "A", -1: "A⁻¹", 0: ""}[self.relative]
         S = "S" if self.flips else ""
         parts = ["D" if self.angles_in_degrees else "", *((R, S) if self.flip_first else (S, R))]
+        parts += ["P"] if self.order else []
         return "·".join(p for p in parts if p)
 
 
@@ -220,6 +228,26 @@ def _offset_readings(model, theta0) -> list[tuple[int, ...]]:
     return out
 
 
+#: joints listed in another order are searched for models of up to this many coordinates (n! − 1 maps)
+ORDER_UP_TO_DOF = 4
+
+
+def _orders(model, T, theta0) -> list[Candidate]:
+    """The declared map with the hand's coordinates in another order, of the same kinds (an angle
+    for an angle): joints listed in the wrong order, M[1,1] and M[2,2] trading values.  With the
+    map's coordinate i the hand's ``order[i]``, φ = P θ and T' = T·P, θ0' = P⁻¹ θ0."""
+    n = model.nv
+    if n > ORDER_UP_TO_DOF:
+        return []
+    out = []
+    for order in itertools.permutations(range(n)):
+        if order == tuple(range(n)) or any(model.angular[i] != model.angular[j] for i, j in enumerate(order)):
+            continue
+        P = np.eye(n)[list(order)]
+        out.append(Candidate(shifts=(0,) * n, T=T @ P, theta0=P.T @ theta0, order=order))
+    return out
+
+
 def _key(c: Candidate, revolute: np.ndarray) -> bytes:
     """What makes two candidates one map: T' and the joint offsets, as (cos, sin) on revolute joints."""
     offset = c.T @ c.theta0
@@ -260,6 +288,7 @@ def candidates(model, T, theta0, revolute) -> list[Candidate]:
                             th0,
                         )
                     )
+    found += _orders(model, T, theta0)
     found.sort(key=lambda c: (len(c.traps), c.touched))  # stable: the enumeration order breaks ties
     seen, out = set(), []
     revolute = np.asarray(revolute, dtype=bool)

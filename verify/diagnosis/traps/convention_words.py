@@ -12,11 +12,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from pendverify.analytic.source_file import where
 from pendverify.diagnosis.traps.convention_maps import (
     ABSOLUTE_RELATIVE,
     DEG,
     DEGREES,
     HALF,
+    ORDER,
     PIVOT,
     QUARTER,
     SIGN,
@@ -100,6 +102,53 @@ def _sign_clause(model, c: Candidate) -> str:
     return f"{SIGN}: {_names(model, c.flips)} {verb} the other way round{where}"
 
 
+def _order_clause(model, c: Candidate) -> str:
+    joints = model.urdf_joints or [f"joint {i + 1}" for i in range(model.nv)]
+    moved = sorted((k, i) for i, k in enumerate(c.order) if i != k)
+    pairs = ", ".join(f"{model.coordinates[k]} is {joints[i]}'s coordinate" for k, i in moved)
+    return f"{ORDER}: the hand model's coordinates are the joints in another order than the map's ({pairs})"
+
+
+#: a coordinate-map key of a model file, by the form the model is written in: the key of a text or
+#: LaTeX file's [urdf] table, of a declaration's "urdf" dict, the class attribute of a Python class
+_MAP_KEYS = {
+    "joints": ("joints", "urdf_joints"),
+    "transform": ("transform", "joint_transform"),
+    "offset": ("offset", "joint_offset"),
+}
+
+
+def _number(x: float):
+    """An entry of a map as a file would hold it: an integer where it is one."""
+    x = float(x)
+    return round(x) if abs(x - round(x)) <= 1e-12 else float(f"{x:.12g}")
+
+
+def declared_as(model, c: Candidate, theta0) -> str:
+    """Where and how the model file declares the map ``c`` leads to: the keys the user edits
+    (``joints`` reordered for joints listed in another order under an identity map, else
+    ``transform`` and, where it changes, ``offset``), in the model's own form."""
+    cls = type(model)
+    spec = getattr(cls, "text_spec", None)
+    declared = np.eye(model.nv) if model.joint_transform is None else model.joint_transform
+    identity = np.array_equal(np.asarray(declared, float), np.eye(model.nv))
+    values = {}
+    if c.order and identity and not np.any(theta0) and model.urdf_joints:
+        values["joints"] = [model.urdf_joints[c.order.index(k)] for k in range(model.nv)]
+    else:
+        values["transform"] = [[_number(x) for x in row] for row in c.T]
+        if not np.allclose(c.theta0, theta0, rtol=0, atol=1e-12):
+            values["offset"] = [_number(x) for x in c.theta0]
+    if spec is None:
+        keys = [f"{cls.__name__}.{_MAP_KEYS[k][1]} = {v}" for k, v in values.items()]
+        return f"declare it as {' and '.join(keys)} in {where(cls)}"
+    if str(spec.path).endswith(".toml"):
+        keys = [f"{k} = {v}" for k, v in values.items()]
+        return f"declare it as {' and '.join(keys)} under [urdf] in {spec.path}"
+    keys = [f'DECLARATION["urdf"]["{k}"] = {v}' for k, v in values.items()]
+    return f"declare it as {' and '.join(keys)} in {spec.path}"
+
+
 def pivot_clause(links: dict[str, int], mr2: dict[str, float]) -> str:
     """The pivot fit's clause: which links' inertias are about the pivot, or counted twice; each with the
     other side M cannot tell from it (``pendverify.diagnosis.traps.inertia``, "Which side is wrong")."""
@@ -155,6 +204,8 @@ def single(model, c: Candidate, theta0) -> str:
             )
     elif trap == SIGN:
         sentence = f"{_sign_clause(model, c)}; with T → T·S = {c.T.tolist()}, {PASSES}"
+    elif trap == ORDER:
+        sentence = f"{_order_clause(model, c)}; with the joints in that order {PASSES}"
     else:  # a zero shift
         phrase = _shift_phrase(model, c.shifts)
         sentence = f"{_zero_clause(model, c, trap == HALF)}; with θ0 shifted by {phrase} {PASSES}"
@@ -170,7 +221,9 @@ def clauses(model, c: Candidate, theta0, links: dict[str, int], mr2: dict[str, f
     """One clause per trap of ``c`` (and the pivot fit's ``links``), in the order of ``c.traps``."""
     clauses = []
     for trap in c.traps:
-        if trap == SIGN:
+        if trap == ORDER:
+            clauses.append(_order_clause(model, c))
+        elif trap == SIGN:
             clauses.append(_sign_clause(model, c))
         elif trap == ABSOLUTE_RELATIVE:
             clauses.append(_relative_clause(c))

@@ -33,7 +33,9 @@ confirmation decides.  A failure that neither ``crba`` nor ``gravity`` shows is 
 convention trap: every one of them changes M or H.
 
 The diagnosis is a ``Finding`` of kind ``convention`` about the whole model (quantity
-None), its message the sentence of ``convention_words``; ``details`` holds ``traps`` (the
+None), its message the sentence of ``convention_words`` — when the map alone makes every check
+pass, with the keys of the model file that declare it (``joints``, ``transform``, ``offset``:
+``convention_words.declared_as``); ``details`` holds ``traps`` (the
 short names, ``convention_maps``), ``residual``, the map it names (``T``, ``theta0``), the
 pivot fit (``links``: link → c_b, +1 the URDF's inertia about the pivot, −1 the hand's
 counted twice) and the ``alternatives`` confirmed with it (each with the same fields).
@@ -103,6 +105,8 @@ def _sentence(model, system, c: Candidate, links, residual, passes, alternatives
     else:
         sentence = words.joint(model, c, theta0, links, mr2)
     sentence = words.with_fit(sentence, residual, passes)
+    if passes and not links:  # the map alone: what to write in the model file
+        sentence += f"; {words.declared_as(model, c, theta0)}"
     if alternatives:
         sentence += words.alternatives(model, alternatives, theta0, mr2)
     return sentence
