@@ -101,12 +101,12 @@ def _results(model, system):
         (
             '["m2*l1*lc2*sin(q2)*dq1", "0"]',
             '["-m2*l1*lc2*sin(q2)*dq1", "0"]',
-            "C[2,1]: -dq1*l1*lc2*m2*sin(q2) → ",
+            "C[2,1]: -m2*l1*lc2*sin(q2)*dq1 → m2*l1*lc2*sin(q2)*dq1",
         ),
         (
             '"m2*g*lc2*sin(q1 + q2)"',
             '"m2*g*lc2*cos(q1 + q2)"',
-            "H[2]: g*lc2*m2*cos(q1 + q2) → g*lc2*m2*sin(q1 + q2)",
+            "H[2]: m2*g*lc2*cos(q1 + q2) → m2*g*lc2*sin(q1 + q2)",
         ),
     ],
 )
@@ -272,7 +272,7 @@ def test_one_error_in_m_and_one_in_c_are_repaired_together(tmp_path, capsys, sou
     planted.write_text(text.replace(M22, M22_WRONG).replace(C21, C21_WRONG))
     _, found = _repairs(tmp_path, capsys, planted, *args)
     assert sorted(f["message"].split(" makes")[0] for f in found) == [
-        "C[2,1]: -dq1*l1*lc2*m2*sin(q2) → dq1*l1*lc2*m2*sin(q2)",
+        "C[2,1]: -m2*l1*lc2*sin(q2)*dq1 → m2*l1*lc2*sin(q2)*dq1",
         "M[2,2]: 2*I2 → I2",
     ]
     assert all(("warns" in f) is warns for f in found)
@@ -356,16 +356,16 @@ H_BLOCK = """H = [
             H_BLOCK,
             "l1*cos(q1) + lc2*cos(q1 + q2)",
             "l1*cos(q1) + lc1*cos(q1 + q2)",
-            "V: -g*lc1*m1*cos(q1) - g*m2*(l1*cos(q1) + lc1*cos(q1 + q2)) → "
-            "-g*lc1*m1*cos(q1) - g*m2*(l1*cos(q1) + lc2*cos(q1 + q2))",
+            "V: -m1*g*lc1*cos(q1) - m2*g*(l1*cos(q1) + lc1*cos(q1 + q2)) → "
+            "-m1*g*lc1*cos(q1) - m2*g*(l1*cos(q1) + lc2*cos(q1 + q2))",
         ),
         # H written, V integrated from H: m2 typed for m1 in H[1] (still a gradient)
         (
             V_LINE,
             '"m1*g*lc1*sin(q1) + m2*g*',
             '"m2*g*lc1*sin(q1) + m2*g*',
-            "H[1]: g*lc1*m2*sin(q1) + g*m2*(l1*sin(q1) + lc2*sin(q1 + q2)) → "
-            "g*lc1*m1*sin(q1) + g*m2*(l1*sin(q1) + lc2*sin(q1 + q2))",
+            "H[1]: m2*g*lc1*sin(q1) + m2*g*(l1*sin(q1) + lc2*sin(q1 + q2)) → "
+            "m1*g*lc1*sin(q1) + m2*g*(l1*sin(q1) + lc2*sin(q1 + q2))",
         ),
     ],
 )

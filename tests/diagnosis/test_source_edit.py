@@ -48,3 +48,19 @@ def test_an_entry_whose_text_is_not_in_the_file_is_printed_whole():
         "-m_p g r\\sin\\theta",
         "m_p g r\\sin\\theta",
     )
+
+
+def test_a_word_typed_for_another_is_replaced_in_the_users_own_text():
+    """``\\sin`` written for ``\\cos`` (or one parameter for another) is one word of the user's text
+    replaced, the rest kept as written; a change no single word makes is not shown as one."""
+    cls = api.load_model(EXAMPLES / "cart_pole_latex.toml")
+    notation = Notation.of(cls)
+    mp, g, r, theta = (next(s for s in notation.names if s.name == n) for n in ("mp", "g", "r", "theta"))
+    written = -mp * g * r * sp.sin(theta)
+    assert notation.entry_edit("gravity", 1, written, -mp * g * r * sp.cos(theta)) == (
+        "-m_p g r\\sin\\theta",
+        "-m_p g r\\cos\\theta",
+    )
+    # twice the term is no word of the text: the term rewritten, never a word that reads otherwise
+    old, new = notation.entry_edit("gravity", 1, written, 2 * written)
+    assert old == "-m_p g r\\sin\\theta" and new != old and "\\cos" not in new

@@ -11,7 +11,8 @@ with only the changed term rewritten:
 2. **The terms**: the text split at its ``+`` and ``−`` outside every bracket, each term read
    alone by the same reader.
 3. **The edit**, Δ = new − old, the first that fits of: a term's sign flipped (Δ = −2·t), a term
-   dropped (Δ = −t); else the cheaper (fewer SymPy operations printed) of one term rewritten,
+   dropped (Δ = −t), one word of a term replaced by another (``lc1`` by ``lc2``, ``\\cos`` by
+   ``\\sin``: ``one_word``); else the cheaper (fewer SymPy operations printed) of one term rewritten,
    t → t + Δ (the term it makes simplest), and Δ appended as a term.  A rewritten or appended
    term is printed by the notation's printer (``Notation.render``), and in LaTeX SymPy's
    ``\\sin{\\left(\\theta \\right)}`` is written ``\\sin\\theta`` (``\\sin(\\theta_1 + \\theta_2)``
@@ -261,6 +262,9 @@ def minimal_edit(source: SourceText, text: str, old, new, render) -> str | None:
             return _confirmed(source, replaced(k, flipped), new)
         if source.same(delta + values[k], 0):  # the term dropped
             return _confirmed(source, replaced(k, None), new)
+    swapped = one_word(source, text, spans, values, delta, new)
+    if swapped is not None:
+        return swapped
     options = []
     for k in range(len(spans)):
         rewritten = sp.factor_terms(sp.expand(values[k] + delta))
@@ -269,6 +273,38 @@ def minimal_edit(source: SourceText, text: str, old, new, render) -> str | None:
     if sp.count_ops(delta) + 1 < ops:
         return _confirmed(source, f"{text.rstrip()} {piece(delta, False)}", new)
     return _confirmed(source, replaced(k, piece(rewritten, k == 0)), new)
+
+
+#: a word of a model's text: a name (``lc2``, ``theta_1``, ``m_{2}``) or a LaTeX command (``\\sin``)
+_WORD = re.compile(r"\\?[A-Za-z][A-Za-z0-9]*(?:_(?:\{[^{}]*\}|[A-Za-z0-9]+))?")
+#: words tried in place of another, besides the entry's own and the names of the edit's symbols
+_FUNCTION_WORDS = {False: ("sin", "cos"), True: ("\\sin", "\\cos")}
+#: the readings one search for a word may take (a term of 10 words, 20 words to try in each)
+MAX_WORD_READS = 400
+
+
+def one_word(source: SourceText, text: str, spans, values, delta, new) -> str | None:
+    """``text`` with one word of one term replaced by another word, when that term then reads as
+    itself + Δ (a parameter typed for another, ``sin`` for ``cos``), confirmed by reading the whole
+    text; None when no single word does it within ``MAX_WORD_READS`` readings."""
+    words = {m.group() for m in _WORD.finditer(text)} | set(_FUNCTION_WORDS[source.latex])
+    if not source.latex:
+        words |= {x.name for x in sp.sympify(new).free_symbols}
+    reads = 0
+    for k, (_, a, b) in enumerate(spans):
+        wanted = values[k] + delta
+        for found in _WORD.finditer(text, a, b):
+            for word in sorted(words - {found.group()}):
+                if reads >= MAX_WORD_READS:
+                    return None
+                term = text[a : found.start()] + word + text[found.end() : b]
+                reads += 1
+                value = source.read(term)
+                if value is None or not source.same(_signed(text, spans[k][0]) * value, wanted):
+                    continue
+                edited = text[: found.start()] + word + text[found.end() :]
+                return _confirmed(source, edited, new)
+    return None
 
 
 def _confirmed(source: SourceText, edited: str, new) -> str | None:
