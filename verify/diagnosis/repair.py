@@ -5,16 +5,31 @@
 2. **What**: per slot, the edits that make it agree at the screening states
    (``pendverify.diagnosis.candidates``: the inverses of ``pendverify mutate``'s operators,
    coefficients and added terms solved for), ordered simplest first.
-3. **Confirmed**: a candidate becomes a repair only when the edited model
+3. **Checked**: a candidate becomes a repair only when the edited model
    (``pendverify.symbolic.edited``) passes every applicable check on every state of the
-   report's batch; candidates are confirmed simplest first, at most ``CONFIRMATIONS`` of
-   them, within the time bound.  Once one is confirmed, the next simple edits (of
-   this entry or another, ``ALTERNATIVE_TRIES`` of them) are confirmed too and the ones that
-   pass are shown as alternatives (up to ``ALTERNATIVES``): with the given parameter values two
-   edits can give the same numbers (m = 2·m2 makes m2 → m the same as a factor 2), and an error
-   in B shows as well in a hand-written q̈ that uses it; the checks cannot tell which one the
-   derivation meant.  When no single edit
-   passes, pairs of edits of one entry are tried for models of up to three degrees of freedom.
+   report's batch, and then again at each perturbed parameter set
+   (``pendverify.diagnosis.perturbed``: the parameters moved, the robot description rewritten
+   for each) on the first ``PERTURBED_STATES`` of those states.  One that fails at a perturbed
+   set is a coincidence of the parameter values (``I → 4*I`` where I = m·l²/12 and lc = l/2):
+   it is not a repair, and the search goes on; the sentence that says no repair was found names
+   it.  Candidates are checked simplest first, at most ``CONFIRMATIONS`` of them, within the
+   time bound.  Once one holds, the next simple edits (of this entry or another,
+   ``ALTERNATIVE_TRIES`` of them; any edit, fitted terms too, when the first one involves a
+   parameter that was not moved on its own) are checked too, and the ones that hold are shown
+   as alternatives (up to ``ALTERNATIVES``).
+4. **Confirmed**: the repair is *confirmed* (``details["confirmed"]``) when it held at every
+   perturbed set, every parameter of the edit was moved on its own there, and no other edit
+   held: it is then the same function of the parameters as what the robot says, not only the
+   same numbers.  Otherwise it holds at these values only, and the message says why: a
+   parameter of the edit could not be moved in the description (its reason), or was moved
+   only together with others that share its value (m1 = m2: an edit and the same edit with m1
+   and m2 exchanged cannot be told apart), or another edit holds as well (an error in B shows
+   as well in a hand-written q̈ that uses it).  Each alternative is named with the relation
+   under which the two agree, solved for one parameter (``I → 4*I`` and ``I → I + mp*r**2``
+   differ unless I = mp*r**2/3).
+
+When no single edit passes, pairs of edits of one entry are tried for models of up to three
+degrees of freedom.
 
 The repair is printed in the model's own notation, where it sits
 (``pendverify.diagnosis.notation``).
@@ -22,6 +37,7 @@ The repair is printed in the model's own notation, where it sits
 
 from __future__ import annotations
 
+import functools
 import time
 
 import numpy as np
@@ -29,6 +45,7 @@ import sympy as sp
 
 from pendverify.analytic.forms import entry_position
 from pendverify.analytic.symbolic_reading import SymbolicModel
+from pendverify.checks.batch import CheckBatch
 from pendverify.checks.catalogue import applicable_checks, run_checks
 from pendverify.diagnosis.candidates import (
     RANK,
@@ -41,9 +58,11 @@ from pendverify.diagnosis.candidates import (
 )
 from pendverify.diagnosis.finding import Finding
 from pendverify.diagnosis.notation import Notation
+from pendverify.diagnosis.perturbed import perturbations
 from pendverify.diagnosis.slots import QUANTITY, SCREEN_STATES, Slot, entry_label, evaluator, find_slots
 from pendverify.symbolic.edited import edited_model
 from pendverify.symbolic.edits import Edit
+from pendverify.symbolic.zero_test import trig_normal_form
 
 CONFIRMATIONS = 12
 #: pairs of edits of one entry are tried for models of up to this many degrees of freedom
@@ -56,21 +75,44 @@ ALTERNATIVES = 2
 ALTERNATIVE_TRIES = 4
 #: how long the search for alternatives goes on after the first repair
 ALTERNATIVE_SECONDS = 2.0
+#: states a candidate is checked on at each perturbed set: the screening states.  The candidate
+#: already matched Pinocchio on every state at the file's values, so it is the right function of
+#: the state there; what a perturbed set tests is the parameters, and a wrong edit's difference
+#: (a trigonometric polynomial of a few terms in the state, not zero as a function at the moved
+#: parameters) is non-zero at almost every state: 24 states, the special ones first, find it.
+PERTURBED_STATES = SCREEN_STATES
 
 
-def _confirmed(batch, sm, changes: dict) -> bool:
-    """Whether the model with ``changes`` passes every applicable check on every state of ``batch``."""
+def _passes(model, system, states) -> bool:
+    """Whether ``model`` passes every applicable check on every state of ``states`` against ``system``."""
+    names = applicable_checks(model, system)
+    with np.errstate(all="ignore"):
+        try:
+            results = run_checks("repair", model, system, states, 0, names)
+        except (ArithmeticError, ValueError, np.linalg.LinAlgError):
+            return False
+    return all(r.passed for r in results)
+
+
+def _confirmed(batch, sm, changes: dict, moved_sets=None) -> str:
+    """Whether the model with ``changes`` passes every applicable check: "fails" (on some state of
+    ``batch``), "coincidence" (on every state, but not at one of ``moved_sets``, a callable giving
+    the perturbed sets, on the first ``PERTURBED_STATES``), or "holds" (module docstring)."""
     edits: dict[str, list] = {}
     for (method, index), (old, new) in changes.items():
         edits.setdefault(method, []).append((index, old, new))
     repaired = edited_model(batch.model, sm, edits, "Repaired")
-    names = applicable_checks(repaired, batch.system)
-    with np.errstate(all="ignore"):
-        try:
-            results = run_checks("repair", repaired, batch.system, batch.states, 0, names)
-        except (ArithmeticError, ValueError, np.linalg.LinAlgError):
-            return False
-    return all(r.passed for r in results)
+    if not _passes(repaired, batch.system, batch.states):
+        return "fails"
+    states = batch.states[:PERTURBED_STATES]
+    derived = bool({"gravity_scale", "diagonal_scale"} - set(type(batch.model).hand_written()))
+    for moved in moved_sets() if moved_sets is not None else ():
+        model = type(repaired)(moved.params)  # the same edited class: its generated code is reused
+        if derived:  # the tolerance scales of the model as given, at these values (``edited_model``)
+            model.use_derived_scales(moved.model.derived_scales())
+        if not _passes(model, moved.system, states):
+            return "coincidence"
+    return "holds"
 
 
 def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
@@ -119,10 +161,7 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
         )
     notation = Notation.of(type(batch.model))
     if confirm.found:
-        findings = _findings(*confirm.found[0], forms, notation)
-        for changes, edit, slot in confirm.found[1:]:
-            findings += _findings(changes, edit, slot, forms, notation, alternative=True)
-        return findings, ""
+        return confirm.findings(forms, notation), ""
     where = ", ".join(s.label for s in slots[:6]) + (f" and {len(slots) - 6} more" if len(slots) > 6 else "")
     bound = (
         f" (the search stopped at its time bound: searched {len(screened)} of {len(slots)} entries)"
@@ -133,19 +172,47 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
     return [], (
         f"no repair: no single edit of {where} (nor one edit of each, for two entries,{also}) makes every "
         f"check pass; {confirm.tried} candidate(s) tried against every check{bound}"
+        f"{confirm.coincidence_note(forms, notation)}"
     )
 
 
 class _Confirmation:
     """The candidates every check confirms, in the order they come: the first, then alternatives
-    (module docstring); how many were tried; when the search for alternatives ends."""
+    (module docstring); the coincidences (every check passes at the file's values, not at a
+    perturbed set); how many were tried; when the search for alternatives ends."""
 
     def __init__(self, batch, sm, deadline: float):
         self.batch, self.sm, self.deadline = batch, sm, deadline
         self.found: list = []
+        self.coincidences: list = []
         self.tried, self.tried_at_first, self.longest = 0, 0, 0.0
         self.seen: set = set()
         self.alternatives_until = float("inf")
+        self._perturbation = None
+
+    @property
+    def perturbation(self):
+        """The perturbed sets (``pendverify.diagnosis.perturbed``), made when first needed: at the
+        first candidate that passes at the file's values."""
+        if self._perturbation is None:
+            states = self.batch.states[:PERTURBED_STATES]
+            screening = self.batch.subset(range(len(states)))
+            differing = {(s.method, s.index) for s in find_slots(screening, self.sm)}
+
+            def consistent(model, system) -> bool:  # no entry that agrees here disagrees there
+                with np.errstate(all="ignore"):
+                    try:
+                        slots = find_slots(CheckBatch(model, system, states), self.sm)
+                    except (ArithmeticError, ValueError, np.linalg.LinAlgError):
+                        return False
+                return {(s.method, s.index) for s in slots} <= differing
+
+            self._perturbation = perturbations(self.batch.model, self.batch.system, consistent)
+        return self._perturbation
+
+    def _limits(self, changes) -> list[str]:
+        """Why an edit is not confirmed even when it holds: its parameters not moved on their own."""
+        return self.perturbation.why_not_alone(_edit_parameters(changes, self.sm))
 
     def run(self, ordered) -> None:
         for rank, changes, edit, slot in ordered:
@@ -153,8 +220,11 @@ class _Confirmation:
             late = time.perf_counter() + self.longest > min(self.deadline, self.alternatives_until)
             if late or self.tried >= CONFIRMATIONS or len(self.found) > ALTERNATIVES:
                 return
-            if self.found and (rank > RANK["scale"] and rank != RANK["pair"]):
-                return  # an alternative is a simple edit, not a shift or a fitted term that happens to fit
+            simple = rank <= RANK["scale"] or rank == RANK["pair"]
+            if self.found and not simple and not self._limits(self.found[0][0]):
+                # after a confirmed edit an alternative is a simple edit, not a shift or a fitted term;
+                # after one that holds at these values only, any edit that holds is worth naming
+                return
             key = tuple(sorted((m, i, str(new)) for (m, i), (_, new) in changes.items()))
             if key in self.seen:
                 continue  # the same edit again
@@ -163,16 +233,126 @@ class _Confirmation:
             self.seen.add(key)
             self.tried += 1
             started = time.perf_counter()
-            if _confirmed(self.batch, self.sm, changes):
+            verdict = _confirmed(self.batch, self.sm, changes, lambda: self.perturbation.sets)
+            if verdict == "holds":
                 self.found.append((changes, edit, slot))
                 if len(self.found) == 1:
                     self.tried_at_first = self.tried
                     self.alternatives_until = time.perf_counter() + ALTERNATIVE_SECONDS
+            elif verdict == "coincidence":
+                self.coincidences.append((changes, edit, slot))
             self.longest = max(self.longest, time.perf_counter() - started)
 
+    def findings(self, forms: dict, notation) -> list[Finding]:
+        """The ``repair`` findings of what was found: the first, confirmed or not and why, then the
+        alternatives, each with the relation under which it agrees with the first."""
+        (changes, edit, slot), others = self.found[0], self.found[1:]
+        sets = len(self.perturbation.sets)
+        limits = self._limits(changes)
+        confirmed = not limits and not others and sets > 0
+        if confirmed:
+            verdict = (
+                f"makes every check pass on every state, at these parameter values and at {sets} others "
+            )
+            verdict += f"({self.perturbation.how})"
+        else:
+            also = [f"{_shown(c, e, forms, notation)} holds as well{_unless(changes, c, self, notation)}"
+                    for c, e, _ in others]  # fmt: skip
+            if limits:
+                verdict = "makes every check pass on every state at these parameter values; not confirmed: "
+            else:
+                verdict = f"makes every check pass on every state, and at {sets} other parameter sets; "
+                verdict += "not confirmed: "
+            verdict += "; ".join(limits + also)
+        out = _findings(changes, edit, slot, forms, notation, verdict, confirmed)
+        for c, e, s in others:
+            verdict = (
+                "makes every check pass on every state as well; not confirmed: the checks cannot tell it "
+                f"from the first{_unless(c, changes, self, notation)}"
+            )
+            out += _findings(c, e, s, forms, notation, verdict, False, alternative=True)
+        return out
 
-def _findings(changes: dict, edit: Edit, slot: Slot, forms: dict, notation, alternative: bool = False):
-    """The ``repair`` findings of one confirmed edit (one per entry it changes)."""
+    def coincidence_note(self, forms: dict, notation) -> str:
+        """For the sentence that says no repair was found: the edits that passed at the file's values
+        only (module docstring), or ""."""
+        if not self.coincidences:
+            return ""
+        shown = ", ".join(_shown(c, e, forms, notation) for c, e, _ in self.coincidences[:2])
+        more = f" and {len(self.coincidences) - 2} more" if len(self.coincidences) > 2 else ""
+        return (
+            f"; {shown}{more} make(s) every check pass at these parameter values, but not at other values "
+            f"({self.perturbation.how}): a coincidence of the values, not a repair"
+        )
+
+
+def _edit_parameters(changes: dict, sm) -> set[str]:
+    """The parameters an edit involves: those of the difference it makes to each entry."""
+    names = {symbol: name for name, symbol in sm.parameters.items()}
+    out = set()
+    for old, new in changes.values():
+        out |= {names[s] for s in sp.expand(new - old).free_symbols if s in names}
+    return out
+
+
+def _shown(changes: dict, edit: Edit, forms: dict, notation) -> str:
+    """An edit, short, in the model's notation: ``M[2,2]: I → 4*I``."""
+    (method, index), (old, new) = next(iter(changes.items()))
+    label = entry_label(method, forms[method], index)
+    written, suggested = notation.render(old), notation.render(new)
+    if len(written) + len(suggested) <= 80:
+        return f"{label}: {written} → {suggested}"
+    return f"{label}: {notation.render(edit.old)} → {notation.render(edit.new)}"
+
+
+def _unless(changes: dict, other: dict, confirmation: _Confirmation, notation) -> str:
+    """ ": they differ unless I = mp*r**2/3": the relation under which two edits of the same entries
+    give the same numbers, solved for one parameter (one that was not moved on its own first);
+    "" when the edits change different entries or the relation is not one equation."""
+    if set(changes) != set(other):
+        return ""
+    key = next(iter(changes))
+    relation = parameter_relation(changes[key][1] - other[key][1], confirmation.sm)
+    if relation is None:
+        return ""
+    moved = confirmation.perturbation
+    preferred = [p for p in relation.free_symbols if str(p) not in moved.independent]
+    for symbol in sorted(preferred, key=str) + sorted(relation.free_symbols - set(preferred), key=str):
+        solutions = sp.solve(relation, symbol)
+        if len(solutions) == 1:
+            return f": they differ unless {notation.render(symbol)} = {notation.render(solutions[0])}"
+    return ""
+
+
+def parameter_relation(difference, sm) -> sp.Expr | None:
+    """The polynomial of the parameters that must vanish for two entries whose ``difference`` is
+    given to agree at every state, or None when that is not one equation.  The difference is
+    written as a polynomial in sin θ, cos θ, the rates and inputs (``trig_normal_form``); it
+    vanishes at every state when each coefficient does, and that is one relation when all the
+    coefficients share a factor (their GCD) and are otherwise numbers."""
+    states = set(sm.flat_arguments("qvuw"))
+    form = trig_normal_form(sp.expand(difference), sm.angles)
+    if form is None or form == 0:
+        return None
+    parameters = set(sm.parameters.values())
+    others = sorted(form.free_symbols - parameters, key=str)
+    if states & form.free_symbols - set(others):  # pragma: no cover - every state symbol is in others
+        return None
+    coefficients = sp.Poly(form, *others).coeffs() if others else [form]
+    common = functools.reduce(sp.gcd, coefficients)
+    if not common.free_symbols or any(not sp.cancel(c / common).is_number for c in coefficients):
+        return None
+    # a factor that is one parameter vanishes only where that parameter is 0: not a relation
+    factors = [f for f, _ in sp.factor_list(common)[1] if f.is_Add]
+    return sp.Mul(*factors) if factors else None
+
+
+def _findings(
+    changes: dict, edit: Edit, slot: Slot, forms: dict, notation, verdict: str, confirmed: bool,
+    alternative: bool = False,
+):  # fmt: skip
+    """The ``repair`` findings of one edit that makes every check pass (one per entry it changes);
+    ``verdict`` says whether it is confirmed (``_Confirmation.findings``)."""
     out = []
     for (method, index), (old, new) in changes.items():
         label = entry_label(method, forms[method], index)
@@ -185,11 +365,7 @@ def _findings(changes: dict, edit: Edit, slot: Slot, forms: dict, notation, alte
         )
         if edit.operator == "pair":
             shown += f" (two edits: {edit.what})"
-        message = f"{label}: {shown} makes every check pass on every state ({location})"
-        if alternative:
-            message = (
-                f"or, equally: {message} (with these parameter values the checks cannot tell the two apart)"
-            )
+        message = f"{'or, equally: ' if alternative else ''}{label}: {shown} {verdict} ({location})"
         quantity = QUANTITY.get(method)
         value = forms[method]
         if isinstance(value, sp.MatrixBase):
@@ -208,6 +384,7 @@ def _findings(changes: dict, edit: Edit, slot: Slot, forms: dict, notation, alte
                     "suggested_source": suggested,
                     "location": location,
                     "checks_pass": True,
+                    "confirmed": confirmed,
                 },
             )
         )
