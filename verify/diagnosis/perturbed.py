@@ -103,11 +103,13 @@ class Perturbation:
 
     def why_not_alone(self, names) -> list[str]:
         """Why each of ``names`` was not moved on its own, in words (empty: all were)."""
-        out = []
+        out, equal = [], []
         for group in self.groups:
-            inside = sorted(set(group) & set(names))
-            if inside:
-                out.append(f"{' and '.join(group)} share a value and were moved only together")
+            inside = [n for n in group if n in set(names)]
+            if inside:  # the edit's own first: "m2 = m1"
+                equal.append(" = ".join(inside + [n for n in group if n not in inside]))
+        if equal:
+            out.append(f"{', '.join(equal)} here and at every set (equal values are moved together)")
         out += [f"{n} was not moved ({self.fixed[n]})" for n in sorted(set(names) & set(self.fixed))]
         if not self.sets and not out:
             out.append(f"no parameter set could be made ({self.refused or 'nothing to move'})")

@@ -60,6 +60,7 @@ from pendverify.diagnosis.finding import Finding
 from pendverify.diagnosis.notation import Notation
 from pendverify.diagnosis.perturbed import perturbations
 from pendverify.diagnosis.slots import QUANTITY, SCREEN_STATES, Slot, entry_label, evaluator, find_slots
+from pendverify.errors import PendverifyError
 from pendverify.symbolic.edited import edited_model
 from pendverify.symbolic.edits import Edit
 from pendverify.symbolic.zero_test import trig_normal_form
@@ -89,8 +90,8 @@ def _passes(model, system, states) -> bool:
     with np.errstate(all="ignore"):
         try:
             results = run_checks("repair", model, system, states, 0, names)
-        except (ArithmeticError, ValueError, np.linalg.LinAlgError):
-            return False
+        except (ArithmeticError, ValueError, np.linalg.LinAlgError, PendverifyError):
+            return False  # a scale that cannot be derived too: what is not shown to pass does not
     return all(r.passed for r in results)
 
 
@@ -110,7 +111,12 @@ def _confirmed(batch, sm, changes: dict, moved_sets=None) -> str:
         model = type(repaired)(moved.params)  # the same edited class: its generated code is reused
         if derived:  # the tolerance scales of the model as given, at these values (``edited_model``)
             model.use_derived_scales(moved.model.derived_scales())
-        if not _passes(model, moved.system, states):
+        if _passes(model, moved.system, states):
+            continue
+        # the model as given can have degenerate scales (an H planted as 0 has a gravity scale 0,
+        # which the rounding at the file's values may meet and other values not): the repaired
+        # model's own, derived from its M and H, decide then
+        if not derived or not _passes(type(repaired)(moved.params), moved.system, states):
             return "coincidence"
     return "holds"
 
@@ -245,19 +251,19 @@ class _Confirmation:
 
     def findings(self, forms: dict, notation) -> list[Finding]:
         """The ``repair`` findings of what was found: the first, confirmed or not and why, then the
-        alternatives, each with the relation under which it agrees with the first."""
-        (changes, edit, slot), others = self.found[0], self.found[1:]
+        alternatives (the other edits that held, and the first with members of a group of equal
+        parameters exchanged), each with the relation under which it agrees with the first."""
+        (changes, edit, slot), found = self.found[0], self.found[1:]
+        others = [(c, e, s, _unless(changes, c, self, notation)) for c, e, s in found]
+        others += self._exchanges(changes, edit, slot)
         sets = len(self.perturbation.sets)
         limits = self._limits(changes)
         confirmed = not limits and not others and sets > 0
         if confirmed:
-            verdict = (
-                f"makes every check pass on every state, at these parameter values and at {sets} others "
-            )
-            verdict += f"({self.perturbation.how})"
+            verdict = "makes every check pass on every state, at these parameter values and at "
+            verdict += f"{sets} others ({self.perturbation.how})"
         else:
-            also = [f"{_shown(c, e, forms, notation)} holds as well{_unless(changes, c, self, notation)}"
-                    for c, e, _ in others]  # fmt: skip
+            also = [f"{_shown(c, e, forms, notation)} holds as well{unless}" for c, e, _, unless in others]
             if limits:
                 verdict = "makes every check pass on every state at these parameter values; not confirmed: "
             else:
@@ -265,13 +271,45 @@ class _Confirmation:
                 verdict += "not confirmed: "
             verdict += "; ".join(limits + also)
         out = _findings(changes, edit, slot, forms, notation, verdict, confirmed)
-        for c, e, s in others:
-            verdict = (
-                "makes every check pass on every state as well; not confirmed: the checks cannot tell it "
-                f"from the first{_unless(c, changes, self, notation)}"
-            )
+        for c, e, s, unless in others:
+            verdict = f"makes every check pass on every state as well; not confirmed: like the first{unless}"
             out += _findings(c, e, s, forms, notation, verdict, False, alternative=True)
         return out
+
+    def _exchanges(self, changes: dict, edit: Edit, slot: Slot) -> list:
+        """The edit with the members of groups of equal parameters exchanged in what it changes
+        (``add I2`` → ``add I1``), as [(changes, edit, slot, relation)]: at most one, every group
+        the edit's difference holds exchanged at once.  The members' values are the same float
+        here and at every perturbed set, so the exchanged edit gives the same numbers, bit for
+        bit, and passes every check the first passed.  Listed only where the edit puts in or
+        takes out whole terms (each term of its difference has the coefficient ±1: ``I2 → 2*I2``
+        adds I2, so ``+ I1`` is an edit the user could have meant), not where it changes a term's
+        sign or factor (``m2*l1*lc2*sin(theta2)`` flipped: the same flip with m1 would be a new
+        term of two masses)."""
+        params, symbols = self.batch.model.params, self.sm.parameters
+        differences = [sp.expand(new - old) for old, new in changes.values()]
+        whole = all(abs(term.as_coeff_Mul()[0]) == 1 for d in differences for term in sp.Add.make_args(d))
+        swap = {}
+        for group in self.perturbation.groups:
+            if len({float(getattr(params, n)) for n in group}) != 1:
+                continue  # equal to rounding only: the numbers would differ in the last bits
+            inside = [n for n in group if any(d.has(symbols[n]) for d in differences)]
+            if inside:
+                a, b = symbols[inside[0]], symbols[next(n for n in group if n != inside[0])]
+                swap.update({a: b, b: a})
+        if not swap or not whole:
+            return []
+        exchanged = {}
+        for key, (old, new) in changes.items():
+            forms = (old + (new - old).xreplace(swap), sp.expand(old + (new - old).xreplace(swap)))
+            exchanged[key] = (old, min(forms, key=lambda f: len(str(f))))
+        if all(sp.expand(n - changes[k][1]) == 0 for k, (_, n) in exchanged.items()):
+            return []
+        pairs = sorted({tuple(sorted((str(a), str(b)))) for a, b in swap.items()})
+        where = " and ".join(f"{a} = {b}" for a, b in pairs)
+        (old, new) = next(iter(exchanged.values()))
+        what = f"{edit.what}, with {where.replace(' = ', ' and ')} exchanged"
+        return [(exchanged, Edit("exchange", old, new, new, what), slot, f": the two agree where {where}")]
 
     def coincidence_note(self, forms: dict, notation) -> str:
         """For the sentence that says no repair was found: the edits that passed at the file's values
@@ -293,6 +331,14 @@ def _edit_parameters(changes: dict, sm) -> set[str]:
     for old, new in changes.values():
         out |= {names[s] for s in sp.expand(new - old).free_symbols if s in names}
     return out
+
+
+def _products(expr, parameters: set) -> set:
+    """The product of ``parameters`` in each term of ``expr`` (numbers and state functions left out)."""
+    return {
+        sp.Mul(*[f for f in sp.Mul.make_args(term) if f.free_symbols and f.free_symbols <= parameters])
+        for term in sp.Add.make_args(expr)
+    }
 
 
 def _shown(changes: dict, edit: Edit, forms: dict, notation) -> str:
@@ -319,8 +365,14 @@ def _unless(changes: dict, other: dict, confirmation: _Confirmation, notation) -
     preferred = [p for p in relation.free_symbols if str(p) not in moved.independent]
     for symbol in sorted(preferred, key=str) + sorted(relation.free_symbols - set(preferred), key=str):
         solutions = sp.solve(relation, symbol)
-        if len(solutions) == 1:
+        if len(solutions) == 1 and not sp.fraction(solutions[0])[1].free_symbols:
             return f": they differ unless {notation.render(symbol)} = {notation.render(solutions[0])}"
+    terms = sp.Add.make_args(relation)
+    if len(terms) == 2:  # no parameter solved for without dividing by another: both sides
+        left, right = (
+            (terms[0], -terms[1]) if terms[0].could_extract_minus_sign() is False else (-terms[0], terms[1])
+        )
+        return f": they differ unless {notation.render(left)} = {notation.render(right)}"
     return ""
 
 
