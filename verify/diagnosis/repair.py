@@ -38,6 +38,7 @@ The repair is printed in the model's own notation, where it sits
 from __future__ import annotations
 
 import functools
+import itertools
 import time
 
 import numpy as np
@@ -50,6 +51,7 @@ from pendverify.checks.catalogue import applicable_checks, run_checks
 from pendverify.diagnosis.candidates import (
     RANK,
     candidates,
+    equal_valued,
     monomials_for,
     pairs_within,
     screen_slot,
@@ -82,6 +84,9 @@ ALTERNATIVE_SECONDS = 2.0
 #: (a trigonometric polynomial of a few terms in the state, not zero as a function at the moved
 #: parameters) is non-zero at almost every state: 24 states, the special ones first, find it.
 PERTURBED_STATES = SCREEN_STATES
+#: edits tried in place of one that proved a coincidence, giving the same numbers with other
+#: parameters (``_rematched``); each is a check run of a small model, a fraction of the bound
+REMATCHES = 6
 
 
 def _passes(model, system, states) -> bool:
@@ -236,18 +241,31 @@ class _Confirmation:
                 continue  # the same edit again
             if self.found and self.tried - self.tried_at_first >= ALTERNATIVE_TRIES:
                 return
-            self.seen.add(key)
-            self.tried += 1
-            started = time.perf_counter()
-            verdict = _confirmed(self.batch, self.sm, changes, lambda: self.perturbation.sets)
-            if verdict == "holds":
-                self.found.append((changes, edit, slot))
-                if len(self.found) == 1:
-                    self.tried_at_first = self.tried
-                    self.alternatives_until = time.perf_counter() + ALTERNATIVE_SECONDS
-            elif verdict == "coincidence":
-                self.coincidences.append((changes, edit, slot))
-            self.longest = max(self.longest, time.perf_counter() - started)
+            if self._check(changes, edit, slot) == "coincidence" and not self.found:
+                # the same numbers from other parameters: tried at once, each against every set
+                for variant, rematch in _rematched(changes, self.sm, self.batch.model.params, slot):
+                    late = time.perf_counter() + self.longest > self.deadline
+                    if late or self._check(variant, rematch, slot) == "holds":
+                        break
+
+    def _check(self, changes: dict, edit: Edit, slot: Slot) -> str:
+        """``_confirmed``'s verdict on one candidate, recorded (found, a coincidence, tried)."""
+        key = tuple(sorted((m, i, str(new)) for (m, i), (_, new) in changes.items()))
+        if key in self.seen:
+            return "seen"
+        self.seen.add(key)
+        self.tried += 1
+        started = time.perf_counter()
+        verdict = _confirmed(self.batch, self.sm, changes, lambda: self.perturbation.sets)
+        if verdict == "holds":
+            self.found.append((changes, edit, slot))
+            if len(self.found) == 1:
+                self.tried_at_first = self.tried
+                self.alternatives_until = time.perf_counter() + ALTERNATIVE_SECONDS
+        elif verdict == "coincidence":
+            self.coincidences.append((changes, edit, slot))
+        self.longest = max(self.longest, time.perf_counter() - started)
+        return verdict
 
     def findings(self, forms: dict, notation) -> list[Finding]:
         """The ``repair`` findings of what was found: the first, confirmed or not and why, then the
@@ -322,6 +340,46 @@ class _Confirmation:
             f"; {shown}{more} make(s) every check pass at these parameter values, but not at other values "
             f"({self.perturbation.how}): a coincidence of the values, not a repair"
         )
+
+
+def _rematched(changes: dict, sm, params, slot: Slot) -> list[tuple[dict, Edit]]:
+    """Edits that give the same numbers as ``changes`` (an edit of one entry that proved a
+    coincidence) at the file's values, with other parameters: each term of what the edit adds,
+    then each term of the entry it writes, whose parameters times its number is matched by
+    another product of parameters of the same value (``equal_valued``: ``3*I`` → ``mp*l**2``
+    where I = mp·l²/3, ``l*m/2`` → ``l**2*m`` where l = 0.5, ``l1*lc2`` → ``l1*lc2*m2`` where
+    m2 = 1).  At most ``REMATCHES``, products as they stand and the model's own first."""
+    if len(changes) != 1:
+        return []
+    ((key, (old, new)),) = changes.items()
+    values = {sm.parameters[p]: float(getattr(params, p)) for p in sm.parameters}
+    own, generic = monomials_for(
+        sm, {p: float(getattr(params, p)) for p in sm.parameters}, QUANTITY.get(slot.method, "")
+    )
+    parameters = set(values)
+    out = []
+    for base, source in ((old, sp.expand(new - old)), (sp.S.Zero, sp.expand(new))):
+        terms = sp.Add.make_args(source)
+        if len(terms) > 2:
+            continue
+        options = []
+        for term in terms:
+            part = sp.Mul(
+                *[f for f in sp.Mul.make_args(term) if not f.free_symbols or f.free_symbols <= parameters]
+            )
+            value = float(part.xreplace(values))
+            others = [m for m in equal_valued(value, own + generic) if m != part] if value else []
+            options.append([(part, term / part)] + [(m, term / part) for m in others])
+        for combo in itertools.product(*options):
+            if all(choice is option[0] for choice, option in zip(combo, options, strict=True)):
+                continue
+            written = base + sp.Add(*[m * rest for m, rest in combo])
+            if written != new:
+                what = f"{new} → {written} (the same numbers here)"
+                out.append(({key: (old, written)}, Edit("rematched", old, written, written, what)))
+            if len(out) == REMATCHES:
+                return out
+    return out
 
 
 def _edit_parameters(changes: dict, sm) -> set[str]:
