@@ -134,7 +134,7 @@ def perturbations(model, system, consistent=None, count: int = SETS, seed: int =
         except PendverifyError as exc:
             cause = f"the description could not be read for rewriting: {exc}"
     else:
-        cause = f"the {READERS[loaded.format]} description is not rewritten (only a URDF is)"
+        cause = f"the {READERS[loaded.format]} description is not rewritten, only a URDF is"
     free_damping = system.urdf_damping() is None
     units, fixed, written = [], {}, set()
     for name, kind in kinds.items():

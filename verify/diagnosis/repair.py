@@ -241,11 +241,16 @@ class _Confirmation:
                 continue  # the same edit again
             if self.found and self.tried - self.tried_at_first >= ALTERNATIVE_TRIES:
                 return
-            if self._check(changes, edit, slot) == "coincidence" and not self.found:
-                # the same numbers from other parameters: tried at once, each against every set
+            verdict = self._check(changes, edit, slot)
+            first_limited = verdict == "holds" and len(self.found) == 1 and self._limits(changes)
+            if (verdict == "coincidence" and not self.found) or first_limited:
+                # the same numbers from other parameters, tried at once against every set: in place
+                # of a coincidence, or as the alternatives of a repair that holds at these values only
                 for variant, rematch in _rematched(changes, self.sm, self.batch.model.params, slot):
                     late = time.perf_counter() + self.longest > self.deadline
-                    if late or self._check(variant, rematch, slot) == "holds":
+                    if late or len(self.found) > ALTERNATIVES:
+                        break
+                    if self._check(variant, rematch, slot) == "holds" and not first_limited:
                         break
 
     def _check(self, changes: dict, edit: Edit, slot: Slot) -> str:
