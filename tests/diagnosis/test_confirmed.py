@@ -22,9 +22,9 @@ from pendverify.checks.batch import CheckBatch
 from pendverify.checks.catalogue import applicable_checks, run_checks
 from pendverify.checks.sampling import sample_states
 from pendverify.cli import main
+from pendverify.diagnosis.alternatives import relation
 from pendverify.diagnosis.corpus import CORPUS_SAMPLES, CORPUS_SEED, sample_plants, score_model
 from pendverify.diagnosis.explain import explain
-from pendverify.diagnosis.repair import parameter_relation
 from pendverify.robot.system import PinocchioSystem
 from pendverify.shipped import shipped_file
 from pendverify.symbolic.edited import edited_model
@@ -132,15 +132,15 @@ def test_equal_parameters_moved_together_state_the_exchange():
     assert any(sp.expand(sp.sympify(f.details["suggested"]) - planted) == 0 for f in findings)
 
 
-def test_a_relation_is_solved_for_one_parameter():
+def test_the_relation_two_edits_agree_under_is_one_equation_of_the_parameters():
     ((_, model, _, _),) = _targets("corpus_cart_pole")
     sm = SymbolicModel.of(type(model))
     inertia, mp, half = (sm.parameters[n] for n in ("I", "mp", "l"))
     theta = sm.angles[0]
-    relation = parameter_relation((3 * inertia - mp * half**2) * sp.cos(theta), sm)
-    assert sp.cancel(relation / (3 * inertia - mp * half**2)) in (1, -1)  # up to its sign
+    found = relation((3 * inertia - mp * half**2) * sp.cos(theta), sm)
+    assert sp.cancel(found / (3 * inertia - mp * half**2)) in (1, -1)  # up to its sign
     two = (inertia - mp) * sp.cos(theta) + (inertia - half) * sp.sin(theta)  # two relations, not one
-    assert parameter_relation(two, sm) is None
+    assert relation(two, sm) is None
 
 
 @pytest.mark.parametrize(

@@ -26,7 +26,8 @@
    and m2 exchanged cannot be told apart), or another edit holds as well (an error in B shows
    as well in a hand-written q̈ that uses it).  Each alternative is named with the relation
    under which the two agree, solved for one parameter (``I → 4*I`` and ``I → I + mp*r**2``
-   differ unless I = mp*r**2/3).
+   differ unless I = mp*r**2/3): ``pendverify.diagnosis.alternatives``, which also gives the
+   edits tried in place of a coincidence (the same numbers from other parameters).
 
 When no single edit passes, pairs of edits of one entry are tried for models of up to three
 degrees of freedom.
@@ -37,8 +38,6 @@ The repair is printed in the model's own notation, where it sits
 
 from __future__ import annotations
 
-import functools
-import itertools
 import time
 
 import numpy as np
@@ -48,10 +47,10 @@ from pendverify.analytic.forms import entry_position
 from pendverify.analytic.symbolic_reading import SymbolicModel
 from pendverify.checks.batch import CheckBatch
 from pendverify.checks.catalogue import applicable_checks, run_checks
+from pendverify.diagnosis.alternatives import edit_parameters, exchanged, rematched, shown, unless
 from pendverify.diagnosis.candidates import (
     RANK,
     candidates,
-    equal_valued,
     monomials_for,
     pairs_within,
     screen_slot,
@@ -65,7 +64,6 @@ from pendverify.diagnosis.slots import QUANTITY, SCREEN_STATES, Slot, entry_labe
 from pendverify.errors import PendverifyError
 from pendverify.symbolic.edited import edited_model
 from pendverify.symbolic.edits import Edit
-from pendverify.symbolic.zero_test import trig_normal_form
 
 CONFIRMATIONS = 12
 #: pairs of edits of one entry are tried for models of up to this many degrees of freedom
@@ -84,9 +82,6 @@ ALTERNATIVE_SECONDS = 2.0
 #: (a trigonometric polynomial of a few terms in the state, not zero as a function at the moved
 #: parameters) is non-zero at almost every state: 24 states, the special ones first, find it.
 PERTURBED_STATES = SCREEN_STATES
-#: edits tried in place of one that proved a coincidence, giving the same numbers with other
-#: parameters (``_rematched``); each is a check run of a small model, a fraction of the bound
-REMATCHES = 6
 
 
 def _passes(model, system, states) -> bool:
@@ -223,7 +218,7 @@ class _Confirmation:
 
     def _limits(self, changes) -> list[str]:
         """Why an edit is not confirmed even when it holds: its parameters not moved on their own."""
-        return self.perturbation.why_not_alone(_edit_parameters(changes, self.sm))
+        return self.perturbation.why_not_alone(edit_parameters(changes, self.sm))
 
     def run(self, ordered) -> None:
         for rank, changes, edit, slot in ordered:
@@ -246,7 +241,7 @@ class _Confirmation:
             if (verdict == "coincidence" and not self.found) or first_limited:
                 # the same numbers from other parameters, tried at once against every set: in place
                 # of a coincidence, or as the alternatives of a repair that holds at these values only
-                for variant, rematch in _rematched(changes, self.sm, self.batch.model.params, slot):
+                for variant, rematch in rematched(changes, self.sm, self.batch.model.params, slot):
                     late = time.perf_counter() + self.longest > self.deadline
                     if late or len(self.found) > ALTERNATIVES:
                         break
@@ -277,8 +272,10 @@ class _Confirmation:
         alternatives (the other edits that held, and the first with members of a group of equal
         parameters exchanged), each with the relation under which it agrees with the first."""
         (changes, edit, slot), found = self.found[0], self.found[1:]
-        others = [(c, e, s, _unless(changes, c, self, notation)) for c, e, s in found]
-        others += self._exchanges(changes, edit, slot)
+        independent = self.perturbation.independent
+        others = [(c, e, s, unless(changes, c, self.sm, independent, notation)) for c, e, s in found]
+        groups, params = self.perturbation.groups, self.batch.model.params
+        others += exchanged(changes, edit, slot, groups, params, self.sm)
         sets = len(self.perturbation.sets)
         limits = self._limits(changes)
         confirmed = not limits and not others and sets > 0
@@ -286,7 +283,7 @@ class _Confirmation:
             verdict = "makes every check pass on every state, at these parameter values and at "
             verdict += f"{sets} others ({self.perturbation.how})"
         else:
-            also = [f"{_shown(c, e, forms, notation)} holds as well{unless}" for c, e, _, unless in others]
+            also = [f"{shown(c, e, forms, notation)} holds as well{why}" for c, e, _, why in others]
             if limits:
                 verdict = "makes every check pass on every state at these parameter values; not confirmed: "
             else:
@@ -294,172 +291,22 @@ class _Confirmation:
                 verdict += "not confirmed: "
             verdict += "; ".join(limits + also)
         out = _findings(changes, edit, slot, forms, notation, verdict, confirmed)
-        for c, e, s, unless in others:
-            verdict = f"makes every check pass on every state as well; not confirmed: like the first{unless}"
+        for c, e, s, why in others:
+            verdict = f"makes every check pass on every state as well; not confirmed: like the first{why}"
             out += _findings(c, e, s, forms, notation, verdict, False, alternative=True)
         return out
-
-    def _exchanges(self, changes: dict, edit: Edit, slot: Slot) -> list:
-        """The edit with the members of groups of equal parameters exchanged in what it changes
-        (``add I2`` → ``add I1``), as [(changes, edit, slot, relation)]: at most one, every group
-        the edit's difference holds exchanged at once.  The members' values are the same float
-        here and at every perturbed set, so the exchanged edit gives the same numbers, bit for
-        bit, and passes every check the first passed.  Listed only where the edit puts in or
-        takes out whole terms (each term of its difference has the coefficient ±1: ``I2 → 2*I2``
-        adds I2, so ``+ I1`` is an edit the user could have meant), not where it changes a term's
-        sign or factor (``m2*l1*lc2*sin(theta2)`` flipped: the same flip with m1 would be a new
-        term of two masses)."""
-        params, symbols = self.batch.model.params, self.sm.parameters
-        differences = [sp.expand(new - old) for old, new in changes.values()]
-        whole = all(abs(term.as_coeff_Mul()[0]) == 1 for d in differences for term in sp.Add.make_args(d))
-        swap = {}
-        for group in self.perturbation.groups:
-            if len({float(getattr(params, n)) for n in group}) != 1:
-                continue  # equal to rounding only: the numbers would differ in the last bits
-            inside = [n for n in group if any(d.has(symbols[n]) for d in differences)]
-            if inside:
-                a, b = symbols[inside[0]], symbols[next(n for n in group if n != inside[0])]
-                swap.update({a: b, b: a})
-        if not swap or not whole:
-            return []
-        exchanged = {}
-        for key, (old, new) in changes.items():
-            forms = (old + (new - old).xreplace(swap), sp.expand(old + (new - old).xreplace(swap)))
-            exchanged[key] = (old, min(forms, key=lambda f: len(str(f))))
-        if all(sp.expand(n - changes[k][1]) == 0 for k, (_, n) in exchanged.items()):
-            return []
-        pairs = sorted({tuple(sorted((str(a), str(b)))) for a, b in swap.items()})
-        where = " and ".join(f"{a} = {b}" for a, b in pairs)
-        (old, new) = next(iter(exchanged.values()))
-        what = f"{edit.what}, with {where.replace(' = ', ' and ')} exchanged"
-        return [(exchanged, Edit("exchange", old, new, new, what), slot, f": the two agree where {where}")]
 
     def coincidence_note(self, forms: dict, notation) -> str:
         """For the sentence that says no repair was found: the edits that passed at the file's values
         only (module docstring), or ""."""
         if not self.coincidences:
             return ""
-        shown = ", ".join(_shown(c, e, forms, notation) for c, e, _ in self.coincidences[:2])
+        edits = ", ".join(shown(c, e, forms, notation) for c, e, _ in self.coincidences[:2])
         more = f" and {len(self.coincidences) - 2} more" if len(self.coincidences) > 2 else ""
         return (
-            f"; {shown}{more} make(s) every check pass at these parameter values, but not at other values "
+            f"; {edits}{more} make(s) every check pass at these parameter values, but not at other values "
             f"({self.perturbation.how}): a coincidence of the values, not a repair"
         )
-
-
-def _rematched(changes: dict, sm, params, slot: Slot) -> list[tuple[dict, Edit]]:
-    """Edits that give the same numbers as ``changes`` (an edit of one entry that proved a
-    coincidence) at the file's values, with other parameters: each term of what the edit adds,
-    then each term of the entry it writes, whose parameters times its number is matched by
-    another product of parameters of the same value (``equal_valued``: ``3*I`` → ``mp*l**2``
-    where I = mp·l²/3, ``l*m/2`` → ``l**2*m`` where l = 0.5, ``l1*lc2`` → ``l1*lc2*m2`` where
-    m2 = 1).  At most ``REMATCHES``, products as they stand and the model's own first."""
-    if len(changes) != 1:
-        return []
-    ((key, (old, new)),) = changes.items()
-    values = {sm.parameters[p]: float(getattr(params, p)) for p in sm.parameters}
-    own, generic = monomials_for(
-        sm, {p: float(getattr(params, p)) for p in sm.parameters}, QUANTITY.get(slot.method, "")
-    )
-    parameters = set(values)
-    out = []
-    for base, source in ((old, sp.expand(new - old)), (sp.S.Zero, sp.expand(new))):
-        terms = sp.Add.make_args(source)
-        if len(terms) > 2:
-            continue
-        options = []
-        for term in terms:
-            part = sp.Mul(
-                *[f for f in sp.Mul.make_args(term) if not f.free_symbols or f.free_symbols <= parameters]
-            )
-            value = float(part.xreplace(values))
-            others = [m for m in equal_valued(value, own + generic) if m != part] if value else []
-            options.append([(part, term / part)] + [(m, term / part) for m in others])
-        for combo in itertools.product(*options):
-            if all(choice is option[0] for choice, option in zip(combo, options, strict=True)):
-                continue
-            written = base + sp.Add(*[m * rest for m, rest in combo])
-            if written != new:
-                what = f"{new} → {written} (the same numbers here)"
-                out.append(({key: (old, written)}, Edit("rematched", old, written, written, what)))
-            if len(out) == REMATCHES:
-                return out
-    return out
-
-
-def _edit_parameters(changes: dict, sm) -> set[str]:
-    """The parameters an edit involves: those of the difference it makes to each entry."""
-    names = {symbol: name for name, symbol in sm.parameters.items()}
-    out = set()
-    for old, new in changes.values():
-        out |= {names[s] for s in sp.expand(new - old).free_symbols if s in names}
-    return out
-
-
-def _products(expr, parameters: set) -> set:
-    """The product of ``parameters`` in each term of ``expr`` (numbers and state functions left out)."""
-    return {
-        sp.Mul(*[f for f in sp.Mul.make_args(term) if f.free_symbols and f.free_symbols <= parameters])
-        for term in sp.Add.make_args(expr)
-    }
-
-
-def _shown(changes: dict, edit: Edit, forms: dict, notation) -> str:
-    """An edit, short, in the model's notation: ``M[2,2]: I → 4*I``."""
-    (method, index), (old, new) = next(iter(changes.items()))
-    label = entry_label(method, forms[method], index)
-    written, suggested = notation.render(old), notation.render(new)
-    if len(written) + len(suggested) <= 80:
-        return f"{label}: {written} → {suggested}"
-    return f"{label}: {notation.render(edit.old)} → {notation.render(edit.new)}"
-
-
-def _unless(changes: dict, other: dict, confirmation: _Confirmation, notation) -> str:
-    """ ": they differ unless I = mp*r**2/3": the relation under which two edits of the same entries
-    give the same numbers, solved for one parameter (one that was not moved on its own first);
-    "" when the edits change different entries or the relation is not one equation."""
-    if set(changes) != set(other):
-        return ""
-    key = next(iter(changes))
-    relation = parameter_relation(changes[key][1] - other[key][1], confirmation.sm)
-    if relation is None:
-        return ""
-    moved = confirmation.perturbation
-    preferred = [p for p in relation.free_symbols if str(p) not in moved.independent]
-    for symbol in sorted(preferred, key=str) + sorted(relation.free_symbols - set(preferred), key=str):
-        solutions = sp.solve(relation, symbol)
-        if len(solutions) == 1 and not sp.fraction(solutions[0])[1].free_symbols:
-            return f": they differ unless {notation.render(symbol)} = {notation.render(solutions[0])}"
-    terms = sp.Add.make_args(relation)
-    if len(terms) == 2:  # no parameter solved for without dividing by another: both sides
-        left, right = (
-            (terms[0], -terms[1]) if terms[0].could_extract_minus_sign() is False else (-terms[0], terms[1])
-        )
-        return f": they differ unless {notation.render(left)} = {notation.render(right)}"
-    return ""
-
-
-def parameter_relation(difference, sm) -> sp.Expr | None:
-    """The polynomial of the parameters that must vanish for two entries whose ``difference`` is
-    given to agree at every state, or None when that is not one equation.  The difference is
-    written as a polynomial in sin θ, cos θ, the rates and inputs (``trig_normal_form``); it
-    vanishes at every state when each coefficient does, and that is one relation when all the
-    coefficients share a factor (their GCD) and are otherwise numbers."""
-    states = set(sm.flat_arguments("qvuw"))
-    form = trig_normal_form(sp.expand(difference), sm.angles)
-    if form is None or form == 0:
-        return None
-    parameters = set(sm.parameters.values())
-    others = sorted(form.free_symbols - parameters, key=str)
-    if states & form.free_symbols - set(others):  # pragma: no cover - every state symbol is in others
-        return None
-    coefficients = sp.Poly(form, *others).coeffs() if others else [form]
-    common = functools.reduce(sp.gcd, coefficients)
-    if not common.free_symbols or any(not sp.cancel(c / common).is_number for c in coefficients):
-        return None
-    # a factor that is one parameter vanishes only where that parameter is 0: not a relation
-    factors = [f for f, _ in sp.factor_list(common)[1] if f.is_Add]
-    return sp.Mul(*factors) if factors else None
 
 
 def _findings(
