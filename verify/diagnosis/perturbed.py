@@ -52,7 +52,12 @@ Which parameters move (``Perturbation``):
 * the rest are not moved, each with the reason (a value 0, a value not in the URDF, a
   combination of parameters in the file, a description ``Binding`` cannot rewrite: MJCF,
   SDFormat, a Pinocchio model), and so the repairs that involve them hold at these values
-  only.
+  only;
+* nor is a parameter the URDF holds alone at one site and combined with others elsewhere (a
+  tip frame at l, the centre of mass at l/2 and m·l²/12): moved, it makes entries of the model
+  that agree with the URDF at the file's values disagree, and then a right repair would fail
+  too.  ``consistent`` (given by the repair search: no entry that agrees at the file's values
+  disagrees at the set) finds it, each move tried alone when a set is not consistent.
 
 The sets are drawn with ``SEED``: the same model gets the same sets every time.
 """
@@ -196,18 +201,24 @@ def perturbations(model, system, consistent=None, count: int = SETS, seed: int =
         if consistent is None or consistent(moved.model, moved.system):
             out.sets.append(moved)
             continue
+        culprits = []
         for unit in list(units):  # which move breaks what agreed: each alone
             try:
                 alone = made({unit: factors[unit]})
             except PendverifyError:
                 continue
             if not consistent(alone.model, alone.system):
-                units.remove(unit)
-                for name in unit:
-                    out.fixed[name] = (
-                        "moved in the URDF, entries that agree at the file's values disagree: "
-                        "the URDF holds it combined with other parameters too"
-                    )
+                culprits.append(unit)
+        if not culprits:  # only moves together break it: no set is made
+            out.refused = "moved together, the parameters make entries that agree here disagree"
+            units.clear()
+        for unit in culprits:
+            units.remove(unit)
+            for name in unit:
+                out.fixed[name] = (
+                    "moved in the URDF, entries that agree at the file's values disagree: "
+                    "the URDF holds it combined with other parameters too"
+                )
         out.sets.clear()  # the sets kept so far moved those as well
     grouped = set(binding.groups) if binding is not None else set()
     out.independent = tuple(u[0] for u in units if u not in grouped)
