@@ -195,6 +195,7 @@ class _Confirmation:
         self.seen: set = set()
         self.alternatives_until = float("inf")
         self._perturbation = None
+        self._limits_of: dict = {}
 
     @property
     def perturbation(self):
@@ -217,8 +218,12 @@ class _Confirmation:
         return self._perturbation
 
     def _limits(self, changes) -> list[str]:
-        """Why an edit is not confirmed even when it holds: its parameters not moved on their own."""
-        return self.perturbation.why_not_alone(edit_parameters(changes, self.sm))
+        """Why an edit is not confirmed even when it holds: its parameters not moved on their own
+        (kept per edit: the first repair's are asked for each candidate after it)."""
+        key = tuple(sorted((m, i, str(new)) for (m, i), (_, new) in changes.items()))
+        if key not in self._limits_of:
+            self._limits_of[key] = self.perturbation.why_not_alone(edit_parameters(changes, self.sm))
+        return self._limits_of[key]
 
     def run(self, ordered) -> None:
         for rank, changes, edit, slot in ordered:
