@@ -128,6 +128,8 @@ def perturbations(model, system, consistent=None, count: int = SETS, seed: int =
     the model where it agreed at the file's values; a set that does not is not kept, and each
     parameter (or group) whose move alone breaks that agreement is not moved (module docstring)."""
     params = model.params
+    if not dataclasses.is_dataclass(params):
+        return Perturbation(refused="the parameters are not a parameter set")
     kinds = {f.name: f.metadata.get("kind") for f in dataclasses.fields(params)}
     loaded = system.urdf
     binding, cause = None, ""
@@ -195,7 +197,7 @@ def perturbations(model, system, consistent=None, count: int = SETS, seed: int =
         factors = {unit: _factor(rng) for unit in units}
         try:
             moved = made(factors)
-        except PendverifyError as exc:
+        except (PendverifyError, ValueError, ArithmeticError) as exc:  # a rule, the strict reader
             out.refused = str(exc)
             continue
         if consistent is None or consistent(moved.model, moved.system):
@@ -205,7 +207,7 @@ def perturbations(model, system, consistent=None, count: int = SETS, seed: int =
         for unit in list(units):  # which move breaks what agreed: each alone
             try:
                 alone = made({unit: factors[unit]})
-            except PendverifyError:
+            except (PendverifyError, ValueError, ArithmeticError):
                 continue
             if not consistent(alone.model, alone.system):
                 culprits.append(unit)
