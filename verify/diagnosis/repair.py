@@ -64,6 +64,7 @@ from pendverify.diagnosis.slots import QUANTITY, SCREEN_STATES, Slot, entry_labe
 from pendverify.errors import PendverifyError
 from pendverify.symbolic.edited import edited_model
 from pendverify.symbolic.edits import Edit
+from pendverify.symbolic.zero_test import is_zero, probe
 
 CONFIRMATIONS = 12
 #: pairs of edits of one entry are tried for models of up to this many degrees of freedom
@@ -277,6 +278,7 @@ class _Confirmation:
         alternatives (the other edits that held, and the first with members of a group of equal
         parameters exchanged), each with the relation under which it agrees with the first."""
         (changes, edit, slot), found = self.found[0], self.found[1:]
+        found = [f for f in found if not _same_edit(f[0], changes, self.sm)]  # written otherwise
         independent = self.perturbation.independent
         others = [(c, e, s, unless(changes, c, self.sm, independent, notation)) for c, e, s in found]
         groups, params = self.perturbation.groups, self.batch.model.params
@@ -312,6 +314,14 @@ class _Confirmation:
             f"; {edits}{more} make(s) every check pass at these parameter values, but not at other values "
             f"({self.perturbation.how}): a coincidence of the values, not a repair"
         )
+
+
+def _same_edit(changes: dict, other: dict, sm) -> bool:
+    """Whether two edits write the same entries as the same functions (``l1**2*(m1 + m2)`` and
+    ``l1**2*m1 + l1**2*m2``): one repair, not two."""
+    differences = [changes[key][1] - other[key][1] for key in changes] if set(changes) == set(other) else None
+    # a probe in 50 digits tells most different ones apart at once; the exact test decides the rest
+    return differences is not None and all(not probe(d) and is_zero(d, sm.angles) for d in differences)
 
 
 def _findings(
