@@ -20,14 +20,17 @@
 4. **Confirmed**: the repair is *confirmed* (``details["confirmed"]``) when it held at every
    perturbed set, every parameter of the edit was moved on its own there, and no other edit
    held: it is then the same function of the parameters as what the robot says, not only the
-   same numbers.  Otherwise it holds at these values only, and the message says why: a
-   parameter of the edit could not be moved in the description (its reason), or was moved
-   only together with others that share its value (m1 = m2: an edit and the same edit with m1
-   and m2 exchanged cannot be told apart), or another edit holds as well (an error in B shows
-   as well in a hand-written q̈ that uses it).  Each alternative is named with the relation
-   under which the two agree, solved for one parameter (``I → 4*I`` and ``I → I + mp*r**2``
-   differ unless I = mp*r**2/3): ``pendverify.diagnosis.alternatives``, which also gives the
-   edits tried in place of a coincidence (the same numbers from other parameters).
+   same numbers.  Otherwise the message says why not: a parameter of the edit could not be
+   moved in the description (its reason), or was moved only together with others that share
+   its value (m1 = m2: an edit and the same edit with m1 and m2 exchanged cannot be told
+   apart), or another edit holds as well (an error in B shows as well in a hand-written q̈
+   that uses it), or it edits what no check compares with the robot (B, W, and D where the
+   URDF declares no damping: ``B[1,1]: 1 → 0`` passes every check when the q̈ that uses B
+   lost its input, since both sides of aba take B from the model).  Each alternative is
+   named with the relation under which the two agree, solved for one parameter (``I → 4*I``
+   and ``I → I + mp*r**2`` differ unless I = mp*r**2/3): ``pendverify.diagnosis.alternatives``,
+   which also gives the edits tried in place of a coincidence (the same numbers from other
+   parameters).
 
 When no single edit passes, pairs of edits of one entry are tried for models of up to three
 degrees of freedom.
@@ -83,6 +86,9 @@ ALTERNATIVE_SECONDS = 2.0
 #: (a trigonometric polynomial of a few terms in the state, not zero as a function at the moved
 #: parameters) is non-zero at almost every state: 24 states, the special ones first, find it.
 PERTURBED_STATES = SCREEN_STATES
+#: what no check compares with the robot (B and W enter both sides of aba; D too where the URDF
+#: declares no damping): an edit of them is never confirmed
+UNCOMPARED = ("input_matrix", "disturbance_matrix")
 
 
 def _passes(model, system, states) -> bool:
@@ -223,7 +229,17 @@ class _Confirmation:
         (kept per edit: the first repair's are asked for each candidate after it)."""
         key = tuple(sorted((m, i, str(new)) for (m, i), (_, new) in changes.items()))
         if key not in self._limits_of:
-            self._limits_of[key] = self.perturbation.why_not_alone(edit_parameters(changes, self.sm))
+            limits = self.perturbation.why_not_alone(edit_parameters(changes, self.sm))
+            free = self.batch.system.urdf_damping() is None
+            unchecked = sorted(
+                {QUANTITY[m] for m, _ in changes if m in UNCOMPARED or (m == "damping_matrix" and free)}
+            )
+            if unchecked:
+                limits.append(
+                    f"no check compares {' or '.join(unchecked)} with the robot, so an edit of it and "
+                    "the same change where it is used cannot be told apart"
+                )
+            self._limits_of[key] = limits
         return self._limits_of[key]
 
     def run(self, ordered) -> None:
@@ -286,12 +302,13 @@ class _Confirmation:
         sets = len(self.perturbation.sets)
         limits = self._limits(changes)
         confirmed = not limits and not others and sets > 0
+        values_only = bool(self.perturbation.why_not_alone(edit_parameters(changes, self.sm)))
         if confirmed:
             verdict = "makes every check pass on every state, at these parameter values and at "
             verdict += f"{sets} others ({self.perturbation.how})"
         else:
             also = [f"{shown(c, e, forms, notation)} holds as well{why}" for c, e, _, why in others]
-            if limits:
+            if values_only:
                 verdict = "makes every check pass on every state at these parameter values; not confirmed: "
             else:
                 verdict = f"makes every check pass on every state, and at {sets} other parameter sets; "
