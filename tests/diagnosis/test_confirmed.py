@@ -170,6 +170,22 @@ def test_a_model_whose_parameters_all_move_keeps_its_exact_confirmed_repair(
     assert sp.simplify(restored - original) == 0, first.message
 
 
+def test_an_edit_of_what_no_check_compares_is_never_confirmed():
+    """The cart-pole's f lost its input u: B[1,1] = 0 passes every check as well (aba takes B from
+    the model on both sides), so it is printed, but not as confirmed."""
+    ((label, model, system, _),) = [t for t in shipped_targets() if t[0].startswith("cart_pole, model (P")]
+    sm = SymbolicModel.of(type(model))
+    original = sm.closed_forms["f"][0]
+    planted = original.subs(sm.symbols["u"][0], 0)
+    edited = edited_model(model, sm, {"f": [(0, original, planted)]}, "Planted")
+    states = sample_states(model, CORPUS_SAMPLES, CORPUS_SEED)
+    batch = CheckBatch(edited, system, states)
+    results = run_checks(label, edited, system, states, CORPUS_SEED, applicable_checks(edited, system), batch)
+    repairs = [f for f in explain(batch, results) if f.kind == "repair"]
+    assert repairs and not _confirmed(repairs)
+    assert "no check compares B with the robot" in repairs[0].message
+
+
 def test_coincident_corpus_no_wrong_repair_confirmed_and_the_rest_stated(capsys):
     targets = [t for t in class_targets() if t[0].endswith(f"({COINCIDENT})")]
     assert len(targets) >= 4
