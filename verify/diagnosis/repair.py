@@ -224,9 +224,10 @@ class _Confirmation:
             self._perturbation = perturbations(self.batch.model, self.batch.system, consistent)
         return self._perturbation
 
-    def _limits(self, changes) -> list[str]:
-        """Why an edit is not confirmed even when it holds: its parameters not moved on their own
-        (kept per edit: the first repair's are asked for each candidate after it)."""
+    def _limits(self, changes, values: bool = False) -> list[str]:
+        """Why an edit is not confirmed even when it holds: its parameters not moved on their own,
+        then (unless ``values``: those alone) what it edits that no check compares with the robot.
+        Kept per edit: the first repair's are asked for each candidate after it."""
         key = tuple(sorted((m, i, str(new)) for (m, i), (_, new) in changes.items()))
         if key not in self._limits_of:
             limits = self.perturbation.why_not_alone(edit_parameters(changes, self.sm))
@@ -234,13 +235,13 @@ class _Confirmation:
             unchecked = sorted(
                 {QUANTITY[m] for m, _ in changes if m in UNCOMPARED or (m == "damping_matrix" and free)}
             )
-            if unchecked:
-                limits.append(
-                    f"no check compares {' or '.join(unchecked)} with the robot, so an edit of it and "
-                    "the same change where it is used cannot be told apart"
-                )
-            self._limits_of[key] = limits
-        return self._limits_of[key]
+            other = [
+                f"no check compares {' or '.join(unchecked)} with the robot, so an edit of it and "
+                "the same change where it is used cannot be told apart"
+            ]
+            self._limits_of[key] = (limits, other if unchecked else [])
+        limits, other = self._limits_of[key]
+        return limits if values else limits + other
 
     def run(self, ordered) -> None:
         for rank, changes, edit, slot in ordered:
@@ -249,8 +250,8 @@ class _Confirmation:
             if late or self.tried >= CONFIRMATIONS or len(self.found) > ALTERNATIVES:
                 return
             simple = rank <= RANK["scale"] or rank == RANK["pair"]
-            if self.found and not simple and not self._limits(self.found[0][0]):
-                # after a confirmed edit an alternative is a simple edit, not a shift or a fitted term;
+            if self.found and not simple and not self._limits(self.found[0][0], values=True):
+                # after an edit whose parameters all moved, an alternative is a simple edit, not a fitted term;
                 # after one that holds at these values only, any edit that holds is worth naming
                 return
             key = tuple(sorted((m, i, str(new)) for (m, i), (_, new) in changes.items()))
@@ -259,7 +260,7 @@ class _Confirmation:
             if self.found and self.tried - self.tried_at_first >= ALTERNATIVE_TRIES:
                 return
             verdict = self._check(changes, edit, slot)
-            first_limited = verdict == "holds" and len(self.found) == 1 and self._limits(changes)
+            first_limited = verdict == "holds" and len(self.found) == 1 and self._limits(changes, values=True)
             if (verdict == "coincidence" and not self.found) or first_limited:
                 # the same numbers from other parameters, tried at once against every set: in place
                 # of a coincidence, or as the alternatives of a repair that holds at these values only
@@ -302,7 +303,7 @@ class _Confirmation:
         sets = len(self.perturbation.sets)
         limits = self._limits(changes)
         confirmed = not limits and not others and sets > 0
-        values_only = bool(self.perturbation.why_not_alone(edit_parameters(changes, self.sm)))
+        values_only = bool(self._limits(changes, values=True))
         if confirmed:
             verdict = "makes every check pass on every state, at these parameter values and at "
             verdict += f"{sets} others ({self.perturbation.how})"
