@@ -251,7 +251,7 @@ class _Confirmation:
                 return
             simple = rank <= RANK["scale"] or rank == RANK["pair"]
             if self.found and not simple and not self._limits(self.found[0][0], values=True):
-                # after an edit whose parameters all moved, an alternative is a simple edit, not a fitted term;
+                # after an edit whose parameters all moved an alternative is a simple edit, not a fit;
                 # after one that holds at these values only, any edit that holds is worth naming
                 return
             key = tuple(sorted((m, i, str(new)) for (m, i), (_, new) in changes.items()))
