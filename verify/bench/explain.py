@@ -4,9 +4,12 @@ The corpus of ``pendverify.diagnosis.corpus`` on every model file the worked exa
 (the Python class, and the same model as LaTeX or text where one is shipped) and on the models
 of ``examples/diagnosis_corpus.toml`` (one per class of model the examples do not cover), each against
 its URDF and parameter set: per model, how many planted errors the checks detect, how many
-the diagnosis names at the right entry, repairs (confirmed by every check) and restores (the
-planted edit or an equivalent one), whether the untouched model is clean, and the time a
-diagnosis takes (mean and largest, per planted error, on one core).  ``quick`` draws up to
+the diagnosis names at the right entry, repairs (every check passes) and restores (the planted
+edit or an equivalent one), how many of those are printed as confirmed (they held at perturbed
+parameter sets too) or with the ambiguity stated (they hold at these values only, and the
+message says so), how many wrong repairs are printed as confirmed (never any, by design),
+whether the untouched model is clean, and the time a diagnosis takes (mean and largest, per
+planted error, on one core).  ``quick`` draws up to
 ``QUICK_PER_OPERATOR`` planted errors of each operator per model (seeded) instead of all.  A
 catalogue entry with ``pairs = N`` is planted N pairs of errors in two different keys instead
 (``QUICK_PAIRS`` with ``quick``): the class of two errors at once.
@@ -30,6 +33,8 @@ from pendverify.display import REPR_LIMIT, html_table, shortened
 QUICK_PER_OPERATOR = 2
 #: pairs of planted errors drawn per paired model with ``quick`` (``paired_classes``)
 QUICK_PAIRS = 6
+#: what is counted per model (``pendverify.diagnosis.corpus.Score``)
+SCORED = ("detected", "named", "repaired", "restored", "confirmed", "ambiguity_stated", "wrong_confirmed")
 #: the diagnosis's bound on a model of up to 3 degrees of freedom on this project's 2-core machine
 BOUND_S = 10.0
 
@@ -48,17 +53,16 @@ class ExplainBench:
         return f"{head}{shortened(totals, REPR_LIMIT - len(head) - 1)}>"
 
     def _repr_html_(self) -> str:
-        whats = ("detected", "named", "repaired", "restored")
+        whats = SCORED
         cells = [(m.label, len(m.scores), *(m.count(w) for w in whats)) for m in self.models]
         return html_table(
             ("model", "planted", *whats), cells, f"bench explain ({'quick' if self.quick else 'full'})"
         )
 
     def totals(self) -> dict[str, int]:
-        return {
-            what: sum(m.count(what) for m in self.models)
-            for what in ("detected", "named", "repaired", "restored")
-        } | {"planted": sum(len(m.scores) for m in self.models)}
+        return {what: sum(m.count(what) for m in self.models) for what in SCORED} | {
+            "planted": sum(len(m.scores) for m in self.models)
+        }
 
 
 #: the shipped list of the corpus's models besides the worked examples, one per class of model

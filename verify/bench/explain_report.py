@@ -1,5 +1,7 @@
 """The text of ``pendverify bench explain``: one row per model file, the totals against the 90 %
-target, the largest diagnosis against the time bound (``pendverify.bench.explain`` measures)."""
+target, the repairs printed as confirmed or with their ambiguity stated, the wrong ones printed
+as confirmed (the target is none), the largest diagnosis against the time bound
+(``pendverify.bench.explain`` measures)."""
 
 from __future__ import annotations
 
@@ -22,6 +24,9 @@ def table(bench: ExplainBench) -> str:
         "named",
         "repaired",
         "restored",
+        "confirmed",
+        "ambiguous",
+        "wrong conf.",
         "clean",
         "mean s",
         "max s",
@@ -39,6 +44,9 @@ def table(bench: ExplainBench) -> str:
                 _rate(m.count("named"), detected),
                 _rate(m.count("repaired"), detected),
                 _rate(m.count("restored"), detected),
+                str(m.count("confirmed")),
+                str(m.count("ambiguity_stated")),
+                str(m.count("wrong_confirmed")),
                 "yes" if m.clean else "NO",
                 f"{np.mean(seconds):.2f}",
                 f"{max(seconds):.2f}",
@@ -57,6 +65,9 @@ def table(bench: ExplainBench) -> str:
         f"repaired {_rate(t['repaired'], t['detected'])}, the planted edit or an equivalent one "
         f"{_rate(t['restored'], t['detected'])} (target ≥ 90 %: "
         f"{'met' if t['detected'] and t['restored'] >= 0.9 * t['detected'] else 'NOT met'})",
+        f"restored and confirmed {_rate(t['confirmed'], t['detected'])}, restored with the ambiguity "
+        f"stated {_rate(t['ambiguity_stated'], t['detected'])}; wrong repairs printed as confirmed: "
+        f"{t['wrong_confirmed']} (target 0: {'met' if t['wrong_confirmed'] == 0 else 'NOT met'})",
         f"untouched models clean: {sum(m.clean for m in bench.models)}/{len(bench.models)}; "
         f"largest diagnosis {slowest:.2f} s (bound {BOUND_S:g} s for up to 3 degrees of freedom: "
         f"{'met' if slowest <= BOUND_S else 'NOT met'})",

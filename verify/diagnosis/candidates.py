@@ -480,3 +480,23 @@ def slot_pairs(a: Slot, b: Slot) -> list[tuple[int, dict, Edit, Slot]]:
         changes = {(a.method, a.index): (a.expr, ea.expr), (b.method, b.index): (b.expr, eb.expr)}
         out.append((20 + RANK.get(ea.operator, 9) + RANK.get(eb.operator, 9), changes, ea, a))
     return sorted(out, key=lambda c: c[0])
+
+
+def equal_valued(value: float, monomials, limit: int = 4) -> list[sp.Expr]:
+    """Up to ``limit`` expressions ± a simple fraction times a product of parameters (of
+    ``monomials``, (value, expression) pairs) equal to ``value`` to 1e-9, products as they stand
+    first, in ``monomials``' order (``_matched``'s, which gives only the first): at parameter
+    values that satisfy relations several are, and a repair that proves a coincidence
+    (``pendverify.diagnosis.repair``) is tried again with the others."""
+    close = 1e-9 * abs(value)
+    out = []
+    for whole in (True, False):
+        for v, expr in monomials:
+            ratio = Fraction(abs(value) / v).limit_denominator(12)
+            if (ratio == 1) is whole and ratio in FRACTIONS and abs(float(ratio) * v - abs(value)) <= close:
+                found = sp.sign(value) * sp.Rational(ratio.numerator, ratio.denominator) * expr
+                if found not in out:
+                    out.append(found)
+                if len(out) == limit:
+                    return out
+    return out

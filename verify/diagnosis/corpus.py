@@ -18,6 +18,16 @@ repaired
 restored
     the repair gives back the entries as they were, or ones proved equal to them
     (``pendverify.symbolic.zero_test``): the planted edit or an equivalent one;
+confirmed
+    a repair printed as confirmed (``details["confirmed"]``: it held at perturbed parameter sets
+    too, ``pendverify.diagnosis.repair``) restores the planted entry;
+wrong_confirmed
+    a repair is printed as confirmed, and none that is restores the planted entry: advice that
+    must never be given, whatever the parameter values;
+ambiguity_stated
+    no repair is printed as confirmed, and one printed as holding at these values only (the
+    first or an alternative it names) restores the planted entry: the user is told the fix and
+    that the checks cannot single it out;
 seconds
     how long the diagnosis took (``explain``, after the checks, as ``check`` runs it).
 
@@ -142,6 +152,9 @@ class Score:
     named: bool = False
     repaired: bool = False
     restored: bool = False
+    confirmed: bool = False
+    wrong_confirmed: bool = False
+    ambiguity_stated: bool = False
     seconds: float = 0.0
     message: str = ""
 
@@ -176,12 +189,17 @@ def _named(plant: Plant, findings, forms) -> bool:
     return (quantity, index) in named
 
 
-def _restored(findings, plant: Plant, sm: SymbolicModel) -> bool:
-    """Whether a confirmed repair of the planted entry gives back the original (or an equal) entry."""
+def _restored(findings, plant: Plant, sm: SymbolicModel, confirmed: bool | None = None) -> bool:
+    """Whether a repair of the planted entry that makes every check pass (and is ``confirmed``, or
+    not, when that is given) gives back the original (or an equal) entry."""
     names = {s.name: s for group in sm.symbols.values() for s in group}
     names |= {p.name: p for p in sm.parameters.values()} | FUNCTIONS | CONSTANTS
     for f in findings:
-        if f.kind == "repair" and f.details.get("checks_pass") and f.details["written"] == str(plant.new):
+        if f.kind != "repair" or not f.details.get("checks_pass"):
+            continue
+        if confirmed is not None and bool(f.details.get("confirmed")) is not confirmed:
+            continue
+        if f.details["written"] == str(plant.new):
             suggested = read_expression(f.details["suggested"], names)
             if is_zero(suggested - plant.original, sm.angles):
                 return True
@@ -224,6 +242,12 @@ def score_model(
             score.named = all(_named(p, findings, forms) for p in group)
             score.repaired = any(f.kind == "repair" and f.details.get("checks_pass") for f in findings)
             score.restored = all(_restored(findings, p, sm) for p in group)
+            printed_confirmed = any(f.kind == "repair" and f.details.get("confirmed") for f in findings)
+            score.confirmed = all(_restored(findings, p, sm, confirmed=True) for p in group)
+            score.wrong_confirmed = printed_confirmed and not score.confirmed
+            score.ambiguity_stated = not printed_confirmed and all(
+                _restored(findings, p, sm, confirmed=False) for p in group
+            )
             score.message = next((f.message for f in findings if f.kind == "repair"), "")
         out.scores.append(score)
         if progress is not None:

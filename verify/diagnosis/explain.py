@@ -98,5 +98,7 @@ def explain(batch, results, deadline_s: float = REPAIR_DEADLINE_S) -> list[Findi
         why_not = f"{why_not}; {stopped}" if why_not else stopped
     if why_not:  # said as a repair that is not one: checks_pass false, nothing suggested
         details = {"written": None, "suggested": None, "suggested_source": None, "location": None}
-        findings.append(Finding("repair", why_not, details={**details, "checks_pass": False}))
+        findings.append(
+            Finding("repair", why_not, details={**details, "checks_pass": False, "confirmed": False})
+        )
     return ranked(findings)

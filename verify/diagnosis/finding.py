@@ -8,7 +8,8 @@ field           meaning
 ==============  ===========================================================================
 kind            ``entry`` (an entry that differs), ``pattern`` (the shape of its
                 difference over the states), ``repair`` (an edit of the model's own
-                expressions after which every check passes on every state), ``parameters``
+                expressions after which every check passes on every state, confirmed or
+                at these parameter values only), ``parameters``
                 (the hand model is this robot with other inertial parameters),
                 ``convention`` (a coordinate or inertia convention trap), ``structural``
                 (no inertial parameters explain the difference)
@@ -22,8 +23,12 @@ message         the finding in words, as the text report prints it
 A ``repair`` adds ``written`` and ``suggested`` (the entry before and after the edit, in
 SymPy syntax over the model's own names), ``suggested_source`` (the edit in the model's own
 notation: LaTeX for a LaTeX file, SymPy syntax for a text file, the Python expression for
-a class), ``location`` (file, key or method, and entry) and ``checks_pass`` (true only when
-every check was re-run on every state and passed).  A ``parameters`` finding adds
+a class), ``location`` (file, key or method, and entry), ``checks_pass`` (true when every
+check was re-run on every state at the parameter file's values and passed) and ``confirmed``
+(true only when it also passed at perturbed parameter sets, the description rewritten for
+each, every parameter of the edit moved on its own, and no other edit passed: the same
+function of the parameters, not the same numbers; ``pendverify.diagnosis.repair``).  A
+``parameters`` finding adds
 ``link``, ``parameter``, ``model_value`` and ``urdf_value``.
 """
 

@@ -5,21 +5,40 @@
 2. **What**: per slot, the edits that make it agree at the screening states
    (``pendverify.diagnosis.candidates``: the inverses of ``pendverify mutate``'s operators,
    coefficients and added terms solved for), ordered simplest first.
-3. **Confirmed**: a candidate becomes a repair only when the edited model
+3. **Checked**: a candidate becomes a repair only when the edited model
    (``pendverify.symbolic.edited``) passes every applicable check on every state of the
-   report's batch; candidates are confirmed simplest first, at most ``CONFIRMATIONS`` of
-   them, within the time bound.  Once one is confirmed, the next simple edits (of
-   this entry or another, ``ALTERNATIVE_TRIES`` of them) are confirmed too and the ones that
-   pass are shown as alternatives (up to ``ALTERNATIVES``): with the given parameter values two
-   edits can give the same numbers (m = 2·m2 makes m2 → m the same as a factor 2), and an error
-   in B shows as well in a hand-written q̈ that uses it; the checks cannot tell which one the
-   derivation meant.  When no single edit
-   passes, pairs of edits of one entry are tried for models of up to three degrees of freedom.
-   When still none passes and the written C is not Pinocchio's, the screened edits are confirmed
-   again against the model's own baseline: the warning of a C that is a valid C·q̇ but not the
-   Christoffel C, nothing worse (``pendverify.diagnosis.acceptance``).  Then, for models of up
-   to three degrees of freedom, one edit of each of two entries that each passed their own
-   screen (``cross_pairs``): two errors in different keys, one in M and one in C.
+   report's batch, and then again at each perturbed parameter set
+   (``pendverify.diagnosis.perturbed``: the parameters moved, the robot description rewritten
+   for each) on the first ``PERTURBED_STATES`` of those states.  One that fails at a perturbed
+   set is a coincidence of the parameter values (``I → 4*I`` where I = m·l²/12 and lc = l/2):
+   it is not a repair, and the search goes on; the sentence that says no repair was found names
+   it.  Candidates are checked simplest first, at most ``CONFIRMATIONS`` of them, within the
+   time bound.  Once one holds, the next simple edits (of this entry or another,
+   ``ALTERNATIVE_TRIES`` of them; any edit, fitted terms too, when the first one involves a
+   parameter that was not moved on its own) are checked too, and the ones that hold are shown
+   as alternatives (up to ``ALTERNATIVES``).
+4. **Confirmed**: the repair is *confirmed* (``details["confirmed"]``) when it held at every
+   perturbed set, every parameter of the edit was moved on its own there, and no other edit
+   held: it is then the same function of the parameters as what the robot says, not only the
+   same numbers.  Otherwise the message says why not: a parameter of the edit could not be
+   moved in the description (its reason), or was moved only together with others that share
+   its value (m1 = m2: an edit and the same edit with m1 and m2 exchanged cannot be told
+   apart), or another edit holds as well (an error in B shows as well in a hand-written q̈
+   that uses it), or it edits what no check compares with the robot (B, W, and D where the
+   URDF declares no damping: ``B[1,1]: 1 → 0`` passes every check when the q̈ that uses B
+   lost its input, since both sides of aba take B from the model).  Each alternative is
+   named with the relation under which the two agree, solved for one parameter (``I → 4*I``
+   and ``I → I + mp*r**2`` differ unless I = mp*r**2/3): ``pendverify.diagnosis.alternatives``,
+   which also gives the edits tried in place of a coincidence (the same numbers from other
+   parameters).
+
+When no single edit passes, pairs of edits of one entry are tried for models of up to three
+degrees of freedom.  When still none passes and the written C is not Pinocchio's, the screened
+edits are checked again against the model's own baseline: the warning of a C that is a valid
+C·q̇ but not the Christoffel C, nothing worse (``pendverify.diagnosis.acceptance``).  Then, for
+models of up to three degrees of freedom, one edit of each of two entries that each passed their
+own screen (``cross_pairs``): two errors in different keys, one in M and one in C.  Each pass
+shares the perturbed sets and the coincidences found before it.
 
 The repair is printed in the model's own notation, where it sits
 (``pendverify.diagnosis.notation``).  A key the model derives from another (H = ∂V/∂q of a text
@@ -37,8 +56,10 @@ import sympy as sp
 
 from pendverify.analytic.forms import entry_position
 from pendverify.analytic.symbolic_reading import SymbolicModel
+from pendverify.checks.batch import CheckBatch
 from pendverify.checks.catalogue import applicable_checks, run_checks
-from pendverify.diagnosis.acceptance import accepted, matrix_c_note, written_c_differs
+from pendverify.diagnosis.acceptance import accepted, matrix_c_note, passes, written_c_differs
+from pendverify.diagnosis.alternatives import edit_parameters, exchanged, rematched, shown, unless
 from pendverify.diagnosis.candidates import (
     RANK,
     candidates,
@@ -52,9 +73,12 @@ from pendverify.diagnosis.candidates import (
 from pendverify.diagnosis.derived import derived_methods, with_derived
 from pendverify.diagnosis.finding import Finding
 from pendverify.diagnosis.notation import TEXT_KEYS, Notation
+from pendverify.diagnosis.perturbed import perturbations
 from pendverify.diagnosis.slots import QUANTITY, SCREEN_STATES, Slot, entry_label, evaluator, find_slots
+from pendverify.errors import PendverifyError
 from pendverify.symbolic.edited import edited_model
 from pendverify.symbolic.edits import Edit
+from pendverify.symbolic.zero_test import is_zero, probe
 
 CONFIRMATIONS = 12
 #: pairs of edits of one entry are tried for models of up to this many degrees of freedom
@@ -67,22 +91,56 @@ ALTERNATIVES = 2
 ALTERNATIVE_TRIES = 4
 #: how long the search for alternatives goes on after the first repair
 ALTERNATIVE_SECONDS = 2.0
+#: states a candidate is checked on at each perturbed set: the screening states.  The candidate
+#: already matched Pinocchio on every state at the file's values, so it is the right function of
+#: the state there; what a perturbed set tests is the parameters, and a wrong edit's difference
+#: (a trigonometric polynomial of a few terms in the state, not zero as a function at the moved
+#: parameters) is non-zero at almost every state: 24 states, the special ones first, find it.
+PERTURBED_STATES = SCREEN_STATES
+#: what no check compares with the robot (B and W enter both sides of aba; D too where the URDF
+#: declares no damping): an edit of them is never confirmed
+UNCOMPARED = ("input_matrix", "disturbance_matrix")
 
 
-def _confirmed(batch, sm, changes: dict, baseline: bool = False) -> bool:
-    """Whether the model with ``changes`` passes every applicable check on every state of ``batch``
-    (``baseline``: or is back to the model's own warning, ``pendverify.diagnosis.acceptance``)."""
+def _passes(model, system, states, accept=None) -> bool:
+    """Whether ``model`` passes every applicable check on every state of ``states`` against ``system``
+    (``accept``: a judge of the results other than "every check passes", ``acceptance``)."""
+    names = applicable_checks(model, system)
+    with np.errstate(all="ignore"):
+        try:
+            results = run_checks("repair", model, system, states, 0, names)
+        except (ArithmeticError, ValueError, np.linalg.LinAlgError, PendverifyError):
+            return False  # a scale that cannot be derived too: what is not shown to pass does not
+    return accept(results) if accept is not None else all(r.passed for r in results)
+
+
+def _confirmed(batch, sm, changes: dict, moved_sets=None, baseline: bool = False) -> str:
+    """Whether the model with ``changes`` passes every applicable check: "fails" (on some state of
+    ``batch``), "coincidence" (on every state, but not at one of ``moved_sets``, a callable giving
+    the perturbed sets, on the first ``PERTURBED_STATES``), or "holds" (module docstring).
+    ``baseline``: or is back to the model's own warning (``pendverify.diagnosis.acceptance``)."""
     edits: dict[str, list] = {}
     for (method, index), (old, new) in changes.items():
         edits.setdefault(method, []).append((index, old, new))
     repaired = edited_model(batch.model, sm, edits, "Repaired")
-    names = applicable_checks(repaired, batch.system)
-    with np.errstate(all="ignore"):
-        try:
-            results = run_checks("repair", repaired, batch.system, batch.states, 0, names)
-        except (ArithmeticError, ValueError, np.linalg.LinAlgError):
-            return False
-    return accepted(results, batch, sm, changes, baseline)
+    if not _passes(repaired, batch.system, batch.states, lambda r: accepted(r, batch, sm, changes, baseline)):
+        return "fails"
+    # at the moved sets, the model's own warning is what the repair is back to when ``baseline``
+    moved_accept = passes if baseline else None
+    states = batch.states[:PERTURBED_STATES]
+    derived = bool({"gravity_scale", "diagonal_scale"} - set(type(batch.model).hand_written()))
+    for moved in moved_sets() if moved_sets is not None else ():
+        model = type(repaired)(moved.params)  # the same edited class: its generated code is reused
+        if derived:  # the tolerance scales of the model as given, at these values (``edited_model``)
+            model.use_derived_scales(moved.model.derived_scales())
+        if _passes(model, moved.system, states, moved_accept):
+            continue
+        # the model as given can have degenerate scales (an H planted as 0 has a gravity scale 0,
+        # which the rounding at the file's values may meet and other values not): the repaired
+        # model's own, derived from its M and H, decide then
+        if not derived or not _passes(type(repaired)(moved.params), moved.system, states, moved_accept):
+            return "coincidence"
+    return "holds"
 
 
 def _groups(slots: list[Slot], n: int) -> list[list[Slot]]:
@@ -133,7 +191,7 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
 
     pool = sum_pool(sm)
     monomials: dict[str, tuple] = {}
-    confirm = _Confirmation(batch, sm, deadline)
+    confirm = _Confirmation(batch, sm, deadline, derived=derived, screening=screening)
     screened = []
     for group in _groups(slots, batch.model.nv):
         for slot in group:
@@ -159,11 +217,10 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
                 for edit in pairs_within(slot, sm, evaluate, pool, deadline)
             ),
         )
-    tried = 0  # by the passes before
     if not confirm.found and time.perf_counter() < deadline and written_c_differs(batch, sm):
         # no edit makes every check pass; the written C is not Pinocchio's: the screened edits
         # again, a repair now one that is back to that C's warning (acceptance)
-        tried, confirm = confirm.tried, _Confirmation(batch, sm, deadline, baseline=True)
+        confirm = confirm.again(baseline=True)
         run(confirm, candidates(slots, screened))
         if not confirm.found and len(slots) == 2 and len(screened) == 2:
             run(confirm, slot_pairs(*slots))
@@ -172,35 +229,11 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
         for baseline in (False, True) if written_c_differs(batch, sm) else (False,):
             if confirm.found or time.perf_counter() > deadline:
                 break
-            tried += confirm.tried
-            confirm = _Confirmation(batch, sm, deadline, baseline=baseline)
+            confirm = confirm.again(baseline)
             run(confirm, cross_pairs(screened))
     notation = Notation.of(type(batch.model))
     if confirm.found:
-        findings = []
-        for k, (changes, edit, slot) in enumerate(confirm.found):
-            written = {key: change for key, change in changes.items() if key[0] not in derived}
-            found = _findings(written, edit, slot, forms, notation, alternative=k > 0)
-            if len(found) > 1:  # one repair in several entries: each finding names the others
-                labels = [
-                    f"{f.quantity}[{','.join(map(str, f.index))}]" if f.index else f.quantity for f in found
-                ]
-                found = [
-                    dataclasses.replace(
-                        f, message=f"{f.message}; together with the edit of {', '.join(others)}"
-                    )
-                    for f, others in ((f, labels[:i] + labels[i + 1 :]) for i, f in enumerate(found))
-                ]
-            note = matrix_c_note(screening, sm, changes)
-            if note:  # coriolis and skew warn after the repair, as before the error
-                found = [
-                    dataclasses.replace(
-                        f, message=f"{f.message}; {note}", details={**f.details, "warns": note}
-                    )
-                    for f in found
-                ]
-            findings += found
-        return findings, ""
+        return confirm.findings(forms, notation), ""
     where = ", ".join(s.label for s in slots[:6]) + (f" and {len(slots) - 6} more" if len(slots) > 6 else "")
     bound = (
         f" (the search stopped at its time bound: searched {len(screened)} of {len(slots)} entries)"
@@ -211,20 +244,74 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
     also += " nor one edit of each of two entries," if crossed else ""
     return [], (
         f"no repair: no single edit of {where} (nor one edit of each, for two entries,{also}) makes every "
-        f"check pass; {tried + confirm.tried} candidate(s) tried against every check{bound}"
+        f"check pass; {confirm.tried_before + confirm.tried} candidate(s) tried against every check{bound}"
+        f"{confirm.coincidence_note(forms, notation)}"
     )
 
 
 class _Confirmation:
     """The candidates every check confirms, in the order they come: the first, then alternatives
-    (module docstring); how many were tried; when the search for alternatives ends."""
+    (module docstring); the coincidences (every check passes at the file's values, not at a
+    perturbed set); how many were tried; when the search for alternatives ends."""
 
-    def __init__(self, batch, sm, deadline: float, baseline: bool = False):
+    def __init__(self, batch, sm, deadline: float, baseline: bool = False, derived=None, screening=None):
         self.batch, self.sm, self.deadline, self.baseline = batch, sm, deadline, baseline
+        #: the keys derived from others (never printed as edited) and the screening states
+        self.derived, self.screening = derived or {}, screening
         self.found: list = []
+        self.coincidences: list = []
         self.tried, self.tried_at_first, self.longest = 0, 0, 0.0
+        self.tried_before = 0  # by the passes before this one (``again``)
         self.seen: set = set()
         self.alternatives_until = float("inf")
+        self._perturbation = None
+        self._limits_of: dict = {}
+
+    def again(self, baseline: bool) -> _Confirmation:
+        """A new pass (module docstring) sharing this one's perturbed sets, coincidences and count."""
+        nxt = _Confirmation(self.batch, self.sm, self.deadline, baseline, self.derived, self.screening)
+        nxt._perturbation, nxt.coincidences = self._perturbation, self.coincidences
+        nxt.tried_before = self.tried_before + self.tried
+        return nxt
+
+    @property
+    def perturbation(self):
+        """The perturbed sets (``pendverify.diagnosis.perturbed``), made when first needed: at the
+        first candidate that passes at the file's values."""
+        if self._perturbation is None:
+            states = self.batch.states[:PERTURBED_STATES]
+            screening = self.batch.subset(range(len(states)))
+            differing = {(s.method, s.index) for s in find_slots(screening, self.sm)}
+
+            def consistent(model, system) -> bool:  # no entry that agrees here disagrees there
+                with np.errstate(all="ignore"):
+                    try:
+                        slots = find_slots(CheckBatch(model, system, states), self.sm)
+                    except (ArithmeticError, ValueError, np.linalg.LinAlgError):
+                        return False
+                return {(s.method, s.index) for s in slots} <= differing
+
+            self._perturbation = perturbations(self.batch.model, self.batch.system, consistent)
+        return self._perturbation
+
+    def _limits(self, changes, values: bool = False) -> list[str]:
+        """Why an edit is not confirmed even when it holds: its parameters not moved on their own,
+        then (unless ``values``: those alone) what it edits that no check compares with the robot.
+        Kept per edit: the first repair's are asked for each candidate after it."""
+        key = tuple(sorted((m, i, str(new)) for (m, i), (_, new) in changes.items()))
+        if key not in self._limits_of:
+            limits = self.perturbation.why_not_alone(edit_parameters(changes, self.sm))
+            free = self.batch.system.urdf_damping() is None
+            unchecked = sorted(
+                {QUANTITY[m] for m, _ in changes if m in UNCOMPARED or (m == "damping_matrix" and free)}
+            )
+            other = [
+                f"no check compares {' or '.join(unchecked)} with the robot, so an edit of it and "
+                "the same change where it is used cannot be told apart"
+            ]
+            self._limits_of[key] = (limits, other if unchecked else [])
+        limits, other = self._limits_of[key]
+        return limits if values else limits + other
 
     def run(self, ordered) -> None:
         for rank, changes, edit, slot in ordered:
@@ -232,26 +319,132 @@ class _Confirmation:
             late = time.perf_counter() + self.longest > min(self.deadline, self.alternatives_until)
             if late or self.tried >= CONFIRMATIONS or len(self.found) > ALTERNATIVES:
                 return
-            if self.found and (rank > RANK["scale"] and rank != RANK["pair"]):
-                return  # an alternative is a simple edit, not a shift or a fitted term that happens to fit
+            simple = rank <= RANK["scale"] or rank == RANK["pair"]
+            if self.found and not simple and not self._limits(self.found[0][0], values=True):
+                # after an edit whose parameters all moved an alternative is a simple edit, not a fit;
+                # after one that holds at these values only, any edit that holds is worth naming
+                return
             key = tuple(sorted((m, i, str(new)) for (m, i), (_, new) in changes.items()))
             if key in self.seen:
                 continue  # the same edit again
             if self.found and self.tried - self.tried_at_first >= ALTERNATIVE_TRIES:
                 return
-            self.seen.add(key)
-            self.tried += 1
-            started = time.perf_counter()
-            if _confirmed(self.batch, self.sm, changes, self.baseline):
-                self.found.append((changes, edit, slot))
-                if len(self.found) == 1:
-                    self.tried_at_first = self.tried
-                    self.alternatives_until = time.perf_counter() + ALTERNATIVE_SECONDS
-            self.longest = max(self.longest, time.perf_counter() - started)
+            verdict = self._check(changes, edit, slot)
+            first_limited = verdict == "holds" and len(self.found) == 1 and self._limits(changes, values=True)
+            if (verdict == "coincidence" and not self.found) or first_limited:
+                # the same numbers from other parameters, tried at once against every set: in place
+                # of a coincidence, or as the alternatives of a repair that holds at these values only
+                for variant, rematch in rematched(changes, self.sm, self.batch.model.params, slot):
+                    late = time.perf_counter() + self.longest > self.deadline
+                    if late or len(self.found) > ALTERNATIVES:
+                        break
+                    if self._check(variant, rematch, slot) == "holds" and not first_limited:
+                        break
+
+    def _check(self, changes: dict, edit: Edit, slot: Slot) -> str:
+        """``_confirmed``'s verdict on one candidate, recorded (found, a coincidence, tried)."""
+        key = tuple(sorted((m, i, str(new)) for (m, i), (_, new) in changes.items()))
+        if key in self.seen:
+            return "seen"
+        self.seen.add(key)
+        self.tried += 1
+        started = time.perf_counter()
+        verdict = _confirmed(self.batch, self.sm, changes, lambda: self.perturbation.sets, self.baseline)
+        if verdict == "holds":
+            self.found.append((changes, edit, slot))
+            if len(self.found) == 1:
+                self.tried_at_first = self.tried
+                self.alternatives_until = time.perf_counter() + ALTERNATIVE_SECONDS
+        elif verdict == "coincidence":
+            self.coincidences.append((changes, edit, slot))
+        self.longest = max(self.longest, time.perf_counter() - started)
+        return verdict
+
+    def findings(self, forms: dict, notation) -> list[Finding]:
+        """The ``repair`` findings of what was found: the first, confirmed or not and why, then the
+        alternatives (the other edits that held, and the first with members of a group of equal
+        parameters exchanged), each with the relation under which it agrees with the first."""
+        (changes, edit, slot), found = self.found[0], self.found[1:]
+        found = [f for f in found if not _same_edit(f[0], changes, self.sm)]  # written otherwise
+        independent = self.perturbation.independent
+        others = [(c, e, s, unless(changes, c, self.sm, independent, notation)) for c, e, s in found]
+        groups, params = self.perturbation.groups, self.batch.model.params
+        others += exchanged(changes, edit, slot, groups, params, self.sm)
+        sets = len(self.perturbation.sets)
+        limits = self._limits(changes)
+        confirmed = not limits and not others and sets > 0
+        values_only = bool(self._limits(changes, values=True))
+        if confirmed:
+            verdict = "makes every check pass on every state, at these parameter values and at "
+            verdict += f"{sets} others ({self.perturbation.how})"
+        else:
+            also = [f"{shown(c, e, forms, notation)} holds as well{why}" for c, e, _, why in others]
+            if values_only:
+                verdict = "makes every check pass on every state at these parameter values; not confirmed: "
+            else:
+                verdict = f"makes every check pass on every state, and at {sets} other parameter sets; "
+                verdict += "not confirmed: "
+            verdict += "; ".join(limits + also)
+        out = self._dressed(
+            changes, _findings(self._written(changes), edit, slot, forms, notation, verdict, confirmed)
+        )
+        for c, e, s, why in others:
+            verdict = f"makes every check pass on every state as well; not confirmed: like the first{why}"
+            out += self._dressed(
+                c, _findings(self._written(c), e, s, forms, notation, verdict, False, alternative=True)
+            )
+        return out
+
+    def _written(self, changes: dict) -> dict:
+        """The changes of the keys the model writes (a derived key is derived again, not edited)."""
+        return {key: change for key, change in changes.items() if key[0] not in self.derived}
+
+    def _dressed(self, changes: dict, found: list[Finding]) -> list[Finding]:
+        """The findings of one repair, each naming the others of a repair of several entries, and
+        noting the warning of a C that is not the Christoffel one where the repaired model keeps it."""
+        if len(found) > 1:
+            labels = [
+                f"{f.quantity}[{','.join(map(str, f.index))}]" if f.index else f.quantity for f in found
+            ]
+            found = [
+                dataclasses.replace(f, message=f"{f.message}; together with the edit of {', '.join(others)}")
+                for f, others in ((f, labels[:i] + labels[i + 1 :]) for i, f in enumerate(found))
+            ]
+        note = matrix_c_note(self.screening, self.sm, changes) if self.screening is not None else ""
+        if note:  # coriolis and skew warn after the repair, as before the error
+            found = [
+                dataclasses.replace(f, message=f"{f.message}; {note}", details={**f.details, "warns": note})
+                for f in found
+            ]
+        return found
+
+    def coincidence_note(self, forms: dict, notation) -> str:
+        """For the sentence that says no repair was found: the edits that passed at the file's values
+        only (module docstring), or ""."""
+        if not self.coincidences:
+            return ""
+        edits = ", ".join(shown(c, e, forms, notation) for c, e, _ in self.coincidences[:2])
+        more = f" and {len(self.coincidences) - 2} more" if len(self.coincidences) > 2 else ""
+        return (
+            f"; {edits}{more} make(s) every check pass at these parameter values, but not at other values "
+            f"({self.perturbation.how}): a coincidence of the values, not a repair"
+        )
 
 
-def _findings(changes: dict, edit: Edit, slot: Slot, forms: dict, notation, alternative: bool = False):
-    """The ``repair`` findings of one confirmed edit (one per entry it changes)."""
+def _same_edit(changes: dict, other: dict, sm) -> bool:
+    """Whether two edits write the same entries as the same functions (``l1**2*(m1 + m2)`` and
+    ``l1**2*m1 + l1**2*m2``): one repair, not two."""
+    differences = [changes[key][1] - other[key][1] for key in changes] if set(changes) == set(other) else None
+    # a probe in 50 digits tells most different ones apart at once; the exact test decides the rest
+    return differences is not None and all(not probe(d) and is_zero(d, sm.angles) for d in differences)
+
+
+def _findings(
+    changes: dict, edit: Edit, slot: Slot, forms: dict, notation, verdict: str, confirmed: bool,
+    alternative: bool = False,
+):  # fmt: skip
+    """The ``repair`` findings of one edit that makes every check pass (one per entry it changes);
+    ``verdict`` says whether it is confirmed (``_Confirmation.findings``)."""
     out = []
     for (method, index), (old, new) in changes.items():
         label = entry_label(method, forms[method], index)
@@ -264,11 +457,7 @@ def _findings(changes: dict, edit: Edit, slot: Slot, forms: dict, notation, alte
         )
         if edit.operator == "pair":
             shown += f" (two edits: {edit.what})"
-        message = f"{label}: {shown} makes every check pass on every state ({location})"
-        if alternative:
-            message = (
-                f"or, equally: {message} (with these parameter values the checks cannot tell the two apart)"
-            )
+        message = f"{'or, equally: ' if alternative else ''}{label}: {shown} {verdict} ({location})"
         quantity = QUANTITY.get(method)
         value = forms[method]
         if isinstance(value, sp.MatrixBase):
@@ -287,6 +476,7 @@ def _findings(changes: dict, edit: Edit, slot: Slot, forms: dict, notation, alte
                     "suggested_source": suggested,
                     "location": location,
                     "checks_pass": True,
+                    "confirmed": confirmed,
                 },
             )
         )

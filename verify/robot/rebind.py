@@ -18,9 +18,15 @@ gravity    nowhere: Pinocchio takes g from the parameter set
 A value equal (to 1e-12) in more than one parameter of those kinds is ambiguous;
 a value found nowhere (a drawing-only length, or a URDF that holds a combination
 of parameters, such as an inertia about the joint) is unbound.  Either way the
-parameter cannot be changed, and ``rewrite`` says so naming it; it never guesses.
-A parameter whose value is 0 is unbound (every zero would match).  What the
-rewritten URDF means is checked like any URDF: by the checks.
+parameter cannot be changed on its own, and ``rewrite`` says so naming it; it never
+guesses.  A parameter whose value is 0 is unbound (every zero would match).
+
+Parameters that share a value (m1 = m2, l1 = l2: textbook sets often do) form a
+*group* (``groups``): the URDF cannot say which of its sites is whose, but all of
+them can be changed together.  ``rewrite`` accepts a set in which every member of
+a group has one new value, and writes it at every site that held the group's value;
+members given different values are refused naming them.  What the rewritten URDF
+means is checked like any URDF: by the checks.
 """
 
 from __future__ import annotations
@@ -63,6 +69,8 @@ class Binding:
     params: ParameterSet
     sites: dict[str, list[tuple[ET.Element, Site]]] = field(default_factory=dict)
     reasons: dict[str, str] = field(default_factory=dict)
+    #: the parameters that share a value, each group sorted (module docstring), and its sites
+    groups: dict[tuple[str, ...], list[tuple[ET.Element, Site]]] = field(default_factory=dict)
 
     @classmethod
     def of(cls, urdf_text: str, params: ParameterSet, source: str = "<URDF>") -> Binding:
@@ -81,20 +89,30 @@ class Binding:
                 candidates[f.name] = [s for s in _sites(root, kind) if _same(abs(_value(*s)), value)]
                 if not candidates[f.name]:
                     binding.reasons[f.name] = f"its value {value!r} is not in the URDF's {_where(kind)}"
+        clashes = {}
         for name, found in candidates.items():
-            clash = sorted(
+            clashes[name] = sorted(
                 other
                 for other, theirs in candidates.items()
                 if other != name and any(s[0] is t[0] and s[1] == t[1] for s in found for t in theirs)
             )
-            if clash:
-                binding.reasons[name] = f"its value also belongs to {', '.join(clash)} in the URDF"
+            if clashes[name]:
+                binding.reasons[name] = f"its value also belongs to {', '.join(clashes[name])} in the URDF"
             elif found:
                 binding.sites[name] = found
+        for group in _components(clashes):
+            merged: dict = {}
+            for name in group:
+                merged.update({(id(e), s.attribute, s.component): (e, s) for e, s in candidates[name]})
+            binding.groups[group] = list(merged.values())
         return binding
 
     def bound(self, name: str) -> bool:
         return name in self.sites
+
+    def group_of(self, name: str) -> tuple[str, ...] | None:
+        """The group of parameters that share ``name``'s value (module docstring), or None."""
+        return next((g for g in self.groups if name in g), None)
 
     def link_groups(self) -> dict[str, tuple[str, ...]]:
         """{link: the mass and inertia parameters bound inside its <inertial>} (links with any)."""
@@ -121,11 +139,41 @@ class Binding:
             old, new = float(getattr(self.params, f.name)), float(getattr(params, f.name))
             if old == new or f.metadata.get("kind") in IN_PINOCCHIO:
                 continue
-            if f.name not in self.sites:
+            group = self.group_of(f.name)
+            if group is not None:
+                values = {float(getattr(params, g)) for g in group}
+                if len(values) > 1:
+                    raise RebindError(
+                        f"parameter {f.name} cannot be changed in the URDF apart from "
+                        f"{', '.join(g for g in group if g != f.name)}: {self.reasons[f.name]}; "
+                        "they can be changed together, to one value"
+                    )
+                sites = self.groups[group]
+            elif f.name in self.sites:
+                sites = self.sites[f.name]
+            else:
                 raise RebindError(f"parameter {f.name} cannot be changed in the URDF: {self.reasons[f.name]}")
-            for element, site in self.sites[f.name]:
+            for element, site in sites:
                 _set(index[id(element)], site, site.sign * new)
         return ET.tostring(root, encoding="unicode") + "\n"
+
+
+def _components(clashes: dict[str, list[str]]) -> list[tuple[str, ...]]:
+    """The groups of parameters linked by shared sites (connected components), each sorted."""
+    seen: set[str] = set()
+    out = []
+    for name in clashes:
+        if name in seen or not clashes[name]:
+            continue
+        group, todo = set(), [name]
+        while todo:
+            n = todo.pop()
+            if n not in group:
+                group.add(n)
+                todo += clashes[n]
+        seen |= group
+        out.append(tuple(sorted(group)))
+    return out
 
 
 def _where(kind: str) -> str:
