@@ -36,7 +36,7 @@ from pendverify.analytic.params import read_toml
 from pendverify.analytic.text_expression import read_expression
 from pendverify.analytic.text_parse import CONSTANTS, FUNCTIONS
 from pendverify.errors import PendverifyError
-from pendverify.symbolic.zero_test import is_zero
+from pendverify.symbolic.zero_test import is_zero, probe
 
 #: what a piece of text that does not read as an expression raises (the readers' own errors)
 UNREADABLE = (PendverifyError, ValueError, TypeError, ArithmeticError)
@@ -79,8 +79,11 @@ class SourceText:
         return None if isinstance(value, sp.MatrixBase) else plain(value)
 
     def same(self, a, b) -> bool:
+        """Whether ``a`` and ``b`` are equal: most pieces of text tried are not, and a numeric probe
+        (``probe``, 50 digits) says so at once; the exact test decides the rest."""
         try:
-            return is_zero(sp.sympify(a) - sp.sympify(b), self.angles)
+            difference = sp.sympify(a) - sp.sympify(b)
+            return not probe(difference) and is_zero(difference, self.angles)
         except UNREADABLE:
             return False
 
