@@ -6,11 +6,12 @@ matched against q·p1^a1·…·pk^ak, a small fraction q (``candidates.FRACTIONS
 such product fits:
 
 * **Units first.** Only products with the coefficient's physical dimension are tried, so that a
-  parameter worth 1 (m1 = 1 kg) or two lengths in ratio 2 do not make every product fit.  With
-  L_i = m for a prismatic coordinate and 1 for an angle, and E = kg·m²/s² an energy:
-  M[i,j] is E·s²/(L_i·L_j), H[i] is E/L_i, V is E, det M is Π_i E·s²/L_i²; a C[i,j] term
-  c·q̇_k·f(q) has c = E·s²/(L_i·L_j·L_k), a C·q̇[i] term c·q̇_j·q̇_k·f(q) has
-  c = E·s²/(L_i·L_j·L_k).  Parameters of a kind without a fixed unit (damping, or none
+  parameter worth 1 (m1 = 1 kg) or two lengths in ratio 2 do not make every product fit.  The
+  entry's own unit is the units check's (``pendverify.checks.dimensions.required``: with
+  L_i = m for a prismatic coordinate and 1 for an angle and E = kg·m²/s², M[i,j] is
+  E·s²/(L_i·L_j), H[i] is E/L_i, ...); a coefficient's is that over the rates its basis function
+  holds (q̇_k is L_k/s): a C[i,j] term c·q̇_k·f(q) has c = E·s²/(L_i·L_j·L_k), a C·q̇[i] term
+  c·q̇_j·q̇_k·f(q) has c = E·s²/(L_i·L_j·L_k).  Parameters of a kind without a fixed unit (damping, or none
   declared) are not used; neither is a term that has no fixed-unit reading (a constant in C, a
   friction term of C·q̇): it keeps its number.
 * **Exactly.** A product fits when |q·v − |c|| is within the coefficient's uncertainty
@@ -31,13 +32,11 @@ from fractions import Fraction
 import numpy as np
 import sympy as sp
 
+from pendverify.checks.dimensions import LENGTH, NONE, SECOND, inverse, mul, power, required
 from pendverify.diagnosis.candidates import DIMENSIONS, FRACTIONS
 
 DEGREE = 4
 FLOOR = 1e-12
-ENERGY = np.array([1, 2, -2])  # kg·m²/s² in (kg, m, s)
-SECOND = np.array([0, 0, 1])
-METRE = np.array([0, 1, 0])
 
 
 def _fixed_parameters(params) -> tuple[tuple[str, float, tuple], ...]:
@@ -66,33 +65,38 @@ def _products(parameters: tuple, dimension: tuple) -> tuple[tuple[float, sp.Expr
     return tuple(out)
 
 
+#: the quantity of an entry → (its method, the number of rates a basis function of its difference has)
+_METHODS = {
+    "M": ("mass_matrix", 0),
+    "H": ("gravity", 0),
+    "V": ("potential_energy", 0),
+    "detM": ("det_mass_matrix", 0),
+    "C": ("coriolis_matrix", 1),
+    "Cqdot": ("coriolis_force", 2),
+}
+
+
 def coefficient_dimension(quantity: str, index: tuple[int, ...], function, model) -> tuple | None:
     """The physical dimension (kg, m, s) of the coefficient of basis ``function`` in an entry of
-    ``quantity`` at ``index`` (0-based), or None when it has no fixed unit (module docstring)."""
-    angular = list(model.angular)
-    length = [np.zeros(3, int) if a else METRE for a in angular]
+    ``quantity`` at ``index`` (0-based): the entry's own (``pendverify.checks.dimensions.required``)
+    over the rates in ``function`` (a rate of coordinate k is q_k/s); None when it has no fixed
+    unit (module docstring)."""
+    if quantity not in _METHODS:
+        return None
+    method, rates_expected = _METHODS[quantity]
+    angular = tuple(bool(a) for a in model.angular)
+    need, _ = required(method, tuple(index), angular)
     rates = {f"d{c}": k for k, c in enumerate(model.coordinates)}
     function = sp.sympify(function)
     powers = function.as_powers_dict()  # a rate's exponent in the basis function (dθ1² → 2)
     count = [(rates[s.name], int(powers.get(s, 1))) for s in function.free_symbols if s.name in rates]
-    rate_length = sum((p * length[k] for k, p in count), np.zeros(3, int))
-    n_rates = sum(p for _, p in count)
-    inertia = ENERGY + 2 * SECOND
-    if quantity == "M" and not n_rates:
-        i, j = index
-        out = inertia - length[i] - length[j]
-    elif quantity == "H" and not n_rates:
-        out = ENERGY - length[index[0]]
-    elif quantity == "V" and not n_rates:
-        out = ENERGY
-    elif quantity == "detM" and not n_rates:
-        out = sum((inertia - 2 * L for L in length), np.zeros(3, int))
-    elif quantity == "C" and n_rates == 1:
-        i, j = index
-        out = inertia - length[i] - length[j] - rate_length
-    elif quantity == "Cqdot" and n_rates == 2:
-        out = ENERGY - length[index[0]] - rate_length + n_rates * SECOND
-    else:
+    if need is None or sum(p for _, p in count) != rates_expected:
+        return None
+    out = need
+    for k, p in count:
+        rate = mul(NONE if angular[k] else LENGTH, inverse(SECOND))
+        out = mul(out, inverse(power(rate, Fraction(p))))
+    if any(x.denominator != 1 for x in out):
         return None
     return tuple(int(x) for x in out)
 
@@ -111,8 +115,8 @@ def written_coefficient(c: float, uncertainty: float, dimension: tuple, paramete
     if len(fits) != 1:
         return None
     text = str(fits.pop())
-    for power, superscript in (("**2", "²"), ("**3", "³"), ("**4", "⁴")):
-        text = text.replace(power, superscript)
+    for exponent, superscript in (("**2", "²"), ("**3", "³"), ("**4", "⁴")):
+        text = text.replace(exponent, superscript)
     return text.replace("*", "·")
 
 
