@@ -367,7 +367,8 @@ def test_no_claim_on_the_explain_corpus_but_where_a_plant_changes_a_dimension():
     each term's dimension (a sign, a dropped or doubled term, a factor, a parameter of the same kind,
     sin ↔ cos, an angle swap, ± m·r² in M) and gets no claim; a swap of a position's rate with an
     angle's (ẋ ↔ θ̇) changes it, and only there is a claim made (not where the rate multiplies an
-    undecided damping coefficient: ẋ·b_x → θ̇·b_x); 9 of the 1750 plants are named."""
+    undecided damping coefficient: ẋ·b_x → θ̇·b_x); 9 of the 1734 plants (the worked examples' files,
+    none in a key the model derives) are named."""
     from pendverify.analytic.forms import entry_position
     from pendverify.analytic.symbolic_reading import SymbolicModel
     from pendverify.bench.explain import shipped_targets
@@ -389,7 +390,7 @@ def test_no_claim_on_the_explain_corpus_but_where_a_plant_changes_a_dimension():
             changes = plant.operator == "swap θ̇" and len(swapped & position_rates) == 1
             assert changes or not clashes, f"{label=} {plant.operator=} {plant.what=} {clashes=}"
             caught, planted = caught + bool(clashes), planted + 1
-    assert planted >= 1750 and caught >= 9, (planted, caught)  # measured: 1750 and 9
+    assert planted >= 1734 and caught >= 9, (planted, caught)  # measured: 1734 and 9
 
 
 def test_every_kind_has_the_dimension_of_its_declared_unit():

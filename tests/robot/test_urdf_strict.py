@@ -363,7 +363,7 @@ def test_shipped_urdfs_are_accepted(name, capfd):
     model, facts, log = build_pinocchio_model(SHIPPED[name].read_text(), name)
     assert log == []
     assert capfd.readouterr().err == ""
-    assert model.njoints >= 3
+    assert model.njoints >= 2  # the universe and at least one joint (a single pendulum has one)
     assert set(facts.joint_dynamics) <= set(facts.joint_types)
 
 

@@ -113,7 +113,6 @@ def run(args: argparse.Namespace) -> int:
     from pendverify import api
     from pendverify.atomic import check_output, check_report_output, write_atomic
     from pendverify.checks.junit import to_junit
-    from pendverify.exitcodes import BAD_INPUT
 
     if args.files:
         from pendverify.errors import OptionConflictError
@@ -143,5 +142,6 @@ def run(args: argparse.Namespace) -> int:
         write_json_report(args, report.to_json())
     if report.passed and not report.robot_compared:
         # a model alone whose units agree is not verified: a script that forgot --urdf must not pass
-        return BAD_INPUT
+        # (2, as for bad usage: pendverify.exitcodes)
+        return 2
     return 0 if report.passed else 1

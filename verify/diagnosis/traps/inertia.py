@@ -51,6 +51,7 @@ from pendverify.checks.batch import CheckBatch
 from pendverify.diagnosis.finding import Finding
 from pendverify.diagnosis.traps.fit import FIT_RESIDUAL, fit_words
 from pendverify.robot.coordinates import CoordinateMap
+from pendverify.robot.jacobian import joint_jacobian
 from pendverify.robot.system import PinocchioSystem
 
 COEFF_TOL = 1e-3  # how close a fitted coefficient must be to an integer
@@ -92,7 +93,9 @@ def turning_axes(model: pin.Model, joint: int) -> np.ndarray:
     for _ in range(AXIS_CONFIGURATIONS):
         q = pin.integrate(model, pin.neutral(model), rng.uniform(-np.pi, np.pi, model.nv))
         pin.computeJointJacobians(model, data, q)
-        columns.append(pin.getJointJacobian(model, data, joint, pin.ReferenceFrame.LOCAL)[3:, :])
+        columns.append(
+            joint_jacobian(model, data, joint, pin.ReferenceFrame.LOCAL)[3:, :]
+        )  # 6×nv, nv = 1 too
     u, s, _ = np.linalg.svd(np.hstack(columns))
     # the columns are unit axes or cross products of them: rank at rounding level of 1
     return u[:, : int(np.sum(s > 1e-9 * max(float(s[0]), 1.0)))] if s.size else np.zeros((3, 0))
