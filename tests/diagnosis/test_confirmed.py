@@ -226,3 +226,25 @@ def test_the_untouched_coincident_models_pass_check(entry, capsys):
     args = ["--analytic", _shipped(entry["model"]), "--urdf", _shipped(entry["urdf"])]
     status = main(["check", *args, "--params", _shipped(entry["params"]), "--no-explain"])
     assert status == 0, capsys.readouterr().out
+
+
+def test_a_repair_accepted_with_coriolis_and_skew_warning_is_never_confirmed():
+    """The Furuta pendulum's C[1,2] with a term dropped: putting it, doubled, into C[1,1] gives the
+    same C·q̇, and the repair accepted against the model's own warning (coriolis and skew warn) holds
+    at every perturbed set — but C itself is not compared, so it is not printed as confirmed
+    (the full corpus once printed this wrong edit as confirmed)."""
+    from pendverify.analytic.symbolic_reading import SymbolicModel
+    from pendverify.bench.explain import shipped_targets
+    from pendverify.diagnosis.corpus import plants, score_model
+
+    label, model, system, _ = next(t for t in shipped_targets() if t[0].startswith("furuta_pendulum"))
+    chosen = [
+        p
+        for p in plants(SymbolicModel.of(type(model)))
+        if (p.method, p.index, p.operator) == ("coriolis_matrix", 1, "drop")
+    ]
+    assert chosen, "the planted error of this test"
+    (score,) = score_model(label, model, system, chosen).scores
+    assert score.detected and not score.wrong_confirmed, score.message
+    if score.repaired and not score.restored:  # a C with the same C·q̇: held, not confirmed
+        assert "not confirmed" in score.message and "only C·q̇ is compared" in score.message, score.message

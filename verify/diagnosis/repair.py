@@ -309,7 +309,13 @@ class _Confirmation:
                 f"no check compares {' or '.join(unchecked)} with the robot, so an edit of it and "
                 "the same change where it is used cannot be told apart"
             ]
-            self._limits_of[key] = (limits, other if unchecked else [])
+            other = other if unchecked else []
+            if self.baseline:  # accepted against the model's own warning: C itself is not compared
+                other.append(
+                    "it is accepted with coriolis and skew warning, so only C·q̇ is compared with the "
+                    "robot, not C itself (another C with the same C·q̇ passes as well)"
+                )
+            self._limits_of[key] = (limits, other)
         limits, other = self._limits_of[key]
         return limits if values else limits + other
 
