@@ -31,7 +31,9 @@ def assert_verified(
 ) -> CheckReport:
     """Run ``pendverify.check(model, urdf, params, **check_options)``; fail unless the report passes.
 
-    Passing means ``report.passed``: every check passes, or passes with warnings (a warning
+    Passing means ``report.passed`` with the model compared with a robot (a model given without
+    ``urdf`` gets its units checked alone, which verifies nothing against a robot, and fails
+    here): every check passes, or passes with warnings (a warning
     fails with ``strict=True``); a failure or a refusal (a state beyond the trust limit) raises
     ``AssertionError`` whose message is the full check table, the same text as the CLI's.
     ``check_options`` are ``check``'s keywords: ``erd``, ``samples``, ``seed``, ``strict``,
@@ -39,6 +41,6 @@ def assert_verified(
     """
     __tracebackhide__ = True  # pytest: show the caller's line, not this helper's
     report = check(model, urdf, params, **check_options)
-    if not report.passed:
+    if not report.passed or not report.robot_compared:  # a model alone's units verify no robot
         raise AssertionError(report.table())
     return report

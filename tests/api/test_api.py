@@ -562,3 +562,13 @@ def test_certify_set_signs_with_a_key_and_recheck_trusts_only_that_key(tmp_path)
         recheck(str(issued.path), trust=str(other_public))
     with pytest.raises(pendverify.PendverifyError, match="key"):
         pendverify.certify_set(tmp_path / "bad", params, key=tmp_path / "no-such.pem", samples=40)
+
+
+def test_assert_verified_fails_on_a_model_alone_whose_units_agree():
+    """A model without ``urdf`` gets its units row alone: nothing was compared with a robot, so the
+    helper a user's test suite calls must not pass (the report says NOT verified)."""
+    model = Path(__file__).resolve().parents[2] / "examples" / "minimal_double_pendulum.py"
+    report = pendverify.check(model)
+    assert report.passed and not report.robot_compared
+    with pytest.raises(AssertionError, match="NOT verified"):
+        assert_verified(model)
