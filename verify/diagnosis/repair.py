@@ -298,7 +298,7 @@ class _Confirmation:
         """Why an edit is not confirmed even when it holds: its parameters not moved on their own,
         then (unless ``values``: those alone) what it edits that no check compares with the robot.
         Kept per edit: the first repair's are asked for each candidate after it."""
-        key = tuple(sorted((m, i, str(new)) for (m, i), (_, new) in changes.items()))
+        key = _edit_key(changes)
         if key not in self._limits_of:
             limits = self.perturbation.why_not_alone(edit_parameters(changes, self.sm))
             free = self.batch.system.urdf_damping() is None
@@ -330,7 +330,7 @@ class _Confirmation:
                 # after an edit whose parameters all moved an alternative is a simple edit, not a fit;
                 # after one that holds at these values only, any edit that holds is worth naming
                 return
-            key = tuple(sorted((m, i, str(new)) for (m, i), (_, new) in changes.items()))
+            key = _edit_key(changes)
             if key in self.seen:
                 continue  # the same edit again
             if self.found and self.tried - self.tried_at_first >= ALTERNATIVE_TRIES:
@@ -349,7 +349,7 @@ class _Confirmation:
 
     def _check(self, changes: dict, edit: Edit, slot: Slot) -> str:
         """``_confirmed``'s verdict on one candidate, recorded (found, a coincidence, tried)."""
-        key = tuple(sorted((m, i, str(new)) for (m, i), (_, new) in changes.items()))
+        key = _edit_key(changes)
         if key in self.seen:
             return "seen"
         self.seen.add(key)
@@ -435,6 +435,11 @@ class _Confirmation:
             f"; {edits}{more} make(s) every check pass at these parameter values, but not at other values "
             f"({self.perturbation.how}): a coincidence of the values, not a repair"
         )
+
+
+def _edit_key(changes: dict) -> tuple:
+    """What identifies an edit among the candidates: each entry it changes and the text it writes."""
+    return tuple(sorted((m, i, str(new)) for (m, i), (_, new) in changes.items()))
 
 
 def _same_edit(changes: dict, other: dict, sm) -> bool:
