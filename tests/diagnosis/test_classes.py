@@ -305,6 +305,9 @@ def _convention(tmp_path, capsys, declared: str) -> str:
     capsys.readouterr()
     (findings,) = json.loads(out_json.read_text())["diagnoses"].values()
     (convention,) = [f for f in findings if f["kind"] == "convention"]
+    assert convention["exact"]
+    # the convention is the fix: no sentence that no edit was found, no fit in the declared coordinates
+    assert not [f for f in findings if f["kind"] in ("repair", "parameters")], findings
     return convention["message"]
 
 

@@ -9,9 +9,10 @@ In order:
    about the pivot, friction missing from q̈);
 3. the inertial parameters the model implies: whether it is this robot's dynamics with other
    masses, centres of mass or inertias, and which; or that no mass distribution explains it
-   (``pendverify.diagnosis.parameters``);
+   (``pendverify.diagnosis.parameters``), unless a convention explains the failure exactly;
 4. the repair, a single edit (or a pair) of the model's own expressions confirmed by every
-   check on every state, or a sentence saying none was found (``pendverify.diagnosis.repair``).
+   check on every state, or a sentence saying none was found (``pendverify.diagnosis.repair``)
+   where no convention explains the failure exactly.
 
 Only a model with a failing check on trusted states is diagnosed (the caller decides).  The
 whole diagnosis is bounded by ``deadline_s``: each step starts only while time is left (the
@@ -51,6 +52,13 @@ REPAIR_DEADLINE_S = 10.0
 FINISHING_S = 0.5
 
 
+def _exact_convention(findings: list[Finding]) -> bool:
+    """Whether a convention trap explains the failure exactly: every check passes under it.  Its
+    finding names the file key that fixes it; the inertial parameters the model implies in the
+    declared coordinates, and a sentence that no edit of the expressions was found, add nothing."""
+    return any(f.kind == "convention" and f.details.get("exact") for f in findings)
+
+
 def explain(batch, results, deadline_s: float = REPAIR_DEADLINE_S) -> list[Finding]:
     """The diagnosis of a model whose checks ``results`` on ``batch`` fail (module docstring)."""
     start = time.perf_counter()
@@ -84,7 +92,7 @@ def explain(batch, results, deadline_s: float = REPAIR_DEADLINE_S) -> list[Findi
         for what, step in steps:
             if late():
                 skipped.append(what)
-            else:
+            elif not (what == "the inertial parameters" and _exact_convention(findings)):
                 findings += step()
         left = deadline_s - (time.perf_counter() - start) - FINISHING_S
         if left > 0:
@@ -92,6 +100,8 @@ def explain(batch, results, deadline_s: float = REPAIR_DEADLINE_S) -> list[Findi
         else:
             repairs, why_not = [], ""
             skipped.append("repairs")
+        if not repairs and _exact_convention(findings):
+            why_not = ""  # the convention is the fix, with the file key it edits: no edit is missing
     findings += repairs
     if skipped:
         stopped = f"diagnosis bounded at {deadline_s:g} s; not searched: {', '.join(skipped)}"

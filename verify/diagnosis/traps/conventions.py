@@ -184,6 +184,7 @@ def coordinate_conventions(model, system, failing, states, unsearched: list | No
     details = {
         "traps": _traps(c, links),
         "residual": float(residual),
+        "exact": bool(exact),
         "T": c.T.tolist(),
         "theta0": c.theta0.tolist(),
         "links": links,
