@@ -248,3 +248,25 @@ def test_a_repair_accepted_with_coriolis_and_skew_warning_is_never_confirmed():
     assert score.detected and not score.wrong_confirmed, score.message
     if score.repaired and not score.restored:  # a C with the same C·q̇: held, not confirmed
         assert "not confirmed" in score.message and "only C·q̇ is compared" in score.message, score.message
+
+
+@pytest.mark.parametrize("planted", ["1.1*(I + lc**2*m)", "11*I/10 + 11*lc**2*m/10", "3*I + 3*lc**2*m/2"])
+def test_a_wrong_number_written_in_an_entry_is_put_right_and_confirmed(planted):
+    """A decimal factor (which SymPy spreads over the sum: 1.1·I + 1.1·lc²·m, so no one-term
+    coefficient undoes it) or a wrong number on two terms: the number solved for, confirmed."""
+    findings, _ = _repairs("corpus_pendulum_rod", "mass_matrix", 0, planted)
+    first = findings[0]
+    assert first.details["confirmed"], first.message
+    assert sp.expand(sp.sympify(first.details["suggested"]) - sp.sympify("I + lc**2*m")) == 0, first.message
+
+
+def test_a_decimal_factor_is_removed_from_the_users_own_text(tmp_path, capsys):
+    """The repair as an edit of the string the user wrote, the whole number written as one."""
+    text = shipped_file("examples", "corpus_pendulum_rod.toml").read_text()
+    assert text.count('M = [["I + m*lc**2"]]') == 1
+    planted = tmp_path / "decimal.toml"
+    planted.write_text(text.replace('M = [["I + m*lc**2"]]', 'M = [["1.1*(I + m*lc**2)"]]'))
+    urdf, params = (shipped_file("examples", f"corpus_pendulum_rod{s}") for s in (".urdf", "_params.toml"))
+    assert main(["check", "--analytic", str(planted), "--urdf", str(urdf), "--params", str(params)]) == 1
+    out = capsys.readouterr().out
+    assert "M[1,1]: 1.1*(I + m*lc**2) → I + lc**2*m makes every check pass on every state, at these" in out

@@ -15,7 +15,9 @@ are found from the numbers rather than enumerated blindly:
   products first) — this undoes a dropped term and an inertia about the pivot (± m·r²);
 * a restored term: a sum completed by the one term it lacks, as the same sum stands elsewhere
   in the model (a term dropped inside det M or M⁻¹);
-* a det M completed by what it lacks of the determinant of the written M.
+* a det M completed by what it lacks of the determinant of the written M;
+* a number written in the entry put right (a decimal factor, a 3 for a 2): solved for where
+  the entry is affine in it, kept when it is a simple fraction.
 
 ``candidates`` orders what passed the screen for confirmation, simplest first (``RANK``): each
 edit alone, then the same edit wherever the same expression stands in other slots (a shared
@@ -101,6 +103,42 @@ def _coefficient_edits(slot: Slot, evaluate) -> list[Edit]:
             expr = new if whole else with_term(slot.expr, path, terms, i, new)
             operator = {0: "drop", -1: "sign"}.get(k, "scale")
             out.append(Edit(operator, term, new, expr, f"{term} → {new}"))
+    return out
+
+
+#: the largest denominator of the number a written number may be put right to: the fractions of
+#: hand derivations (½, ⅓, ¼, 1/12 of a rod's inertia)
+NUMBER_DENOMINATOR = 12
+
+
+def _number_edits(slot: Slot, evaluate) -> list[Edit]:
+    """A number written in the entry (``1.1`` in ``1.1*(I + m*lc**2)``, which SymPy spreads over
+    the sum's terms) put right: every occurrence of it replaced by the value that makes the entry
+    agree, solved for where the entry is affine in it (its values at 0, 1 and 2 on a line), and
+    kept when that value is a fraction of denominator at most ``NUMBER_DENOMINATOR``.  What no
+    coefficient of ``COEFFICIENTS`` undoes: a decimal factor, a 3 for a 2."""
+    if slot.row is not None or slot.target is None:
+        return []
+    numbers = {n for n, _ in walk(slot.expr) if n.is_Number and abs(n) != 1 and n != 0}
+    out = []
+    for number in sorted(numbers, key=str):
+        at = [evaluate(slot.expr.xreplace({number: sp.Integer(v)}), slot.symbols) for v in (0, 1, 2)]
+        slope = at[1] - at[0]
+        ok = np.isfinite(slope) & np.isfinite(slot.target) & np.isfinite(at[2])
+        scale = np.max(np.abs(at[0][ok]), initial=0.0) + np.max(np.abs(slope[ok]), initial=0.0)
+        if not ok.any() or np.max(np.abs(at[2][ok] - 2 * at[1][ok] + at[0][ok])) > 1e-9 * max(scale, 1e-300):
+            continue  # not affine in the number (inside a power or a function)
+        denominator = float(np.dot(slope[ok], slope[ok]))
+        if not denominator > 0:
+            continue
+        value = float(np.dot(slope[ok], slot.target[ok] - at[0][ok]) / denominator)
+        fraction = Fraction(value).limit_denominator(NUMBER_DENOMINATOR) if np.isfinite(value) else None
+        if fraction is None or abs(float(fraction) - value) > 1e-9 * max(1.0, abs(value)):
+            continue
+        new = sp.Rational(fraction.numerator, fraction.denominator)
+        if new != number:
+            expr = slot.expr.xreplace({number: new})
+            out.append(Edit("number", number, new, expr, f"{number} → {new}"))
     return out
 
 
@@ -369,7 +407,7 @@ def screen_slot(slot: Slot, batch, sm, evaluate, monomials, pool, deadline: floa
     """The edits of one slot that make it agree at the screening states, in ``slot.matches``."""
     edits = _coefficient_edits(slot, evaluate) + _added_term_edits(slot, batch, monomials, sm.kinds)
     edits += _restored_term_edits(slot, pool) + _constant_edits(slot, monomials)
-    edits += _determinant_edits(slot, sm)
+    edits += _determinant_edits(slot, sm) + _number_edits(slot, evaluate)
     edits += list(structural_edits(slot.expr, sm.angles, sm.symbols["v"], sm.kinds))
     # simplest first: an added term that SymPy folds into a swapped angle is kept as the swap
     edits.sort(key=lambda e: RANK.get(e.operator, 9))
@@ -427,6 +465,7 @@ RANK = {
     "swap θ̇": 2,
     "parameter": 2,
     "constant": 2,
+    "number": 2,
     "sin↔cos": 3,
     "scale": 4,
     "offset": 5,

@@ -270,7 +270,11 @@ def minimal_edit(source: SourceText, text: str, old, new, render) -> str | None:
         return swapped
     options = []
     for k in range(len(spans)):
-        rewritten = sp.factor_terms(sp.expand(values[k] + delta))
+        rewritten = sp.expand(values[k] + delta)
+        # a decimal factor put right leaves 0.9999999999999999·x (1.1 − 0.1 in binary): written as
+        # the whole number it is to rounding; the edited text is read back and compared below
+        whole = {f: sp.Integer(round(f)) for f in rewritten.atoms(sp.Float) if abs(f - round(f)) <= 1e-12}
+        rewritten = sp.factor_terms(rewritten.xreplace(whole))
         options.append((sp.count_ops(rewritten), k, rewritten))
     ops, k, rewritten = min(options, key=lambda o: o[:2])
     if sp.count_ops(delta) + 1 < ops:
