@@ -71,7 +71,8 @@ from dataclasses import dataclass, field
 
 from pendverify.errors import PendverifyError
 from pendverify.robot.description import READERS
-from pendverify.robot.rebind import IN_PINOCCHIO, Binding
+from pendverify.robot.model_rebind import ModelBinding
+from pendverify.robot.rebind import IN_PINOCCHIO, Binding, Bound
 
 SETS = 2
 LEAST_MOVE, MOST_MOVE = 0.1, 0.3  # |ln factor| (module docstring)
@@ -140,8 +141,8 @@ def perturbations(model, system, consistent=None, count: int = SETS, seed: int =
             binding = Binding.of(loaded.text, params, loaded.source)
         except PendverifyError as exc:
             cause = f"the description could not be read for rewriting: {exc}"
-    else:
-        cause = f"the {READERS[loaded.format]} description is not rewritten, only a URDF is"
+    else:  # MJCF, SDFormat, a Pinocchio model: moved in the model read (module docstring)
+        binding = ModelBinding.of(loaded, params)
     free_damping = system.urdf_damping() is None
     units, fixed, written = [], {}, set()
     for name, kind in kinds.items():
@@ -166,7 +167,12 @@ def perturbations(model, system, consistent=None, count: int = SETS, seed: int =
         written |= {n for group in binding.groups for n in group}
     out = Perturbation(fixed=fixed)
     rewritten = bool(written)
-    out.how = f"the {READERS[loaded.format]} rewritten for each" if rewritten else "another g for each"
+    if not rewritten:
+        out.how = "another g for each"
+    elif isinstance(binding, ModelBinding):
+        out.how = f"the {READERS[loaded.format]} description's Pinocchio model moved for each"
+    else:
+        out.how = f"the {READERS[loaded.format]} rewritten for each"
 
     triples = _moment_triples(binding) if binding is not None else []
 
@@ -214,12 +220,13 @@ def perturbations(model, system, consistent=None, count: int = SETS, seed: int =
         if not culprits:  # only moves together break it: no set is made
             out.refused = "moved together, the parameters make entries that agree here disagree"
             units.clear()
+        holder = "the Pinocchio model" if isinstance(binding, ModelBinding) else "the URDF"
         for unit in culprits:
             units.remove(unit)
             for name in unit:
                 out.fixed[name] = (
-                    "moved in the URDF, entries that agree at the file's values disagree: "
-                    "the URDF holds it combined with other parameters too"
+                    f"moved in {holder}, entries that agree at the file's values disagree: "
+                    f"{holder} holds it combined with other parameters too"
                 )
         out.sets.clear()  # the sets kept so far moved those as well
     grouped = set(binding.groups) if binding is not None else set()
@@ -230,14 +237,14 @@ def perturbations(model, system, consistent=None, count: int = SETS, seed: int =
     return out
 
 
-def _moment_triples(binding: Binding) -> list[tuple[str, str, str]]:
-    """(ixx, iyy, izz parameters) of each ``<inertia>`` whose three moments are three parameters,
-    each bound there alone."""
+def _moment_triples(binding: Bound) -> list[tuple[str, str, str]]:
+    """(ixx, iyy, izz parameters) of each inertia (a URDF's ``<inertia>``, a Pinocchio body's
+    rotational inertia) whose three moments are three parameters, each bound there alone."""
     by_element: dict = {}
     for name, sites in binding.sites.items():
         if len(sites) == 1 and sites[0][1].attribute in ("ixx", "iyy", "izz"):
-            element, site = sites[0]
-            by_element.setdefault(id(element), {})[site.attribute] = name
+            site = sites[0][1]
+            by_element.setdefault(site.path, {})[site.attribute] = name
     return [(d["ixx"], d["iyy"], d["izz"]) for d in by_element.values() if len(d) == 3]
 
 

@@ -1,0 +1,204 @@
+"""Repairs confirmed on a description that is not rewritten: the parameters moved in its Pinocchio model.
+
+An MJCF (SDFormat, a ``pinocchio.Model``) is not rewritten; each perturbed set moves the
+parameters in the Pinocchio model read from it (``pendverify.robot.model_rebind``), so a repair
+is confirmed there as on a URDF.  Each test plants one error in a model checked against an MJCF
+and asserts what the repair says: the exact edit confirmed, a coincidence of the file's values
+caught at the moved sets, and a parameter the model holds nowhere alone left unmoved with its
+reason.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+import sympy as sp
+
+from pendverify.analytic import DoublePendulum
+from pendverify.analytic.symbolic_reading import SymbolicModel
+from pendverify.checks.batch import CheckBatch
+from pendverify.checks.catalogue import applicable_checks, run_checks
+from pendverify.checks.sampling import sample_states
+from pendverify.diagnosis.corpus import CORPUS_SAMPLES, CORPUS_SEED
+from pendverify.diagnosis.explain import explain
+from pendverify.diagnosis.perturbed import SETS, perturbations
+from pendverify.errors import RebindError
+from pendverify.robot.model_rebind import ModelBinding
+from pendverify.robot.system import PinocchioSystem
+from pendverify.symbolic.edited import edited_model
+from pendverify.targets import plugin_target
+
+from ..conftest import default_params
+
+REPO = Path(__file__).resolve().parents[2]
+EXAMPLES = REPO / "examples"
+#: the words only a confirmed repair is printed with (``test_confirmed``)
+CONFIRMED_WORDS = "at these parameter values and at"
+MOVED = "(the MJCF description's Pinocchio model moved for each)"
+
+#: the classic cart-pole of examples/corpus_cart_pole.urdf in MJCF: I = mp·l²/3 (a uniform pole
+#: of length 2l about its centre), so 4·I gives the numbers of I + mp·l²; the pole's moment about
+#: its own axis is 1e-6 kg·m² (MuJoCo wants every moment > 0; it never spins about it)
+CART_POLE_MJCF = """<mujoco model="corpus_cart_pole">
+  <compiler angle="radian" inertiafromgeom="false"/>
+  <option gravity="0 0 -9.81"/>
+  <worldbody>
+    <body name="cart">
+      <joint name="cart_slider" type="slide" axis="1 0 0"/>
+      <inertial pos="0 0 0" mass="1.0" diaginertia="0.01 0.01 0.01"/>
+      <body name="pole">
+        <joint name="pole_hinge" type="hinge" axis="0 -1 0"/>
+        <inertial pos="0 0 -0.5" mass="0.1" diaginertia="0.008333333333333333 0.008333333333333333 1e-6"/>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+#: examples/corpus_pendulum_rod.urdf in MJCF, its body frame turned by PHI about the hinge (y): the
+#: centre of mass is the same point (0.25 m straight down at θ = 0) but its components in the
+#: body's frame are 0.25·sin φ and 0.25·cos φ, so the model holds lc nowhere alone.  The inertia's
+#: axes stay the body's: turned about the hinge, its moment about the hinge is the same I
+PHI = 0.4
+ROD_MJCF = f"""<mujoco model="corpus_pendulum_rod">
+  <compiler angle="radian" inertiafromgeom="false"/>
+  <option gravity="0 0 -9.81"/>
+  <worldbody>
+    <body name="rod" quat="{math.cos(PHI / 2)!r} 0 {math.sin(PHI / 2)!r} 0">
+      <joint name="hinge" type="hinge" axis="0 1 0" damping="0.1"/>
+      <inertial pos="{0.25 * math.sin(PHI)!r} 0 {-0.25 * math.cos(PHI)!r}" mass="1.0"
+                diaginertia="0.020833333333333332 0.020833333333333332 1e-6"/>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+
+def _mjcf_target(tmp_path, model: str, text: str, params: str):
+    """The target of the shipped model file ``model`` and parameter file ``params`` on MJCF ``text``."""
+    path = tmp_path / "robot.mjcf.xml"
+    path.write_text(text)
+    return plugin_target(str(EXAMPLES / model), str(path), str(EXAMPLES / params))
+
+
+def _repairs(model, system, method: str, index: int, planted: str):
+    """The repair findings of ``model`` on ``system`` with entry ``index`` of ``method`` replaced
+    by ``planted`` (SymPy syntax over the model's names)."""
+    sm = SymbolicModel.of(type(model))
+    names = {s.name: s for group in sm.symbols.values() for s in group}
+    names |= {p.name: p for p in sm.parameters.values()}
+    value = sm.closed_forms[method]
+    original = value[index] if isinstance(value, sp.MatrixBase) else value
+    model = edited_model(model, sm, {method: [(index, original, sp.sympify(planted, locals=names))]}, "P")
+    states = sample_states(model, CORPUS_SAMPLES, CORPUS_SEED)
+    batch = CheckBatch(model, system, states)
+    results = run_checks(
+        "planted", model, system, states, CORPUS_SEED, applicable_checks(model, system), batch
+    )
+    assert not all(r.passed for r in results), "the planted error must fail a check"
+    findings = [f for f in explain(batch, results) if f.kind == "repair"]
+    for f in findings:  # the confirmed words belong to a confirmed repair only
+        assert (CONFIRMED_WORDS in f.message) is bool(f.details.get("confirmed")), f.message
+    return findings
+
+
+def _same(suggested: str, expected: str) -> bool:
+    return sp.expand(sp.sympify(suggested) - sp.sympify(expected)) == 0
+
+
+def _passes_at_every_set(model, perturbation) -> None:
+    """The untouched model passes every check at each moved set, as at the file's values."""
+    states = sample_states(model, CORPUS_SAMPLES, CORPUS_SEED)
+    for moved in perturbation.sets:
+        results = run_checks("moved", moved.model, moved.system, states, CORPUS_SEED,
+                             applicable_checks(moved.model, moved.system))  # fmt: skip
+        assert all(r.passed for r in results), (moved.params, [r for r in results if not r.passed])
+
+
+def test_the_double_pendulums_mjcf_moves_its_parameters_and_confirms_the_repair():
+    """examples/double_pendulum.mjcf.xml: every parameter the model holds moves (l2 is a drawing
+    length, held nowhere); the untouched model passes at each set; I2 dropped from M[2,2] is
+    repaired by I2 + m2·r2², confirmed (before: it held "at these parameter values" only)."""
+    params = default_params("double_pendulum")
+    system = PinocchioSystem.for_model(DoublePendulum, EXAMPLES / "double_pendulum.mjcf.xml", params.g)
+    model = DoublePendulum(params)
+    perturbation = perturbations(model, system)
+    assert set(perturbation.independent) == {"m1", "m2", "l1", "r1", "r2", "I1", "I2", "b1", "b2", "g"}
+    assert perturbation.how == "the MJCF description's Pinocchio model moved for each"
+    assert len(perturbation.sets) == SETS
+    for moved in perturbation.sets:  # the moved model holds the moved values, read back by its reader
+        read = moved.system.geometry.params
+        for name in ("m1", "m2", "l1", "r1", "r2", "I1", "I2", "b1", "b2"):
+            assert math.isclose(getattr(read, name), getattr(moved.params, name), rel_tol=1e-12), name
+            assert getattr(moved.params, name) != getattr(params, name), name
+        assert moved.system.urdf_damping().tolist() == [moved.params.b1, moved.params.b2]
+    _passes_at_every_set(model, perturbation)
+    findings = _repairs(model, system, "mass_matrix", 3, "r2**2*m2")
+    first = findings[0]
+    assert first.details["confirmed"], first.message
+    assert _same(first.details["suggested"], "I2 + m2*r2**2"), first.message
+    assert MOVED in first.message
+
+
+def test_a_coincidence_of_an_mjcfs_values_is_caught_at_the_moved_sets(tmp_path):
+    """The cart-pole in MJCF, I = mp·l²/3: with mp·l² missing from M[2,2], 4·I makes every check
+    pass at the file's values; the moved sets catch it, and I + mp·l² is confirmed.  Before the
+    parameters moved in the model, 4·I was printed as holding and nothing was confirmed."""
+    target = _mjcf_target(tmp_path, "corpus_cart_pole_latex.toml", CART_POLE_MJCF, "corpus_cart_pole.toml")
+    findings = _repairs(target.model, target.system, "mass_matrix", 3, "I")
+    first = findings[0]
+    assert first.details["confirmed"], first.message
+    assert _same(first.details["suggested"], "I + l**2*mp"), first.message
+    assert MOVED in first.message
+    assert not any(f.details["suggested"] and _same(f.details["suggested"], "4*I") for f in findings)
+
+
+def test_a_parameter_the_model_holds_nowhere_alone_stays_unmoved_with_its_reason(tmp_path):
+    """The rod in a turned body frame: lc is in the model only as 0.25·sin φ and 0.25·cos φ, so
+    it is not moved, and says why.  m, I and b move: with m·lc² missing from M, 4·I (I = m·lc²/3
+    here) is caught, I + m·lc² holds and is not confirmed, naming lc's reason."""
+    target = _mjcf_target(tmp_path, "corpus_pendulum_rod.toml", ROD_MJCF, "corpus_pendulum_rod_params.toml")
+    perturbation = perturbations(target.model, target.system)
+    assert perturbation.fixed == {
+        "lc": "its value 0.25 is not in the Pinocchio model's centres of mass (inertias[j].lever) "
+        "or joint placements (jointPlacements[j].translation)"
+    }
+    assert set(perturbation.independent) == {"m", "I", "b", "g"} and len(perturbation.sets) == SETS
+    _passes_at_every_set(target.model, perturbation)
+    findings = _repairs(target.model, target.system, "mass_matrix", 0, "I")
+    first = findings[0]
+    assert _same(first.details["suggested"], "I + lc**2*m") and not first.details["confirmed"], first.message
+    assert "not confirmed: lc was not moved (its value 0.25 is not in the Pinocchio model's" in first.message
+    assert not any(f.details["suggested"] and _same(f.details["suggested"], "4*I") for f in findings)
+
+
+def test_where_a_parameter_cannot_move_the_ambiguity_is_stated(tmp_path):
+    """The turned rod with m·lc for m·lc² in M: lc is not moved, so I + m·lc/4 and I + m·lc² both
+    hold at every set; neither is confirmed, and the message says under which relation they agree."""
+    target = _mjcf_target(tmp_path, "corpus_pendulum_rod.toml", ROD_MJCF, "corpus_pendulum_rod_params.toml")
+    findings = _repairs(target.model, target.system, "mass_matrix", 0, "I + m*lc")
+    assert not any(f.details["confirmed"] for f in findings)
+    first = findings[0]
+    assert "not confirmed: lc was not moved (its value 0.25 is not in the Pinocchio model's" in first.message
+    assert "holds as well: they differ unless lc = 1/4" in first.message
+    suggested = [f.details["suggested"] for f in findings]
+    assert any(_same(s, "I + lc**2*m") for s in suggested) and any(_same(s, "I + lc*m/4") for s in suggested)
+
+
+def test_an_inertia_moved_in_the_model_stays_a_rigid_bodys(tmp_path):
+    """Moved alone, the rod's I (its two moments across the rod) keeps the triangle inequality
+    with the 1e-6 axial moment; a move that would break it is refused by joint, not kept."""
+    target = _mjcf_target(tmp_path, "corpus_pendulum_rod.toml", ROD_MJCF, "corpus_pendulum_rod_params.toml")
+    params = target.model.params
+    binding = ModelBinding.of(target.system.urdf, params)
+    assert [s.attribute for _, s in binding.sites["I"]] == ["ixx", "iyy"]
+    moved = binding.rewrite(params.replace(I=params.I * 1.3)).model
+    assert math.isclose(moved.inertias[1].inertia[1, 1], params.I * 1.3, rel_tol=1e-12)
+    assert moved.inertias[1].lever.tolist() == target.system.urdf.model.inertias[1].lever.tolist()
+    assert target.system.urdf.model.inertias[1].inertia[1, 1] == pytest.approx(params.I, rel=1e-12)
+    with pytest.raises(
+        RebindError, match=r"joint 'hinge': the moved rotational inertia has principal moments"
+    ):
+        binding.rewrite(params.replace(I=1e-9))  # 1e-9 + 1e-9 < the axial 1e-6: no rigid body
