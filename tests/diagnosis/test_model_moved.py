@@ -26,9 +26,10 @@ from pendverify.diagnosis.explain import explain
 from pendverify.diagnosis.perturbed import SETS, perturbations
 from pendverify.errors import RebindError
 from pendverify.robot.model_rebind import ModelBinding
+from pendverify.robot.pinocchio_model import describe_model
 from pendverify.robot.system import PinocchioSystem
 from pendverify.symbolic.edited import edited_model
-from pendverify.targets import plugin_target
+from pendverify.targets import plugin_target, select_targets
 
 from ..conftest import default_params
 
@@ -36,7 +37,7 @@ REPO = Path(__file__).resolve().parents[2]
 EXAMPLES = REPO / "examples"
 #: the words only a confirmed repair is printed with (``test_confirmed``)
 CONFIRMED_WORDS = "at these parameter values and at"
-MOVED = "(the MJCF description's Pinocchio model moved for each)"
+MOVED = "(the MJCF's Pinocchio model moved for each)"
 
 #: the classic cart-pole of examples/corpus_cart_pole.urdf in MJCF: I = mp·l²/3 (a uniform pole
 #: of length 2l about its centre), so 4·I gives the numbers of I + mp·l²; the pole's moment about
@@ -126,7 +127,7 @@ def test_the_double_pendulums_mjcf_moves_its_parameters_and_confirms_the_repair(
     model = DoublePendulum(params)
     perturbation = perturbations(model, system)
     assert set(perturbation.independent) == {"m1", "m2", "l1", "r1", "r2", "I1", "I2", "b1", "b2", "g"}
-    assert perturbation.how == "the MJCF description's Pinocchio model moved for each"
+    assert perturbation.how == "the MJCF's Pinocchio model moved for each"
     assert len(perturbation.sets) == SETS
     for moved in perturbation.sets:  # the moved model holds the moved values, read back by its reader
         read = moved.system.geometry.params
@@ -185,6 +186,35 @@ def test_where_a_parameter_cannot_move_the_ambiguity_is_stated(tmp_path):
     assert "holds as well: they differ unless lc = 1/4" in first.message
     suggested = [f.details["suggested"] for f in findings]
     assert any(_same(s, "I + lc**2*m") for s in suggested) and any(_same(s, "I + lc*m/4") for s in suggested)
+
+
+def test_a_pinocchio_model_given_to_the_api_moves_its_parameters(tmp_path):
+    """The same cart-pole given as a ``pinocchio.Model`` (no file at all): its repair is confirmed
+    as the MJCF's, the model moved for each set."""
+    target = _mjcf_target(tmp_path, "corpus_cart_pole_latex.toml", CART_POLE_MJCF, "corpus_cart_pole.toml")
+    selection = select_targets(type(target.model), describe_model(target.system.model), target.model.params)
+    (given,) = selection.targets
+    assert given.system.urdf.format == "pinocchio"
+    perturbation = perturbations(given.model, given.system)
+    assert set(perturbation.independent) == {"mc", "mp", "l", "I", "g"} and len(perturbation.sets) == SETS
+    assert perturbation.how == "the Pinocchio model moved for each"
+    findings = _repairs(given.model, given.system, "mass_matrix", 3, "I")
+    assert findings[0].details["confirmed"] and _same(findings[0].details["suggested"], "I + l**2*mp")
+
+
+def test_an_sdformat_description_moves_its_parameters():
+    """Drake's Acrobot.sdf (``tests/robot/test_drake_sdf.py``), read through Drake into Pinocchio:
+    its masses, lengths and inertias move, and the untouched hand model passes at each set.
+    Skipped when pydrake is not installed."""
+    pytest.importorskip("pydrake.common")
+    from ..robot.test_drake_sdf import ACROBOT, ACROBOT_PARAMS, DrakeAcrobot
+
+    (target,) = select_targets(DrakeAcrobot, ACROBOT, ACROBOT_PARAMS).targets
+    perturbation = perturbations(target.model, target.system)
+    assert perturbation.how == "the SDFormat's Pinocchio model moved for each"
+    moved = set(perturbation.independent) | {n for group in perturbation.groups for n in group}
+    assert {"m1", "m2", "I1", "I2", "r1"} <= moved and len(perturbation.sets) == SETS
+    _passes_at_every_set(target.model, perturbation)
 
 
 def test_an_inertia_moved_in_the_model_stays_a_rigid_bodys(tmp_path):
