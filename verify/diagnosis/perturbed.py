@@ -35,11 +35,11 @@ thin or flat body meets almost with equality (Furuta's arm: 1.057e-3 ≤ 1.060e-
 reader refuses that URDF (``ModelBinding`` that model).  The factors then move the body's second
 moments of mass instead, A = ∫x² dm = (Iyy + Izz − Ixx)/2, B = (Ixx + Izz − Iyy)/2,
 C = (Ixx + Iyy − Izz)/2 (all ≥ 0 by the triangle inequality), and the moments follow:
-Ixx = B + C, Iyy = A + C, Izz = A + B.  They then satisfy the inequality whatever the factors, and still move apart
-(by the moved share of B and C: 0.5 % of Iyy for Furuta's arm, some 1e10 times the checks'
-tolerance).  A body that is exactly flat (C = 0) keeps Izz = Ixx + Iyy: a physical identity, not
-a coincidence.  Any other rule a draw breaks (a rule across parameters, the strict reader) makes
-it drawn again, up to ``DRAWS`` times per set.
+Ixx = B + C, Iyy = A + C, Izz = A + B.  They then satisfy the inequality whatever the
+factors, and still move apart (by the moved share of B and C: 0.5 % of Iyy for Furuta's arm,
+some 1e10 times the checks' tolerance).  A body that is exactly flat (C = 0) keeps
+Izz = Ixx + Iyy: a physical identity, not a coincidence.  Any other rule a draw breaks (a rule
+across parameters, the strict reader) makes it drawn again, up to ``DRAWS`` times per set.
 
 Where the parameters move.  What the checks compare a model with is the Pinocchio model read
 from the description: a kinematic tree whose dynamics are a function of its joints' placements
