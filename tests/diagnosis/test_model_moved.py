@@ -217,6 +217,65 @@ def test_an_sdformat_description_moves_its_parameters():
     _passes_at_every_set(target.model, perturbation)
 
 
+#: a rod pendulum whose hinge carries a rotor of inertia a (MuJoCo's armature, on M's diagonal)
+ROTOR_MODEL = """name = "rod_with_rotor"
+inputs = ["tau"]
+M = [["I + m*lc**2 + a"]]
+C = [["0"]]
+H = ["g*m*lc*sin(theta)"]
+B = [["1"]]
+[coordinates]
+theta = "angle"
+[parameters]
+m = { kind = "mass", unit = "kg" }
+lc = { kind = "offset", unit = "m" }
+I = { kind = "inertia", unit = "kg·m²" }
+a = { kind = "inertia", unit = "kg·m²" }
+g = { kind = "gravity", unit = "m/s²" }
+[urdf]
+joints = ["hinge"]
+transform = [[1]]
+offset = [0]
+"""
+ROTOR_PARAMS = """model = "rod_with_rotor"
+[parameters]
+m = 1.0
+lc = 0.25
+I = 0.020833333333333332
+a = 0.003
+g = 9.81
+"""
+ROTOR_MJCF = """<mujoco model="rod_with_rotor">
+  <compiler angle="radian" inertiafromgeom="false"/>
+  <worldbody>
+    <body name="rod">
+      <joint name="hinge" type="hinge" axis="0 1 0" armature="0.003"/>
+      <inertial pos="0 0 -0.25" mass="1.0" diaginertia="0.020833333333333332 0.020833333333333332 1e-6"/>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+
+def test_an_armature_moves_in_the_model_and_m_follows(tmp_path):
+    """The rotor's a is the MJCF's armature, which Pinocchio adds to M's diagonal: it moves in
+    ``model.armature``, the untouched model passes at each set, and with a dropped from M the
+    repair I + m·lc² + a is confirmed."""
+    for name, text in (("rotor.toml", ROTOR_MODEL), ("rotor_params.toml", ROTOR_PARAMS)):
+        (tmp_path / name).write_text(text)
+    (tmp_path / "rotor.mjcf.xml").write_text(ROTOR_MJCF)
+    target = plugin_target(
+        str(tmp_path / "rotor.toml"), str(tmp_path / "rotor.mjcf.xml"), str(tmp_path / "rotor_params.toml")
+    )
+    perturbation = perturbations(target.model, target.system)
+    assert set(perturbation.independent) == {"m", "lc", "I", "a", "g"} and len(perturbation.sets) == SETS
+    for moved in perturbation.sets:
+        assert moved.system.model.armature.tolist() == [moved.params.a] != [0.003]
+    _passes_at_every_set(target.model, perturbation)
+    findings = _repairs(target.model, target.system, "mass_matrix", 0, "I + m*lc**2")
+    assert findings[0].details["confirmed"] and _same(findings[0].details["suggested"], "I + m*lc**2 + a")
+
+
 def test_an_inertia_moved_in_the_model_stays_a_rigid_bodys(tmp_path):
     """Moved alone, the rod's I (its two moments across the rod) keeps the triangle inequality
     with the 1e-6 axial moment; a move that would break it is refused by joint, not kept."""

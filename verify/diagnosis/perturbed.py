@@ -49,15 +49,16 @@ equations of motion are linear in the inertial parameters).  A URDF or xacro is 
 ``<dynamics>``) and read again.  An MJCF, an SDFormat file or a ``pinocchio.Model`` given to the
 API is not rewritten; its Pinocchio model is moved instead (``robot.model_rebind.ModelBinding``:
 the value found in ``inertias[j]``'s mass, lever or rotational inertia, in
-``jointPlacements[j].translation``, or in a declared joint damping), with the same matching
+``jointPlacements[j].translation``, in a declared joint damping or armature), with the same matching
 rules, and each set's system is built from the moved copy.  Both are the same function of the
 parameters: the reader copies each number of the file into one field of the model unchanged
 (where it combines numbers, no parameter is found there), so moving the value in the model is
 what rewriting it in the file and reading it again would give.  Nothing else a check reads comes
 from the file: the closed form's parameters are read off the moved model by the model's geometry
 reader, the declared damping is moved in the description's facts with ``model.damping``, an
-MJCF's armature and gravity are no parameter's and stay as read; MuJoCo's and Drake's
-cross-checks compare a file with its reading and are not run again (there is no moved file).
+MJCF's armature in ``model.armature`` (where a parameter holds its value; else it stays as
+read), its gravity is g's (above); MuJoCo's and Drake's cross-checks compare a file with its
+reading and are not run again (there is no moved file).
 
 Which parameters move (``Perturbation``):
 

@@ -11,13 +11,18 @@ value, by kind, with ``rebind.match``: the rules ``Binding`` applies to a URDF's
 =========  ==============================================================================
 kind       where its value is looked for (j: each joint but the universe)
 =========  ==============================================================================
-mass       ``model.inertias[j].mass``
-inertia    ``model.inertias[j].inertia`` (about the centre of mass): ixx … izz (|value|)
+mass       ``model.inertias[j].mass``; a slide's armature ``model.armature`` (kg)
+inertia    ``model.inertias[j].inertia`` (about the centre of mass): ixx … izz (|value|);
+           a hinge's armature ``model.armature`` (kg·m², a rotor inertia on M's diagonal)
 length     the components of ``model.inertias[j].lever`` (the centre of mass in the joint's
 offset     frame) and of ``model.jointPlacements[j].translation`` (|value|; the sign is kept)
 damping    a joint's damping the description declares (its facts, and ``model.damping``)
 gravity    nowhere: the system takes g from the parameter set
 =========  ==============================================================================
+
+An armature is looked for on joints of one degree of freedom whose armature is not 0 (an MJCF's
+``armature``, which the reader copies from MuJoCo's ``dof_armature``), under both kinds: the
+value's unit depends on the joint, which the kind does not say.
 
 ``rewrite`` gives a copy of the description read (``LoadedDescription``) whose model holds the
 new values at those fields: what rewriting the file at the same places would give, since the
@@ -53,8 +58,9 @@ from pendverify.robot.strict import JointDynamics
 _ENTRIES = {"ixx": (0, 0), "ixy": (0, 1), "ixz": (0, 2), "iyy": (1, 1), "iyz": (1, 2), "izz": (2, 2)}
 #: kind -> where its value is looked for, in words
 WHERE = {
-    "mass": "masses (inertias[j].mass)",
-    "inertia": "rotational inertias about the centres of mass (inertias[j].inertia)",
+    "mass": "masses (inertias[j].mass) or joint armatures (armature)",
+    "inertia": "rotational inertias about the centres of mass (inertias[j].inertia) or joint armatures "
+    "(armature)",
     "length": "centres of mass (inertias[j].lever) or joint placements (jointPlacements[j].translation)",
     "offset": "centres of mass (inertias[j].lever) or joint placements (jointPlacements[j].translation)",
     "damping": "declared joint damping",
@@ -97,6 +103,10 @@ class ModelBinding(Bound):
                 damping = np.array(model.damping, dtype=float)
                 damping[model.joints[j].idx_v] = value
                 model.damping = damping
+            elif site.path.startswith("armature"):
+                armature = np.array(model.armature, dtype=float)
+                armature[model.joints[j].idx_v] = value
+                model.armature = armature
             else:
                 inertia = model.inertias[j]
                 mass, lever, rotational = inertia.mass, inertia.lever.copy(), inertia.inertia.copy()
@@ -127,6 +137,9 @@ def _found(loaded: LoadedDescription, kind: str):
 
     for j in range(1, model.njoints):
         inertia = model.inertias[j]
+        one = model.joints[j].nv == 1
+        if kind in ("mass", "inertia") and one and model.armature[model.joints[j].idx_v] != 0:
+            put(j, "armature", "armature", None, model.armature[model.joints[j].idx_v])
         if kind == "mass":
             put(j, "inertias", "mass", None, inertia.mass)
         elif kind == "inertia":
@@ -138,7 +151,7 @@ def _found(loaded: LoadedDescription, kind: str):
                 put(j, "jointPlacements", "translation", c, model.jointPlacements[j].translation[c])
         else:  # damping: where the description declares it, on a joint of one degree of freedom
             declared = loaded.facts.joint_dynamics.get(model.names[j])
-            if declared is not None and declared.damping is not None and model.joints[j].nv == 1:
+            if declared is not None and declared.damping is not None and one:
                 put(j, "joint_dynamics", "damping", None, declared.damping)
     return out
 
