@@ -13,11 +13,13 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 import sympy as sp
 
 from pendverify.analytic import DoublePendulum
 from pendverify.analytic.symbolic_reading import SymbolicModel
+from pendverify.bench.explain import shipped_targets
 from pendverify.checks.batch import CheckBatch
 from pendverify.checks.catalogue import applicable_checks, run_checks
 from pendverify.checks.sampling import sample_states
@@ -274,6 +276,26 @@ def test_an_armature_moves_in_the_model_and_m_follows(tmp_path):
     _passes_at_every_set(target.model, perturbation)
     findings = _repairs(target.model, target.system, "mass_matrix", 0, "I + m*lc**2")
     assert findings[0].details["confirmed"] and _same(findings[0].details["suggested"], "I + m*lc**2 + a")
+
+
+def test_furutas_tight_inertias_move_in_its_pinocchio_model_and_stay_a_rigid_bodys():
+    """Furuta's pendulum given as a ``pinocchio.Model``: its arm's moments (1.7e-5, 1.043e-3,
+    1.057e-3) meet the triangle inequality almost with equality.  Each is bound alone to a diagonal
+    entry of the arm's rotational inertia, so the three move through the second moments of mass
+    (``perturbed``), as in its URDF: each moves, their ratios differ, the inequality holds, and the
+    untouched model passes at each set."""
+    ((_, model, system, _),) = [t for t in shipped_targets() if t[0].startswith("furuta_pendulum, model (P")]
+    (given,) = select_targets(type(model), describe_model(system.model), model.params).targets
+    perturbation = perturbations(given.model, given.system)
+    assert len(perturbation.sets) == SETS and {"Jrxx", "Jryy", "Jrzz"} <= set(perturbation.independent)
+    for moved in perturbation.sets:
+        p = moved.params
+        assert p.Jrzz <= p.Jrxx + p.Jryy and p.Jpxx <= p.Jpyy + p.Jpzz
+        assert all(getattr(p, n) != getattr(model.params, n) for n in ("Jrxx", "Jryy", "Jrzz"))
+        assert not math.isclose(p.Jryy / model.params.Jryy, p.Jrzz / model.params.Jrzz, rel_tol=1e-6)
+        arm = moved.system.model.inertias[1].inertia
+        assert np.allclose(np.diag(arm), [p.Jrxx, p.Jryy, p.Jrzz], rtol=1e-12, atol=0), (arm, p)
+    _passes_at_every_set(given.model, perturbation)
 
 
 def test_an_inertia_moved_in_the_model_stays_a_rigid_bodys(tmp_path):
