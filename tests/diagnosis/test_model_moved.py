@@ -19,7 +19,7 @@ import sympy as sp
 
 from pendverify.analytic import DoublePendulum
 from pendverify.analytic.symbolic_reading import SymbolicModel
-from pendverify.bench.explain import shipped_targets
+from pendverify.bench.explain import class_targets, shipped_targets
 from pendverify.checks.batch import CheckBatch
 from pendverify.checks.catalogue import applicable_checks, run_checks
 from pendverify.checks.sampling import sample_states
@@ -276,6 +276,21 @@ def test_an_armature_moves_in_the_model_and_m_follows(tmp_path):
     _passes_at_every_set(target.model, perturbation)
     findings = _repairs(target.model, target.system, "mass_matrix", 0, "I + m*lc**2")
     assert findings[0].details["confirmed"] and _same(findings[0].details["suggested"], "I + m*lc**2 + a")
+
+
+def test_equal_rods_move_in_groups_in_the_pinocchio_model():
+    """The double pendulum of two equal rods given as a ``pinocchio.Model``: m1 = m2, lc1 = lc2,
+    I1 = I2 and l1 = l2 share their values and sites there as in its URDF, so each pair moves by
+    one factor and stays equal (``rebind.match``'s groups, whatever holds the values)."""
+    ((_, model, system, _),) = [t for t in class_targets() if t[0].startswith("corpus_double_pendulum")]
+    (given,) = select_targets(type(model), describe_model(system.model), model.params).targets
+    perturbation = perturbations(given.model, given.system)
+    assert set(perturbation.groups) == {("m1", "m2"), ("lc1", "lc2"), ("I1", "I2"), ("l1", "l2")}
+    assert perturbation.independent == ("g",) and perturbation.fixed == {} and len(perturbation.sets) == SETS
+    for moved in perturbation.sets:
+        p = moved.params
+        assert p.m1 == p.m2 != model.params.m1 and p.I1 == p.I2 != model.params.I1 and p.lc1 == p.lc2
+    _passes_at_every_set(given.model, perturbation)
 
 
 def test_furutas_tight_inertias_move_in_its_pinocchio_model_and_stay_a_rigid_bodys():
