@@ -27,6 +27,10 @@ them can be changed together.  ``rewrite`` accepts a set in which every member o
 a group has one new value, and writes it at every site that held the group's value;
 members given different values are refused naming them.  What the rewritten URDF
 means is checked like any URDF: by the checks.
+
+These rules do not depend on what holds the values: ``match`` applies them to the places
+a holder lists (a URDF's attributes here; a loaded Pinocchio model's fields in
+``pendverify.robot.model_rebind``), and ``changes`` lists what a new set writes where.
 """
 
 from __future__ import annotations
