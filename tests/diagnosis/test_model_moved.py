@@ -313,6 +313,85 @@ def test_furutas_tight_inertias_move_in_its_pinocchio_model_and_stay_a_rigid_bod
     _passes_at_every_set(given.model, perturbation)
 
 
+#: a double pendulum whose link 1 is a uniform rod given by its length l: its centre of mass at
+#: l/2 and inertia m1·l²/12, joint 2 at l (examples/corpus_double_pendulum.toml otherwise)
+BY_LENGTH_MODEL = """name = "rod_and_pendulum"
+inputs = ["tau1", "tau2"]
+M = [
+  [
+    "m1*l**2/12 + I2 + m1*l**2/4 + m2*(l**2 + lc2**2 + 2*l*lc2*cos(theta2))",
+    "I2 + m2*(lc2**2 + l*lc2*cos(theta2))",
+  ],
+  ["I2 + m2*(lc2**2 + l*lc2*cos(theta2))", "I2 + m2*lc2**2"],
+]
+C = [
+  ["-m2*l*lc2*sin(theta2)*dtheta2", "-m2*l*lc2*sin(theta2)*(dtheta1 + dtheta2)"],
+  ["m2*l*lc2*sin(theta2)*dtheta1", "0"],
+]
+H = ["g*((m1*l/2 + m2*l)*sin(theta1) + m2*lc2*sin(theta1 + theta2))", "g*m2*lc2*sin(theta1 + theta2)"]
+B = [["1", "0"], ["0", "1"]]
+[coordinates]
+theta1 = "angle"
+theta2 = "angle"
+[parameters]
+m1 = { kind = "mass", unit = "kg" }
+m2 = { kind = "mass", unit = "kg" }
+l = { kind = "length", unit = "m" }
+lc2 = { kind = "offset", unit = "m" }
+I2 = { kind = "inertia", unit = "kg·m²" }
+g = { kind = "gravity", unit = "m/s²" }
+[urdf]
+joints = ["joint1", "joint2"]
+transform = [[1, 0], [0, 1]]
+offset = [0, 0]
+"""
+BY_LENGTH_PARAMS = """model = "rod_and_pendulum"
+[parameters]
+m1 = 1.0
+m2 = 0.7
+l = 0.6
+lc2 = 0.35
+I2 = 0.004
+g = 9.81
+"""
+BY_LENGTH_MJCF = """<mujoco model="rod_and_pendulum">
+  <compiler angle="radian" inertiafromgeom="false"/>
+  <worldbody>
+    <body name="link1">
+      <joint name="joint1" type="hinge" axis="0 1 0"/>
+      <inertial pos="0 0 -0.3" mass="1.0" diaginertia="0.03 0.03 1e-6"/>
+      <body name="link2" pos="0 0 -0.6">
+        <joint name="joint2" type="hinge" axis="0 1 0"/>
+        <inertial pos="0 0 -0.35" mass="0.7" diaginertia="0.004 0.004 1e-6"/>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+
+def test_a_parameter_the_model_holds_alone_and_combined_is_not_moved(tmp_path):
+    """l is joint 2's placement alone, and l/2, m1·l²/12 in link 1's inertia: moved alone, it makes
+    entries that agree at the file's values disagree, so it is not moved (nor m1, which
+    m1·l²/12 holds combined), and the repair of a sign in M[1,2] is kept, not confirmed, saying why."""
+    for name, text in (
+        ("m.toml", BY_LENGTH_MODEL),
+        ("p.toml", BY_LENGTH_PARAMS),
+        ("r.mjcf.xml", BY_LENGTH_MJCF),
+    ):
+        (tmp_path / name).write_text(text)
+    target = plugin_target(str(tmp_path / "m.toml"), str(tmp_path / "r.mjcf.xml"), str(tmp_path / "p.toml"))
+    assert perturbations(target.model, target.system).independent == ("m1", "m2", "l", "lc2", "I2", "g")
+    findings = _repairs(target.model, target.system, "mass_matrix", 1, "I2 + m2*(lc2**2 - l*lc2*cos(theta2))")
+    first = findings[0]
+    assert _same(first.details["suggested"], "I2 + m2*(lc2**2 + l*lc2*cos(theta2))"), first.message
+    assert not first.details["confirmed"], first.message
+    assert (
+        "l was not moved (moved in the Pinocchio model, entries that agree at the file's values disagree: "
+        "the Pinocchio model holds it combined with other parameters too)"
+    ) in first.message
+
+
 def test_an_inertia_moved_in_the_model_stays_a_rigid_bodys(tmp_path):
     """Moved alone, the rod's I (its two moments across the rod) keeps the triangle inequality
     with the 1e-6 axial moment; a move that would break it is refused by joint, not kept."""
