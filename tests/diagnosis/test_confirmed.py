@@ -10,7 +10,6 @@ the ambiguity stated, with the relation under which the alternatives agree, wher
 
 from __future__ import annotations
 
-import dataclasses
 import sys
 
 import pytest
@@ -25,7 +24,6 @@ from pendverify.cli import main
 from pendverify.diagnosis.alternatives import relation
 from pendverify.diagnosis.corpus import CORPUS_SAMPLES, CORPUS_SEED, sample_plants, score_model
 from pendverify.diagnosis.explain import explain
-from pendverify.robot.system import PinocchioSystem
 from pendverify.shipped import shipped_file
 from pendverify.symbolic.edited import edited_model
 
@@ -103,21 +101,6 @@ def test_a_coincidence_alone_is_named_as_one_not_as_a_repair():
     assert "V: 0 → -g*lc2*m2*cos(theta1 + theta2) - 3*g*cos(theta1)/4" in only.message
     assert "make(s) every check pass at these parameter values, but not at other values" in only.message
     assert "(the URDF rewritten for each): a coincidence of the values, not a repair" in only.message
-
-
-def test_where_the_description_cannot_be_rewritten_the_ambiguity_is_stated():
-    """The same cart-pole seen as an MJCF (not rewritten: only g moves): I → 4·I and
-    I → I + mp·l² both hold, and the message says under which relation they agree."""
-    ((_, model, system, _),) = _targets("corpus_cart_pole")
-    mjcf = dataclasses.replace(system.urdf, format="mjcf")
-    findings, _ = _repairs("corpus_cart_pole", "mass_matrix", 3, "I", PinocchioSystem.for_model(
-        type(model), mjcf, model.params.g))  # fmt: skip
-    assert not _confirmed(findings)
-    first = findings[0]
-    assert "not confirmed: I was not moved (the MJCF description is not rewritten" in first.message
-    assert "I + l^{2} m_p holds as well: they differ unless I = \\frac{l^{2} m_p}{3}" in first.message
-    suggested = {sp.sympify(f.details["suggested"]) for f in findings}
-    assert sp.sympify("I + l**2*mp") in suggested and sp.sympify("4*I") in suggested
 
 
 def test_equal_parameters_moved_together_state_the_exchange():

@@ -9,13 +9,11 @@ named with its reason; equal values move together.
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
 import sympy as sp
 
-from pendverify.analytic import DoublePendulum
 from pendverify.analytic.symbolic_reading import SymbolicModel
 from pendverify.bench.explain import class_targets, shipped_targets
 from pendverify.checks.batch import CheckBatch
@@ -24,13 +22,8 @@ from pendverify.checks.sampling import sample_states
 from pendverify.diagnosis.corpus import CORPUS_SAMPLES, CORPUS_SEED
 from pendverify.diagnosis.explain import explain
 from pendverify.diagnosis.perturbed import LEAST_MOVE, MOST_MOVE, SETS, perturbations
-from pendverify.robot.system import PinocchioSystem
 from pendverify.symbolic.edited import edited_model
 from pendverify.targets import plugin_target
-
-from ..conftest import default_params
-
-REPO = Path(__file__).resolve().parents[2]
 
 
 def _passes_at_every_set(model, perturbation) -> None:
@@ -72,22 +65,6 @@ def test_furutas_tight_inertias_move_and_keep_the_triangle_inequality():
         assert all(getattr(p, n) != getattr(model.params, n) for n in ("Jrxx", "Jryy", "Jrzz"))
         assert not math.isclose(p.Jryy / model.params.Jryy, p.Jrzz / model.params.Jrzz, rel_tol=1e-6)
     _passes_at_every_set(model, perturbation)
-
-
-def test_an_mjcf_moves_only_gravity_and_says_why():
-    params = default_params("double_pendulum")
-    system = PinocchioSystem.for_model(
-        DoublePendulum, REPO / "examples" / "double_pendulum.mjcf.xml", params.g
-    )
-    model = DoublePendulum(params)
-    perturbation = perturbations(model, system)
-    assert perturbation.independent == ("g",) and perturbation.how == "another g for each"
-    assert perturbation.fixed["m1"] == "the MJCF description is not rewritten, only a URDF is"
-    assert all(s.params.m1 == params.m1 and s.params.g != params.g for s in perturbation.sets)
-    _passes_at_every_set(model, perturbation)
-    assert perturbation.why_not_alone({"m2", "g"}) == [
-        "m2 was not moved (the MJCF description is not rewritten, only a URDF is)"
-    ]
 
 
 ROD = """name = "rod_by_length"

@@ -7,7 +7,8 @@ on every state and still be the wrong formula (``l*m → l*m/2`` for a missing `
 l = 0.5; ``I → 4*I`` for a missing m·l², with I = m·l²/12 and lc = l/2).  A repair
 (``pendverify.diagnosis.repair``) is therefore checked again at other parameter values, the
 robot description rewritten for each, as a sweep does for a user's model
-(``pendverify.robot.rebind.Binding``, ``pendverify.certify.sweep_task.set_urdf``).
+(``pendverify.robot.rebind.Binding``, ``pendverify.certify.sweep_task.set_urdf``), or, for a
+description that is not rewritten, its Pinocchio model moved (below).
 
 Derivation.  Let c be the edited entry and t the entry that makes the checks pass; both are
 functions of the state q and the parameters p.  An edit that passes at the file's values p0
@@ -29,35 +30,61 @@ robot's).  Factors are continuous draws, so that moved parameters do not fall on
 relations (a ratio of 2) either.
 
 Moments of inertia.  Where a link's three moments are three parameters (Ixx, Iyy, Izz, bound
-alone), moving each by its own factor can leave the triangle inequality Izz ≤ Ixx + Iyy, which
-a thin or flat body meets almost with equality (Furuta's arm: 1.057e-3 ≤ 1.060e-3), and the
-strict reader refuses that URDF.  The factors then move the body's second moments of mass
-instead, A = ∫x² dm = (Iyy + Izz − Ixx)/2, B = (Ixx + Izz − Iyy)/2, C = (Ixx + Iyy − Izz)/2
-(all ≥ 0 by the triangle inequality), and the moments follow: Ixx = B + C, Iyy = A + C,
-Izz = A + B.  They then satisfy the inequality whatever the factors, and still move apart
-(by the moved share of B and C: 0.5 % of Iyy for Furuta's arm, some 1e10 times the checks'
-tolerance).  A body that is exactly flat (C = 0) keeps Izz = Ixx + Iyy: a physical identity,
-not a coincidence.  Any other rule a draw breaks (a rule across parameters, the strict reader)
-makes it drawn again, up to ``DRAWS`` times per set.
+alone), moving each by its own factor can leave the triangle inequality Izz ≤ Ixx + Iyy, which a
+thin or flat body meets almost with equality (Furuta's arm: 1.057e-3 ≤ 1.060e-3), and the strict
+reader refuses that URDF (``ModelBinding`` that model).  The factors then move the body's second
+moments of mass instead, A = ∫x² dm = (Iyy + Izz − Ixx)/2, B = (Ixx + Izz − Iyy)/2,
+C = (Ixx + Iyy − Izz)/2 (all ≥ 0 by the triangle inequality), and the moments follow:
+Ixx = B + C, Iyy = A + C, Izz = A + B.  They then satisfy the inequality whatever the
+factors, and still move apart (by the moved share of B and C: 0.5 % of Iyy for Furuta's arm,
+some 1e10 times the checks' tolerance).  A body that is exactly flat (C = 0) keeps
+Izz = Ixx + Iyy: a physical identity, not a coincidence.  Any other rule a draw breaks (a rule
+across parameters, the strict reader) makes it drawn again, up to ``DRAWS`` times per set.
+
+Where the parameters move.  What the checks compare a model with is the Pinocchio model read
+from the description: a kinematic tree whose dynamics are a function of its joints' placements
+and of each joint's body inertia (mass, centre of mass, rotational inertia about it; the
+equations of motion are linear in the inertial parameters).  A URDF or xacro is rewritten
+(``rebind.Binding``: a parameter's value found in ``<inertial>``, a joint's ``<origin>`` or
+``<dynamics>``) and read again.  An MJCF, an SDFormat file or a ``pinocchio.Model`` given to the
+API is not rewritten; its Pinocchio model is moved instead (``robot.model_rebind.ModelBinding``:
+the value found in ``inertias[j]``'s mass, lever or rotational inertia, in
+``jointPlacements[j].translation``, in a declared joint damping or armature), with the same matching
+rules, and each set's system is built from the moved copy.  Both are the same function of the
+parameters: the reader copies each number of the file into one field of the model unchanged
+(where it combines numbers, no parameter is found there), so moving the value in the model is
+what rewriting it in the file and reading it again would give.  Nothing else a check reads comes
+from the file: the closed form's parameters are read off the moved model by the model's geometry
+reader, the declared damping is moved in the description's facts with ``model.damping``, an
+MJCF's armature in ``model.armature`` (where a parameter holds its value; else it stays as
+read), its gravity is g's (above); MuJoCo's and Drake's cross-checks compare a file with its
+reading and are not run again (there is no moved file).
 
 Which parameters move (``Perturbation``):
 
 * gravity (``IN_PINOCCHIO``): freely; each set's system is built with its g;
-* damping, where the description declares no ``<dynamics damping>``: freely (the checks
-  compare D with nothing in it, ``needs_urdf_damping``);
-* every other parameter ``Binding`` finds alone in the URDF: on its own (*independent*);
-* parameters that share a value (``Binding.groups``: m1 = m2): together, by one factor, so
-  they stay equal.  Two edits that differ only by exchanging members of a group agree at
-  every such set: a repair that involves a member is not told apart from its exchange;
-* the rest are not moved, each with the reason (a value 0, a value not in the URDF, a
-  combination of parameters in the file, a description ``Binding`` cannot rewrite: MJCF,
-  SDFormat, a Pinocchio model), and so the repairs that involve them hold at these values
-  only;
-* nor is a parameter the URDF holds alone at one site and combined with others elsewhere (a
-  tip frame at l, the centre of mass at l/2 and m·l²/12): moved, it makes entries of the model
-  that agree with the URDF at the file's values disagree, and then a right repair would fail
-  too.  ``consistent`` (given by the repair search: no entry that agrees at the file's values
-  disagrees at the set) finds it, each move tried alone when a set is not consistent.
+* damping, where the description declares no damping: freely (the checks compare D with nothing
+  in it, ``needs_urdf_damping``);
+* every other parameter the binding finds alone (in the URDF, or in the Pinocchio model of an
+  MJCF, SDFormat or Pinocchio-model description): on its own (*independent*);
+* parameters that share a value (``groups``: m1 = m2): together, by one factor, so they stay
+  equal.  Two edits that differ only by exchanging members of a group agree at every such set:
+  a repair that involves a member is not told apart from its exchange;
+* the rest are not moved, each with the reason (a value 0, a value the description holds
+  nowhere alone: a drawing length, a combination of parameters such as an inertia about the
+  joint or a centre of mass in a turned frame), and so the repairs that involve them hold at
+  these values only;
+* nor is a parameter the description holds alone at one site and combined with others
+  elsewhere (a tip frame at l, the centre of mass at l/2 and m·l²/12): moved, it makes entries
+  of the model that agree with the description at the file's values disagree, and then a right
+  repair would fail too.  ``consistent`` (given by the repair search: no entry that agrees at the
+  file's values disagrees at the set) finds it, each move tried alone when a set is not
+  consistent.
+
+A moved rotational inertia must stay a rigid body's: in a URDF the strict reader refuses one
+that is not; in a Pinocchio model ``ModelBinding.rewrite`` does (the same rules).  Either way the
+draw is made again, and the moments of a triple of parameters move through the second moments
+of mass (above), so they keep the triangle inequality.
 
 The sets are drawn with ``SEED``: the same model gets the same sets every time.
 """
@@ -71,7 +98,9 @@ from dataclasses import dataclass, field
 
 from pendverify.errors import PendverifyError
 from pendverify.robot.description import READERS
-from pendverify.robot.rebind import IN_PINOCCHIO, Binding
+from pendverify.robot.model_rebind import ModelBinding
+from pendverify.robot.pinocchio_model import FORMAT as PINOCCHIO
+from pendverify.robot.rebind import IN_PINOCCHIO, Binding, Bound
 
 SETS = 2
 LEAST_MOVE, MOST_MOVE = 0.1, 0.3  # |ln factor| (module docstring)
@@ -140,8 +169,8 @@ def perturbations(model, system, consistent=None, count: int = SETS, seed: int =
             binding = Binding.of(loaded.text, params, loaded.source)
         except PendverifyError as exc:
             cause = f"the description could not be read for rewriting: {exc}"
-    else:
-        cause = f"the {READERS[loaded.format]} description is not rewritten, only a URDF is"
+    else:  # MJCF, SDFormat, a Pinocchio model: moved in the model read (module docstring)
+        binding = ModelBinding.of(loaded, params)
     free_damping = system.urdf_damping() is None
     units, fixed, written = [], {}, set()
     for name, kind in kinds.items():
@@ -166,7 +195,13 @@ def perturbations(model, system, consistent=None, count: int = SETS, seed: int =
         written |= {n for group in binding.groups for n in group}
     out = Perturbation(fixed=fixed)
     rewritten = bool(written)
-    out.how = f"the {READERS[loaded.format]} rewritten for each" if rewritten else "another g for each"
+    if not rewritten:
+        out.how = "another g for each"
+    elif isinstance(binding, ModelBinding):  # a Pinocchio model given as one is its own description
+        whose = "the" if loaded.format == PINOCCHIO else f"the {READERS[loaded.format]}'s"
+        out.how = f"{whose} Pinocchio model moved for each"
+    else:
+        out.how = f"the {READERS[loaded.format]} rewritten for each"
 
     triples = _moment_triples(binding) if binding is not None else []
 
@@ -214,12 +249,13 @@ def perturbations(model, system, consistent=None, count: int = SETS, seed: int =
         if not culprits:  # only moves together break it: no set is made
             out.refused = "moved together, the parameters make entries that agree here disagree"
             units.clear()
+        holder = "the Pinocchio model" if isinstance(binding, ModelBinding) else "the URDF"
         for unit in culprits:
             units.remove(unit)
             for name in unit:
                 out.fixed[name] = (
-                    "moved in the URDF, entries that agree at the file's values disagree: "
-                    "the URDF holds it combined with other parameters too"
+                    f"moved in {holder}, entries that agree at the file's values disagree: "
+                    f"{holder} holds it combined with other parameters too"
                 )
         out.sets.clear()  # the sets kept so far moved those as well
     grouped = set(binding.groups) if binding is not None else set()
@@ -230,14 +266,14 @@ def perturbations(model, system, consistent=None, count: int = SETS, seed: int =
     return out
 
 
-def _moment_triples(binding: Binding) -> list[tuple[str, str, str]]:
-    """(ixx, iyy, izz parameters) of each ``<inertia>`` whose three moments are three parameters,
-    each bound there alone."""
+def _moment_triples(binding: Bound) -> list[tuple[str, str, str]]:
+    """(ixx, iyy, izz parameters) of each inertia (a URDF's ``<inertia>``, a Pinocchio body's
+    rotational inertia) whose three moments are three parameters, each bound there alone."""
     by_element: dict = {}
     for name, sites in binding.sites.items():
         if len(sites) == 1 and sites[0][1].attribute in ("ixx", "iyy", "izz"):
-            element, site = sites[0]
-            by_element.setdefault(id(element), {})[site.attribute] = name
+            site = sites[0][1]
+            by_element.setdefault(site.path, {})[site.attribute] = name
     return [(d["ixx"], d["iyy"], d["izz"]) for d in by_element.values() if len(d) == 3]
 
 

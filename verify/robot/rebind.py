@@ -27,6 +27,10 @@ them can be changed together.  ``rewrite`` accepts a set in which every member o
 a group has one new value, and writes it at every site that held the group's value;
 members given different values are refused naming them.  What the rewritten URDF
 means is checked like any URDF: by the checks.
+
+These rules do not depend on what holds the values: ``match`` applies them to the places
+a holder lists (a URDF's attributes here; a loaded Pinocchio model's fields in
+``pendverify.robot.model_rebind``), and ``changes`` lists what a new set writes where.
 """
 
 from __future__ import annotations
@@ -61,8 +65,94 @@ class Site:
     sign: float
 
 
+class Bound:
+    """What every binding answers: which parameters are bound alone, which share a value.
+
+    ``sites``: parameter → the sites holding its value; ``groups``: the parameters that share a
+    value (module docstring) → their sites; ``reasons``: parameter → why it is bound alone nowhere.
+    """
+
+    params: ParameterSet
+    sites: dict
+    reasons: dict[str, str]
+    groups: dict
+
+    def bound(self, name: str) -> bool:
+        return name in self.sites
+
+    def group_of(self, name: str) -> tuple[str, ...] | None:
+        """The group of parameters that share ``name``'s value (module docstring), or None."""
+        return next((g for g in self.groups if name in g), None)
+
+    def _kind(self, name: str) -> str:
+        return next(f.metadata.get("kind") for f in dataclasses.fields(self.params) if f.name == name)
+
+
+def match(binding: Bound, found, holder: str, where) -> None:
+    """Fill ``binding``'s sites, groups and reasons (module docstring), whatever holds the values.
+
+    ``found(kind)`` is the list of (element, ``Site``, value) a parameter of that kind may sit at,
+    or, for a kind ``holder`` (``"the URDF"``) does not hold, the reason in words; ``where(kind)``
+    names those places in words.  Sites are told apart by ``Site`` alone (its path names the element)."""
+    candidates = {}
+    for f in dataclasses.fields(binding.params):
+        kind, value = f.metadata.get("kind"), float(getattr(binding.params, f.name))
+        if kind in IN_PINOCCHIO:
+            continue
+        places = found(kind)
+        if isinstance(places, str):
+            binding.reasons[f.name] = places
+        elif value == 0:
+            binding.reasons[f.name] = f"its value is 0, which cannot be told apart in {holder}"
+        else:
+            candidates[f.name] = [(e, s) for e, s, v in places if _same(abs(v), value)]
+            if not candidates[f.name]:
+                binding.reasons[f.name] = f"its value {value!r} is not in {holder}'s {where(kind)}"
+    clashes = {}
+    for name, mine in candidates.items():
+        clashes[name] = sorted(
+            other
+            for other, theirs in candidates.items()
+            if other != name and any(s == t for _, s in mine for _, t in theirs)
+        )
+        if clashes[name]:
+            binding.reasons[name] = f"its value also belongs to {', '.join(clashes[name])} in {holder}"
+        elif mine:
+            binding.sites[name] = mine
+    for group in _components(clashes):
+        merged: dict = {}
+        for name in group:
+            merged.update({s: (e, s) for e, s in candidates[name]})
+        binding.groups[group] = list(merged.values())
+
+
+def changes(binding: Bound, params: ParameterSet, holder: str):
+    """(element, ``Site``, value to write) for every parameter of ``params`` that differs from
+    ``binding``'s; a parameter bound nowhere, or a group given different values, is refused by name."""
+    for f in dataclasses.fields(params):
+        old, new = float(getattr(binding.params, f.name)), float(getattr(params, f.name))
+        if old == new or f.metadata.get("kind") in IN_PINOCCHIO:
+            continue
+        group = binding.group_of(f.name)
+        if group is not None:
+            values = {float(getattr(params, g)) for g in group}
+            if len(values) > 1:
+                raise RebindError(
+                    f"parameter {f.name} cannot be changed in {holder} apart from "
+                    f"{', '.join(g for g in group if g != f.name)}: {binding.reasons[f.name]}; "
+                    "they can be changed together, to one value"
+                )
+            sites = binding.groups[group]
+        elif f.name in binding.sites:
+            sites = binding.sites[f.name]
+        else:
+            raise RebindError(f"parameter {f.name} cannot be changed in {holder}: {binding.reasons[f.name]}")
+        for element, site in sites:
+            yield element, site, site.sign * new
+
+
 @dataclass
-class Binding:
+class Binding(Bound):
     """Where each parameter of a set sits in a URDF; ``reasons`` says why the others are unbound."""
 
     root: ET.Element
@@ -76,43 +166,14 @@ class Binding:
     def of(cls, urdf_text: str, params: ParameterSet, source: str = "<URDF>") -> Binding:
         root = parse_xml(urdf_text, source)  # the strict readers' XML: no DTD, bounded
         binding = cls(root, params)
-        candidates = {}
-        for f in dataclasses.fields(params):
-            kind, value = f.metadata.get("kind"), float(getattr(params, f.name))
-            if kind in IN_PINOCCHIO:
-                continue
+
+        def found(kind: str):
             if kind not in SITES:
-                binding.reasons[f.name] = f"its kind {kind!r} is not one the URDF reader knows"
-            elif value == 0:
-                binding.reasons[f.name] = "its value is 0, which cannot be told apart in the URDF"
-            else:
-                candidates[f.name] = [s for s in _sites(root, kind) if _same(abs(_value(*s)), value)]
-                if not candidates[f.name]:
-                    binding.reasons[f.name] = f"its value {value!r} is not in the URDF's {_where(kind)}"
-        clashes = {}
-        for name, found in candidates.items():
-            clashes[name] = sorted(
-                other
-                for other, theirs in candidates.items()
-                if other != name and any(s[0] is t[0] and s[1] == t[1] for s in found for t in theirs)
-            )
-            if clashes[name]:
-                binding.reasons[name] = f"its value also belongs to {', '.join(clashes[name])} in the URDF"
-            elif found:
-                binding.sites[name] = found
-        for group in _components(clashes):
-            merged: dict = {}
-            for name in group:
-                merged.update({(id(e), s.attribute, s.component): (e, s) for e, s in candidates[name]})
-            binding.groups[group] = list(merged.values())
+                return f"its kind {kind!r} is not one the URDF reader knows"
+            return [(e, s, _value(e, s)) for e, s in _sites(root, kind)]
+
+        match(binding, found, "the URDF", _where)
         return binding
-
-    def bound(self, name: str) -> bool:
-        return name in self.sites
-
-    def group_of(self, name: str) -> tuple[str, ...] | None:
-        """The group of parameters that share ``name``'s value (module docstring), or None."""
-        return next((g for g in self.groups if name in g), None)
 
     def link_groups(self) -> dict[str, tuple[str, ...]]:
         """{link: the mass and inertia parameters bound inside its <inertial>} (links with any)."""
@@ -128,33 +189,12 @@ class Binding:
                 groups[link.get("name", "?")] = names
         return groups
 
-    def _kind(self, name: str) -> str:
-        return next(f.metadata.get("kind") for f in dataclasses.fields(self.params) if f.name == name)
-
     def rewrite(self, params: ParameterSet) -> str:
         """The URDF with every changed parameter's attributes set to its new value."""
         root = copy.deepcopy(self.root)
         index = {id(old): new for old, new in zip(self.root.iter(), root.iter(), strict=True)}
-        for f in dataclasses.fields(params):
-            old, new = float(getattr(self.params, f.name)), float(getattr(params, f.name))
-            if old == new or f.metadata.get("kind") in IN_PINOCCHIO:
-                continue
-            group = self.group_of(f.name)
-            if group is not None:
-                values = {float(getattr(params, g)) for g in group}
-                if len(values) > 1:
-                    raise RebindError(
-                        f"parameter {f.name} cannot be changed in the URDF apart from "
-                        f"{', '.join(g for g in group if g != f.name)}: {self.reasons[f.name]}; "
-                        "they can be changed together, to one value"
-                    )
-                sites = self.groups[group]
-            elif f.name in self.sites:
-                sites = self.sites[f.name]
-            else:
-                raise RebindError(f"parameter {f.name} cannot be changed in the URDF: {self.reasons[f.name]}")
-            for element, site in sites:
-                _set(index[id(element)], site, site.sign * new)
+        for element, site, value in changes(self, params, "the URDF"):
+            _set(index[id(element)], site, value)
         return ET.tostring(root, encoding="unicode") + "\n"
 
 
