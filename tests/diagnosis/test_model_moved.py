@@ -190,6 +190,24 @@ def test_where_a_parameter_cannot_move_the_ambiguity_is_stated(tmp_path):
     assert any(_same(s, "I + lc**2*m") for s in suggested) and any(_same(s, "I + lc*m/4") for s in suggested)
 
 
+def test_an_edit_whose_number_stands_for_an_unmoved_parameter_is_not_confirmed(tmp_path):
+    """The turned rod with lc dropped from H: g·m·sin θ/4 (lc = 0.25, never moved) holds at every set
+    and involves only moved parameters; it is not confirmed, the message naming lc as the model's
+    unmoved parameter.  A parameter of the URDF rod that moves is still confirmed (the same plant on
+    the URDF, where lc moves, gets g·lc·m·sin θ confirmed)."""
+    target = _mjcf_target(tmp_path, "corpus_pendulum_rod.toml", ROD_MJCF, "corpus_pendulum_rod_params.toml")
+    findings = _repairs(target.model, target.system, "gravity", 0, "g*m*sin(theta)")
+    assert not any(f.details["confirmed"] for f in findings)
+    assert "lc of your model was not moved (lc: its value 0.25 is not in" in findings[0].message
+    assert "so an edit whose numbers stand for its value holds at every set as well" in findings[0].message
+    urdf = [t for t in class_targets() if t[0].startswith("corpus_pendulum_rod")]
+    ((_, model, system, _),) = urdf
+    (first, *_) = _repairs(model, system, "gravity", 0, "g*m*sin(theta)")
+    assert first.details["confirmed"] and _same(first.details["suggested"], "g*lc*m*sin(theta)"), (
+        first.message
+    )
+
+
 def test_a_pinocchio_model_given_to_the_api_moves_its_parameters(tmp_path):
     """The same cart-pole given as a ``pinocchio.Model`` (no file at all): its repair is confirmed
     as the MJCF's, the model moved for each set."""

@@ -18,19 +18,21 @@
    parameter that was not moved on its own) are checked too, and the ones that hold are shown
    as alternatives (up to ``ALTERNATIVES``).
 4. **Confirmed**: the repair is *confirmed* (``details["confirmed"]``) when it held at every
-   perturbed set, every parameter of the edit was moved on its own there, and no other edit
-   held: it is then the same function of the parameters as what the robot says, not only the
-   same numbers.  Otherwise the message says why not: a parameter of the edit could not be
-   moved in the description (its reason), or was moved only together with others that share
-   its value (m1 = m2: an edit and the same edit with m1 and m2 exchanged cannot be told
-   apart), or another edit holds as well (an error in B shows as well in a hand-written q̈
-   that uses it), or it edits what no check compares with the robot (B, W, and D where the
-   URDF declares no damping: ``B[1,1]: 1 → 0`` passes every check when the q̈ that uses B
-   lost its input, since both sides of aba take B from the model).  Each alternative is
-   named with the relation under which the two agree, solved for one parameter (``I → 4*I``
-   and ``I → I + mp*r**2`` differ unless I = mp*r**2/3): ``pendverify.diagnosis.alternatives``,
-   which also gives the edits tried in place of a coincidence (the same numbers from other
-   parameters).
+   perturbed set, every parameter of the edit was moved on its own there, every other parameter
+   the model's closed forms use was moved too, and no other edit held: it is then the same
+   function of the parameters as what the robot says, not only the same numbers.  (A parameter
+   left at its value is a number at every set, and an edit's number can stand for it: with lc =
+   0.25 unmoved, ``g*m*sin(theta) → g*m*sin(theta)/4`` holds at every set where
+   ``g*lc*m*sin(theta)`` is the repair.)  Otherwise the message says why not: a parameter of the
+   edit, or of the model, could not be moved in the description (its reason), or was moved only
+   together with others that share its value (m1 = m2: an edit and the same edit with m1 and m2
+   exchanged cannot be told apart), or another edit holds as well (an error in B shows as well in
+   a hand-written q̈ that uses it), or it edits what no check compares with the robot (B, W, and D
+   where the URDF declares no damping: ``B[1,1]: 1 → 0`` passes every check when the q̈ that uses
+   B lost its input, since both sides of aba take B from the model).  Each alternative is named
+   with the relation under which the two agree, solved for one parameter (``I → 4*I`` and ``I → I
+   + mp*r**2`` differ unless I = mp*r**2/3): ``pendverify.diagnosis.alternatives``, which also
+   gives the edits tried in place of a coincidence (the same numbers from other parameters).
 
 When no single edit passes, pairs of edits of one entry are tried for models of up to three
 degrees of freedom.  When still none passes and the written C is not Pinocchio's, the screened
@@ -49,6 +51,7 @@ model that writes V) is not repaired: an edit of its source is confirmed with it
 from __future__ import annotations
 
 import dataclasses
+import functools
 import time
 
 import numpy as np
@@ -267,6 +270,13 @@ class _Confirmation:
         self._perturbation = None
         self._limits_of: dict = {}
 
+    @functools.cached_property
+    def _used(self) -> set[str]:
+        """The parameters the model's closed forms use."""
+        names = {symbol: name for name, symbol in self.sm.parameters.items()}
+        forms = [v for v in self.sm.closed_forms.values() if isinstance(v, sp.Basic)]
+        return {names[s] for form in forms for s in form.free_symbols if s in names}
+
     def again(self, baseline: bool) -> _Confirmation:
         """A new pass (module docstring) sharing this one's perturbed sets, coincidences and count."""
         nxt = _Confirmation(self.batch, self.sm, self.deadline, baseline, self.derived, self.screening)
@@ -300,7 +310,16 @@ class _Confirmation:
         Kept per edit: the first repair's are asked for each candidate after it."""
         key = _edit_key(changes)
         if key not in self._limits_of:
-            limits = self.perturbation.why_not_alone(edit_parameters(changes, self.sm))
+            involved = edit_parameters(changes, self.sm)
+            limits = self.perturbation.why_not_alone(involved)
+            hidden = sorted(set(self.perturbation.fixed) & self._used - involved)
+            if hidden and self.perturbation.sets:  # what the edit's numbers may stand for
+                limits.append(
+                    f"{_names(hidden)} of your model {'was' if len(hidden) == 1 else 'were'} not moved "
+                    f"({'; '.join(f'{n}: {self.perturbation.fixed[n]}' for n in hidden[:3])}"
+                    f"{'; …' if len(hidden) > 3 else ''}), so an edit whose numbers stand for "
+                    f"{'its value' if len(hidden) == 1 else 'their values'} holds at every set as well"
+                )
             free = self.batch.system.urdf_damping() is None
             unchecked = sorted(
                 {QUANTITY[m] for m, _ in changes if m in UNCOMPARED or (m == "damping_matrix" and free)}
@@ -435,6 +454,14 @@ class _Confirmation:
             f"; {edits}{more} make(s) every check pass at these parameter values, but not at other values "
             f"({self.perturbation.how}): a coincidence of the values, not a repair"
         )
+
+
+def _names(names: list[str]) -> str:
+    """``lc``, ``lc and m``, ``I, lc, m and 2 more``."""
+    shown = names[:3]
+    if len(names) > 3:
+        return f"{', '.join(shown)} and {len(names) - 3} more"
+    return shown[0] if len(shown) == 1 else f"{', '.join(shown[:-1])} and {shown[-1]}"
 
 
 def _edit_key(changes: dict) -> tuple:
