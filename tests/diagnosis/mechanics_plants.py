@@ -6,8 +6,10 @@ of L are the bodies') or a ``KanesMethod`` (speeds u_i = θ̇_i) of the same sys
 (−m g N.y at each mass centre) for both, or the bodies' potential energy (``gravity="energy"``,
 Lagrange only).  Plants: ``inertia`` multiplies link 2's inertia I2 (1 is right), ``weight_mass``
 is the mass whose weight acts at link 2's centre (``"m2"`` is right), ``torque_sign`` multiplies
-τ2 in the elbow torque on link 2 (1 is right), ``elbow`` the angle swapped for θ2 in link 2's
-centre position — an error of the kinematics, which no edit of a body, particle or load undoes.
+the friction torque −b2 θ̇2 on link 2 (1 is right; a sign of τ2 no check could see: B enters both
+sides of every comparison), ``c1_axis`` the axis of link 1 along which its centre of mass is
+placed (``"x"`` is right; ``"y"`` is an error of the kinematics, which no edit of a body, particle
+or load undoes: it turns link 1's gravity torque m1 g r1 cos θ1 into −m1 g r1 sin θ1, H[1] alone).
 """
 
 from __future__ import annotations
@@ -30,28 +32,28 @@ __all__ = ["DECLARATION", "derivation"]
 
 
 def derivation(
-    kind="lagrange", inertia_factor=1, weight_mass="m2", torque_sign=1, gravity="load", kinematics=1
+    kind="lagrange", inertia_factor=1, weight_mass="m2", torque_sign=1, gravity="load", c1_axis="x"
 ):
     theta1, theta2 = dynamicsymbols("theta1 theta2")
     m1, m2, l1, r1, r2, I1, I2, b1, b2, g = sp.symbols(list(KINDS))
     tau1, tau2 = dynamicsymbols("tau1 tau2")
     N = ReferenceFrame("N")
     A = N.orientnew("A", "Axis", (theta1, N.z))
-    B = A.orientnew("B", "Axis", (kinematics * theta2, A.z))
+    B = A.orientnew("B", "Axis", (theta2, A.z))
     origin = Point("O")
     origin.set_vel(N, 0)
-    C1 = origin.locatenew("C1", r1 * A.x)
+    C1 = origin.locatenew("C1", r1 * getattr(A, c1_axis))
     P = origin.locatenew("P", l1 * A.x)
     C2 = P.locatenew("C2", r2 * B.x)
     if kind == "kane":
         u1, u2 = dynamicsymbols("u1 u2")
         A.set_ang_vel(N, u1 * N.z)
-        B.set_ang_vel(A, kinematics * u2 * A.z)
+        B.set_ang_vel(A, u2 * A.z)
     for point, base, frame in ((C1, origin, A), (P, origin, A), (C2, P, B)):
         point.v2pt_theory(base, N, frame)
     link1 = RigidBody("link1", C1, A, m1, (inertia(A, 0, 0, I1), C1))
     link2 = RigidBody("link2", C2, B, m2, (inertia(B, 0, 0, inertia_factor * I2), C2))
-    elbow = (torque_sign * tau2 - b2 * theta2.diff()) * N.z
+    elbow = (tau2 - torque_sign * b2 * theta2.diff()) * N.z
     loads = [(A, (tau1 - b1 * theta1.diff()) * N.z - (tau2 - b2 * theta2.diff()) * N.z), (B, elbow)]
     weights = [(C1, -m1 * g * N.y), (C2, -sp.Symbol(weight_mass) * g * N.y)]
     if gravity == "energy":

@@ -1,0 +1,88 @@
+"""The repair of a ``sympy.physics.mechanics`` derivation names what the user wrote.
+
+Planted in the derivation (``tests/diagnosis/mechanics_plants.py``), by Lagrange (given its
+bodies) and by Kane: link 2's inertia doubled, link 2's weight computed with m1, the friction
+torque on link 2 with the wrong sign, link 2's potential energy with m1 (Lagrange's bodies
+carrying it).  Each gets one confirmed repair naming that body or load and putting the item
+back; the correct derivation passes and gets no diagnosis; link 1's centre of mass placed along
+the wrong axis (kinematics, no item to edit) still gets today's entry-level repair of H[1],
+with the source edits tried said where no repair is found.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import pendverify
+from pendverify.analytic.symbolic_reading import SymbolicModel
+from pendverify.api import load_model
+from pendverify.diagnosis.mechanics_source import source_items
+from tests.diagnosis.mechanics_plants import DECLARATION, derivation
+
+REPO = Path(__file__).resolve().parents[2]
+URDF = REPO / "urdf" / "double_pendulum.urdf"
+PARAMS = REPO / "examples" / "minimal_double_pendulum.toml"
+SAMPLES = 12
+
+
+def _findings(method, kind="repair"):
+    report = pendverify.check(method, URDF, PARAMS, samples=SAMPLES, declaration=DECLARATION)
+    found = [f for fs in report.diagnoses.values() for f in fs]
+    return report, [f for f in found if f.kind == kind]
+
+
+PLANTS = [
+    (dict(inertia_factor=2), "body link2 (inertia): 2*I2 → I2", "I2"),
+    (dict(weight_mass="m1"), "load on C2 (N.y): -g*m1 → -g*m2", "-g*m2"),
+    (dict(torque_sign=-1), "load on B (N.z): b2*dtheta2 + tau2 → -b2*dtheta2 + tau2", "-b2*dtheta2 + tau2"),
+]
+
+
+@pytest.mark.parametrize("kind", ["lagrange", "kane"])
+@pytest.mark.parametrize("plant, words, suggested", PLANTS)
+def test_a_planted_error_in_the_derivation_is_repaired_naming_the_item(kind, plant, words, suggested):
+    report, repairs = _findings(derivation(kind, **plant))
+    assert report.status == "fail"
+    assert len(repairs) == 1, [f.message for f in repairs]
+    repair = repairs[0]
+    assert repair.message.startswith(words), f"{kind=} {plant=}: {repair.message}"
+    assert "at these parameter values and at 2 others" in repair.message
+    assert repair.details["confirmed"] is True and repair.details["suggested"] == suggested
+    assert repair.details["source_item"].startswith(words.split(" (")[0])
+
+
+def test_a_potential_energy_with_the_wrong_mass_is_repaired_in_the_body():
+    _, repairs = _findings(derivation("lagrange", gravity="energy", weight_mass="m1"))
+    assert [f.message.split(":")[0] for f in repairs] == ["body link2 (potential energy)"]
+    assert repairs[0].details["confirmed"] is True
+    assert repairs[0].details["suggested"].startswith("g*m2*")
+    assert set(repairs[0].details["entries"]) == {"H[1]", "H[2]"}
+
+
+@pytest.mark.parametrize("kind", ["lagrange", "kane"])
+def test_the_correct_derivation_gets_no_claim(kind):
+    report, repairs = _findings(derivation(kind))
+    assert report.status == "pass" and not report.diagnoses and not repairs
+
+
+@pytest.mark.parametrize("kind", ["lagrange", "kane"])
+def test_an_error_no_source_edit_undoes_gets_the_entry_repair(kind):
+    report, repairs = _findings(derivation(kind, c1_axis="y"))
+    _, entries = _findings(derivation(kind, c1_axis="y"), "entry")
+    assert {f.quantity for f in entries} >= {"H"}
+    assert len(repairs) == 1 and repairs[0].message.startswith("H[1]: "), [f.message for f in repairs]
+    assert "source_item" not in repairs[0].details
+
+
+def test_the_items_of_a_derivation():
+    names = {}
+    for kind in ("lagrange", "kane"):
+        cls = load_model(derivation(kind), DECLARATION)
+        names[kind] = [i.name() for i in source_items(cls.derivation, SymbolicModel.of(cls))]
+    assert names["lagrange"] == names["kane"]
+    assert "body link2: inertia I2" in names["kane"] and "body link1: mass m1" in names["kane"]
+    assert "load on C2: (-g*m2)*N.y" in names["kane"]
+    pair = load_model((load_model(derivation(), DECLARATION).derivation.M, derivation().forcing), DECLARATION)
+    assert source_items(pair.derivation, SymbolicModel.of(pair)) == []
