@@ -31,6 +31,7 @@ instance pickles without it, and the class pickles by reference as before.
 
 from __future__ import annotations
 
+import dataclasses
 import types
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -144,6 +145,10 @@ class Derivation:
     speeds: dict  # Kane: each generalised speed → the coordinate whose rate it is
     M: sp.Matrix  # the mass matrix in the model's symbols, rows in the declaration's order
     forcing: sp.Matrix
+    #: items written otherwise than in ``method``: {position among the derivation's items (in
+    #: ``pendverify.diagnosis.mechanics_source.source_items``'s order): the expression written}
+    #: — a derivation with one item edited (``edited``), M and forcing its own
+    written: tuple = ()
 
     def in_model_symbols(self, expr, what: str = "derivation"):
         """``expr`` (in the method's dynamic symbols) in the model's symbols (module docstring)."""
@@ -154,6 +159,17 @@ class Derivation:
         in a module of its own (never registered: the model file's module is left alone)."""
         module = types.ModuleType(f"{self.spec.name}_rebuilt")
         return mechanics_model((M, forcing), self.declaration, self.source, module)
+
+    def edited(self, position: int, expr, M, forcing):
+        """The model class of this derivation with item ``position`` written as ``expr`` (the
+        model's symbols) and M q̈ = forcing what it gives: rebuilt through the pair form, and
+        keeping the method's items for a repair to edit (the corpus plants errors this way)."""
+        cls = self.rebuilt(M, forcing)
+        written = (*(w for w in self.written if w[0] != position), (position, expr))
+        cls.derivation = dataclasses.replace(
+            self, M=cls.derivation.M, forcing=cls.derivation.forcing, written=written
+        )
+        return cls
 
 
 def mechanics_model(method, declaration: Mapping, source: str | Path = "<declaration>", module=None):

@@ -14,8 +14,9 @@ loads, a Lagrangian.  A repair of such a model names what was written (``source_
 * an (M, forcing) pair: nothing (the repair is an edit of an entry, as for any model).
 
 Each item's candidate edits are the single-expression edits of an entry
-(``pendverify.diagnosis.candidates.expression_edits``: a sign, a drop, a factor 2 or ½,
-a symbol swapped for another of its kind, sin↔cos, …), applied to the item's expression.
+(``pendverify.diagnosis.candidates.expression_edits``: a sign, a drop, a factor 2 or ½ on one
+term, a symbol swapped for another of its kind, sin↔cos, …), applied to the item's expression,
+after a sign or factor 2 or ½ on the whole item (``WHOLE_FACTORS``).
 
 **The effect of an edit** Δ = new − old of an item on M q̈ = f.  Lagrange's equations are linear
 in L, and the generalised forces linear in the loads, so an edit adds to them what the change
@@ -39,6 +40,8 @@ confirms as any other (``pendverify.diagnosis.repair``).
 
 from __future__ import annotations
 
+import dataclasses
+import itertools
 import time
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -53,6 +56,9 @@ from pendverify.errors import PendverifyError
 from pendverify.symbolic.edits import Edit
 from pendverify.symbolic.zero_test import is_zero, probe
 
+#: factors of a whole item (of several terms) tried before the edits of one term: the inverses of
+#: a sign or factor on the whole of it
+WHOLE_FACTORS = (sp.Integer(-1), sp.Integer(2), sp.Rational(1, 2))
 #: edits of one item tried at most (the first ones: the simplest are enumerated first)
 EDITS_PER_ITEM = 40
 
@@ -215,6 +221,8 @@ def source_items(derivation, sm) -> list[SourceItem]:
             items += _load_items(load, frame, rates, mapped)
     except (PendverifyError, AttributeError, TypeError, ValueError):
         return []
+    for position, expr in derivation.written:  # an item written otherwise (``Derivation.edited``)
+        items[position] = dataclasses.replace(items[position], expr=mapped(expr))
     return items
 
 
@@ -235,7 +243,12 @@ def _lagrangian_items(L, bodies, frame, mapped) -> list[SourceItem]:
 def item_edits(item: SourceItem, sm) -> Iterator[SourceEdit]:
     """The candidate edits of one item, simplest first within the item (``EDITS_PER_ITEM`` at most)."""
     seen = set()
-    for edit in expression_edits(item.expr, sm):
+    whole = [  # the item as a whole scaled (a load written twice): one factor on all its terms
+        Edit("scale", item.expr, k * item.expr, k * item.expr, f"{item.expr} → {k}·({item.expr})")
+        for k in WHOLE_FACTORS
+        if item.expr.is_Add
+    ]
+    for edit in itertools.chain(whole, expression_edits(item.expr, sm)):
         if edit.expr == item.expr or edit.expr in seen:
             continue
         seen.add(edit.expr)
@@ -328,3 +341,16 @@ class SourceSearch:
             if slot is not None:
                 self.passed += 1
                 yield edit.rank, changes, edit, slot
+
+
+def planted_model(model, sm, position: int, new):
+    """The model class of ``model``'s derivation with item ``position`` written as ``new``
+    (``Derivation.edited``; the corpus of planted errors), or None when it is refused."""
+    derivation = type(model).derivation
+    item = source_items(derivation, sm)[position]
+    dM, df = effect(item, new, sm)
+    mapped = _Mapper(derivation, sm)
+    try:
+        return derivation.edited(position, new, mapped(derivation.M) + dM, mapped(derivation.forcing) + df)
+    except PendverifyError:
+        return None

@@ -410,7 +410,7 @@ class _Confirmation:
             verdict = "makes every check pass on every state, at these parameter values and at "
             verdict += f"{sets} others ({self.perturbation.how})"
         else:
-            also = [f"{shown(c, e, forms, notation)} holds as well{why}" for c, e, _, why in others]
+            also = [f"{_shown(c, e, forms, notation)} holds as well{why}" for c, e, _, why in others]
             if values_only:
                 verdict = "makes every check pass on every state at these parameter values; not confirmed: "
             else:
@@ -462,15 +462,19 @@ class _Confirmation:
         only (module docstring), or ""."""
         if not self.coincidences:
             return ""
-        edits = ", ".join(
-            e.shown(notation.render) if isinstance(e, SourceEdit) else shown(c, e, forms, notation)
-            for c, e, _ in self.coincidences[:2]
-        )
+        edits = ", ".join(_shown(c, e, forms, notation) for c, e, _ in self.coincidences[:2])
         more = f" and {len(self.coincidences) - 2} more" if len(self.coincidences) > 2 else ""
         return (
             f"; {edits}{more} make(s) every check pass at these parameter values, but not at other values "
             f"({self.perturbation.how}): a coincidence of the values, not a repair"
         )
+
+
+def _shown(changes: dict, edit, forms: dict, notation) -> str:
+    """An edit, short: the source item it edits for a source edit, else the entry (``shown``)."""
+    return (
+        edit.shown(notation.render) if isinstance(edit, SourceEdit) else shown(changes, edit, forms, notation)
+    )
 
 
 def _edit_key(changes: dict) -> tuple:
