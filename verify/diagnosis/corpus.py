@@ -227,7 +227,8 @@ def _restored(findings, plant: Plant, sm: SymbolicModel, confirmed: bool | None 
 def _planted(model, sm: SymbolicModel, group) -> tuple:
     """(the planted model, the entry plants it amounts to): the entries edited for entry plants; for a
     ``SOURCE`` plant the derivation with the item edited (``mechanics_source.planted_model``),
-    and each entry of the closed forms it changes as a plant (None when the pair form refuses it)."""
+    and each entry it changes in a key the model writes as a plant (None when the pair form
+    refuses it)."""
     if group[0].method != SOURCE:
         edits: dict[str, list] = {}
         for p in group:
@@ -242,9 +243,11 @@ def _planted(model, sm: SymbolicModel, group) -> tuple:
     )
     item = source_items(type(model).derivation, sm)[plant.index]
     changes = entry_changes(type(model).derivation, sm, item, plant.new) or {}
+    derived = derived_methods(type(model))  # V integrated from H: never repaired itself
     entry_group = tuple(
         Plant(method, index, plant.operator, old, new, plant.what)
         for (method, index), (old, new) in changes.items()
+        if method not in derived
     )
     return cls(params), entry_group
 
