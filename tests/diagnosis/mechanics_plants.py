@@ -6,8 +6,10 @@ of L are the bodies') or a ``KanesMethod`` (speeds u_i = θ̇_i) of the same sys
 (−m g N.y at each mass centre) for both, or the bodies' potential energy (``gravity="energy"``,
 Lagrange only).  Plants: ``inertia`` multiplies link 2's inertia I2 (1 is right), ``weight_mass``
 is the mass whose weight acts at link 2's centre (``"m2"`` is right), ``torque_sign`` multiplies
-the friction torque −b2 θ̇2 on link 2 (1 is right; a sign of τ2 no check could see: B enters both
-sides of every comparison), ``c1_axis`` the axis of link 1 along which its centre of mass is
+the friction torque −b2 θ̇2 on link 2, a load of its own (1 is right; the input torques are loads
+of their own too: a sign of τ2 no check could see, since B enters both sides of every comparison,
+and a sign flipped on a load holding both τ2 and b2 θ̇2 has two repairs the checks cannot tell
+apart), ``c1_axis`` the axis of link 1 along which its centre of mass is
 placed (``"x"`` is right; ``"y"`` is an error of the kinematics, which no edit of a body, particle
 or load undoes: it turns link 1's gravity torque m1 g r1 cos θ1 into −m1 g r1 sin θ1, H[1] alone).
 """
@@ -53,8 +55,12 @@ def derivation(
         point.v2pt_theory(base, N, frame)
     link1 = RigidBody("link1", C1, A, m1, (inertia(A, 0, 0, I1), C1))
     link2 = RigidBody("link2", C2, B, m2, (inertia(B, 0, 0, inertia_factor * I2), C2))
-    elbow = (tau2 - torque_sign * b2 * theta2.diff()) * N.z
-    loads = [(A, (tau1 - b1 * theta1.diff()) * N.z - (tau2 - b2 * theta2.diff()) * N.z), (B, elbow)]
+    inputs = [(A, (tau1 - tau2) * N.z), (B, tau2 * N.z)]
+    friction = [
+        (A, (b2 * theta2.diff() - b1 * theta1.diff()) * N.z),
+        (B, -torque_sign * b2 * theta2.diff() * N.z),
+    ]
+    loads = inputs + friction
     weights = [(C1, -m1 * g * N.y), (C2, -sp.Symbol(weight_mass) * g * N.y)]
     if gravity == "energy":
         link1.potential_energy = m1 * g * C1.pos_from(origin).dot(N.y)

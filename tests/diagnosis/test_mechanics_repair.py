@@ -2,7 +2,7 @@
 
 Planted in the derivation (``tests/diagnosis/mechanics_plants.py``), by Lagrange (given its
 bodies) and by Kane: link 2's inertia doubled, link 2's weight computed with m1, the friction
-torque on link 2 with the wrong sign, link 2's potential energy with m1 (Lagrange's bodies
+torque on link 2 (a load of its own) with the wrong sign, link 2's potential energy with m1 (Lagrange's bodies
 carrying it).  Each gets one confirmed repair naming that body or load and putting the item
 back; the correct derivation passes and gets no diagnosis; link 1's centre of mass placed along
 the wrong axis (kinematics, no item to edit) still gets today's entry-level repair of H[1],
@@ -36,7 +36,7 @@ def _findings(method, kind="repair"):
 PLANTS = [
     (dict(inertia_factor=2), "body link2 (inertia): 2*I2 → I2", "I2"),
     (dict(weight_mass="m1"), "load on C2 (N.y): -g*m1 → -g*m2", "-g*m2"),
-    (dict(torque_sign=-1), "load on B (N.z): b2*dtheta2 + tau2 → -b2*dtheta2 + tau2", "-b2*dtheta2 + tau2"),
+    (dict(torque_sign=-1), "load on B (N.z): b2*dtheta2 → -b2*dtheta2", "-b2*dtheta2"),
 ]
 
 
