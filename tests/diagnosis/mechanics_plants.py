@@ -4,7 +4,8 @@ in what the user writes (for the repair tests).
 ``derivation(kind, **plants)`` builds a ``LagrangesMethod`` (given its bodies, so that the terms
 of L are the bodies') or a ``KanesMethod`` (speeds u_i = θ̇_i) of the same system, gravity a load
 (−m g N.y at each mass centre) for both, or the bodies' potential energy (``gravity="energy"``,
-Lagrange only).  Plants: ``inertia`` multiplies link 2's inertia I2 (1 is right), ``weight_mass``
+Lagrange only; ``given_bodies=False``: the ``LagrangesMethod`` is given L alone, so its items
+are the terms of L).  Plants: ``inertia`` multiplies link 2's inertia I2 (1 is right), ``weight_mass``
 is the mass whose weight acts at link 2's centre (``"m2"`` is right), ``torque_sign`` multiplies
 the friction torque −b2 θ̇2 on link 2, a load of its own (1 is right; the input torques are loads
 of their own too: a sign of τ2 no check could see, since B enters both sides of every comparison,
@@ -34,7 +35,13 @@ __all__ = ["DECLARATION", "derivation"]
 
 
 def derivation(
-    kind="lagrange", inertia_factor=1, weight_mass="m2", torque_sign=1, gravity="load", c1_axis="x"
+    kind="lagrange",
+    inertia_factor=1,
+    weight_mass="m2",
+    torque_sign=1,
+    gravity="load",
+    c1_axis="x",
+    given_bodies=True,
 ):
     theta1, theta2 = dynamicsymbols("theta1 theta2")
     m1, m2, l1, r1, r2, I1, I2, b1, b2, g = sp.symbols(list(KINDS))
@@ -74,7 +81,11 @@ def derivation(
         method.kanes_equations(bodies, loads + weights)
         return method
     method = LagrangesMethod(
-        Lagrangian(N, *bodies), [theta1, theta2], forcelist=loads + weights, bodies=bodies, frame=N
+        Lagrangian(N, *bodies),
+        [theta1, theta2],
+        forcelist=loads + weights,
+        bodies=bodies if given_bodies else None,
+        frame=N,
     )
     method.form_lagranges_equations()
     return method

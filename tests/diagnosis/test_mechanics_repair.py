@@ -14,6 +14,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+import sympy as sp
 
 import pendverify
 from pendverify.analytic.symbolic_reading import SymbolicModel
@@ -59,6 +60,46 @@ def test_a_potential_energy_with_the_wrong_mass_is_repaired_in_the_body():
     assert repairs[0].details["confirmed"] is True
     assert repairs[0].details["suggested"].startswith("g*m2*")
     assert set(repairs[0].details["entries"]) == {"H[1]", "H[2]"}
+
+
+def test_a_lagrangian_without_its_bodies_is_repaired_in_its_terms():
+    method = derivation("lagrange", gravity="energy", weight_mass="m1", given_bodies=False)
+    _, repairs = _findings(method)
+    assert len(repairs) == 1 and repairs[0].message.startswith("Lagrangian (term): -g*m1*"), repairs
+    assert repairs[0].details["suggested"].startswith("-g*m2*") and repairs[0].details["confirmed"] is True
+
+
+def test_a_particle_has_its_mass_as_an_item():
+    from sympy.physics.mechanics import KanesMethod, Particle, Point, ReferenceFrame, dynamicsymbols
+
+    theta1, u1, tau1 = dynamicsymbols("theta1 u1 tau1")
+    m2, l1, g = sp.symbols("m2 l1 g")
+    N = ReferenceFrame("N")
+    A = N.orientnew("A", "Axis", (theta1, N.z))
+    A.set_ang_vel(N, u1 * N.z)
+    origin = Point("O")
+    origin.set_vel(N, 0)
+    P = origin.locatenew("P", l1 * A.x)
+    P.v2pt_theory(origin, N, A)
+    bob = Particle("bob", P, m2)
+    method = KanesMethod(N, q_ind=[theta1], u_ind=[u1], kd_eqs=[theta1.diff() - u1])
+    method.kanes_equations([bob], [(P, -m2 * g * N.y), (A, tau1 * N.z)])
+    declaration = {
+        "name": "point_pendulum",
+        "coordinates": {"theta1": "angle"},
+        "inputs": ["tau1"],
+        "parameters": {"m2": {"kind": "mass"}, "l1": {"kind": "length"}, "g": {"kind": "gravity"}},
+        "urdf": {"joints": ["joint1"]},
+    }
+    cls = load_model(method, declaration)
+    items = source_items(cls.derivation, SymbolicModel.of(cls))
+    assert [i.name() for i in items] == [
+        "particle bob: mass m2",
+        "load on P: (-g*m2)*N.y",
+        "load on A: (tau1)*N.z",
+    ]
+    assert str(items[0].weight) == "dtheta1**2*l1**2/2"  # ½ v·v: δL of a mass edit per unit
+    assert [str(w) for w in items[1].load] == ["l1*cos(theta1)"]  # N.y · ∂v_P/∂θ̇1 = N.y · l1 A.y
 
 
 @pytest.mark.parametrize("kind", ["lagrange", "kane"])

@@ -22,8 +22,8 @@ after a sign or factor 2 or ½ on the whole item (``WHOLE_FACTORS``).
 in L, and the generalised forces linear in the loads, so an edit adds to them what the change
 alone gives.  An energy item changes L by δL = w·Δ, w the item's *weight*: ½ v·v for a mass
 (v the velocity of the mass centre in the inertial frame), ½ ω_i ω_j for a diagonal inertia
-measure number I_ii and ω_i ω_j for I_ij = I_ji (ω in the body's frame), −1 for a term of a
-potential energy, 1 for a term of L.  With δL(q, q̇):
+measure number I_ii and ω_i ω_j for I_ij = I_ji (ω in the body's frame), −1 for a body's
+potential energy (as written, whole), 1 for a term of L.  With δL(q, q̇):
 
     δM_ij = ∂²δL/∂q̇_i∂q̇_j,    δf_i = ∂δL/∂q_i − Σ_j ∂²δL/∂q̇_i∂q_j q̇_j
 
@@ -317,6 +317,7 @@ class SourceSearch:
         self.slots = {(s.method, s.index): s for s in slots}
         self.items = source_items(derivation, sm)
         self.tried = self.passed = 0
+        self.stopped = False  # at ``deadline``, before every edit was tried
 
     def _screened(self, changes: dict):
         """The first slot the changes repair when they pass the screen, else None."""
@@ -334,6 +335,7 @@ class SourceSearch:
         edits = sorted((e for item in self.items for e in item_edits(item, self.sm)), key=lambda e: e.rank)
         for edit in edits:
             if time.perf_counter() > self.deadline:
+                self.stopped = True
                 return
             self.tried += 1
             changes = entry_changes(self.derivation, self.sm, edit.item, edit.new)
