@@ -158,3 +158,16 @@ def test_the_mechanics_class_of_the_corpus():
     for s in detected:
         if not s.repaired:  # what was tried is said, the source edits first
             assert "edit(s) of the KanesMethod's bodies, particles and loads" in s.message, s.message
+
+
+def test_the_derivation_kept_on_the_class_leaves_pickling_and_the_code_cache_alone():
+    import pickle
+
+    from pendverify.numerics.codegen.cache import model_key
+    from pendverify.targets import parameter_values
+
+    cls = load_model(REPO / "examples" / "corpus_mechanics_double_pendulum.py")
+    model = cls(parameter_values(cls, REPO / "examples" / "corpus_mechanics_double_pendulum_params.toml"))
+    again = pickle.loads(pickle.dumps(model))
+    assert type(again) is cls and again.params == model.params
+    assert cls.derivation.kind == "KanesMethod" and model_key(cls) is not None

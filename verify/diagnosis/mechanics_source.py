@@ -49,7 +49,7 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
-from pendverify.analytic.symbolic_reading import entries
+from pendverify.analytic.symbolic_reading import SymbolicModel, entries
 from pendverify.diagnosis.candidates import RANK, expression_edits
 from pendverify.diagnosis.slots import SCREEN_RTOL
 from pendverify.errors import PendverifyError
@@ -201,8 +201,9 @@ def _load_items(load, frame, rates, mapped) -> list[SourceItem]:
 
 
 def source_items(derivation, sm) -> list[SourceItem]:
-    """The items the derivation is written from (module docstring); [] for an (M, forcing) pair or
-    when an item cannot be put in the model's symbols."""
+    """The items the derivation is written from (module docstring); [] for an (M, forcing) pair, or
+    when SymPy cannot give an item's weights (a frame whose angular velocity is not defined) or an
+    item cannot be put in the model's symbols: the repair then searches the entries alone."""
     method, kind = derivation.method, derivation.kind
     if kind not in ("LagrangesMethod", "KanesMethod"):
         return []
@@ -277,8 +278,6 @@ def entry_changes(derivation, sm, item: SourceItem, new) -> dict | None:
     """The candidate's changes {(method, index): (old, new)} to the model's closed forms: M' and f'
     rebuilt through the pair form (module docstring); None when the rebuilt model is refused or
     its closed forms are not the model's keys."""
-    from pendverify.analytic.symbolic_reading import SymbolicModel
-
     dM, df = effect(item, new, sm)
     if all(x == 0 for x in dM) and all(x == 0 for x in df):
         return {}
