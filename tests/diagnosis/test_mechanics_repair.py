@@ -155,9 +155,10 @@ def test_the_mechanics_class_of_the_corpus():
     undoable = [s for s in detected if s.plant.operator != "drop"]
     assert all(s.restored for s in undoable), [(s.plant.what, s.message) for s in undoable if not s.restored]
     assert sum(s.confirmed for s in detected) >= 0.75 * len(detected)
-    for s in detected:
-        if not s.repaired:  # what was tried is said, the source edits first
-            assert "edit(s) of the KanesMethod's bodies, particles and loads" in s.message, s.message
+    unrepaired = [s for s in detected if not s.repaired]
+    assert unrepaired  # the seeded sample holds link 2's mass dropped, which no single edit restores
+    for s in unrepaired:  # what was tried is said, the source edits first
+        assert "edit(s) of the KanesMethod's bodies, particles and loads (8 items) were screened" in s.message
 
 
 def test_the_derivation_kept_on_the_class_leaves_pickling_and_the_code_cache_alone():

@@ -274,9 +274,9 @@ def _source_search(batch, sm, slots, evaluate, confirm, deadline: float):
     confirm.run(search.candidates())
     bound = ", stopped at its share of the time bound" if search.stopped else ""
     return search, (
-        f"; before them, {search.tried} edit(s) of the {derivation.kind}'s bodies, particles and loads "
-        f"({len(search.items)} items{bound}), of which {search.passed} passed the screen and "
-        f"{confirm.tried} were tried against every check"
+        f"; first, {search.tried} edit(s) of the {derivation.kind}'s bodies, particles and loads "
+        f"({len(search.items)} items{bound}) were screened: {search.passed} passed, and {confirm.tried} "
+        "of the candidates tried against every check were these"
     )
 
 
