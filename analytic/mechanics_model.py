@@ -20,11 +20,21 @@ matched BY NAME: the dynamic symbol ``theta1(t)`` is coordinate ``theta1``, its 
 ``dtheta1`` and ``ddtheta1``; a symbol (or a dynamic symbol, as inputs often are) is the
 parameter, input or disturbance of its name.  A name the declaration does not give is
 refused, naming it.
+
+The class keeps what it was made from (``derivation``, a ``Derivation``: the method object, the
+declaration, the map of the method's dynamic symbols to the model's): a repair is searched
+among the items the user wrote — a body's mass or inertia, a load, a term of the Lagrangian
+(``pendverify.diagnosis.mechanics_source``) — and each candidate rebuilt through the pair form
+``(M', forcing')`` with the same declaration (``rebuilt``).  It is a class attribute: a model
+instance pickles without it, and the class pickles by reference as before.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import types
 from collections.abc import Mapping
+from dataclasses import dataclass
 from pathlib import Path
 
 import sympy as sp
@@ -123,6 +133,45 @@ def _mapped(reader: Reader, spec: TextModelSpec, expr, speeds: dict, what: str):
     return mapped
 
 
+@dataclass(frozen=True, eq=False)
+class Derivation:
+    """What a mechanics model class was made from (module docstring)."""
+
+    method: object  # the LagrangesMethod, KanesMethod or (M, forcing) pair, as given
+    kind: str  # "LagrangesMethod", "KanesMethod" or "(mass_matrix, forcing)"
+    declaration: Mapping
+    source: str
+    spec: TextModelSpec
+    speeds: dict  # Kane: each generalised speed → the coordinate whose rate it is
+    M: sp.Matrix  # the mass matrix in the model's symbols, rows in the declaration's order
+    forcing: sp.Matrix
+    #: items written otherwise than in ``method``: {position among the derivation's items (in
+    #: ``pendverify.diagnosis.mechanics_source.source_items``'s order): the expression written}
+    #: — a derivation with one item edited (``edited``), M and forcing its own
+    written: tuple = ()
+
+    def in_model_symbols(self, expr, what: str = "derivation"):
+        """``expr`` (in the method's dynamic symbols) in the model's symbols (module docstring)."""
+        return _mapped(Reader(Path(self.source)), self.spec, sp.sympify(expr), self.speeds, what)
+
+    def rebuilt(self, M, forcing):
+        """The model class of the pair ``(M, forcing)`` (the model's symbols) with this declaration,
+        in a module of its own (never registered: the model file's module is left alone)."""
+        module = types.ModuleType(f"{self.spec.name}_rebuilt")
+        return mechanics_model((M, forcing), self.declaration, self.source, module)
+
+    def edited(self, position: int, expr, M, forcing):
+        """The model class of this derivation with item ``position`` written as ``expr`` (the
+        model's symbols) and M q̈ = forcing what it gives: rebuilt through the pair form, and
+        keeping the method's items for a repair to edit (the corpus plants errors this way)."""
+        cls = self.rebuilt(M, forcing)
+        written = (*(w for w in self.written if w[0] != position), (position, expr))
+        cls.derivation = dataclasses.replace(
+            self, M=cls.derivation.M, forcing=cls.derivation.forcing, written=written
+        )
+        return cls
+
+
 def mechanics_model(method, declaration: Mapping, source: str | Path = "<declaration>", module=None):
     """The model class of a ``sympy.physics.mechanics`` derivation and its declaration (docstring).
 
@@ -159,8 +208,11 @@ def mechanics_model(method, declaration: Mapping, source: str | Path = "<declara
     spec.equations["M"], spec.equations["f"] = M, F
     spec.derived["M"] = f"the {kind}'s mass matrix"  # f's parts say "from the …'s forcing: …"
     spec.derived["f"] = f"the {kind}'s forcing"
+    derivation = Derivation(method, kind, dict(declaration), str(source), spec, speeds, M, F)
     complete_equations(reader, spec)
-    return build_model_class(spec, module)
+    cls = build_model_class(spec, module)
+    cls.derivation = derivation
+    return cls
 
 
 def model_file_declaration(module, path: Path):

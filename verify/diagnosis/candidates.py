@@ -420,17 +420,23 @@ def screen_slot(slot: Slot, batch, sm, evaluate, monomials, pool, deadline: floa
 FIRST_EDITS = 15
 
 
-def _enumerated(slot: Slot, sm, pool) -> Iterator[Edit]:
-    """The edits of an entry that need no fit: a sign, a drop, a factor 2 or ½ on each term, the
-    structural edits and the restored terms (a pair's two edits are each of these, or the
-    second a solved coefficient: never an added term, which would fit anything).  One at a
-    time, as they are evaluated: the time bound stops a long entry's (a q̈ written out) early."""
-    for path, terms in sums(slot.expr):
+def expression_edits(expr, sm) -> Iterator[Edit]:
+    """The edits of one expression that need no fit: a sign, a drop, a factor 2 or ½ on each term,
+    and the structural edits (``pendverify.symbolic.edits``), one at a time."""
+    for path, terms in sums(expr):
         for i, term in enumerate(terms):
             for k in COEFFICIENTS[:4]:
                 new = sp.Rational(k.numerator, k.denominator) * term
-                yield Edit("scale", term, new, with_term(slot.expr, path, terms, i, new), f"{term} → {new}")
-    yield from structural_edits(slot.expr, sm.angles, sm.symbols["v"], sm.kinds)
+                yield Edit("scale", term, new, with_term(expr, path, terms, i, new), f"{term} → {new}")
+    yield from structural_edits(expr, sm.angles, sm.symbols["v"], sm.kinds)
+
+
+def _enumerated(slot: Slot, sm, pool) -> Iterator[Edit]:
+    """The edits of an entry that need no fit (``expression_edits``) and the restored terms (a
+    pair's two edits are each of these, or the second a solved coefficient: never an added term,
+    which would fit anything).  One at a time, as they are evaluated: the time bound stops a long
+    entry's (a q̈ written out) early."""
+    yield from expression_edits(slot.expr, sm)
     yield from _restored_term_edits(slot, pool)
 
 

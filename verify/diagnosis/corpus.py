@@ -38,6 +38,7 @@ once, in different keys) is scored the same way, each of the two named and resto
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import random
 import time
@@ -56,6 +57,7 @@ from pendverify.checks.sampling import sample_states
 from pendverify.diagnosis.acceptance import passes
 from pendverify.diagnosis.derived import derived_methods
 from pendverify.diagnosis.explain import explain
+from pendverify.diagnosis.mechanics_source import entry_changes, planted_model, source_items
 from pendverify.diagnosis.slots import QUANTITY
 from pendverify.symbolic.edited import edited_model
 from pendverify.symbolic.edits import parameter_edits, term_edits, trig_edits, walk
@@ -126,9 +128,25 @@ def entry_plants(method: str, index: int, expr, sm: SymbolicModel, kinds: dict) 
     return [Plant(method, index, op, expr, *found[op]) for op in OPERATORS if op in found]
 
 
+#: the ``method`` of a plant in an item of a ``sympy.physics.mechanics`` derivation (its ``index``:
+#: the item's position, ``pendverify.diagnosis.mechanics_source.source_items``)
+SOURCE = "source"
+
+
 def plants(sm: SymbolicModel) -> list[Plant]:
     """Every planted error of the corpus for one model, in the keys it writes (not in one it derives
-    from another, ``pendverify.diagnosis.derived``: a user cannot type an error there)."""
+    from another, ``pendverify.diagnosis.derived``: a user cannot type an error there); for a model
+    made from a ``sympy.physics.mechanics`` derivation, in what the derivation is written from
+    (its bodies, particles, loads: ``SOURCE`` plants), with the same operators."""
+    derivation = getattr(sm.cls, "derivation", None)
+    items = source_items(derivation, sm) if derivation is not None else []
+    if items:
+        return [
+            p
+            for k, item in enumerate(items)
+            if item.expr != 0
+            for p in entry_plants(SOURCE, k, item.expr, sm, sm.kinds)
+        ]
     kinds = sm.kinds
     derived = derived_methods(sm.cls)
     out = []
@@ -206,6 +224,60 @@ def _restored(findings, plant: Plant, sm: SymbolicModel, confirmed: bool | None 
     return False
 
 
+def _planted(model, sm: SymbolicModel, group) -> tuple:
+    """(the planted model, the entry plants it amounts to): the entries edited for entry plants; for a
+    ``SOURCE`` plant the derivation with the item edited (``mechanics_source.planted_model``),
+    and each entry it changes in a key the model writes as a plant (None when the pair form
+    refuses it)."""
+    if group[0].method != SOURCE:
+        edits: dict[str, list] = {}
+        for p in group:
+            edits.setdefault(p.method, []).append((p.index, p.original, p.new))
+        return edited_model(model, sm, edits, "Planted"), group
+    plant = group[0]
+    cls = planted_model(model, sm, plant.index, plant.new)
+    if cls is None:
+        return None, ()
+    params = cls.params_type(
+        **{f.name: getattr(model.params, f.name) for f in dataclasses.fields(cls.params_type)}
+    )
+    item = source_items(type(model).derivation, sm)[plant.index]
+    changes = entry_changes(type(model).derivation, sm, item, plant.new) or {}
+    derived = derived_methods(type(model))  # V integrated from H: never repaired itself
+    entry_group = tuple(
+        Plant(method, index, plant.operator, old, new, plant.what)
+        for (method, index), (old, new) in changes.items()
+        if method not in derived
+    )
+    return cls(params), entry_group
+
+
+def _source_restored(findings, plant: Plant, sm: SymbolicModel, confirmed: bool | None = None) -> bool:
+    """Whether a repair of a source item (``details["source_item"]``) that makes every check pass
+    (and is ``confirmed``, or not, when given) writes the planted item back as it was."""
+    names = {s.name: s for group in sm.symbols.values() for s in group}
+    names |= {p.name: p for p in sm.parameters.values()} | FUNCTIONS | CONSTANTS
+    for f in findings:
+        if f.kind != "repair" or "source_item" not in f.details or not f.details.get("checks_pass"):
+            continue
+        if confirmed is not None and bool(f.details.get("confirmed")) is not confirmed:
+            continue
+        if f.details["written"] == str(plant.new):
+            if is_zero(read_expression(f.details["suggested"], names) - plant.original, sm.angles):
+                return True
+    return False
+
+
+def _all_restored(findings, group, entry_group, sm: SymbolicModel, confirmed: bool | None = None) -> bool:
+    """Whether every planted error of ``group`` is restored: an entry plant by a repair of its entry;
+    a ``SOURCE`` plant by a repair of its item, or by repairs of every entry it changes."""
+    if group[0].method == SOURCE:
+        if _source_restored(findings, group[0], sm, confirmed):
+            return True
+        group = entry_group
+    return all(_restored(findings, p, sm, confirmed) for p in group)
+
+
 def score_model(
     label: str, model, system, chosen=None, deadline_s: float = 10.0, progress=None
 ) -> ModelScores:
@@ -222,10 +294,9 @@ def score_model(
         group = item if isinstance(item, tuple) else (item,)  # a pair: two errors at once
         plant = group[0]
         score = Score(plant, also=group[1:])
-        edits: dict[str, list] = {}
-        for p in group:
-            edits.setdefault(p.method, []).append((p.index, p.original, p.new))
-        planted = edited_model(model, sm, edits, "Planted")
+        planted, entry_group = _planted(model, sm, group)
+        if planted is None:  # a derivation the pair form refuses once edited: not a model to score
+            continue
         with np.errstate(all="ignore"):
             batch = CheckBatch(planted, system, states)
             try:
@@ -239,14 +310,16 @@ def score_model(
             start = time.perf_counter()  # the diagnosis alone, as check runs it after the checks
             findings = explain(batch, results, deadline_s)
             score.seconds = time.perf_counter() - start
-            score.named = all(_named(p, findings, forms) for p in group)
+            score.named = any(_named(p, findings, forms) for p in entry_group)
+            if group[0].method != SOURCE:  # entry plants: every one named
+                score.named = all(_named(p, findings, forms) for p in group)
             score.repaired = any(f.kind == "repair" and f.details.get("checks_pass") for f in findings)
-            score.restored = all(_restored(findings, p, sm) for p in group)
+            score.restored = _all_restored(findings, group, entry_group, sm)
             printed_confirmed = any(f.kind == "repair" and f.details.get("confirmed") for f in findings)
-            score.confirmed = all(_restored(findings, p, sm, confirmed=True) for p in group)
+            score.confirmed = _all_restored(findings, group, entry_group, sm, confirmed=True)
             score.wrong_confirmed = printed_confirmed and not score.confirmed
-            score.ambiguity_stated = not printed_confirmed and all(
-                _restored(findings, p, sm, confirmed=False) for p in group
+            score.ambiguity_stated = not printed_confirmed and _all_restored(
+                findings, group, entry_group, sm, confirmed=False
             )
             score.message = next((f.message for f in findings if f.kind == "repair"), "")
         out.scores.append(score)

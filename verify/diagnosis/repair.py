@@ -75,6 +75,7 @@ from pendverify.diagnosis.candidates import (
 )
 from pendverify.diagnosis.derived import derived_methods, with_derived
 from pendverify.diagnosis.finding import Finding
+from pendverify.diagnosis.mechanics_source import SourceEdit, SourceSearch
 from pendverify.diagnosis.notation import TEXT_KEYS, Notation
 from pendverify.diagnosis.perturbed import perturbations
 from pendverify.diagnosis.slots import QUANTITY, SCREEN_STATES, Slot, entry_label, evaluator, find_slots
@@ -100,6 +101,11 @@ ALTERNATIVE_SECONDS = 2.0
 #: (a trigonometric polynomial of a few terms in the state, not zero as a function at the moved
 #: parameters) is non-zero at almost every state: 24 states, the special ones first, find it.
 PERTURBED_STATES = SCREEN_STATES
+#: the share of the time left that the edits of a mechanics derivation's items may use: the entry
+#: search after them (``search_repair``) is the fallback for an error no item edit undoes (one of
+#: the kinematics) and needs its time too; the items' search took 1–2 s of the 10 s bound on the
+#: corpus's Kane double pendulum
+SOURCE_SHARE = 0.5
 #: what no check compares with the robot (B and W enter both sides of aba; D too where the URDF
 #: declares no damping): an edit of them is never confirmed
 UNCOMPARED = ("input_matrix", "disturbance_matrix")
@@ -192,9 +198,15 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
     def run(confirmation, ordered) -> None:  # each candidate with its derived keys derived again
         confirmation.run((r, with_derived(c, sm, derived), e, s) for r, c, e, s in ordered)
 
+    notation = Notation.of(type(batch.model))
+    confirm = _Confirmation(batch, sm, deadline, derived=derived, screening=screening)
+    source, said = _source_search(batch, sm, slots, evaluate, confirm, deadline)
+    if confirm.found:
+        return confirm.findings(forms, notation), ""
+    if source is not None:
+        confirm = confirm.again(baseline=False)  # the entries next, sharing the perturbed sets
     pool = sum_pool(sm)
     monomials: dict[str, tuple] = {}
-    confirm = _Confirmation(batch, sm, deadline, derived=derived, screening=screening)
     screened = []
     for group in _groups(slots, batch.model.nv):
         for slot in group:
@@ -234,7 +246,6 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
                 break
             confirm = confirm.again(baseline)
             run(confirm, cross_pairs(screened))
-    notation = Notation.of(type(batch.model))
     if confirm.found:
         return confirm.findings(forms, notation), ""
     where = ", ".join(s.label for s in slots[:6]) + (f" and {len(slots) - 6} more" if len(slots) > 6 else "")
@@ -248,7 +259,27 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
     return [], (
         f"no repair: no single edit of {where} (nor one edit of each, for two entries,{also}) makes every "
         f"check pass; {confirm.tried_before + confirm.tried} candidate(s) tried against every check{bound}"
-        f"{confirm.coincidence_note(forms, notation)}"
+        f"{said}{confirm.coincidence_note(forms, notation)}"
+    )
+
+
+def _source_search(batch, sm, slots, evaluate, confirm, deadline: float):
+    """The edits of what a ``sympy.physics.mechanics`` derivation is written from (its bodies,
+    particles, loads, Lagrangian: ``pendverify.diagnosis.mechanics_source``), confirmed as any
+    candidate; (the search or None, the words for the sentence that says no repair was found)."""
+    derivation = getattr(type(batch.model), "derivation", None)
+    if derivation is None:
+        return None, ""
+    now = time.perf_counter()
+    search = SourceSearch(derivation, sm, slots, evaluate, now + SOURCE_SHARE * (deadline - now))
+    if not search.items:
+        return None, ""
+    confirm.run(search.candidates())
+    bound = ", stopped at its share of the time bound" if search.stopped else ""
+    return search, (
+        f"; first, {search.tried} edit(s) of the {derivation.kind}'s bodies, particles and loads "
+        f"({len(search.items)} items{bound}) were screened: {search.passed} passed, and {confirm.tried} "
+        "of the candidates tried against every check were these"
     )
 
 
@@ -356,6 +387,8 @@ class _Confirmation:
                 return
             verdict = self._check(changes, edit, slot)
             first_limited = verdict == "holds" and len(self.found) == 1 and self._limits(changes, values=True)
+            if isinstance(edit, SourceEdit):
+                continue  # its alternatives are other source edits, which come in their turn
             if (verdict == "coincidence" and not self.found) or first_limited:
                 # the same numbers from other parameters, tried at once against every set: in place
                 # of a coincidence, or as the alternatives of a repair that holds at these values only
@@ -403,22 +436,29 @@ class _Confirmation:
             verdict = "makes every check pass on every state, at these parameter values and at "
             verdict += f"{sets} others ({self.perturbation.how})"
         else:
-            also = [f"{shown(c, e, forms, notation)} holds as well{why}" for c, e, _, why in others]
+            also = [f"{_shown(c, e, forms, notation)} holds as well{why}" for c, e, _, why in others]
             if values_only:
                 verdict = "makes every check pass on every state at these parameter values; not confirmed: "
             else:
                 verdict = f"makes every check pass on every state, and at {sets} other parameter sets; "
                 verdict += "not confirmed: "
             verdict += "; ".join(limits + also)
-        out = self._dressed(
-            changes, _findings(self._written(changes), edit, slot, forms, notation, verdict, confirmed)
-        )
+        out = self._dressed(changes, self._printed(changes, edit, slot, forms, notation, verdict, confirmed))
         for c, e, s, why in others:
             verdict = f"makes every check pass on every state as well; not confirmed: like the first{why}"
-            out += self._dressed(
-                c, _findings(self._written(c), e, s, forms, notation, verdict, False, alternative=True)
-            )
+            out += self._dressed(c, self._printed(c, e, s, forms, notation, verdict, False, alternative=True))
         return out
+
+    def _printed(self, changes, edit, slot, forms, notation, verdict, confirmed, alternative=False):
+        """The findings of one repair: one naming the source item for a source edit, else one per
+        written entry it changes."""
+        written = self._written(changes)
+        if isinstance(edit, SourceEdit):
+            derivation = type(self.batch.model).derivation
+            return [
+                _source_finding(written, edit, derivation, forms, notation, verdict, confirmed, alternative)
+            ]
+        return _findings(written, edit, slot, forms, notation, verdict, confirmed, alternative)
 
     def _written(self, changes: dict) -> dict:
         """The changes of the keys the model writes (a derived key is derived again, not edited)."""
@@ -448,7 +488,7 @@ class _Confirmation:
         only (module docstring), or ""."""
         if not self.coincidences:
             return ""
-        edits = ", ".join(shown(c, e, forms, notation) for c, e, _ in self.coincidences[:2])
+        edits = ", ".join(_shown(c, e, forms, notation) for c, e, _ in self.coincidences[:2])
         more = f" and {len(self.coincidences) - 2} more" if len(self.coincidences) > 2 else ""
         return (
             f"; {edits}{more} make(s) every check pass at these parameter values, but not at other values "
@@ -462,6 +502,13 @@ def _names(names: list[str]) -> str:
     if len(names) > 3:
         return f"{', '.join(shown)} and {len(names) - 3} more"
     return shown[0] if len(shown) == 1 else f"{', '.join(shown[:-1])} and {shown[-1]}"
+
+
+def _shown(changes: dict, edit, forms: dict, notation) -> str:
+    """An edit, short: the source item it edits for a source edit, else the entry (``shown``)."""
+    return (
+        edit.shown(notation.render) if isinstance(edit, SourceEdit) else shown(changes, edit, forms, notation)
+    )
 
 
 def _edit_key(changes: dict) -> tuple:
@@ -519,3 +566,40 @@ def _findings(
             )
         )
     return out
+
+
+def _source_finding(
+    changes: dict, edit: SourceEdit, derivation, forms: dict, notation, verdict: str, confirmed: bool,
+    alternative: bool = False,
+):  # fmt: skip
+    """The ``repair`` finding of a source edit that makes every check pass: the item it edits named
+    (``body link2 (inertia): 2*I2 → I2``), then the entries of the closed forms it changes."""
+    item = edit.item
+    written, suggested = notation.render(item.expr), notation.render(edit.new)
+    labels = [entry_label(method, forms[method], index) for method, index in changes]
+    location = f"{derivation.source}, the {derivation.kind}'s {item.owner}"
+    message = (
+        f"{'or, equally: ' if alternative else ''}{item.label}: {written} → {suggested} {verdict} "
+        f"({location}; it changes {', '.join(labels)})"
+    )
+    method, index = next(iter(changes))
+    value = forms[method]
+    position = (
+        tuple(i + 1 for i in entry_position(method, value.shape, index))
+        if isinstance(value, sp.MatrixBase)
+        else ()
+    )
+    entries_changed = {
+        label: [str(old), str(new)] for label, (old, new) in zip(labels, changes.values(), strict=True)
+    }
+    details = {
+        "written": str(item.expr),
+        "suggested": str(edit.new),
+        "suggested_source": suggested,
+        "location": location,
+        "source_item": item.name(notation.render),
+        "entries": entries_changed,
+        "checks_pass": True,
+        "confirmed": confirmed,
+    }
+    return Finding("repair", message, QUANTITY.get(method), position, details)
