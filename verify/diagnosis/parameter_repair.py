@@ -261,7 +261,7 @@ def search_parameter_repair(batch, deadline_s: float, unread: str) -> tuple[list
     return [], (
         f"no repair: none of {len(edits)} edits of the parameters the code is given (p → k·p, another "
         f"parameter of p's units, two exchanged, p ± a product of parameters of its units) makes "
-        f"every check pass; {search.tried} passed the screen and were tried against every check{bound}; "
+        f"every check pass ({search.tried} passed the screen, each then run through every check){bound}; "
         f"the code's own expressions were not edited: {unread}{search.coincidence_note()}"
     )
 
