@@ -27,10 +27,12 @@ import pytest
 import sympy as sp
 
 from pendverify.analytic.derived_scales import term_bound
+from pendverify.bench.explain import QUICK_PER_OPERATOR, class_targets
 from pendverify.bench.explain import _target as load_target
 from pendverify.checks.batch import CheckBatch
 from pendverify.checks.catalogue import applicable_checks, run_checks
 from pendverify.checks.sampling import sample_states
+from pendverify.diagnosis.code_corpus import OPERATORS, code_plants, sample_code_plants, score_code_model
 from pendverify.diagnosis.explain import explain
 from pendverify.diagnosis.parameter_repair import ParameterEdit, parameter_edits
 from pendverify.diagnosis.repair import search_repair
@@ -271,3 +273,28 @@ def test_an_edit_outside_a_kinds_rule_is_given_to_the_code(tmp_path):
     edited = ParameterEdit("scale", "g", factor=Fraction(-1)).applied(model.params)
     assert type(edited) is type(model.params) and edited.g == -model.params.g
     assert dataclasses.asdict(edited) == {**model.params.as_dict(), "g": -model.params.g}
+
+
+# --- the corpus's class "dynamics as code" ----------------------------------------------------------
+def test_the_code_corpus_plants_parameter_misuses_and_gets_them_back(capsys):
+    """The catalogue's NumPy-functions double pendulum (``code_corpus``), a seeded sample of each
+    operator: every planted misuse fails a check and is named, the repair gives the parameters back
+    for nearly all, and none that does not is printed as confirmed."""
+    ((label, model, system, _),) = [t for t in class_targets() if t[0].endswith("(dynamics as code)")]
+    chosen = sample_code_plants(model, QUICK_PER_OPERATOR)
+    assert {p.operator for p in chosen} == set(OPERATORS)
+    scored = score_code_model(label, model, system, chosen)
+    assert scored.clean
+    detected = scored.count("detected")
+    with capsys.disabled():
+        confirmed = scored.count("confirmed")
+        print(f"\ncode corpus: {len(chosen)} planted, {detected} detected, {confirmed} confirmed")
+    assert detected == len(chosen) and scored.count("named") == detected
+    assert scored.count("restored") >= 0.9 * detected
+    assert scored.count("wrong_confirmed") == 0
+
+
+def test_a_class_gets_no_code_corpus(tmp_path):
+    """A Python class reads its parameters wherever its methods do: no place to plant a misuse."""
+    model, _ = load_target(*_numeric_class(tmp_path, "triple_pendulum"))
+    assert code_plants(model) == []

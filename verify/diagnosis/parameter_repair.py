@@ -168,22 +168,28 @@ def _pretty(expr) -> str:
     return text.replace("*", "·").replace("-", "−")
 
 
+def alike(a: str, b: str, kinds: dict, values: dict) -> bool:
+    """Whether parameters ``a`` and ``b`` have one dimension (a damping coefficient only with another)
+    and different values: one can stand for the other."""
+    da, db = KIND_DIMENSIONS.get(kinds[a]), KIND_DIMENSIONS.get(kinds[b])
+    same = da == db if da is not None else kinds[a] == kinds[b] is not None
+    return a != b and same and values[a] != values[b]
+
+
 def parameter_edits(params) -> list[ParameterEdit]:
     """The edits tried, in order (module docstring), at most ``EDITS``."""
     kinds = {f.name: f.metadata.get("kind") for f in dataclasses.fields(params)}
     values = params.as_dict()
     names = [n for n in kinds if np.isfinite(values[n]) and values[n] != 0]
 
-    def alike(a: str, b: str) -> bool:  # the same dimension; damping only with damping
-        da, db = KIND_DIMENSIONS.get(kinds[a]), KIND_DIMENSIONS.get(kinds[b])
-        same = da == db if da is not None else kinds[a] == kinds[b] is not None
-        return a != b and same and values[a] != values[b]
-
     out = [ParameterEdit("scale", n, factor=k) for k in FIRST_SCALES for n in names]
     out += [
-        ParameterEdit("exchange", a, b) for i, a in enumerate(names) for b in names[i + 1 :] if alike(a, b)
+        ParameterEdit("exchange", a, b)
+        for i, a in enumerate(names)
+        for b in names[i + 1 :]
+        if alike(a, b, kinds, values)
     ]
-    out += [ParameterEdit("other", a, b) for a in names for b in names if alike(a, b)]
+    out += [ParameterEdit("other", a, b) for a in names for b in names if alike(a, b, kinds, values)]
     out += [ParameterEdit("scale", n, factor=k) for k in LATER_SCALES for n in names]
     fixed = _fixed_parameters(params)
     for name in names:
