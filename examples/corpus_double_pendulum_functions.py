@@ -5,6 +5,7 @@ from the horizontal, θ2 relative to link 1, the URDF's joint angles (urdf/doubl
 parameters examples/minimal_double_pendulum.toml).  SymPy does not read it: its errors are
 repaired in the parameters the functions are given (docs/diagnosis.md).
 """
+
 import numpy as np
 
 
@@ -38,10 +39,16 @@ DECLARATION = {
     "coordinates": {"theta1": "angle", "theta2": "angle"},
     "inputs": ["tau1", "tau2"],
     "parameters": {
-        "m1": {"kind": "mass"}, "m2": {"kind": "mass"}, "l1": {"kind": "length"},
-        "r1": {"kind": "offset"}, "r2": {"kind": "offset"},
-        "I1": {"kind": "inertia"}, "I2": {"kind": "inertia"},
-        "b1": {"kind": "damping"}, "b2": {"kind": "damping"}, "g": {"kind": "gravity"},
+        "m1": {"kind": "mass"},
+        "m2": {"kind": "mass"},
+        "l1": {"kind": "length"},
+        "r1": {"kind": "offset"},
+        "r2": {"kind": "offset"},
+        "I1": {"kind": "inertia"},
+        "I2": {"kind": "inertia"},
+        "b1": {"kind": "damping"},
+        "b2": {"kind": "damping"},
+        "g": {"kind": "gravity"},
     },
     "urdf": {"joints": ["joint1", "joint2"]},
 }
