@@ -202,6 +202,18 @@ def test_an_error_in_one_term_gets_no_parameter_repair_and_its_entries_are_named
     assert {f.index for f in findings if f.kind == "entry" and f.quantity == "M"} == {(1, 2), (2, 1)}
 
 
+def test_a_search_out_of_time_says_how_many_edits_it_screened(tmp_path):
+    path, urdf, params = _conformance(tmp_path, "acrobot", "dynamics_f")
+    path.write_text(_planted(path.read_text(), "m2 = parameters['m2']", "m2 = 2 * parameters['m2']"))
+    batch, _ = _batch(path, urdf, params)
+    count = len(parameter_edits(batch.model.params))
+    repairs, why = search_repair(batch, 0.0)
+    assert repairs == [] and why.startswith(
+        f"no repair: none of the first 0 of {count} edits (the search stopped at its time bound) of the "
+        "parameters the code is given"
+    ), why
+
+
 # --- coincidences of the values ---------------------------------------------------------------------
 def test_a_value_coincidence_is_not_printed_as_confirmed(tmp_path):
     """I2 = m2·r2²/3 in the parameter file and the URDF: the code reading I2 about the pivot is

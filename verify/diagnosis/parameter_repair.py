@@ -250,25 +250,29 @@ def search_parameter_repair(batch, deadline_s: float, unread: str) -> tuple[list
         )
     search = _Search(batch, screening, differs, deadline)
     edits = parameter_edits(model.params)
-    screened = 0
+    screened, screen_s = 0, 0.0
     for edit in edits:
-        if time.perf_counter() + search.longest > deadline or search.done:
+        # a screen is started while the longest screen (and confirmation) so far still fits the bound
+        if time.perf_counter() + max(search.longest, screen_s) > deadline or search.done:
             break
         screened += 1
-        if not differing(type(model)(edit.applied(model.params)), screening):
+        started = time.perf_counter()
+        passed = not differing(type(model)(edit.applied(model.params)), screening)
+        screen_s = max(screen_s, time.perf_counter() - started)
+        if passed and time.perf_counter() + search.longest <= deadline:
             search.confirm(edit)
     if search.found:
         return search.findings(), ""
-    bound = (
-        f" (the search stopped at its time bound: screened {screened} of {len(edits)})"
-        if screened < len(edits) and not search.done
-        else ""
-    )
+    if screened == len(edits):
+        counted = f"none of {len(edits)} edits"
+    else:
+        why = f"after {CONFIRMATIONS} passed the screen" if search.done else "at its time bound"
+        counted = f"none of the first {screened} of {len(edits)} edits (the search stopped {why})"
     return [], (
-        f"no repair: none of {len(edits)} edits of the parameters the code is given (p → k·p, another "
-        f"parameter of p's units, two exchanged, p ± a product of parameters of its units) makes "
-        f"every check pass ({search.tried} passed the screen, each then run through every check){bound}; "
-        f"the code's own expressions were not edited: {unread}{search.coincidence_note()}"
+        f"no repair: {counted} of the parameters the code is given (p → k·p, another parameter of p's "
+        f"units, two exchanged, p ± a product of parameters of its units) makes every check pass "
+        f"({search.tried} passed the screen, each then run through every check); the code's own "
+        f"expressions were not edited: {unread}{search.coincidence_note()}"
     )
 
 
