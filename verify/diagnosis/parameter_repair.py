@@ -61,7 +61,7 @@ from pendverify.analytic.source_file import where
 from pendverify.checks.batch import CheckBatch
 from pendverify.diagnosis.confirmation import PERTURBED_STATES, derives_scales, holds_at
 from pendverify.diagnosis.finding import Finding
-from pendverify.diagnosis.monomials import _fixed_parameters, _products
+from pendverify.diagnosis.monomials import fixed_parameters, products_of
 from pendverify.diagnosis.perturbed import MovedSet, perturbations
 from pendverify.diagnosis.slots import SCREEN_RTOL, SCREEN_STATES
 from pendverify.errors import ParameterError, PendverifyError
@@ -155,8 +155,10 @@ class ParameterEdit:
         masses = [s for s in self.term.free_symbols if kinds.get(str(s)) == "mass"]
         if kinds.get(self.name) == "inertia" and masses:  # m·l²: an inertia about another point
             if self.term.could_extract_minus_sign():
-                return f"{out} (the parallel-axis term {_pretty(-self.term)} counted twice?)"
-            return f"{out} (the parallel-axis term {_pretty(self.term)}: {self.name} taken about the pivot?)"
+                axis = f"the parallel-axis term {_pretty(-self.term)} counted twice"
+                return f"{out} ({axis}: an inertia about the pivot where the centre of mass's belongs?)"
+            axis = f"the parallel-axis term {_pretty(self.term)}"
+            return f"{out} ({axis}: an inertia about the centre of mass where the pivot's belongs?)"
         return out
 
 
@@ -191,14 +193,14 @@ def parameter_edits(params) -> list[ParameterEdit]:
     ]
     out += [ParameterEdit("other", a, b) for a in names for b in names if alike(a, b, kinds, values)]
     out += [ParameterEdit("scale", n, factor=k) for k in LATER_SCALES for n in names]
-    fixed = _fixed_parameters(params)
+    fixed = fixed_parameters(params)
     for name in names:
         dimension = KIND_DIMENSIONS.get(kinds[name])
         if dimension is None:
             continue
         products = [
             expr
-            for _, expr in _products(fixed, dimension)
+            for _, expr in products_of(fixed, dimension)
             if len(expr.free_symbols) <= ADDED_FACTORS and expr != sp.Symbol(name)
         ]
         for expr in sorted(products, key=lambda e: (sp.Poly(e).total_degree(), str(e))):
