@@ -34,7 +34,7 @@ from pendverify.checks.catalogue import applicable_checks, run_checks
 from pendverify.checks.sampling import sample_states
 from pendverify.diagnosis.code_corpus import OPERATORS, code_plants, sample_code_plants, score_code_model
 from pendverify.diagnosis.explain import explain
-from pendverify.diagnosis.parameter_repair import ParameterEdit, parameter_edits
+from pendverify.diagnosis.parameter_repair import ParameterEdit, parameter_edits, read_parameters
 from pendverify.diagnosis.repair import search_repair
 from tests.analytic.test_numpy_model import DOUBLE_PENDULUM
 from tests.conformance.formats import Model, Plant, write_class, write_model, write_parameters
@@ -107,6 +107,11 @@ def _diagnosis(model_file, urdf, params) -> tuple[list, list]:
     return findings, repairs
 
 
+def _count(model) -> int:
+    """How many edits the search tries on ``model`` (those of the parameters its code reads)."""
+    return len(parameter_edits(model.params, read_parameters(model, sample_states(model, SAMPLES, SEED))))
+
+
 def _double_pendulum(tmp_path: Path, text: str, name: str = "dp.py") -> Path:
     path = tmp_path / name
     path.write_text(text)
@@ -171,6 +176,26 @@ def test_a_numeric_class_reading_l1_and_l2_exchanged_gets_the_exchange(tmp_path)
     assert repair.details["location"].endswith(", class Model")
 
 
+def test_numpy_functions_reading_the_length_where_the_centre_of_mass_belongs_get_it(tmp_path):
+    """A pendulum whose code reads l (its tip, a frame of the URDF) where lc (its centre of mass)
+    belongs, and never reads lc: ``l → lc``, not the exchange (lc is not read: the two are one)."""
+    data = REPO / "tests" / "analytic" / "data"
+    text = (data / "pendulum_functions.py").read_text()
+    text = _planted(text, '"l": {"kind": "length"},', '"l": {"kind": "length"}, "lc": {"kind": "offset"},')
+    text = _planted(text, 'PARAMS = {"m": 2.0, "l": 0.5,', 'PARAMS = {"m": 2.0, "l": 0.8, "lc": 0.35,')
+    path = _double_pendulum(tmp_path, text, "pendulum.py")
+    urdf = tmp_path / "pendulum.urdf"
+    tip = '  <joint name="tip" type="fixed">\n    <parent link="bob"/>\n    <child link="tip"/>\n'
+    tip += '    <origin xyz="0 0 -0.8"/>\n  </joint>\n  <link name="tip"/>\n</robot>'
+    described = _planted((data / "pendulum_functions.urdf").read_text(), '<origin xyz="0 0 -0.5"/>',
+                         '<origin xyz="0 0 -0.35"/>')  # fmt: skip
+    urdf.write_text(_planted(described, "</robot>", tip))
+    _, (repair,) = _diagnosis(path, urdf, {"m": 2.0, "l": 0.8, "lc": 0.35, "b": 0.1, "g": 9.81})
+    assert repair.details["confirmed"], repair.message
+    assert (repair.details["written"], repair.details["suggested"]) == ("l", "lc")
+    assert "the code uses l where lc belongs (look where M, G use l)" in repair.message
+
+
 # --- no claim where there is nothing to repair, or no parameter edit holds -------------------------
 @pytest.mark.parametrize("which", ["dynamics", "numpy", "class"])
 def test_a_correct_code_model_gets_no_claim(tmp_path, which):
@@ -196,7 +221,7 @@ def test_an_error_in_one_term_gets_no_parameter_repair_and_its_entries_are_named
     files = _conformance(tmp_path, "acrobot", "numpy_functions", Plant("M", 0, 1))
     findings, (repair,) = _diagnosis(*files)
     assert not repair.details["checks_pass"] and not repair.details["confirmed"]
-    count = len(parameter_edits(load_target(*files)[0].params))
+    count = _count(load_target(*files)[0])
     assert repair.message.startswith(f"no repair: none of {count} edits of the parameters the code is given")
     assert "the code's own expressions were not edited: SymPy cannot read the model (" in repair.message
     assert {f.index for f in findings if f.kind == "entry" and f.quantity == "M"} == {(1, 2), (2, 1)}
@@ -206,7 +231,7 @@ def test_a_search_out_of_time_says_how_many_edits_it_screened(tmp_path):
     path, urdf, params = _conformance(tmp_path, "acrobot", "dynamics_f")
     path.write_text(_planted(path.read_text(), "m2 = parameters['m2']", "m2 = 2 * parameters['m2']"))
     batch, _ = _batch(path, urdf, params)
-    count = len(parameter_edits(batch.model.params))
+    count = _count(batch.model)
     repairs, why = search_repair(batch, 0.0)
     assert repairs == [] and why.startswith(
         f"no repair: none of the first 0 of {count} edits (the search stopped at its time bound) of the "

@@ -178,11 +178,15 @@ def alike(a: str, b: str, kinds: dict, values: dict) -> bool:
     return a != b and same and values[a] != values[b]
 
 
-def parameter_edits(params) -> list[ParameterEdit]:
-    """The edits tried, in order (module docstring), at most ``EDITS``."""
+def parameter_edits(params, read=None) -> list[ParameterEdit]:
+    """The edits tried, in order (module docstring), at most ``EDITS``; ``read``: the parameters the
+    code reads (``read_parameters``; None: all).  An edit changes what the code is given for a
+    parameter it reads; an exchange with one it does not read is the other given for it (l → lc,
+    where the code reads l and not lc), and is tried as that."""
     kinds = {f.name: f.metadata.get("kind") for f in dataclasses.fields(params)}
     values = params.as_dict()
-    names = [n for n in kinds if np.isfinite(values[n]) and values[n] != 0]
+    every = [n for n in kinds if np.isfinite(values[n]) and values[n] != 0]
+    names = [n for n in every if read is None or n in read]
 
     out = [ParameterEdit("scale", n, factor=k) for k in FIRST_SCALES for n in names]
     out += [
@@ -191,7 +195,7 @@ def parameter_edits(params) -> list[ParameterEdit]:
         for b in names[i + 1 :]
         if alike(a, b, kinds, values)
     ]
-    out += [ParameterEdit("other", a, b) for a in names for b in names if alike(a, b, kinds, values)]
+    out += [ParameterEdit("other", a, b) for a in names for b in every if alike(a, b, kinds, values)]
     out += [ParameterEdit("scale", n, factor=k) for k in LATER_SCALES for n in names]
     fixed = fixed_parameters(params)
     for name in names:
@@ -251,7 +255,7 @@ def search_parameter_repair(batch, deadline_s: float, unread: str) -> tuple[list
             f"{len(screening)} screening states"
         )
     search = _Search(batch, screening, differs, deadline)
-    edits = parameter_edits(model.params)
+    edits = parameter_edits(model.params, read_parameters(model, screening.states))
     screened, screen_s = 0, 0.0
     for edit in edits:
         # a screen is started while the longest screen (and confirmation) so far still fits the bound
@@ -348,10 +352,11 @@ class _Search:
 
     def _finding(self, edit: ParameterEdit, verdict: str, confirmed: bool, alternative=False) -> Finding:
         location, parts = _location(type(self.batch.model))
+        users = parts_using(self.batch.model, self.screening.states, edit.name, parts)
         message = (
             f"{'or, equally: ' if alternative else ''}{edit.written()}: every check passes on every "
             f"state when {edit.given_words()}, {verdict}: {edit.meaning(self.kinds)} (look where "
-            f"{self._uses(edit.name, parts)}) ({location})"
+            f"{_uses(users, edit.name, parts)}) ({location})"
         )
         details = {
             "written": edit.written(),
@@ -362,29 +367,6 @@ class _Search:
             "confirmed": confirmed,
         }
         return Finding("repair", message, details=details)
-
-    def _uses(self, name: str, parts: dict[str, str]) -> str:
-        """ "M, G use m2": the parts of the code whose values change with parameter ``name`` at some
-        screening state (``parts``: method → the name the code gives it), or all of them."""
-        model = self.batch.model
-        moved = ParameterEdit("scale", name, factor=Fraction(5, 4))
-        other = type(model)(moved.applied(model.params))
-        states = [{"q": s.q, "v": s.v, "u": s.u, "w": s.w} for s in self.screening.states]
-        names = []
-        with np.errstate(all="ignore"):
-            for method, part in parts.items():
-                for arguments in states:
-                    args = [arguments[a] for a in _ARGUMENTS.get(method, "")]
-                    try:
-                        a = np.asarray(getattr(model, method)(*args), dtype=float)
-                        b = np.asarray(getattr(other, method)(*args), dtype=float)
-                    except FAILURES:
-                        break
-                    if a.shape != b.shape or not np.array_equal(a, b):
-                        names.append(part)
-                        break
-        names = list(dict.fromkeys(names)) or list(dict.fromkeys(parts.values()))
-        return f"{', '.join(names)} use{'s' if len(names) == 1 else ''} {name}"
 
     def coincidence_note(self) -> str:
         """For the sentence that says no repair was found: the edits that held at the file's values
@@ -411,12 +393,17 @@ _ARGUMENTS = {
 }
 
 
+#: the matrices a dynamics-as-code declaration writes, by their methods
+_DECLARED = {"damping_matrix": "D", "input_matrix": "B", "disturbance_matrix": "W"}
+
+
 def _location(model_cls) -> tuple[str, dict[str, str]]:
     """(where the code is: its file and what it defines, its parts: method → the name the code
     gives it)."""
     if issubclass(model_cls, PythonDynamicsModel):
         name = f"DYNAMICS {getattr(model_cls.dynamics, '__name__', 'function')}"
-        return f"{model_cls.source}, {name}", {"acceleration": "DYNAMICS"}
+        declared = {m: f'DECLARATION["{k}"]' for m, k in _DECLARED.items() if m in model_cls.hand_written()}
+        return f"{model_cls.source}, {name}", {"acceleration": "DYNAMICS", **declared}
     if issubclass(model_cls, NumpyFunctionModel):
         parts = {FUNCTIONS[key][2]: key for key in model_cls.functions}
         if "h" in model_cls.functions:
@@ -425,3 +412,36 @@ def _location(model_cls) -> tuple[str, dict[str, str]]:
     parts = {m: f"{model_cls.__name__}.{m}" for m in model_cls.hand_written() if m in _ARGUMENTS or m in (
         "damping_matrix", "input_matrix", "disturbance_matrix")}  # fmt: skip
     return f"{where(model_cls)}, class {model_cls.__name__}", parts
+
+
+def parts_using(model, states, name: str, parts: dict[str, str]) -> list[str]:
+    """The parts of ``model``'s code (``parts``: method → the name the code gives it) whose values
+    change with parameter ``name`` (moved by a quarter) at some state of ``states``."""
+    other = type(model)(ParameterEdit("scale", name, factor=Fraction(5, 4)).applied(model.params))
+    rows = [{"q": s.q, "v": s.v, "u": s.u, "w": s.w} for s in states]
+    out = []
+    with np.errstate(all="ignore"):
+        for method, part in parts.items():
+            for row in rows:
+                args = [row[a] for a in _ARGUMENTS.get(method, "")]
+                try:
+                    a = np.asarray(getattr(model, method)(*args), dtype=float)
+                    b = np.asarray(getattr(other, method)(*args), dtype=float)
+                except FAILURES:
+                    break
+                if a.shape != b.shape or not np.array_equal(a, b):
+                    out.append(part)
+                    break
+    return list(dict.fromkeys(out))
+
+
+def read_parameters(model, states) -> set[str]:
+    """The parameters ``model``'s code reads: those some part of it changes with at ``states``."""
+    _, parts = _location(type(model))
+    return {n for n in model.params.as_dict() if parts_using(model, states, n, parts)}
+
+
+def _uses(found: list[str], name: str, parts: dict[str, str]) -> str:
+    """ "M, G use m2": the parts that use a parameter, or all of them when none was seen to."""
+    names = found or list(dict.fromkeys(parts.values()))
+    return f"{', '.join(names)} use{'s' if len(names) == 1 else ''} {name}"
