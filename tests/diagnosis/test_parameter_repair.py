@@ -335,3 +335,13 @@ def test_a_class_gets_no_code_corpus(tmp_path):
     """A Python class reads its parameters wherever its methods do: no place to plant a misuse."""
     model, _ = load_target(*_numeric_class(tmp_path, "triple_pendulum"))
     assert code_plants(model) == []
+
+
+def test_dynamics_code_is_planted_where_it_reads_its_keywords(tmp_path):
+    """The corpus's plant of a ``DYNAMICS`` model (the acrobot's f(x, u)): the keyword parameters the
+    function gets are edited; the untouched model is clean, each plant fails and is given back."""
+    model, system = load_target(*_conformance(tmp_path, "acrobot", "dynamics_f"))
+    chosen = [p for p in code_plants(model) if p.what in ("m2 read as 2·m2", "g read as −g")]
+    assert len(chosen) == 2
+    scored = score_code_model("acrobot", model, system, chosen)
+    assert scored.clean and scored.count("detected") == 2 and scored.count("confirmed") == 2
