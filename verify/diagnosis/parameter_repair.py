@@ -22,6 +22,13 @@ What is tried (``parameter_edits``), simplest first, at most ``EDITS``:
    mass where the one about the pivot belongs, I → I + m·l² (the parallel-axis term), or the
    other way; m1 → m1 + m2.
 
+Only the parameters the code reads are edited (``read_parameters``: those some part of the code
+changes with at the screening states, each moved by a quarter); one it does not read may be
+what another is given.  An exchange with such a parameter is that substitution (l ↔ lc where the
+code reads l and never lc is l → lc) and is tried as it.  The factors of steps 1 and 3 are
+the slips of a hand derivation named with each; a factor beyond them (5, 1/5) is no common slip
+and would double the edits screened.
+
 Screen, then checks.  Each edit is screened first (``differing``): the edited model's q̈, and,
 for a model that writes them, its M, H and C·q̇ (and D where the description declares damping),
 at the screening states against Pinocchio's, each entry within ``SCREEN_RTOL`` of its
