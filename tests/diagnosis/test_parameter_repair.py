@@ -345,3 +345,13 @@ def test_dynamics_code_is_planted_where_it_reads_its_keywords(tmp_path):
     assert len(chosen) == 2
     scored = score_code_model("acrobot", model, system, chosen)
     assert scored.clean and scored.count("detected") == 2 and scored.count("confirmed") == 2
+
+
+def test_code_that_fails_on_an_edited_value_only_fails_that_edit(tmp_path):
+    """A class whose code raises a KeyError when given g < 0 (the edit g → −g) and reads m2 doubled:
+    that edit does not pass (no traceback), and m2 → m2/2 is found."""
+    unpacked = "p.m2, p.l1, p.r2, p.b2, p.m3, p.l2, p.r3, p.b3, p.g"
+    wrong = '2 * p.m2, p.l1, p.r2, p.b2, p.m3, p.l2, p.r3, p.b3, {"up": p.g}["up" if p.g > 0 else "down"]'
+    files = _numeric_class(tmp_path, "triple_pendulum", (unpacked, wrong))
+    _, (repair,) = _diagnosis(*files)
+    assert repair.details["confirmed"] and repair.details["suggested"] == "m2/2", repair.message
