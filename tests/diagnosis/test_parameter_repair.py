@@ -285,7 +285,75 @@ def test_equal_masses_leave_a_doubled_mass_unconfirmed(tmp_path):
     _, (repair, *_) = _diagnosis(path, urdf, params)
     assert not repair.details["confirmed"] and repair.details["checks_pass"], repair.message
     assert repair.details["suggested"] == "m2/2"
-    assert "at these parameter values; not confirmed: m2 = m1 here and at every set" in repair.message
+    message = repair.message
+    assert "when the code is given m2/2 for m2, at these parameter values: the code uses 2·m2" in message
+    assert "; not confirmed: m2 = m1 here and at every set (equal values are moved together)" in message
+
+
+PIVOT_PENDULUM = """\
+import numpy as np
+
+
+def M(q, p):
+    return np.array([[p.J]])
+
+
+def C(q, v, p):
+    return np.zeros((1, 1))
+
+
+def G(q, p):
+    return np.array([2 * p.m * p.g * p.l * np.sin(q[0])])
+
+
+DECLARATION = {
+    "name": "pivot_pendulum",
+    "coordinates": {"theta": "angle"},
+    "parameters": {
+        "m": {"kind": "mass"}, "l": {"kind": "offset"}, "J": {"kind": "inertia"}, "g": {"kind": "gravity"},
+    },
+    "urdf": {"joints": ["hinge"]},
+}
+PARAMS = {"m": 1.5, "l": 0.4, "J": 0.26, "g": 9.81}
+"""
+PIVOT_URDF = """\
+<?xml version="1.0"?>
+<robot name="pend">
+  <link name="base"/>
+  <joint name="hinge" type="continuous">
+    <parent link="base"/>
+    <child link="bob"/>
+    <axis xyz="0 1 0"/>
+  </joint>
+  <link name="bob">
+    <inertial>
+      <origin xyz="0 0 -0.4"/>
+      <mass value="1.5"/>
+      <inertia ixx="0.02" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.02"/>
+    </inertial>
+  </link>
+</robot>
+"""
+
+
+def test_edits_that_hold_alike_are_all_named_and_none_is_confirmed(tmp_path):
+    """A pendulum whose M is its inertia about the pivot J (one parameter) and whose G reads
+    2·m·g·l: m, l and g enter the code only there, so m → m/2, l → l/2 and g → g/2 all hold; the
+    first is not confirmed, and names the others (J = I + m·l² in the URDF: m is not moved alone)."""
+    urdf = tmp_path / "pendulum.urdf"
+    urdf.write_text(PIVOT_URDF)
+    path = _double_pendulum(tmp_path, PIVOT_PENDULUM, "pendulum.py")
+    _, repairs = _diagnosis(path, urdf, {"m": 1.5, "l": 0.4, "J": 0.26, "g": 9.81})
+    assert [f.details["suggested"] for f in repairs] == ["m/2", "l/2", "g/2"]
+    assert not any(f.details["confirmed"] for f in repairs)
+    first, *others = repairs
+    assert first.message.endswith(
+        "; every check passes as well when the code is given l/2 for l; every check passes as well when "
+        f"the code is given g/2 for g ({first.details['location']})"
+    ), first.message
+    assert all(
+        f.message.startswith("or, equally: ") and "not confirmed: like the first" in f.message for f in others
+    )
 
 
 # --- the edits ----------------------------------------------------------------------------------------

@@ -345,23 +345,24 @@ class _Search:
         limits = perturbation.why_not_alone(first.parameters())
         confirmed = not limits and not others and sets > 0
         if confirmed:
-            verdict = f"at these parameter values and at {sets} others ({perturbation.how})"
+            verdict, why_not = f"at these parameter values and at {sets} others ({perturbation.how})", ""
         else:
-            also = [f"{o.given_words()} holds as well" for o in others]
-            verdict = "at these parameter values; not confirmed: " + "; ".join(limits + also)
-        out = [self._finding(first, verdict, confirmed)]
+            also = [f"every check passes as well when {o.given_words()}" for o in others]
+            verdict, why_not = "at these parameter values", "; not confirmed: " + "; ".join(limits + also)
+        out = [self._finding(first, verdict, why_not, confirmed)]
         for other in others:
-            verdict = "as well; not confirmed: like the first"
-            out.append(self._finding(other, verdict, False, alternative=True))
+            out.append(self._finding(other, "as well", "; not confirmed: like the first", False, True))
         return out
 
-    def _finding(self, edit: ParameterEdit, verdict: str, confirmed: bool, alternative=False) -> Finding:
+    def _finding(self, edit: ParameterEdit, verdict: str, why_not: str, confirmed: bool, alternative=False):
+        """One ``repair`` finding: the edit, ``verdict`` (where it holds), what the code does then,
+        where to look, ``why_not`` (why it is not confirmed, or ""), where the code is."""
         location, parts = _location(type(self.batch.model))
         users = parts_using(self.batch.model, self.screening.states, edit.name, parts)
         message = (
             f"{'or, equally: ' if alternative else ''}{edit.written()}: every check passes on every "
             f"state when {edit.given_words()}, {verdict}: {edit.meaning(self.kinds)} (look where "
-            f"{_uses(users, edit.name, parts)}) ({location})"
+            f"{_uses(users, edit.name, parts)}){why_not} ({location})"
         )
         details = {
             "written": edit.written(),
