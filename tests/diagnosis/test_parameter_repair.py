@@ -33,8 +33,9 @@ from pendverify.checks.batch import CheckBatch
 from pendverify.checks.catalogue import applicable_checks, run_checks
 from pendverify.checks.sampling import sample_states
 from pendverify.diagnosis.code_corpus import OPERATORS, code_plants, sample_code_plants, score_code_model
+from pendverify.diagnosis.code_parts import read_parameters
 from pendverify.diagnosis.explain import explain
-from pendverify.diagnosis.parameter_repair import ParameterEdit, parameter_edits, read_parameters
+from pendverify.diagnosis.parameter_edits import ParameterEdit, parameter_edits
 from pendverify.diagnosis.repair import search_repair
 from tests.analytic.test_numpy_model import DOUBLE_PENDULUM
 from tests.conformance.formats import Model, Plant, write_class, write_model, write_parameters

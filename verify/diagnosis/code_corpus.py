@@ -44,7 +44,7 @@ from pendverify.checks.sampling import sample_states
 from pendverify.diagnosis.acceptance import passes
 from pendverify.diagnosis.corpus import CORPUS_SAMPLES, CORPUS_SEED, ModelScores, Score
 from pendverify.diagnosis.explain import explain
-from pendverify.diagnosis.parameter_repair import ParameterEdit, alike
+from pendverify.diagnosis.parameter_edits import ParameterEdit, alike
 
 OPERATORS = ("factor 2", "factor ½", "sign", "exchange", "pivot")
 #: random parameter sets a repair's composition with the plant is checked at, besides the file's

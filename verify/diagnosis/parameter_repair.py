@@ -7,7 +7,7 @@ cannot be read as expressions, so ``pendverify.diagnosis.repair`` cannot edit th
 parameter used wrongly wherever the code uses it.  The search gives the code an edited set and
 asks whether every check then passes.
 
-What is tried (``parameter_edits``), simplest first, at most ``EDITS``:
+What is tried (``pendverify.diagnosis.parameter_edits``), simplest first, at most ``EDITS``:
 
 1. p → k·p for k in 2, ½, −1: a quantity counted twice or halved (a mass doubled, a length
    where the half-length belongs, a diameter for a radius), a sign (gravity along +z);
@@ -22,9 +22,9 @@ What is tried (``parameter_edits``), simplest first, at most ``EDITS``:
    mass where the one about the pivot belongs, I → I + m·l² (the parallel-axis term), or the
    other way; m1 → m1 + m2.
 
-Only the parameters the code reads are edited (``read_parameters``: those some part of the code
-changes with at the screening states, each moved by a quarter); one it does not read may be
-what another is given.  An exchange with such a parameter is that substitution (l ↔ lc where the
+Only the parameters the code reads are edited (``code_parts.read_parameters``: those some part
+of the code changes with at the screening states, each moved by a quarter); one it does not read
+may be what another is given.  An exchange with such a parameter is that substitution (l ↔ lc where the
 code reads l and never lc is l → lc) and is tried as it.  The factors of steps 1 and 3 are
 the slips of a hand derivation named with each; a factor beyond them (5, 1/5) is no common slip
 and would double the edits screened.
@@ -52,169 +52,23 @@ without the rules when they refuse it (``ParameterEdit.applied``).
 
 from __future__ import annotations
 
-import copy
 import dataclasses
 import time
-from dataclasses import dataclass
-from fractions import Fraction
 
 import numpy as np
-import sympy as sp
 
-from pendverify.analytic.numpy_model import FUNCTIONS, NumpyFunctionModel
-from pendverify.analytic.parameter_set import KIND_DIMENSIONS
-from pendverify.analytic.python_dynamics import PythonDynamicsModel
-from pendverify.analytic.source_file import where
 from pendverify.checks.batch import CheckBatch
+from pendverify.diagnosis.code_parts import location, parts_using, read_parameters, uses
 from pendverify.diagnosis.confirmation import PERTURBED_STATES, derives_scales, holds_at
 from pendverify.diagnosis.finding import Finding
-from pendverify.diagnosis.monomials import fixed_parameters, products_of
+from pendverify.diagnosis.parameter_edits import ParameterEdit, parameter_edits
 from pendverify.diagnosis.perturbed import MovedSet, perturbations
 from pendverify.diagnosis.slots import SCREEN_RTOL, SCREEN_STATES
-from pendverify.errors import ParameterError
 
-#: the factors of step 1 and of step 3 (module docstring)
-FIRST_SCALES = (Fraction(2), Fraction(1, 2), Fraction(-1))
-LATER_SCALES = (Fraction(4), Fraction(1, 4), Fraction(3), Fraction(1, 3), Fraction(12), Fraction(1, 12))
-#: distinct parameters in a product added to or taken from a parameter (m·l² has two)
-ADDED_FACTORS = 2
-#: edits screened at most
-EDITS = 400
 #: edits run through every check at most (each a run of the checks, and of the perturbed sets)
 CONFIRMATIONS = 12
 #: edits that hold shown besides the first
 ALTERNATIVES = 2
-
-
-@dataclass(frozen=True)
-class ParameterEdit:
-    """One edit of the parameter set the code is given (module docstring)."""
-
-    kind: str  # "scale", "exchange", "other" or "add"
-    name: str  # the parameter whose value the code is given otherwise
-    other: str = ""  # exchange, other: the parameter whose value it gets
-    factor: Fraction = Fraction(1)  # scale
-    term: sp.Expr = sp.S.Zero  # add: the product added (with its sign)
-
-    def given(self, values: dict[str, float]) -> dict[str, float]:
-        """The values the code is given in place of ``values``' (only those that change)."""
-        if self.kind == "scale":
-            return {self.name: float(self.factor) * values[self.name]}
-        if self.kind == "exchange":
-            return {self.name: values[self.other], self.other: values[self.name]}
-        if self.kind == "other":
-            return {self.name: values[self.other]}
-        symbols = {sp.Symbol(n): v for n, v in values.items()}
-        return {self.name: values[self.name] + float(self.term.xreplace(symbols))}
-
-    def applied(self, params):
-        """``params`` with the edit, of the same type: validated as a set is where the values keep
-        the kinds' rules, else the same set with the values replaced (module docstring)."""
-        changes = self.given(params.as_dict())
-        try:
-            return params.replace(**changes)
-        except (ParameterError, ValueError, ArithmeticError, TypeError):
-            edited = copy.copy(params)
-            for name, value in changes.items():
-                object.__setattr__(edited, name, value)
-            return edited
-
-    def parameters(self) -> set[str]:
-        """The parameters the edit involves (``Perturbation.why_not_alone``)."""
-        extra = {self.other} if self.other else {str(s) for s in self.term.free_symbols}
-        return {self.name} | extra
-
-    def written(self) -> str:
-        """What the code is given now (SymPy syntax): ``m2``; ``l1, l2`` for an exchange."""
-        return f"{self.name}, {self.other}" if self.kind == "exchange" else self.name
-
-    def suggested(self) -> str:
-        """What the code is to be given instead: ``m2/2``; ``l2, l1`` for an exchange."""
-        p = sp.Symbol(self.name)
-        if self.kind == "scale":
-            return str(sp.Rational(self.factor.numerator, self.factor.denominator) * p)
-        if self.kind == "exchange":
-            return f"{self.other}, {self.name}"
-        return self.other if self.kind == "other" else str(p + self.term)
-
-    def given_words(self) -> str:
-        """ "the code is given m2/2 for m2" (the edit, in words)."""
-        if self.kind == "exchange":
-            return f"the code is given {self.other} for {self.name} and {self.name} for {self.other}"
-        return f"the code is given {self.suggested()} for {self.name}"
-
-    def meaning(self, kinds: dict[str, str]) -> str:
-        """What the code does, if the edit is the repair, in the user's terms."""
-        p = sp.Symbol(self.name)
-        if self.kind == "scale":
-            used = sp.Rational(self.factor.denominator, self.factor.numerator) * p
-            return f"the code uses {_pretty(used)} where the robot has {self.name}"
-        if self.kind == "exchange":
-            return (
-                f"the code uses {self.name} where {self.other} belongs, "
-                f"and {self.other} where {self.name} belongs"
-            )
-        if self.kind == "other":
-            return f"the code uses {self.name} where {self.other} belongs"
-        out = f"the code uses {self.name} where {_pretty(p + self.term)} belongs"
-        masses = [s for s in self.term.free_symbols if kinds.get(str(s)) == "mass"]
-        if kinds.get(self.name) == "inertia" and masses:  # m·l²: an inertia about another point
-            if self.term.could_extract_minus_sign():
-                axis = f"the parallel-axis term {_pretty(-self.term)} counted twice"
-                return f"{out} ({axis}: an inertia about the pivot where the centre of mass's belongs?)"
-            axis = f"the parallel-axis term {_pretty(self.term)}"
-            return f"{out} ({axis}: an inertia about the centre of mass where the pivot's belongs?)"
-        return out
-
-
-def _pretty(expr) -> str:
-    """``2·m2``, ``m2·r2²``, ``−g``: an expression as the messages write it."""
-    text = str(expr)
-    for exponent, superscript in (("**2", "²"), ("**3", "³")):
-        text = text.replace(exponent, superscript)
-    return text.replace("*", "·").replace("-", "−")
-
-
-def alike(a: str, b: str, kinds: dict, values: dict) -> bool:
-    """Whether parameters ``a`` and ``b`` have one dimension (a damping coefficient only with another)
-    and different values: one can stand for the other."""
-    da, db = KIND_DIMENSIONS.get(kinds[a]), KIND_DIMENSIONS.get(kinds[b])
-    same = da == db if da is not None else kinds[a] == kinds[b] is not None
-    return a != b and same and values[a] != values[b]
-
-
-def parameter_edits(params, read=None) -> list[ParameterEdit]:
-    """The edits tried, in order (module docstring), at most ``EDITS``; ``read``: the parameters the
-    code reads (``read_parameters``; None: all).  An edit changes what the code is given for a
-    parameter it reads; an exchange with one it does not read is the other given for it (l → lc,
-    where the code reads l and not lc), and is tried as that."""
-    kinds = {f.name: f.metadata.get("kind") for f in dataclasses.fields(params)}
-    values = params.as_dict()
-    every = [n for n in kinds if np.isfinite(values[n]) and values[n] != 0]
-    names = [n for n in every if read is None or n in read]
-
-    out = [ParameterEdit("scale", n, factor=k) for k in FIRST_SCALES for n in names]
-    out += [
-        ParameterEdit("exchange", a, b)
-        for i, a in enumerate(names)
-        for b in names[i + 1 :]
-        if alike(a, b, kinds, values)
-    ]
-    out += [ParameterEdit("other", a, b) for a in names for b in every if alike(a, b, kinds, values)]
-    out += [ParameterEdit("scale", n, factor=k) for k in LATER_SCALES for n in names]
-    fixed = fixed_parameters(params)
-    for name in names:
-        dimension = KIND_DIMENSIONS.get(kinds[name])
-        if dimension is None:
-            continue
-        products = [
-            expr
-            for _, expr in products_of(fixed, dimension)
-            if len(expr.free_symbols) <= ADDED_FACTORS and expr != sp.Symbol(name)
-        ]
-        for expr in sorted(products, key=lambda e: (sp.Poly(e).total_degree(), str(e))):
-            out += [ParameterEdit("add", name, term=expr), ParameterEdit("add", name, term=-expr)]
-    return out[:EDITS]
 
 
 def differing(model, base) -> set[tuple]:
@@ -357,18 +211,18 @@ class _Search:
     def _finding(self, edit: ParameterEdit, verdict: str, why_not: str, confirmed: bool, alternative=False):
         """One ``repair`` finding: the edit, ``verdict`` (where it holds), what the code does then,
         where to look, ``why_not`` (why it is not confirmed, or ""), where the code is."""
-        location, parts = _location(type(self.batch.model))
+        where, parts = location(type(self.batch.model))
         users = parts_using(self.batch.model, self.screening.states, edit.name, parts)
         message = (
             f"{'or, equally: ' if alternative else ''}{edit.written()}: every check passes on every "
             f"state when {edit.given_words()}, {verdict}: {edit.meaning(self.kinds)} (look where "
-            f"{_uses(users, edit.name, parts)}){why_not} ({location})"
+            f"{uses(users, edit.name, parts)}){why_not} ({where})"
         )
         details = {
             "written": edit.written(),
             "suggested": edit.suggested(),
             "suggested_source": edit.given_words(),
-            "location": location,
+            "location": where,
             "checks_pass": True,
             "confirmed": confirmed,
         }
@@ -385,69 +239,3 @@ class _Search:
             f"; every check passes when {edits}{more} at these parameter values, but not at other values "
             f"({self.perturbation.how}): a coincidence of the values, not a repair"
         )
-
-
-#: each interface method's arguments (``pendverify.analytic.forms.INTERFACE``'s ``args``)
-_ARGUMENTS = {
-    "mass_matrix": "q",
-    "coriolis_matrix": "qv",
-    "coriolis_force": "qv",
-    "bias": "qv",
-    "gravity": "q",
-    "potential_energy": "q",
-    "acceleration": "qvuw",
-}
-
-
-#: the matrices a dynamics-as-code declaration writes, by their methods
-_DECLARED = {"damping_matrix": "D", "input_matrix": "B", "disturbance_matrix": "W"}
-
-
-def _location(model_cls) -> tuple[str, dict[str, str]]:
-    """(where the code is: its file and what it defines, its parts: method → the name the code
-    gives it)."""
-    if issubclass(model_cls, PythonDynamicsModel):
-        name = f"DYNAMICS {getattr(model_cls.dynamics, '__name__', 'function')}"
-        declared = {m: f'DECLARATION["{k}"]' for m, k in _DECLARED.items() if m in model_cls.hand_written()}
-        return f"{model_cls.source}, {name}", {"acceleration": "DYNAMICS", **declared}
-    if issubclass(model_cls, NumpyFunctionModel):
-        parts = {FUNCTIONS[key][2]: key for key in model_cls.functions}
-        if "h" in model_cls.functions:
-            parts |= {"coriolis_force": "h", "gravity": parts.get("gravity", "h")}
-        return f"{model_cls.source}, functions {', '.join(model_cls.functions)}", parts
-    parts = {m: f"{model_cls.__name__}.{m}" for m in model_cls.hand_written() if m in _ARGUMENTS or m in (
-        "damping_matrix", "input_matrix", "disturbance_matrix")}  # fmt: skip
-    return f"{where(model_cls)}, class {model_cls.__name__}", parts
-
-
-def parts_using(model, states, name: str, parts: dict[str, str]) -> list[str]:
-    """The parts of ``model``'s code (``parts``: method → the name the code gives it) whose values
-    change with parameter ``name`` (moved by a quarter) at some state of ``states``."""
-    other = type(model)(ParameterEdit("scale", name, factor=Fraction(5, 4)).applied(model.params))
-    rows = [{"q": s.q, "v": s.v, "u": s.u, "w": s.w} for s in states]
-    out = []
-    with np.errstate(all="ignore"):
-        for method, part in parts.items():
-            for row in rows:
-                args = [row[a] for a in _ARGUMENTS.get(method, "")]
-                try:
-                    a = np.asarray(getattr(model, method)(*args), dtype=float)
-                    b = np.asarray(getattr(other, method)(*args), dtype=float)
-                except Exception:  # the user's code at moved values: not seen to use it
-                    break
-                if a.shape != b.shape or not np.array_equal(a, b):
-                    out.append(part)
-                    break
-    return list(dict.fromkeys(out))
-
-
-def read_parameters(model, states) -> set[str]:
-    """The parameters ``model``'s code reads: those some part of it changes with at ``states``."""
-    _, parts = _location(type(model))
-    return {n for n in model.params.as_dict() if parts_using(model, states, n, parts)}
-
-
-def _uses(found: list[str], name: str, parts: dict[str, str]) -> str:
-    """ "M, G use m2": the parts that use a parameter, or all of them when none was seen to."""
-    names = found or list(dict.fromkeys(parts.values()))
-    return f"{', '.join(names)} use{'s' if len(names) == 1 else ''} {name}"
