@@ -7,7 +7,7 @@ cannot be read as expressions, so ``pendverify.diagnosis.repair`` cannot edit th
 parameter used wrongly wherever the code uses it.  The search gives the code an edited set and
 asks whether every check then passes.
 
-What is tried (``pendverify.diagnosis.parameter_edits``), simplest first, at most ``EDITS``:
+What is tried (``pendverify.diagnosis.parameter_edits``), simplest first, at most its ``EDITS``:
 
 1. p → k·p for k in 2, ½, −1: a quantity counted twice or halved (a mass doubled, a length
    where the half-length belongs, a diameter for a radius), a sign (gravity along +z);
