@@ -39,5 +39,6 @@ def test_untouched_models_get_no_repair_and_no_parameter_claim():
     for label, model, system, _ in corpus_targets():
         batch = CheckBatch(model, system, sample_states(model, CORPUS_SAMPLES, CORPUS_SEED))
         repairs, why = search_repair(batch, 10.0)
-        assert repairs == [] and "no single entry" in why, label
+        # a model SymPy cannot read: its quantities, not its expressions' entries, are screened
+        assert repairs == [] and ("no single entry" in why or "agree with Pinocchio's" in why), label
         assert identify_parameters(batch) == [], label

@@ -12,7 +12,8 @@ whether the untouched model is clean, and the time a diagnosis takes (mean and l
 planted error, on one core).  ``quick`` draws up to
 ``QUICK_PER_OPERATOR`` planted errors of each operator per model (seeded) instead of all.  A
 catalogue entry with ``pairs = N`` is planted N pairs of errors in two different keys instead
-(``QUICK_PAIRS`` with ``quick``): the class of two errors at once.
+(``QUICK_PAIRS`` with ``quick``): the class of two errors at once.  A model SymPy cannot read
+(dynamics as code) is planted parameters read wrongly instead (``pendverify.diagnosis.code_corpus``).
 """
 
 from __future__ import annotations
@@ -20,6 +21,12 @@ from __future__ import annotations
 import sys
 from dataclasses import dataclass
 
+from pendverify.diagnosis.code_corpus import (
+    code_plants,
+    reads_parameters_in_one_place,
+    sample_code_plants,
+    score_code_model,
+)
 from pendverify.diagnosis.corpus import (
     CORPUS_SEED,
     ModelScores,
@@ -137,7 +144,11 @@ def run_explain_bench(quick: bool = False) -> ExplainBench:
     targets = list(corpus_targets())
     paired = paired_classes()
     chosen = {}
+    code = {label for label, model, _, _ in targets if reads_parameters_in_one_place(type(model))}
     for label, model, _, _ in targets:
+        if label in code:  # SymPy cannot read it: parameters read wrongly (``code_corpus``)
+            chosen[label] = sample_code_plants(model, QUICK_PER_OPERATOR) if quick else code_plants(model)
+            continue
         sm = SymbolicModel.of(type(model))
         if label in paired:
             chosen[label] = pair_plants(sm, min(paired[label], QUICK_PAIRS) if quick else paired[label])
@@ -146,6 +157,7 @@ def run_explain_bench(quick: bool = False) -> ExplainBench:
     out = ExplainBench([], {}, quick)
     with bar(sum(len(c) for c in chosen.values()), "explain", "error") as progress:
         for label, model, system, dof in targets:
-            out.models.append(score_model(label, model, system, chosen[label], progress=progress))
+            score = score_code_model if label in code else score_model
+            out.models.append(score(label, model, system, chosen[label], progress=progress))
             out.dof[label] = dof
     return out

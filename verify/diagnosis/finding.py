@@ -27,7 +27,11 @@ a class), ``location`` (file, key or method, and entry), ``checks_pass`` (true w
 check was re-run on every state at the parameter file's values and passed) and ``confirmed``
 (true only when it also passed at perturbed parameter sets, the description rewritten for
 each, every parameter of the edit moved on its own, and no other edit passed: the same
-function of the parameters, not the same numbers; ``pendverify.diagnosis.repair``).  A
+function of the parameters, not the same numbers; ``pendverify.diagnosis.repair``).  For a
+model SymPy cannot read, a repair is an edit of the parameters its code is given
+(``pendverify.diagnosis.parameter_repair``): ``written`` the parameter(s) the code is given
+(``m2``; ``l1, l2`` for an exchange), ``suggested`` what to give it instead (``m2/2``; ``l2, l1``),
+and no quantity or index.  A
 ``parameters`` finding adds
 ``link``, ``parameter``, ``model_value`` and ``urdf_value``.
 """

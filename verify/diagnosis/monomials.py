@@ -39,7 +39,7 @@ DEGREE = 4
 FLOOR = 1e-12
 
 
-def _fixed_parameters(params) -> tuple[tuple[str, float, tuple], ...]:
+def fixed_parameters(params) -> tuple[tuple[str, float, tuple], ...]:
     """(name, value, dimension) of each parameter whose kind has a fixed unit and whose value is > 0."""
     out = []
     if not dataclasses.is_dataclass(params):  # a parameter set without declared kinds: no units to go by
@@ -53,7 +53,7 @@ def _fixed_parameters(params) -> tuple[tuple[str, float, tuple], ...]:
 
 
 @functools.lru_cache(maxsize=64)
-def _products(parameters: tuple, dimension: tuple) -> tuple[tuple[float, sp.Expr], ...]:
+def products_of(parameters: tuple, dimension: tuple) -> tuple[tuple[float, sp.Expr], ...]:
     """(value, expression) of every product of at most ``DEGREE`` parameters with ``dimension``."""
     out = []
     for degree in range(1, DEGREE + 1):
@@ -105,7 +105,7 @@ def written_coefficient(c: float, uncertainty: float, dimension: tuple, paramete
     """|c| as "q·p1·p2…" when exactly one product of the parameters fits it (module docstring)."""
     window = max(uncertainty, FLOOR * abs(c))
     fits = set()
-    for value, expr in _products(parameters, dimension):
+    for value, expr in products_of(parameters, dimension):
         quotient = abs(c) / value
         if not np.isfinite(quotient):  # (a coefficient of 1e300: no product of these values)
             continue
@@ -123,7 +123,7 @@ def written_coefficient(c: float, uncertainty: float, dimension: tuple, paramete
 def coefficient_words(pattern, entry, model) -> list[str | None]:
     """Per term of ``pattern`` (the difference of ``entry``), its coefficient's magnitude as a product of
     ``model``'s parameters, or None to keep the number (module docstring)."""
-    parameters = _fixed_parameters(model.params)
+    parameters = fixed_parameters(model.params)
     out = []
     for (c, _), function, uncertainty in zip(
         pattern.terms, pattern.functions, pattern.uncertainties, strict=True

@@ -149,6 +149,26 @@ class Perturbation:
             out.append(f"no parameter set could be made ({self.refused or 'nothing to move'})")
         return out
 
+    def unmoved_beside(self, involved, used) -> list[str]:
+        """Why an edit of ``involved`` that held at every set is not confirmed for the parameters of
+        ``used`` (those the model uses) that were not moved, in words (empty: every one moved).  A
+        parameter left at its value is the same number at every set, and an edit's number can
+        stand for it: with lc = 0.25 unmoved, ``g*m*sin(theta)/4`` holds at every set where
+        ``g*lc*m*sin(theta)`` is right."""
+        hidden = sorted(set(self.fixed) & set(used) - set(involved))
+        if not hidden or not self.sets:
+            return []
+        reasons = "; ".join(f"{n}: {self.fixed[n]}" for n in hidden[:3]) + ("; …" if len(hidden) > 3 else "")
+        if len(hidden) > 3:
+            names = f"{', '.join(hidden[:3])} and {len(hidden) - 3} more"
+        else:
+            names = " and ".join(filter(None, (", ".join(hidden[:-1]), hidden[-1])))
+        one = len(hidden) == 1
+        return [
+            f"{names} of your model {'was' if one else 'were'} not moved ({reasons}), so an edit whose "
+            f"numbers stand for {'its value' if one else 'their values'} holds at every set as well"
+        ]
+
 
 def perturbations(model, system, consistent=None, count: int = SETS, seed: int = SEED) -> Perturbation:
     """The perturbed sets of ``model``'s parameters on ``system``'s description (module docstring).

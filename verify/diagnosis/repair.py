@@ -60,7 +60,6 @@ import sympy as sp
 from pendverify.analytic.forms import entry_position
 from pendverify.analytic.symbolic_reading import SymbolicModel
 from pendverify.checks.batch import CheckBatch
-from pendverify.checks.catalogue import applicable_checks, run_checks
 from pendverify.diagnosis.acceptance import accepted, matrix_c_note, passes, written_c_differs
 from pendverify.diagnosis.alternatives import edit_parameters, exchanged, rematched, shown, unless
 from pendverify.diagnosis.candidates import (
@@ -73,13 +72,14 @@ from pendverify.diagnosis.candidates import (
     slot_pairs,
     sum_pool,
 )
+from pendverify.diagnosis.confirmation import PERTURBED_STATES, derives_scales, holds_at, passes_checks
 from pendverify.diagnosis.derived import derived_methods, with_derived
 from pendverify.diagnosis.finding import Finding
 from pendverify.diagnosis.mechanics_source import SourceEdit, SourceSearch
 from pendverify.diagnosis.notation import TEXT_KEYS, Notation
+from pendverify.diagnosis.parameter_repair import search_parameter_repair
 from pendverify.diagnosis.perturbed import perturbations
 from pendverify.diagnosis.slots import QUANTITY, SCREEN_STATES, Slot, entry_label, evaluator, find_slots
-from pendverify.errors import PendverifyError
 from pendverify.symbolic.edited import edited_model
 from pendverify.symbolic.edits import Edit
 from pendverify.symbolic.zero_test import is_zero, probe
@@ -95,12 +95,6 @@ ALTERNATIVES = 2
 ALTERNATIVE_TRIES = 4
 #: how long the search for alternatives goes on after the first repair
 ALTERNATIVE_SECONDS = 2.0
-#: states a candidate is checked on at each perturbed set: the screening states.  The candidate
-#: already matched Pinocchio on every state at the file's values, so it is the right function of
-#: the state there; what a perturbed set tests is the parameters, and a wrong edit's difference
-#: (a trigonometric polynomial of a few terms in the state, not zero as a function at the moved
-#: parameters) is non-zero at almost every state: 24 states, the special ones first, find it.
-PERTURBED_STATES = SCREEN_STATES
 #: the share of the time left that the edits of a mechanics derivation's items may use: the entry
 #: search after them (``search_repair``) is the fallback for an error no item edit undoes (one of
 #: the kinematics) and needs its time too; the items' search took 1–2 s of the 10 s bound on the
@@ -109,18 +103,6 @@ SOURCE_SHARE = 0.5
 #: what no check compares with the robot (B and W enter both sides of aba; D too where the URDF
 #: declares no damping): an edit of them is never confirmed
 UNCOMPARED = ("input_matrix", "disturbance_matrix")
-
-
-def _passes(model, system, states, accept=None) -> bool:
-    """Whether ``model`` passes every applicable check on every state of ``states`` against ``system``
-    (``accept``: a judge of the results other than "every check passes", ``acceptance``)."""
-    names = applicable_checks(model, system)
-    with np.errstate(all="ignore"):
-        try:
-            results = run_checks("repair", model, system, states, 0, names)
-        except (ArithmeticError, ValueError, np.linalg.LinAlgError, PendverifyError):
-            return False  # a scale that cannot be derived too: what is not shown to pass does not
-    return accept(results) if accept is not None else all(r.passed for r in results)
 
 
 def _confirmed(batch, sm, changes: dict, moved_sets=None, baseline: bool = False) -> str:
@@ -132,23 +114,20 @@ def _confirmed(batch, sm, changes: dict, moved_sets=None, baseline: bool = False
     for (method, index), (old, new) in changes.items():
         edits.setdefault(method, []).append((index, old, new))
     repaired = edited_model(batch.model, sm, edits, "Repaired")
-    if not _passes(repaired, batch.system, batch.states, lambda r: accepted(r, batch, sm, changes, baseline)):
+    if not passes_checks(
+        repaired, batch.system, batch.states, lambda r: accepted(r, batch, sm, changes, baseline)
+    ):
         return "fails"
     # at the moved sets, the model's own warning is what the repair is back to when ``baseline``
     moved_accept = passes if baseline else None
-    states = batch.states[:PERTURBED_STATES]
-    derived = bool({"gravity_scale", "diagonal_scale"} - set(type(batch.model).hand_written()))
-    for moved in moved_sets() if moved_sets is not None else ():
-        model = type(repaired)(moved.params)  # the same edited class: its generated code is reused
-        if derived:  # the tolerance scales of the model as given, at these values (``edited_model``)
-            model.use_derived_scales(moved.model.derived_scales())
-        if _passes(model, moved.system, states, moved_accept):
-            continue
-        # the model as given can have degenerate scales (an H planted as 0 has a gravity scale 0,
-        # which the rounding at the file's values may meet and other values not): the repaired
-        # model's own, derived from its M and H, decide then
-        if not derived or not _passes(type(repaired)(moved.params), moved.system, states, moved_accept):
-            return "coincidence"
+    sets = moved_sets() if moved_sets is not None else ()
+    states, derived = batch.states[:PERTURBED_STATES], derives_scales(batch.model)
+
+    def make(moved):  # the same edited class: its generated code is reused
+        return type(repaired)(moved.params)
+
+    if not holds_at(make, sets, states, moved_accept, derived):
+        return "coincidence"
     return "holds"
 
 
@@ -176,8 +155,9 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
     try:
         sm = SymbolicModel.of(type(batch.model))
         forms = sm.closed_forms
-    except Exception as exc:
-        return [], f"no repair searched: SymPy cannot read the model ({type(exc).__name__})"
+    except Exception as exc:  # code: the parameters it is given are searched instead
+        unread = f"SymPy cannot read the model ({type(exc).__name__})"
+        return search_parameter_repair(batch, deadline - time.perf_counter(), unread)
     screening = batch.subset(range(min(SCREEN_STATES, len(batch))))
     params = {p: float(getattr(batch.model.params, p)) for p in sm.parameters}
     evaluate = evaluator(
@@ -343,14 +323,7 @@ class _Confirmation:
         if key not in self._limits_of:
             involved = edit_parameters(changes, self.sm)
             limits = self.perturbation.why_not_alone(involved)
-            hidden = sorted(set(self.perturbation.fixed) & self._used - involved)
-            if hidden and self.perturbation.sets:  # what the edit's numbers may stand for
-                limits.append(
-                    f"{_names(hidden)} of your model {'was' if len(hidden) == 1 else 'were'} not moved "
-                    f"({'; '.join(f'{n}: {self.perturbation.fixed[n]}' for n in hidden[:3])}"
-                    f"{'; …' if len(hidden) > 3 else ''}), so an edit whose numbers stand for "
-                    f"{'its value' if len(hidden) == 1 else 'their values'} holds at every set as well"
-                )
+            limits += self.perturbation.unmoved_beside(involved, self._used)
             free = self.batch.system.urdf_damping() is None
             unchecked = sorted(
                 {QUANTITY[m] for m, _ in changes if m in UNCOMPARED or (m == "damping_matrix" and free)}
@@ -494,14 +467,6 @@ class _Confirmation:
             f"; {edits}{more} make(s) every check pass at these parameter values, but not at other values "
             f"({self.perturbation.how}): a coincidence of the values, not a repair"
         )
-
-
-def _names(names: list[str]) -> str:
-    """``lc``, ``lc and m``, ``I, lc, m and 2 more``."""
-    shown = names[:3]
-    if len(names) > 3:
-        return f"{', '.join(shown)} and {len(names) - 3} more"
-    return shown[0] if len(shown) == 1 else f"{', '.join(shown[:-1])} and {shown[-1]}"
 
 
 def _shown(changes: dict, edit, forms: dict, notation) -> str:
