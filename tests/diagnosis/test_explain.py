@@ -181,21 +181,30 @@ def test_the_diagnosis_reaches_junit_the_review_page_and_assert_verified(tmp_pat
         assert_verified(typo, DP_URDF, DP_PARAMS)
 
 
-def test_two_edits_in_one_entry_are_found_when_no_single_edit_is_enough(tmp_path, capsys):
-    """A sign flipped and a factor 2 in the same term: no single edit passes, the pair does; an
-    added term that fits the numbers but not the units (m2·r2 in M[1,1], kg·m where kg·m² is due)
-    is not offered instead."""
+@pytest.mark.parametrize(
+    ("planted", "pair"),
+    [
+        # a wrong number (a sign and a factor 2 at once): one edit of the number, not two
+        ("- 4*m2*l1*r2*cos(theta2)", False),
+        # sin for cos and 6 for 2 in the same term: no single edit passes, the pair does; an added
+        # term that fits the numbers but not the units (m2·r2 in M[1,1], kg·m where kg·m² is due)
+        # is not offered instead
+        ("+ 6*m2*l1*r2*sin(theta2)", True),
+    ],
+)
+def test_two_edits_in_one_entry_are_found_when_no_single_edit_is_enough(tmp_path, capsys, planted, pair):
     text = (REPO / "examples" / "minimal_double_pendulum_text.toml").read_text()
     good = '"I1 + I2 + m1*r1**2 + m2*(l1**2 + r2**2) + 2*m2*l1*r2*cos(theta2)"'
     path = tmp_path / "two.toml"
-    path.write_text(text.replace(good, good.replace("+ 2*m2*l1*r2", "- 4*m2*l1*r2")))
+    path.write_text(text.replace(good, good.replace("+ 2*m2*l1*r2*cos(theta2)", planted)))
     params = REPO / "examples" / "minimal_double_pendulum.toml"
     status, _, report = _check(
         tmp_path, capsys, "--analytic", str(path), "--urdf", str(DP_URDF), "--params", str(params)
     )
     assert status == 1
     (repair,) = [f for f in next(iter(report["diagnoses"].values())) if f["kind"] == "repair"]
-    assert repair["checks_pass"] is True and "(two edits: " in repair["message"]
+    assert repair["checks_pass"] is True and repair["confirmed"] is True
+    assert ("(two edits: " in repair["message"]) is pair, repair["message"]
     assert repair["suggested"] == "I1 + I2 + 2*l1*m2*r2*cos(theta2) + m1*r1**2 + m2*(l1**2 + r2**2)"
 
 

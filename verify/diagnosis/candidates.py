@@ -452,7 +452,9 @@ def pairs_within(slot: Slot, sm, evaluate, pool, deadline: float) -> list[Edit]:
         if time.perf_counter() > deadline:
             break
         inner = dataclasses.replace(slot, expr=first.expr, values=values, matches=[])
-        seconds = itertools.chain(_coefficient_edits(inner, evaluate), _enumerated(inner, sm, pool))
+        seconds = itertools.chain(
+            _coefficient_edits(inner, evaluate), _number_edits(inner, evaluate), _enumerated(inner, sm, pool)
+        )
         for second, _, mismatch in _evaluated(inner, seconds, sm, evaluate, deadline):
             if mismatch <= SCREEN_RTOL and second.expr != slot.expr:
                 out.append(
