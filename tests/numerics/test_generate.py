@@ -209,7 +209,9 @@ def _seed(name: str):
 
 def _example(path: Path):
     cls = load_model_class(path)
-    params = load_parameter_file(path.with_suffix(".toml"), {cls.name: cls.params_type})[2]
+    # a worked example's parameters are NAME.toml beside it, a corpus model's NAME_params.toml
+    found = [p for p in (path.with_suffix(".toml"), path.with_name(f"{path.stem}_params.toml")) if p.exists()]
+    params = load_parameter_file(found[-1], {cls.name: cls.params_type})[2]
     return cls(params)
 
 

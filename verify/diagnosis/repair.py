@@ -199,6 +199,8 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
             screened.append(slot)
         run(confirm, candidates(slots, [s for s in group if any(s is x for x in screened)]))
         if time.perf_counter() > min(deadline, confirm.alternatives_until):
+            if confirm.found and len(screened) < len(slots):
+                confirm.cut("the search for other edits that hold stopped at its time bound")
             break
     if not confirm.found and len(slots) == 2 and len(screened) == 2:  # one edit of each entry
         run(confirm, slot_pairs(*slots))
@@ -256,6 +258,8 @@ def _source_search(batch, sm, slots, evaluate, confirm, deadline: float):
         return None, ""
     confirm.run(search.candidates())
     bound = ", stopped at its share of the time bound" if search.stopped else ""
+    if search.stopped:  # an edit of an item might hold where an edit of the entries does next
+        confirm.cut("the edits of the derivation's items were not all screened (time bound)")
     return search, (
         f"; first, {search.tried} edit(s) of the {derivation.kind}'s bodies, particles and loads "
         f"({len(search.items)} items{bound}) were screened: {search.passed} passed, and {confirm.tried} "
@@ -276,6 +280,9 @@ class _Confirmation:
         self.coincidences: list = []
         self.tried, self.tried_at_first, self.longest = 0, 0, 0.0
         self.tried_before = 0  # by the passes before this one (``again``)
+        #: what a time bound left unsearched where an edit that holds as well might be: a repair is
+        #: not confirmed then, so that what "confirmed" means does not depend on the machine's speed
+        self.unsearched: list[str] = []
         self.seen: set = set()
         self.alternatives_until = float("inf")
         self._perturbation = None
@@ -292,6 +299,7 @@ class _Confirmation:
         """A new pass (module docstring) sharing this one's perturbed sets, coincidences and count."""
         nxt = _Confirmation(self.batch, self.sm, self.deadline, baseline, self.derived, self.screening)
         nxt._perturbation, nxt.coincidences = self._perturbation, self.coincidences
+        nxt.unsearched = self.unsearched
         nxt.tried_before = self.tried_before + self.tried
         return nxt
 
@@ -342,10 +350,17 @@ class _Confirmation:
         limits, other = self._limits_of[key]
         return limits if values else limits + other
 
+    def cut(self, what: str) -> None:
+        """Record that a time bound left ``what`` unsearched (``unsearched``)."""
+        if what not in self.unsearched:
+            self.unsearched.append(what)
+
     def run(self, ordered) -> None:
         for rank, changes, edit, slot in ordered:
             # a confirmation is not started unless the longest one so far still fits in the bound
             late = time.perf_counter() + self.longest > min(self.deadline, self.alternatives_until)
+            if late and self.found:
+                self.cut("the search for other edits that hold stopped at its time bound")
             if late or self.tried >= CONFIRMATIONS or len(self.found) > ALTERNATIVES:
                 return
             simple = rank <= RANK["scale"] or rank == RANK["pair"]
@@ -402,7 +417,7 @@ class _Confirmation:
         groups, params = self.perturbation.groups, self.batch.model.params
         others += exchanged(changes, edit, slot, groups, params, self.sm)
         sets = len(self.perturbation.sets)
-        limits = self._limits(changes)
+        limits = self._limits(changes) + self.unsearched
         confirmed = not limits and not others and sets > 0
         values_only = bool(self._limits(changes, values=True))
         if confirmed:
