@@ -45,7 +45,7 @@ from pendverify.analytic.plugin import load_model_class, validate_model_class
 from pendverify.certify.sweep_limits import DEFAULT_MAX_SETS, WORKER_TIMEOUT_S
 from pendverify.checks.report import CheckReport
 from pendverify.checks.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
-from pendverify.checks.trust import REFUSE_REL
+from pendverify.checks.trust import REFUSE_REL as REFUSE_REL  # re-exported: the bound stress reports
 from pendverify.checks.verification import build_report, model_report
 from pendverify.display import REPR_LIMIT, html_table, shortened
 from pendverify.errors import InputError, PendverifyError, UnknownNameError, missing_file
