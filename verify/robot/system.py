@@ -21,12 +21,12 @@ from pendverify.display import listed, shortened
 from pendverify.robot import seed_geometry  # noqa: F401  (registers the reference systems' readers)
 from pendverify.robot.batch import PinocchioBatch, finite_rows
 from pendverify.robot.coordinates import CoordinateMap
+from pendverify.robot.description import LoadedDescription, load_description
 from pendverify.robot.finite_terms import check_finite_terms
 from pendverify.robot.geometry import MODEL_FORM_RTOL, ModelForm, UrdfGeometry, combined, reader
 from pendverify.robot.gravity_tilt import tilt_form
 from pendverify.robot.joint_map import declared_geometry
 from pendverify.robot.seed_geometry import DEFAULT_G
-from pendverify.robot.urdf import LoadedUrdf, load_urdf
 from pendverify.robot.writer import urdf_for
 from pendverify.validate import finite_state
 
@@ -53,7 +53,7 @@ class PinocchioSystem:
         geometry: UrdfGeometry,
         g: float,
         source: str,
-        urdf: LoadedUrdf | None = None,
+        urdf: LoadedDescription | None = None,
         model_form_rtol: float = MODEL_FORM_RTOL,
         gravity_vector=None,
     ):
@@ -86,7 +86,7 @@ class PinocchioSystem:
     def for_model(
         cls,
         model_cls,
-        urdf: str | Path | LoadedUrdf,
+        urdf: str | Path | LoadedDescription,
         g: float | None = None,
         source: str | None = None,
     ):
@@ -102,11 +102,11 @@ class PinocchioSystem:
         copy of the Pinocchio model (it sets the model's gravity), so the description given
         is left as it was; messages name the source it was read with (``source`` is unused).
         """
-        if isinstance(urdf, LoadedUrdf):
+        if isinstance(urdf, LoadedDescription):
             notes = list(urdf.reading_notes)
             loaded = dataclasses.replace(urdf, model=urdf.model.copy(), reading_notes=notes)
         else:
-            loaded = load_urdf(urdf, source)
+            loaded = load_description(urdf, source)
         check_finite_terms(loaded.model, loaded.source)
         own = loaded.facts.gravity
         if g is not None and own is not None and g != own:
