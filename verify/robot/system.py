@@ -1,6 +1,14 @@
-"""A Pinocchio model evaluated in a closed-form model's coordinates: one constructor, ``for_model``.
+"""A Pinocchio model evaluated in a closed-form model's coordinates.
 
-``PinocchioSystem.for_model(cls, urdf)`` loads the URDF (``pendverify.robot.urdf``),
+Three constructors, all through ``for_model``: ``for_model(cls, urdf)`` for any model class
+and description; ``for_params(params)`` for a built-in parameter set on the URDF the project
+writes for it (``pendverify.robot.writer``); ``from_urdf(name, urdf)`` for a built-in model
+given by its name.  ``PinocchioSystem(model, geometry, g, source)`` itself takes a Pinocchio
+model and a coordinate map already made: ``with_map`` (the same description through another
+map) and the diagnosis's inertia traps (another Pinocchio model of the same description) use it.
+
+``PinocchioSystem.for_model(cls, urdf)`` loads the description
+(``pendverify.robot.description.load_description``),
 asks the model's geometry reader, or its declared map, for the coordinate map
 (``pendverify.robot.geometry``), and hands every quantity Pinocchio computes back
 in the model's coordinates: ``at(θ, θ̇)`` for a batch of states
@@ -90,14 +98,14 @@ class PinocchioSystem:
         g: float | None = None,
         source: str | None = None,
     ):
-        """The one constructor: a description (path or XML text; URDF, xacro, MJCF) seen in model
-        class ``model_cls``'s coordinates.
+        """A description (path or XML text; URDF, xacro, MJCF) seen in model class ``model_cls``'s
+        coordinates: the constructor ``for_params`` and ``from_urdf`` call.
 
         ``g`` is the gravity of the closed form; if None, the description's own (an MJCF's
         ``<option gravity>``), else Pinocchio's default 9.81 m/s².  A description whose own g
         differs from ``g`` is evaluated with ``g``, and its notes say so.
 
-        ``urdf`` may also be a description already read (``load_urdf``'s result): systems
+        ``urdf`` may also be a description already read (``load_description``'s result): systems
         on the same description at several g then read it once.  Each system takes its own
         copy of the Pinocchio model (it sets the model's gravity), so the description given
         is left as it was; messages name the source it was read with (``source`` is unused).
