@@ -284,6 +284,12 @@ def _count(key: str, value: Any) -> int:
     return value
 
 
+def _at_least_one(key: str, value: Any) -> int:
+    if _count(key, value) < 1:
+        raise InputError(OPTIONS_SOURCE, key, value, "must be an integer >= 1")
+    return value
+
+
 def _flag(key: str, value: Any) -> bool:
     if not isinstance(value, bool):
         raise InputError(OPTIONS_SOURCE, key, value, "must be True or False")
@@ -847,6 +853,12 @@ def sweep(
     from pendverify.certify.sweep_run import Workers, run_sweep
 
     resume, force = _flag("resume", resume), _flag("force", force)
+    workers = None if workers is None else _at_least_one("workers", workers)
+    max_sets = _at_least_one("max_sets", max_sets)
+    if isinstance(worker_timeout, bool) or not isinstance(worker_timeout, (int, float)):
+        raise InputError(OPTIONS_SOURCE, "worker_timeout", worker_timeout, "must be a finite number > 0")
+    if not 0 < worker_timeout < math.inf:
+        raise InputError(OPTIONS_SOURCE, "worker_timeout", worker_timeout, "must be a finite number > 0")
     loaded = load_sweep(sweep_file, max_sets)
     check_sweep_names(loaded, str(sweep_file))
     signer = None if key is None else load_private_key(key)  # a bad key fails before any work

@@ -586,6 +586,10 @@ def test_sweep_certifies_every_set_then_resume_keeps_them(tmp_path):
     assert (run.written, run.skipped, present) == (1, 1, 2)
     with pytest.raises(PendverifyError, match="resume"):
         api.sweep(sweep, out, resume="yes")
+    with pytest.raises(PendverifyError, match="key 'workers' = 0: must be an integer >= 1"):
+        api.sweep(sweep, tmp_path / "none", workers=0)
+    with pytest.raises(PendverifyError, match="key 'worker_timeout' = -1: must be a finite number > 0"):
+        api.sweep(sweep, tmp_path / "none", worker_timeout=-1)
     with pytest.raises(PendverifyError, match="exceed the limit of 1"):
         api.sweep(sweep, tmp_path / "small", max_sets=1)
 
