@@ -1,4 +1,5 @@
-"""The installed package ``pendverify`` imports without cycles, and its code reads no bytecode or frames.
+"""The installed package ``pendverify`` imports without cycles, its code reads no bytecode or frames,
+and every command reaches the library through ``pendverify.api`` alone.
 
 The import graph is read from the source files with ``ast``, nothing is imported to
 build it: every ``import`` and ``from … import`` of a pendverify module counts, at
@@ -9,6 +10,11 @@ module that exists).  A cycle is a strongly connected component of more than one
 module.  The modules are those of every package pyproject.toml lists, each found where
 it is installed (``importlib.util.find_spec``: the package-dir mapping puts
 ``pendverify.analytic`` in analytic/, ``pendverify`` in verify/, ...).
+
+The front door (``pendverify.commands``' rule): a command module imports ``pendverify.api``,
+the commands' own helpers and, by name, what ``COMMAND_MAY_IMPORT`` lists — formatters, the
+command line's contract (output paths, errors, exit statuses) and the light rules its options
+are parsed with before ``func`` runs; any other import of pendverify is a door past the API.
 """
 
 from __future__ import annotations
@@ -199,3 +205,95 @@ def test_no_code_reads_bytecode_or_frames():
             for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
                 hits += [f"{relative}:{number}: {word}" for word in INTROSPECTION if word in line]
     assert not hits, "bytecode or frame introspection:\n" + "\n".join(hits)
+
+
+# --- the front door ---------------------------------------------------------------------------------
+#: what a command module may import of pendverify besides ``pendverify.api`` and ``pendverify.commands``:
+#: {module: the names it may import from it}
+COMMAND_MAY_IMPORT = {
+    # the command line's contract: output paths checked and written atomically, errors, exit statuses
+    "pendverify.atomic": {"STDOUT", "check_output", "check_report_output", "write_atomic"},
+    "pendverify.errors": {
+        "InputError",
+        "OptionConflictError",
+        "PendverifyError",
+        "UnknownNameError",
+        "missing_file",
+    },
+    "pendverify.exitcodes": {"BAD_INPUT", "TERMINATED"},
+    # formatters: a result the API returned, as text, JSON, JUnit or a plot
+    "pendverify.jsonio": {"to_json", "versions"},
+    "pendverify.checks.report": {"text_table"},
+    "pendverify.checks.junit": {"to_junit"},
+    "pendverify.bench.plot": {"render"},
+    "pendverify.bench.report": {"fraction", "ratios", "to_csv", "to_markdown"},
+    "pendverify.bench.explain_report": {"table"},
+    "pendverify.bench.certify_report": {"table", "to_json"},
+    "pendverify.bench.timing": {"cpu_model"},  # the machine, in the report's header
+    "pendverify.symbolic.mutation_report": {"format_report"},
+    "pendverify.symbolic.compare": {"format_report"},
+    "pendverify.worked_examples": {"NAMES", "next_commands"},  # the names --help lists; what to type next
+    "pendverify.file_kinds": {"KINDS", "file_kind"},  # the option a stray file belongs behind
+    # the rules options are parsed with (argparse types, defaults, names), light enough for --help
+    "pendverify.analytic": {"MODELS"},
+    "pendverify.simulation.limits": {"MAX_SAMPLES_VARIABLE", "max_samples"},
+    "pendverify.certify.settings_rules": {"samples_option", "seed_option"},
+    "pendverify.certify.sweep_limits": {"DEFAULT_MAX_SETS", "WORKER_TIMEOUT_S"},
+}
+
+
+def doors_past_the_api(path: Path) -> list[str]:
+    """The imports of pendverify in the command module ``path`` that neither go through
+    ``pendverify.api`` nor are allowed by ``COMMAND_MAY_IMPORT``, as ``line: module.name``."""
+    found = []
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), filename=str(path))):
+        if isinstance(node, ast.Import):
+            pairs = [(alias.name, "") for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            # relative: from the package pendverify.commands (level 1) or above it
+            base = ".".join(["pendverify", "commands"][: max(0, 3 - node.level)]) if node.level else ""
+            module = ".".join(part for part in (base, node.module or "") if part)
+            pairs = [(module, alias.name) for alias in node.names]
+        else:
+            pairs = []
+        for module, name in pairs:
+            if module.split(".")[0] != "pendverify":
+                continue
+            through_api = (module, name) == ("pendverify", "api") or module == "pendverify.api"
+            helpers = module == "pendverify.commands" or module.startswith("pendverify.commands.")
+            if not (through_api or helpers or name in COMMAND_MAY_IMPORT.get(module, ())):
+                found.append(f"{node.lineno}: {module}{'.' + name if name else ''}")
+    return found
+
+
+def test_the_front_door_check_finds_a_planted_import_past_the_api(tmp_path):
+    command = tmp_path / "planted.py"
+    command.write_text(
+        "from pendverify.commands import add_command\n"
+        "from pendverify.atomic import check_output\n"
+        "def run(args):\n"
+        "    from pendverify import api\n"
+        "    from pendverify.certify.issue import issue\n"  # past the API
+        "    from pendverify.jsonio import to_json, read_json\n"  # a formatter, and a reader
+        "    import pendverify.stress.catalogue\n"  # past the API
+        "    from pendverify import errors\n"  # a module by name: past the API
+        "    from ..stress import catalogue\n"  # relative, past the API
+        "    from . import simulate\n"  # a sibling command
+    )
+    assert doors_past_the_api(command) == [
+        "5: pendverify.certify.issue.issue",
+        "6: pendverify.jsonio.read_json",
+        "7: pendverify.stress.catalogue",
+        "8: pendverify.errors",
+        "9: pendverify.stress.catalogue",
+    ]
+
+
+def test_every_command_goes_through_the_api():
+    commands = Path(installed_modules()["pendverify.commands"])
+    doors = [
+        f"{path.name}:{door}"
+        for path in sorted(commands.parent.glob("*.py"))
+        for door in doors_past_the_api(path)
+    ]
+    assert not doors, "commands import the library past pendverify.api:\n" + "\n".join(doors)

@@ -18,7 +18,8 @@ table::
 ``check`` chooses its targets through ``pendverify.targets.select_targets``, so the same
 arguments check the same models.  The other functions are those behind ``mutate``,
 ``sympy``, ``show``, ``simulate``, ``render``, ``report``, ``stress``, ``bench``,
-``keygen``, ``certify``, ``recheck`` and ``example``; each imports what it needs when it
+``keygen``, ``certify`` (``certify_set``, and ``sweep`` for ``--sweep``), ``recheck`` and
+``example``; each imports what it needs when it
 is called, so importing this module imports neither SymPy nor SciPy.
 
 Models are given as a built-in name (``pendverify.analytic.MODELS``), a model file (``.py``,
@@ -41,8 +42,10 @@ import pinocchio as pin
 from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
 from pendverify.analytic.parameter_set import check_value
 from pendverify.analytic.plugin import load_model_class, validate_model_class
+from pendverify.certify.sweep_limits import DEFAULT_MAX_SETS, WORKER_TIMEOUT_S
 from pendverify.checks.report import CheckReport
 from pendverify.checks.sampling import DEFAULT_RANDOM_STATES, DEFAULT_SEED
+from pendverify.checks.trust import REFUSE_REL as REFUSE_REL  # re-exported: the bound stress reports
 from pendverify.checks.verification import build_report, model_report
 from pendverify.display import REPR_LIMIT, html_table, shortened
 from pendverify.errors import InputError, PendverifyError, UnknownNameError, missing_file
@@ -58,6 +61,7 @@ if TYPE_CHECKING:
     from pendverify.bench.run import Results
     from pendverify.certify.battery import BatterySettings
     from pendverify.certify.issue import Issued, Rechecked
+    from pendverify.certify.sweep_run import SweepRun
     from pendverify.robot.summary import RobotSummary
     from pendverify.simulation.scene import Scene
     from pendverify.simulation.simulate import Run
@@ -86,6 +90,7 @@ __all__ = [
     "ModelReading",
     "ParamsLike",
     "PinocchioRobot",
+    "SweepCertificates",
     "UrdfLike",
     "animation_html",
     "animation_page",
@@ -112,6 +117,7 @@ __all__ = [
     "ros_packages",
     "simulate",
     "stress",
+    "sweep",
     "trajectory",
     "worked_example",
     "worked_examples",
@@ -275,6 +281,12 @@ def _urdf_file_arg(urdf: UrdfLike, command: str) -> str:
 def _count(key: str, value: Any) -> int:
     if isinstance(value, bool) or not isinstance(value, int) or value < 0:
         raise InputError(OPTIONS_SOURCE, key, value, "must be an integer >= 0")
+    return value
+
+
+def _at_least_one(key: str, value: Any) -> int:
+    if _count(key, value) < 1:
+        raise InputError(OPTIONS_SOURCE, key, value, "must be an integer >= 1")
     return value
 
 
@@ -661,6 +673,10 @@ def read_robot(description: str | Path) -> RobotSummary:
 
 
 # --- stress and benchmarks -------------------------------------------------------------------------
+# REFUSE_REL (pendverify.checks.trust): the predicted relative error above which a result is refused,
+# the bound the near-singular study of ``stress`` holds each quantity to.
+
+
 def stress(
     model: str | Path | None = None,
     urdf: str | Path | None = None,
@@ -796,6 +812,77 @@ def certify_set(
     )
     signer = None if key is None else load_private_key(key)  # a bad key fails before any work
     return issue(target, settings, str(output), force, key=signer)
+
+
+class SweepCertificates(NamedTuple):
+    """What ``sweep`` did: the run (``pendverify.certify.sweep_run.SweepRun``: its summary, the
+    bundles written and kept, whether it stopped or was interrupted) and how many of the sweep's
+    certificates are in the output folder after a run that finished (None after one that did not)."""
+
+    run: SweepRun
+    present: int | None
+
+
+def sweep(
+    sweep_file: str | Path,
+    output: str | Path,
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    worker_timeout: float = WORKER_TIMEOUT_S,
+    resume: bool = False,
+    max_sets: int = DEFAULT_MAX_SETS,
+    key: str | Path | None = None,
+    force: bool = False,
+    log=print,
+) -> SweepCertificates:
+    """Certify every parameter set of a sweep file in parallel: ``pendverify certify --sweep``.
+
+    The sets run on ``workers`` local processes (default one per core) or on the Dask cluster
+    at ``scheduler`` (``tcp://HOST:PORT``; the sweep stops when it has had no worker for
+    ``worker_timeout`` seconds); each passing set's bundle is written into ``output`` as its
+    result arrives (signed by ``key``, an Ed25519 private key file).  A sweep of more than
+    ``max_sets`` sets is refused before any runs; existing files are refused unless ``force``,
+    or with ``resume`` the sets certified there already (digests checked) are kept and the rest
+    computed.  ``log`` takes the line saying which certified sets are recomputed to be signed.
+    """
+    from pendverify.certify.issue import check_sweep_names, write_sweep_certificates
+    from pendverify.certify.signing import load_private_key
+    from pendverify.certify.sweep import load_sweep
+    from pendverify.certify.sweep_output import SameFolder, certificates_in, prepare_output
+    from pendverify.certify.sweep_run import Workers, run_sweep
+
+    resume, force = _flag("resume", resume), _flag("force", force)
+    workers = None if workers is None else _at_least_one("workers", workers)
+    max_sets = _at_least_one("max_sets", max_sets)
+    if isinstance(worker_timeout, bool) or not isinstance(worker_timeout, (int, float)):
+        raise InputError(OPTIONS_SOURCE, "worker_timeout", worker_timeout, "must be a finite number > 0")
+    if not 0 < worker_timeout < math.inf:
+        raise InputError(OPTIONS_SOURCE, "worker_timeout", worker_timeout, "must be a finite number > 0")
+    loaded = load_sweep(sweep_file, max_sets)
+    check_sweep_names(loaded, str(sweep_file))
+    signer = None if key is None else load_private_key(key)  # a bad key fails before any work
+    state = prepare_output(loaded, output, force, resume, signer)
+    if state.resigned:
+        log(
+            f"{len(state.resigned)} set(s) certified in {output} but not signed by --key "
+            "(unsigned, or signed by another key): recomputed and signed"
+        )
+    folder = SameFolder(output)
+
+    def write(result, replace: bool) -> int:
+        folder.check()
+        try:
+            written = write_sweep_certificates(loaded, [result], output, force or replace, signer)
+        except PendverifyError:  # a write that failed because the folder went away says so
+            folder.check()
+            raise
+        folder.wrote()
+        return written
+
+    run = run_sweep(loaded, Workers(scheduler, workers, worker_timeout), write, state.done, state.partial)
+    finished = not (run.lost or run.interrupted)
+    return SweepCertificates(run, certificates_in(loaded, output) if finished else None)
 
 
 def recheck(

@@ -164,14 +164,6 @@ class FastPathError(InputError):
     """A scene uses an effect the compiled back ends do not compile (time-varying, saturated)."""
 
 
-class BrowserError(RuntimeError):
-    """Chromium is missing, failed, or did not answer in time (``pendverify.viz.browser``).
-
-    Not a ``PendverifyError``: nothing the user gave is wrong; the callers that drive a
-    browser catch it and carry on without one.
-    """
-
-
 class BundleNameError(InputError):
     """A set's name cannot name files: it must be a plain file name inside the output folder."""
 

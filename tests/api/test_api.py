@@ -564,6 +564,36 @@ def test_certify_set_signs_with_a_key_and_recheck_trusts_only_that_key(tmp_path)
         pendverify.certify_set(tmp_path / "bad", params, key=tmp_path / "no-such.pem", samples=40)
 
 
+def test_sweep_certifies_every_set_then_resume_keeps_them(tmp_path):
+    """``api.sweep`` is ``certify --sweep``: each set's bundle written, then kept with ``resume``;
+    a set whose certificate is removed is computed again, and bad arguments are refused."""
+    from pendverify import api
+
+    sweep = tmp_path / "sweep.toml"
+    sweep.write_text(
+        'model = "double_pendulum"\ncount = 2\nseed = 5\nsamples = 5\nduration = 0.05\n'
+        "[ranges]\nm1 = [0.5, 2.0]\n"
+    )
+    out = tmp_path / "out"
+    lines = []
+    run, present = api.sweep(sweep, out, workers=1, log=lines.append)
+    names = [f"double_pendulum-{i}" for i in range(2)]
+    assert (run.total, run.written, run.skipped, present) == (2, 2, 0, 2)
+    assert sorted(p.name for p in out.glob("*.cert.json")) == [f"{n}.cert.json" for n in names]
+    assert lines == [] and not run.lost and not run.interrupted
+    (out / f"{names[1]}.cert.json").unlink()
+    run, present = api.sweep(sweep, out, workers=1, resume=True)
+    assert (run.written, run.skipped, present) == (1, 1, 2)
+    with pytest.raises(PendverifyError, match="resume"):
+        api.sweep(sweep, out, resume="yes")
+    with pytest.raises(PendverifyError, match="key 'workers' = 0: must be an integer >= 1"):
+        api.sweep(sweep, tmp_path / "none", workers=0)
+    with pytest.raises(PendverifyError, match="key 'worker_timeout' = -1: must be a finite number > 0"):
+        api.sweep(sweep, tmp_path / "none", worker_timeout=-1)
+    with pytest.raises(PendverifyError, match="exceed the limit of 1"):
+        api.sweep(sweep, tmp_path / "small", max_sets=1)
+
+
 def test_assert_verified_fails_on_a_model_alone_whose_units_agree():
     """A model without ``urdf`` gets its units row alone: nothing was compared with a robot, so the
     helper a user's test suite calls must not pass (the report says NOT verified)."""

@@ -9,7 +9,6 @@ nothing but the JSON on standard output.
 
 from __future__ import annotations
 
-import ast
 import json
 import re
 import shlex
@@ -358,47 +357,3 @@ def test_keygen_quiet_prints_the_fingerprint_alone(tmp_path, capsys):
     lines = capsys.readouterr().out.splitlines()
     assert len(lines) == 1 and lines[0].startswith("fingerprint: ")
     assert len(list((tmp_path / "keys").iterdir())) == 2
-
-
-# --- the commands call the library through pendverify.api ----------------------------------------------
-#: what a command module may import besides ``pendverify.api``: the CLI's own helpers, output,
-#: errors and exit codes, and the formatters of what api returns (tables, JUnit, JSON)
-COMMAND_IMPORTS = {
-    "pendverify",  # from pendverify import api
-    "pendverify.commands",
-    "pendverify.commands.simulate",  # urdf_argument, shared with render
-    "pendverify.atomic",
-    "pendverify.errors",
-    "pendverify.file_kinds",  # which option a file given without one needs (check's stray files)
-    "pendverify.jsonio",
-    "pendverify.analytic",  # MODELS: --model's names
-    "pendverify.simulation.limits",  # --samples' limit
-    "pendverify.worked_examples",  # NAMES for the help, next_commands to print
-    "pendverify.checks.junit",
-    "pendverify.checks.report",
-    "pendverify.checks.trust",  # REFUSE_REL, printed in stress's study
-    "pendverify.stress.trust_study",  # StudyRow.QUANTITIES, the study's columns
-    "pendverify.symbolic.compare",  # format_report
-    "pendverify.symbolic.mutation_report",  # format_report
-    "pendverify.bench.report",
-    "pendverify.bench.plot",
-    "pendverify.bench.certify_report",
-    "pendverify.bench.explain_report",
-    "pendverify.bench.timing",  # cpu_model, for the report's machine
-}
-#: the certify helper routes commands/certify.py through api (certify_set, recheck) separately
-OWN_ROUTE = {"certify.py"}
-
-
-def test_commands_reach_the_library_only_through_api():
-    stray = {}
-    for path in sorted((REPO / "verify" / "commands").glob("*.py")):
-        if path.name in OWN_ROUTE:
-            continue
-        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
-            if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("pendverify"):
-                if node.module not in COMMAND_IMPORTS:
-                    stray.setdefault(path.name, []).append(node.module)
-                elif node.module == "pendverify":
-                    assert [a.name for a in node.names] == ["api"], (path.name, ast.dump(node))
-    assert not stray, stray

@@ -12,8 +12,8 @@ from pendverify.analytic import DoublePendulum
 from pendverify.checks.catalogue import run_checks
 from pendverify.checks.sampling import sample_states
 from pendverify.errors import UrdfShapeError, UserFileError
+from pendverify.robot.description import load_description
 from pendverify.robot.system import PinocchioSystem
-from pendverify.robot.urdf import load_model
 from pendverify.robot.writer import urdf_for
 
 from ..conftest import SEED, default_params
@@ -79,15 +79,15 @@ def test_vertical_axis_is_a_clear_error():
 
 def test_unparsable_and_missing_urdf(tmp_path):
     with pytest.raises(UserFileError, match=r"robot description not found: .*nothing\.urdf; check the path"):
-        load_model(tmp_path / "nothing.urdf")
+        load_description(tmp_path / "nothing.urdf")
     bad = tmp_path / "bad.urdf"
     bad.write_text("<robot name='x'><link name='a'/><joint name='j' type='revolute'></robot>")
     with pytest.raises(UrdfShapeError, match=r"bad\.urdf: malformed XML at line 1, column \d+: mismatched"):
-        load_model(bad)
+        load_description(bad)
     # well-formed XML that Pinocchio refuses: its own reason, not a generic sentence
     bad.write_text("<robot name='x'><link name='a'/><joint name='j' type='revolute'/></robot>")
     with pytest.raises(UrdfShapeError, match=r"bad\.urdf: Pinocchio cannot parse it as URDF: .*j"):
-        load_model(bad)
+        load_description(bad)
 
 
 def test_reversed_axis_and_offset_are_read_off_the_geometry():

@@ -12,7 +12,7 @@ import pytest
 from pendverify.errors import UrdfShapeError
 from pendverify.robot.erd import double_pendulum_urdfs
 from pendverify.robot.inertia_rounding import FLOAT_SLACK, check_inertia_tensor, inertia_tolerance, resolution
-from pendverify.robot.strict import JointDynamics, UrdfFacts, read_urdf_strictly
+from pendverify.robot.strict import DescriptionFacts, JointDynamics, read_urdf_strictly
 from pendverify.robot.urdfdom import build_pinocchio_model
 
 REPO = Path(__file__).resolve().parents[2]
@@ -83,7 +83,7 @@ def test_the_plain_pendulum_is_accepted():
     model, facts, log = build_pinocchio_model(pendulum(), SOURCE)
     assert model.njoints == 3
     assert log == []
-    assert facts == UrdfFacts(
+    assert facts == DescriptionFacts(
         joint_dynamics={"j1": JointDynamics(0.05, None), "j2": JointDynamics(None, 0.01)},
         joint_types={"j1": "revolute", "j2": "continuous"},
     )

@@ -32,11 +32,11 @@ from pendverify.robot.writer import COLOURS, urdf_for
 from pendverify.simulation.scene import load_scene, parse_scene
 from pendverify.simulation.simulate import run_scene
 from pendverify.viz.animation import DEFAULT_FPS, Trajectory, build_scene, render_html
-from pendverify.viz.browser import Chromium, find_chromium
 from pendverify.viz.geometry import LINK_COLOURS, VisualSystem
 from pendverify.viz.plots import energy_plot_svg
 from pendverify.viz.recorder import VIEWER_JS
 from pendverify.viz.review import SceneReview, review_page
+from tests.browser import Chromium, find_chromium
 
 from ..conftest import default_params
 

@@ -32,8 +32,8 @@ from pendverify.checks.sampling import sample_states
 from pendverify.checks.verdict import REFUSED
 from pendverify.checks.verification import guarded_checks
 from pendverify.progress import bar
+from pendverify.robot.description import LoadedDescription, load_description
 from pendverify.robot.system import PinocchioSystem
-from pendverify.robot.urdf import LoadedUrdf, load_urdf
 
 
 @dataclass(frozen=True)
@@ -85,7 +85,7 @@ def check_items(model, system, settings: BatterySettings) -> list[BatteryItem]:
 
 
 def stress_items(
-    model_cls, params, settings: BatterySettings, urdf: str | LoadedUrdf | None = None
+    model_cls, params, settings: BatterySettings, urdf: str | LoadedDescription | None = None
 ) -> list[BatteryItem]:
     """The stress cases that apply to any parameter set, run on this one.
 
@@ -95,7 +95,7 @@ def stress_items(
     (|q̇| ≤ 1e3), zero gravity, and the conditioning guard of
     ``pendverify.checks.trust`` over the sampled states: a set whose
     comparisons would need refusing (near-singular M) is not certified.  They run
-    on ``urdf``, the URDF being certified (text, path or as read by ``load_urdf``; the
+    on ``urdf``, the URDF being certified (text, path or as read by ``load_description``; the
     project's own for the set if None).
     """
     from pendverify.stress import cases, framework
@@ -150,7 +150,7 @@ def run_battery(
 
     ``engines``: effect → the engine its invariant items ran on (``recheck``: the certificate's)."""
     cls = model_class(model)
-    loaded = load_urdf(urdf, f"<URDF being certified: {cls.name}>")  # read once for every part
+    loaded = load_description(urdf, f"<URDF being certified: {cls.name}>")  # read once for every part
     system = PinocchioSystem.for_model(cls, loaded, params.g)
     not_run = invariants_not_run(cls)
     parts = (

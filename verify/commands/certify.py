@@ -117,18 +117,8 @@ def _print_items(items) -> None:
         print(f"{i.name.ljust(width)}  {largest}  {i.error:9.2e}  {i.tolerance:9.2e}  {verdict}")
 
 
-def _key(args):
-    """The private key of ``--key``, loaded before any work (a bad key fails at once)."""
-    from pendverify.certify.signing import load_private_key
-
-    return load_private_key(args.key) if args.key else None
-
-
 def run_certify(args: argparse.Namespace) -> int:
-    from dataclasses import replace
-
-    from pendverify.certify.battery import BatterySettings
-    from pendverify.certify.issue import certification_input, issue
+    from pendverify import api
 
     if args.sweep and args.params_file:
         refuse_together("--sweep", "a parameter file", "a sweep file names its own sets; give one of them")
@@ -136,13 +126,18 @@ def run_certify(args: argparse.Namespace) -> int:
     check_report_output(args.json)
     if args.sweep:
         return _run_sweep(args)
-    settings = BatterySettings()
-    if args.samples:
-        settings = replace(settings, samples=args.samples)
-    if args.seed is not None:
-        settings = replace(settings, seed=args.seed)
-    target = certification_input(args.params_file, args.urdf, args.model, args.params_option, args.analytic)
-    issued = issue(target, settings, args.output, args.force, _key(args))
+    issued = api.certify_set(
+        args.output,
+        args.params_file,
+        urdf=args.urdf,
+        model=args.model,
+        urdf_params=args.params_option,
+        analytic=args.analytic,
+        key=args.key,
+        samples=args.samples,
+        seed=args.seed,
+        force=args.force,
+    )
     if not args.quiet:
         _print_items(issued.items)
         for sentence in issued.not_run:
@@ -177,37 +172,21 @@ def _certify_json(issued) -> str:
 def _run_sweep(args) -> int:
     import sys
 
-    from pendverify.certify.issue import check_sweep_names, write_sweep_certificates
-    from pendverify.certify.sweep import load_sweep
-    from pendverify.certify.sweep_output import SameFolder, certificates_in, prepare_output
-    from pendverify.certify.sweep_run import Workers, run_sweep
-    from pendverify.errors import PendverifyError
+    from pendverify import api
     from pendverify.exitcodes import BAD_INPUT, TERMINATED
 
-    sweep = load_sweep(args.sweep, args.max_sets)
-    check_sweep_names(sweep, args.sweep)
-    key = _key(args)  # a bad key fails before any work
-    state = prepare_output(sweep, args.output, args.force, args.resume, key)
-    if state.resigned and not args.quiet:
-        print(
-            f"{len(state.resigned)} set(s) certified in {args.output} but not signed by --key "
-            "(unsigned, or signed by another key): recomputed and signed"
-        )
-
-    folder = SameFolder(args.output)
-
-    def write(result, replace: bool) -> int:
-        folder.check()
-        try:
-            written = write_sweep_certificates(sweep, [result], args.output, args.force or replace, key)
-        except PendverifyError:  # a write that failed because the folder went away says so
-            folder.check()
-            raise
-        folder.wrote()
-        return written
-
-    workers = Workers(args.scheduler, args.workers, args.worker_timeout)
-    run = run_sweep(sweep, workers, write, state.done, state.partial)
+    run, there = api.sweep(
+        args.sweep,
+        args.output,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        worker_timeout=args.worker_timeout,
+        resume=args.resume,
+        max_sets=args.max_sets,
+        key=args.key,
+        force=args.force,
+        log=(lambda line: None) if args.quiet else print,
+    )
     certified = run.written + run.skipped
     if run.lost:
         print(
@@ -224,8 +203,7 @@ def _run_sweep(args) -> int:
             file=sys.stderr,
         )
         return run.status
-    there = certificates_in(sweep, args.output)  # what is there, not only what was written
-    if there < certified:
+    if there < certified:  # what is there, not only what was written
         print(
             f"pendverify: error: {certified} certificate(s) written or kept, but only {there} of the "
             f"sweep's are in {args.output}: files were removed during the sweep; continue with --resume",
@@ -264,10 +242,10 @@ def _sweep_json(run) -> str:
 
 
 def run_recheck(args: argparse.Namespace) -> int:
-    from pendverify.certify.issue import recheck
+    from pendverify import api
 
     check_report_output(args.json)
-    result = recheck(args.certificate, args.trust, args.run_embedded_code)
+    result = api.recheck(args.certificate, args.trust, args.run_embedded_code)
     if not args.quiet:
         print(f"digest ok: {result.certificate['digest']['value']}")
         print(result.signature)

@@ -114,10 +114,9 @@ def _margin(r) -> float | None:
 
 
 def format_study(study) -> str:
-    from pendverify.checks.trust import REFUSE_REL
-    from pendverify.stress.trust_study import StudyRow
+    from pendverify import api
 
-    labels = {
+    labels = {  # each quantity the study compares, in its column's order
         "det_closed_form": "det closed",
         "det_lu": "det LU",
         "accel_closed_form": "q̈ closed",
@@ -131,7 +130,7 @@ def format_study(study) -> str:
         group = [r for r in study.rows if r.m1 == m1]
         order = ("ok", "warn", "refuse")
         guard = max((r.level for r in group), key=order.index)
-        worst = [max(getattr(r, q) for r in group) for q in StudyRow.QUANTITIES]
+        worst = [max(getattr(r, q) for r in group) for q in labels]
         kappa = max(r.kappa_scaled for r in group)
         rows.append((f"{m1:.0e}", f"{kappa:.1e}", guard, *(f"{e:.1e}" for e in worst)))
     widths = [max(len(h), *(len(row[i]) for row in rows)) for i, h in enumerate(header)]
@@ -143,7 +142,7 @@ def format_study(study) -> str:
     out.append("-" * len(out[-1]))
     out += ["  ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)).rstrip() for row in rows]
     per = ", ".join(f"{labels[q]} ≥ {m:.0e}" for q, m in study.limit_per_quantity.items())
-    out.append(f"trusted to {REFUSE_REL:g} down to m1 [kg]: {per}")
+    out.append(f"trusted to {api.REFUSE_REL:g} down to m1 [kg]: {per}")
     out.append(
         f"measured trust limit (every quantity): m1 ≥ {study.measured_limit:.0e} kg; "
         f"the guard accepts m1 ≥ {study.accepted_limit:.0e} kg and refuses below; {study.zero_mass_note}, "

@@ -207,7 +207,7 @@ def cart_double_pendulum_geometry(model: pin.Model, source: str, g: float | None
     # rod 1 (joint 1 → joint 2) and rod 2 (joint 2 → its centre of mass), in local frames
     rod1 = data.oMi[2].rotation @ model.jointPlacements[3].translation
     rod2 = data.oMi[3].rotation @ model.inertias[3].lever
-    p1 = data.oMi[2].translation  # the base is anchored at the origin (``load_urdf``)
+    p1 = data.oMi[2].translation  # the base is anchored at the origin (``load_description``)
     phi1, phi2 = lean(rod1), lean(rod2) - lean(rod1)
     # θ = A q + θ0 with A = [[1,0,0],[0,s1,0],[0,s1,s2]]; T = A⁻¹.
     A = np.array([[1.0, 0, 0], [0, s1, 0], [0, s1, s2]])

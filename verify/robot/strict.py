@@ -59,7 +59,7 @@ from pendverify.robot.inertia_rounding import check_inertia_tensor
 from pendverify.robot.urdf_numbers import NOT_A_NUMBER, parse_number, parse_vector, quoted, why_not
 from pendverify.robot.xml_reading import parse_xml_as_urdfdom_reads
 
-__all__ = ["DescriptionFacts", "JointDynamics", "UrdfFacts", "read_urdf_strictly"]
+__all__ = ["DescriptionFacts", "JointDynamics", "read_urdf_strictly"]
 
 #: tag → (attribute → how many numbers it holds), following the URDF format.
 VECTORS: dict[str, dict[str, int]] = {
@@ -149,10 +149,6 @@ class DescriptionFacts:
     gravity_vector: tuple[float, float, float] | None = None
 
 
-#: The facts of a URDF (the name the URDF reader has always used).
-UrdfFacts = DescriptionFacts
-
-
 @dataclass(frozen=True)
 class _Place:
     """Where an element sits, for messages: ``link 'link2' <inertial><inertia>``."""
@@ -164,7 +160,7 @@ class _Place:
         return f"{self.owner} {self.path}" if self.path else self.owner
 
 
-def read_urdf_strictly(text: str, source: str) -> UrdfFacts:
+def read_urdf_strictly(text: str, source: str) -> DescriptionFacts:
     """Check every number of a URDF (see the module docstring) and return the facts Pinocchio hides.
 
     ``text`` is the URDF's XML, ``source`` names it in messages.  Any violation raises
@@ -250,7 +246,7 @@ def _check_element(element: ET.Element, parent_element: ET.Element, place: _Plac
 # --------------------------------------------------------------------------- facts
 
 
-def _facts(root: ET.Element, source: str) -> UrdfFacts:
+def _facts(root: ET.Element, source: str) -> DescriptionFacts:
     dynamics: dict[str, JointDynamics] = {}
     types: dict[str, str] = {}
     for joint in root.findall("joint"):
@@ -267,4 +263,4 @@ def _facts(root: ET.Element, source: str) -> UrdfFacts:
                 None if damping is None else float(damping),
                 None if friction is None else float(friction),
             )
-    return UrdfFacts(dynamics, types)
+    return DescriptionFacts(dynamics, types)

@@ -1,6 +1,14 @@
-"""A Pinocchio model evaluated in a closed-form model's coordinates: one constructor, ``for_model``.
+"""A Pinocchio model evaluated in a closed-form model's coordinates.
 
-``PinocchioSystem.for_model(cls, urdf)`` loads the URDF (``pendverify.robot.urdf``),
+Three constructors, all through ``for_model``: ``for_model(cls, urdf)`` for any model class
+and description; ``for_params(params)`` for a built-in parameter set on the URDF the project
+writes for it (``pendverify.robot.writer``); ``from_urdf(name, urdf)`` for a built-in model
+given by its name.  ``PinocchioSystem(model, geometry, g, source)`` itself takes a Pinocchio
+model and a coordinate map already made: ``with_map`` (the same description through another
+map) and the diagnosis's inertia traps (another Pinocchio model of the same description) use it.
+
+``PinocchioSystem.for_model(cls, urdf)`` loads the description
+(``pendverify.robot.description.load_description``),
 asks the model's geometry reader, or its declared map, for the coordinate map
 (``pendverify.robot.geometry``), and hands every quantity Pinocchio computes back
 in the model's coordinates: ``at(θ, θ̇)`` for a batch of states
@@ -21,12 +29,12 @@ from pendverify.display import listed, shortened
 from pendverify.robot import seed_geometry  # noqa: F401  (registers the reference systems' readers)
 from pendverify.robot.batch import PinocchioBatch, finite_rows
 from pendverify.robot.coordinates import CoordinateMap
+from pendverify.robot.description import LoadedDescription, load_description
 from pendverify.robot.finite_terms import check_finite_terms
 from pendverify.robot.geometry import MODEL_FORM_RTOL, ModelForm, UrdfGeometry, combined, reader
 from pendverify.robot.gravity_tilt import tilt_form
 from pendverify.robot.joint_map import declared_geometry
 from pendverify.robot.seed_geometry import DEFAULT_G
-from pendverify.robot.urdf import LoadedUrdf, load_urdf
 from pendverify.robot.writer import urdf_for
 from pendverify.validate import finite_state
 
@@ -53,7 +61,7 @@ class PinocchioSystem:
         geometry: UrdfGeometry,
         g: float,
         source: str,
-        urdf: LoadedUrdf | None = None,
+        urdf: LoadedDescription | None = None,
         model_form_rtol: float = MODEL_FORM_RTOL,
         gravity_vector=None,
     ):
@@ -86,27 +94,27 @@ class PinocchioSystem:
     def for_model(
         cls,
         model_cls,
-        urdf: str | Path | LoadedUrdf,
+        urdf: str | Path | LoadedDescription,
         g: float | None = None,
         source: str | None = None,
     ):
-        """The one constructor: a description (path or XML text; URDF, xacro, MJCF) seen in model
-        class ``model_cls``'s coordinates.
+        """A description (path or XML text; URDF, xacro, MJCF) seen in model class ``model_cls``'s
+        coordinates: the constructor ``for_params`` and ``from_urdf`` call.
 
         ``g`` is the gravity of the closed form; if None, the description's own (an MJCF's
         ``<option gravity>``), else Pinocchio's default 9.81 m/s².  A description whose own g
         differs from ``g`` is evaluated with ``g``, and its notes say so.
 
-        ``urdf`` may also be a description already read (``load_urdf``'s result): systems
+        ``urdf`` may also be a description already read (``load_description``'s result): systems
         on the same description at several g then read it once.  Each system takes its own
         copy of the Pinocchio model (it sets the model's gravity), so the description given
         is left as it was; messages name the source it was read with (``source`` is unused).
         """
-        if isinstance(urdf, LoadedUrdf):
+        if isinstance(urdf, LoadedDescription):
             notes = list(urdf.reading_notes)
             loaded = dataclasses.replace(urdf, model=urdf.model.copy(), reading_notes=notes)
         else:
-            loaded = load_urdf(urdf, source)
+            loaded = load_description(urdf, source)
         check_finite_terms(loaded.model, loaded.source)
         own = loaded.facts.gravity
         if g is not None and own is not None and g != own:

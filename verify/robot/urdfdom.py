@@ -21,10 +21,10 @@ from contextlib import contextmanager
 import pinocchio as pin
 
 from pendverify.errors import UrdfShapeError
-from pendverify.robot.strict import UrdfFacts, read_urdf_strictly
+from pendverify.robot.strict import DescriptionFacts, read_urdf_strictly
 
 
-def build_pinocchio_model(text: str, source: str) -> tuple[pin.Model, UrdfFacts, list[str]]:
+def build_pinocchio_model(text: str, source: str) -> tuple[pin.Model, DescriptionFacts, list[str]]:
     """Read ``text`` strictly, then build its Pinocchio model with urdfdom's log captured.
 
     Returns ``(model, facts, log)``: the model from ``pinocchio.buildModelFromXML``, the

@@ -25,8 +25,8 @@ from pendverify.checks.sampling import DEFAULT_SEED, State, sample_states
 from pendverify.checks.trust import WARN_REL
 from pendverify.checks.verdict import REFUSED, WARN
 from pendverify.checks.verification import trusted
+from pendverify.robot.description import LoadedDescription, load_description
 from pendverify.robot.system import PinocchioSystem
-from pendverify.robot.urdf import LoadedUrdf, load_urdf
 from pendverify.stress.trust_study import StudyResult, cart_study
 from pendverify.validate import model_states
 
@@ -112,9 +112,9 @@ class Context:
     settings: Settings = FULL
     seed: int = SEED
     study: StudyResult | None = None
-    #: the URDF (text, path, or as read by ``load_urdf``) the cases compare with; None: the one
+    #: the URDF (text, path, or as read by ``load_description``) the cases compare with; None: the one
     #: the project writes for each set
-    urdf: str | LoadedUrdf | None = None
+    urdf: str | LoadedDescription | None = None
     #: the model class of the sets (a plug-in's); None: the built-in model each set names
     model_cls: type | None = None
     #: the systems made so far, by parameter set (cases on the same set share one)
@@ -129,8 +129,8 @@ class Context:
         if self.urdf is None:
             system = system_for(params)
         else:
-            if not isinstance(self.urdf, LoadedUrdf):  # read once: the cases' sets differ in g only
-                self.urdf = load_urdf(self.urdf, "<URDF being compared>")
+            if not isinstance(self.urdf, LoadedDescription):  # read once: the cases' sets differ in g only
+                self.urdf = load_description(self.urdf, "<URDF being compared>")
             cls = self.model_cls or MODELS[params.model]
             system = PinocchioSystem.for_model(cls, self.urdf, getattr(params, "g", None))
         with contextlib.suppress(TypeError):  # a set that cannot be a key is not kept

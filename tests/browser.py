@@ -1,4 +1,4 @@
-"""Headless Chromium driven over the DevTools protocol: screenshots and page state.
+"""Headless Chromium driven over the DevTools protocol: screenshots and page state (test support).
 
 ``Chromium()`` starts one headless browser with the flags that work on machines
 without a display or GPU (software WebGL through SwiftShader) and a fresh
@@ -11,9 +11,11 @@ browser, kills its process group if it does not exit, and removes the profile.
 a ``Tab``, which takes screenshots (``Tab.screenshot``) and evaluates
 JavaScript (``Tab.evaluate``), e.g. the animation clock of a rendered page.
 
-Command line (used to make ``docs/animation.png`` and ``docs/review.png``)::
+The browser tests (``tests/viz/test_viz.py``) drive it; it is not part of the installed
+package.  From the repository's root it also makes ``docs/animation.png`` and
+``docs/review.png``::
 
-    python -m pendverify.viz.browser PAGE.html OUT.png [--wait 3] [--size 1000x700]
+    python -m tests.browser PAGE.html OUT.png [--wait 3] [--size 1000x700]
 """
 
 from __future__ import annotations
@@ -32,7 +34,11 @@ import time
 from pathlib import Path
 
 from pendverify.atomic import write_atomic
-from pendverify.errors import BrowserError
+
+
+class BrowserError(RuntimeError):
+    """Chromium is missing, failed, or did not answer in time (``main`` prints it in one line, exit 1)."""
+
 
 CANDIDATES = ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable")
 FLAGS = (
@@ -220,9 +226,7 @@ def screenshot(
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(
-        prog="python -m pendverify.viz.browser", description=__doc__.split("\n")[0]
-    )
+    parser = argparse.ArgumentParser(prog="python -m tests.browser", description=__doc__.split("\n")[0])
     parser.add_argument("page", help="an HTML file")
     parser.add_argument("png", help="the screenshot to write")
     parser.add_argument("--wait", type=float, default=3.0, help="seconds after loading before the shot")
