@@ -32,7 +32,6 @@ import collections
 import dataclasses
 import functools
 import itertools
-import time
 from collections.abc import Iterator
 from fractions import Fraction
 
@@ -41,6 +40,7 @@ import sympy as sp
 
 from pendverify.analytic.parameter_set import KIND_DIMENSIONS
 from pendverify.analytic.symbolic_reading import SymbolicModel, entries
+from pendverify.diagnosis.clock import now
 from pendverify.diagnosis.patterns import basis_for, fit
 from pendverify.diagnosis.slots import QUANTITY, SCREEN_RTOL, Slot
 from pendverify.symbolic.edits import Edit, replace_at, structural_edits, sums, walk, with_term
@@ -354,7 +354,7 @@ def _evaluated(slot: Slot, edits, sm, evaluate, deadline: float):
     seen = set()
     allowed = set(sm.flat_arguments(slot.symbols)) | set(sm.parameters.values())
     for edit in edits:
-        if time.perf_counter() > deadline:
+        if now() > deadline:
             return
         if edit.expr in seen or edit.expr == slot.expr or not edit.expr.free_symbols <= allowed:
             continue
@@ -449,7 +449,7 @@ def pairs_within(slot: Slot, sm, evaluate, pool, deadline: float) -> list[Edit]:
     firsts = sorted(closer, key=lambda x: (x[0], x[1]))[:FIRST_EDITS]
     out = []
     for _, _, first, values in firsts:
-        if time.perf_counter() > deadline:
+        if now() > deadline:
             break
         inner = dataclasses.replace(slot, expr=first.expr, values=values, matches=[])
         seconds = itertools.chain(

@@ -42,7 +42,6 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
-import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 
@@ -51,6 +50,7 @@ import sympy as sp
 
 from pendverify.analytic.symbolic_reading import SymbolicModel, entries
 from pendverify.diagnosis.candidates import RANK, expression_edits
+from pendverify.diagnosis.clock import now
 from pendverify.diagnosis.slots import SCREEN_RTOL
 from pendverify.errors import PendverifyError
 from pendverify.symbolic.edits import Edit
@@ -333,7 +333,7 @@ class SourceSearch:
         """(rank, changes, the source edit, a slot it repairs), as ``_Confirmation.run`` takes them."""
         edits = sorted((e for item in self.items for e in item_edits(item, self.sm)), key=lambda e: e.rank)
         for edit in edits:
-            if time.perf_counter() > self.deadline:
+            if now() > self.deadline:
                 self.stopped = True
                 return
             self.tried += 1

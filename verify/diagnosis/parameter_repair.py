@@ -53,11 +53,11 @@ without the rules when they refuse it (``ParameterEdit.applied``).
 from __future__ import annotations
 
 import dataclasses
-import time
 
 import numpy as np
 
 from pendverify.checks.batch import CheckBatch
+from pendverify.diagnosis.clock import now
 from pendverify.diagnosis.code_parts import location, parts_using, read_parameters, uses
 from pendverify.diagnosis.confirmation import PERTURBED_STATES, derives_scales, holds_at
 from pendverify.diagnosis.finding import Finding
@@ -102,7 +102,7 @@ def differing(model, base) -> set[tuple]:
 def search_parameter_repair(batch, deadline_s: float, unread: str) -> tuple[list[Finding], str]:
     """The confirmed parameter edit of a failing model SymPy cannot read, as findings, and what
     the search did, in words; ``unread``: why SymPy cannot read it (module docstring)."""
-    deadline = time.perf_counter() + deadline_s
+    deadline = now() + deadline_s
     model = batch.model
     if not dataclasses.is_dataclass(model.params):
         return [], f"no repair searched: {unread}, and its parameters are not a parameter set"
@@ -119,13 +119,13 @@ def search_parameter_repair(batch, deadline_s: float, unread: str) -> tuple[list
     screened, screen_s = 0, 0.0
     for edit in edits:
         # a screen is started while the longest screen (and confirmation) so far still fits the bound
-        if time.perf_counter() + max(search.longest, screen_s) > deadline or search.done:
+        if now() + max(search.longest, screen_s) > deadline or search.done:
             break
         screened += 1
-        started = time.perf_counter()
+        started = now()
         passed = not differing(type(model)(edit.applied(model.params)), screening)
-        screen_s = max(screen_s, time.perf_counter() - started)
-        if passed and time.perf_counter() + search.longest <= deadline:
+        screen_s = max(screen_s, now() - started)
+        if passed and now() + search.longest <= deadline:
             search.confirm(edit)
     if search.found:
         return search.findings(), ""
@@ -176,7 +176,7 @@ class _Search:
 
     def confirm(self, edit: ParameterEdit) -> None:
         """Run ``edit`` through every check on every state, then at the perturbed sets."""
-        started = time.perf_counter()
+        started = now()
         self.tried += 1
         batch, model = self.batch, self.batch.model
         derived = derives_scales(model)
@@ -191,7 +191,7 @@ class _Search:
                 self.found.append(edit)
             else:
                 self.coincidences.append(edit)
-        self.longest = max(self.longest, time.perf_counter() - started)
+        self.longest = max(self.longest, now() - started)
 
     def findings(self) -> list[Finding]:
         """The ``repair`` findings: the first edit that held, confirmed or not and why, then the

@@ -52,7 +52,6 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import time
 
 import numpy as np
 import sympy as sp
@@ -72,6 +71,7 @@ from pendverify.diagnosis.candidates import (
     slot_pairs,
     sum_pool,
 )
+from pendverify.diagnosis.clock import now
 from pendverify.diagnosis.confirmation import PERTURBED_STATES, derives_scales, holds_at, passes_checks
 from pendverify.diagnosis.derived import derived_methods, with_derived
 from pendverify.diagnosis.finding import Finding
@@ -150,14 +150,14 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
     next is screened, so that a long entry (an M⁻¹ written with det M inside) does not use the
     time a short one needed.  Once a repair is found, the other slots are screened for
     alternatives for at most ``ALTERNATIVE_SECONDS``."""
-    start = time.perf_counter()
+    start = now()
     deadline = start + deadline_s
     try:
         sm = SymbolicModel.of(type(batch.model))
         forms = sm.closed_forms
     except Exception as exc:  # code: the parameters it is given are searched instead
         unread = f"SymPy cannot read the model ({type(exc).__name__})"
-        return search_parameter_repair(batch, deadline - time.perf_counter(), unread)
+        return search_parameter_repair(batch, deadline - now(), unread)
     screening = batch.subset(range(min(SCREEN_STATES, len(batch))))
     params = {p: float(getattr(batch.model.params, p)) for p in sm.parameters}
     evaluate = evaluator(
@@ -190,7 +190,7 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
     screened = []
     for group in _groups(slots, batch.model.nv):
         for slot in group:
-            if time.perf_counter() > min(deadline, confirm.alternatives_until):
+            if now() > min(deadline, confirm.alternatives_until):
                 break
             quantity = QUANTITY.get(slot.method, "")
             if quantity not in monomials:
@@ -198,7 +198,7 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
             screen_slot(slot, screening, sm, evaluate, monomials[quantity], pool, deadline)
             screened.append(slot)
         run(confirm, candidates(slots, [s for s in group if any(s is x for x in screened)]))
-        if time.perf_counter() > min(deadline, confirm.alternatives_until):
+        if now() > min(deadline, confirm.alternatives_until):
             if confirm.found and len(screened) < len(slots):
                 confirm.cut("the search for other edits that hold stopped at its time bound")
             break
@@ -214,7 +214,7 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
                 for edit in pairs_within(slot, sm, evaluate, pool, deadline)
             ),
         )
-    if not confirm.found and time.perf_counter() < deadline and written_c_differs(batch, sm):
+    if not confirm.found and now() < deadline and written_c_differs(batch, sm):
         # no edit makes every check pass; the written C is not Pinocchio's: the screened edits
         # again, a repair now one that is back to that C's warning (acceptance)
         confirm = confirm.again(baseline=True)
@@ -224,7 +224,7 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
     crossed = not confirm.found and batch.model.nv <= PAIRS_UP_TO_DOF and len(screened) > 2
     if crossed:  # two errors in two entries (of different keys: one in M, one in C)
         for baseline in (False, True) if written_c_differs(batch, sm) else (False,):
-            if confirm.found or time.perf_counter() > deadline:
+            if confirm.found or now() > deadline:
                 break
             confirm = confirm.again(baseline)
             run(confirm, cross_pairs(screened))
@@ -233,7 +233,7 @@ def search_repair(batch, deadline_s: float) -> tuple[list[Finding], str]:
     where = ", ".join(s.label for s in slots[:6]) + (f" and {len(slots) - 6} more" if len(slots) > 6 else "")
     bound = (
         f" (the search stopped at its time bound: searched {len(screened)} of {len(slots)} entries)"
-        if time.perf_counter() > deadline
+        if now() > deadline
         else ""
     )
     also = " nor two edits of one entry," if pairs else ""
@@ -252,8 +252,8 @@ def _source_search(batch, sm, slots, evaluate, confirm, deadline: float):
     derivation = getattr(type(batch.model), "derivation", None)
     if derivation is None:
         return None, ""
-    now = time.perf_counter()
-    search = SourceSearch(derivation, sm, slots, evaluate, now + SOURCE_SHARE * (deadline - now))
+    started = now()
+    search = SourceSearch(derivation, sm, slots, evaluate, started + SOURCE_SHARE * (deadline - started))
     if not search.items:
         return None, ""
     confirm.run(search.candidates())
@@ -358,7 +358,7 @@ class _Confirmation:
     def run(self, ordered) -> None:
         for rank, changes, edit, slot in ordered:
             # a confirmation is not started unless the longest one so far still fits in the bound
-            late = time.perf_counter() + self.longest > min(self.deadline, self.alternatives_until)
+            late = now() + self.longest > min(self.deadline, self.alternatives_until)
             if late and self.found:
                 self.cut("the search for other edits that hold stopped at its time bound")
             if late or self.tried >= CONFIRMATIONS or len(self.found) > ALTERNATIVES:
@@ -381,7 +381,7 @@ class _Confirmation:
                 # the same numbers from other parameters, tried at once against every set: in place
                 # of a coincidence, or as the alternatives of a repair that holds at these values only
                 for variant, rematch in rematched(changes, self.sm, self.batch.model.params, slot):
-                    late = time.perf_counter() + self.longest > self.deadline
+                    late = now() + self.longest > self.deadline
                     if late or len(self.found) > ALTERNATIVES:
                         break
                     if self._check(variant, rematch, slot) == "holds" and not first_limited:
@@ -394,16 +394,16 @@ class _Confirmation:
             return "seen"
         self.seen.add(key)
         self.tried += 1
-        started = time.perf_counter()
+        started = now()
         verdict = _confirmed(self.batch, self.sm, changes, lambda: self.perturbation.sets, self.baseline)
         if verdict == "holds":
             self.found.append((changes, edit, slot))
             if len(self.found) == 1:
                 self.tried_at_first = self.tried
-                self.alternatives_until = time.perf_counter() + ALTERNATIVE_SECONDS
+                self.alternatives_until = now() + ALTERNATIVE_SECONDS
         elif verdict == "coincidence":
             self.coincidences.append((changes, edit, slot))
-        self.longest = max(self.longest, time.perf_counter() - started)
+        self.longest = max(self.longest, now() - started)
         return verdict
 
     def findings(self, forms: dict, notation) -> list[Finding]:
