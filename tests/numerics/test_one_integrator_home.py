@@ -21,7 +21,8 @@ import numpy as np
 import pytest
 
 from pendverify.analytic import MODELS
-from pendverify.numerics.integrators import EULER, RK4, TABLEAUX, Tableau, explicit_rk_step
+from pendverify.numerics.generate import GeneratedSystem
+from pendverify.numerics.integrators import EULER, RK4, TABLEAUX, Tableau, explicit_rk_step, fixedstep_runner
 from pendverify.simulation.integrate import integrate
 from pendverify.simulation.scene import Integrator
 from pendverify.stress import integrators as si
@@ -56,9 +57,6 @@ def rk4_definitions(roots) -> list[str]:
     return found
 
 
-@pytest.mark.xfail(
-    strict=True, reason="RK4 is still written out in the scene driver, the stress suite, fixedstep"
-)
 def test_rk4_is_defined_once_by_its_tableau():
     found = rk4_definitions(REPO / name for name in PACKAGE)
     assert len(found) == 1 and found[0].startswith(f"{HOME}:"), "RK4 written out again:\n" + "\n".join(found)
@@ -173,6 +171,31 @@ def test_the_stress_suites_rk4_takes_the_classical_steps():
     xs = np.column_stack([run.q, run.v])
     assert len(xs) == n + 1 and run.evaluations == RK4.stages * n
     for i in range(n):
-        expected = classical_rk4_step(lambda t, x: f(x), i * h, xs[i], i * h + h)
+        expected = classical_rk4_step(lambda t, x: f(x), 0.0, xs[i], h)  # autonomous: t is read by none
         error = np.max(np.abs(xs[i + 1] - expected))
         assert error <= ROUNDING * EPS * max(1.0, np.max(np.abs(expected))), f"step {i}"
+
+
+# --- the compiled fast path runs the same tableaux --------------------------------------------
+@pytest.mark.slow
+@pytest.mark.parametrize("model_name", sorted(MODELS))
+@pytest.mark.parametrize("name", sorted(TABLEAUX))
+def test_the_compiled_methods_take_the_tableau_steps(model_name, name):
+    """``fixedstep_runner.integrate_fixed`` against ``explicit_rk_step`` on the generated module's
+    own compiled ``_rhs``, each step from the compiled run's previous state."""
+    model = MODELS[model_name](default_params(model_name))
+    system = GeneratedSystem.from_model(model)
+    packed, rhs = system.packed(), system.kernel.module._rhs
+
+    def f(t, x):
+        out = np.empty_like(x)
+        rhs(packed, x, out)
+        return out
+
+    steps, T = 100, 0.5
+    xs, nfev, ok = fixedstep_runner.integrate_fixed(name, system, np.full(2 * model.nv, 0.3), T, steps)
+    assert ok and nfev == TABLEAUX[name].stages * steps
+    for i in range(steps):
+        expected = explicit_rk_step(f, 0.0, xs[i], T / steps, TABLEAUX[name])
+        error = np.max(np.abs(xs[i + 1] - expected))
+        assert error <= ROUNDING * EPS * max(1.0, np.max(np.abs(expected))), f"{model_name} {name} step {i}"

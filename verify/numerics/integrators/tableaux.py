@@ -69,6 +69,10 @@ class Tableau:
             A[i, :i] = row
         return A
 
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, float]:
+        """(a as an s × s array, the weights, the denominator): what the compiled stepper reads."""
+        return self.matrix(), np.array(self.weights, dtype=float), float(self.denominator)
+
     def stability(self, z):
         """R(z) = 1 + z bᵀ (I − zA)⁻¹ 𝟙 at each z (forward substitution: A is strictly lower)."""
         z = np.asarray(z, dtype=complex)
