@@ -17,8 +17,9 @@ method                 order  one step, h
 ``rk4``                4      the classical Runge–Kutta method on x = (q, q̇) (``RK4``)
 =====================  =====  ===========================================================
 
-The two explicit methods are their tableaux (``pendverify.numerics.integrators.tableaux``)
-run by ``_explicit_rk``, the one stepper compiled.  The two implicit methods work in
+The two explicit methods are their tableaux (``pendverify.numerics.integrators.tableaux``):
+``render_explicit_steps`` writes one step of each from its tableau into the generated
+module, the one stepper's sums with the coefficients as literals.  The two implicit methods work in
 canonical coordinates y = (q, p), p = M(q) q̇, where they are symplectic for the
 conservative problems (so the energy error stays bounded instead of drifting); with
 friction or feedback they remain
@@ -42,19 +43,52 @@ import math
 import numpy as np
 
 from pendverify.numerics.codegen.templates import placeholder, template
-from pendverify.numerics.integrators.tableaux import EULER, RK4
+from pendverify.numerics.integrators.tableaux import EULER, RK4, TABLEAUX
 
 METHODS = {"euler": EULER.order, "symplectic_euler": 1, "implicit_midpoint": 2, "rk4": RK4.order}
 MAX_ITERATIONS = 200
 EPS = float(np.finfo(float).eps)
 OK, NOT_CONVERGED, NOT_FINITE = 0, -3, -2
 
-# the explicit methods' tableaux, as the arrays ``_explicit_rk`` reads (copied as exact literals)
-_EULER_A, _EULER_W, _EULER_D = EULER.arrays()
-_RK4_A, _RK4_W, _RK4_D = RK4.arrays()
+#: the explicit methods' stages; ``_run`` holds ``STAGE_ARRAYS`` stage arrays, K0 to K3
+_EULER_STAGES, _RK4_STAGES = EULER.stages, RK4.stages
+STAGE_ARRAYS = 4
 
 # each generated module defines its model's
 _rhs, _hamilton, _to_momentum = placeholder("_rhs"), placeholder("_hamilton"), placeholder("_to_momentum")
+# and one step of each explicit tableau, written from it by ``render_explicit_steps``
+_step_euler, _step_rk4 = placeholder("_step_euler"), placeholder("_step_rk4")
+
+
+def render_explicit_steps() -> str:
+    """numba source of ``_step_<name>(P, x, h, tmp, K0, …)`` for every tableau in ``TABLEAUX``: one
+    step on x in place, its coefficients written in as literals (so the compiled step is
+    straight-line code, as fast as the method written out), the sums those of
+    ``runge_kutta.explicit_rk_step`` in the same order, zero entries left out.  Stage s goes
+    into the array K<s>; ``_run`` holds ``STAGE_ARRAYS`` of them."""
+    stage_arrays = ", ".join(f"K{s}" for s in range(STAGE_ARRAYS))
+    chunks = []
+    for name, tableau in TABLEAUX.items():
+        if tableau.stages > STAGE_ARRAYS:
+            raise ValueError(f"tableau {name}: {tableau.stages} stages, _run holds {STAGE_ARRAYS}")
+        lines = [
+            '@njit(cache=True, error_model="numpy")',
+            f"def _step_{name}(P, x, h, tmp, {stage_arrays}):",
+            f'    """One step of the {name} tableau (pendverify.numerics.integrators.tableaux)."""',
+            "    nx = x.shape[0]",
+        ]
+        for stage, row in enumerate(tableau.a):
+            terms = [f"{a!r} * K{j}[i]" for j, a in enumerate(row) if a]
+            if terms:
+                lines += ["    for i in range(nx):", f"        tmp[i] = x[i] + h * ({' + '.join(terms)})"]
+            lines += [f"    _rhs(P, {'tmp' if terms else 'x'}, K{stage})"]
+        terms = [f"{w!r} * K{j}[i]" for j, w in enumerate(tableau.weights) if w]
+        lines += [
+            "    for i in range(nx):",
+            f"        x[i] += h / {tableau.denominator!r} * ({' + '.join(terms)})",
+        ]
+        chunks.append("\n".join(lines) + "\n")
+    return "\n\n".join(chunks)
 
 
 @template()
@@ -77,30 +111,6 @@ def _converged(delta, y):
 
 # --- the methods --------------------------------------------------------------------------------
 @template()
-def _explicit_rk(P, x, h, A, W, d, K, tmp, f):
-    """One step of the tableau (A, W / d) on x, in place: ``runge_kutta.explicit_rk_step`` compiled,
-    the same sums in the same order.  K holds the stages; f goes to the scratch ``f`` and is
-    copied (a row view K[s] would cost a reference count per stage)."""
-    nx = x.shape[0]
-    for s in range(W.shape[0]):
-        for i in range(nx):
-            acc = 0.0
-            for j in range(s):
-                if A[s, j] != 0.0:
-                    acc += A[s, j] * K[j, i]
-            tmp[i] = x[i] + h * acc
-        _rhs(P, tmp, f)
-        for i in range(nx):
-            K[s, i] = f[i]
-    for i in range(nx):
-        acc = 0.0
-        for j in range(W.shape[0]):
-            if W[j] != 0.0:
-                acc += W[j] * K[j, i]
-        x[i] += h / d * acc
-
-
-@template()
 def _run(method, P, x0, h, steps, every):
     """Integrate ``steps`` steps of size h; states (q, q̇) every ``every`` steps, nfev, status."""
     nx = x0.shape[0]
@@ -108,17 +118,17 @@ def _run(method, P, x0, h, steps, every):
     out = np.empty((steps // every + 1, nx))
     x, y, tmp, z = x0.copy(), np.empty(nx), np.empty(nx), np.empty(nx)
     k1, k2 = np.empty(nx), np.empty(nx)
-    K = np.empty((max(_EULER_W.shape[0], _RK4_W.shape[0]), nx))  # the explicit methods' stages
+    K0, K1, K2, K3 = np.empty(nx), np.empty(nx), np.empty(nx), np.empty(nx)  # STAGE_ARRAYS stages
     out[0] = x0
     _to_momentum(P, x, y)
     nfev, status = 0, OK
     for s in range(1, steps + 1):
         if method == 0:  # explicit Euler
-            _explicit_rk(P, x, h, _EULER_A, _EULER_W, _EULER_D, K, tmp, k1)
-            nfev += _EULER_W.shape[0]
+            _step_euler(P, x, h, tmp, K0, K1, K2, K3)
+            nfev += _EULER_STAGES
         elif method == 3:  # classical RK4
-            _explicit_rk(P, x, h, _RK4_A, _RK4_W, _RK4_D, K, tmp, k1)
-            nfev += _RK4_W.shape[0]
+            _step_rk4(P, x, h, tmp, K0, K1, K2, K3)
+            nfev += _RK4_STAGES
         else:
             # z: the unknown (p_new for symplectic Euler, y_new for implicit midpoint)
             _hamilton(P, y, k1)

@@ -9,7 +9,8 @@ the weights b_i = w_i / d written as whole numbers over one denominator d, the w
 methods are printed (RK4: 1, 2, 2, 1 over 6), so that the common factor h/d is rounded once.
 Consistency (order ≥ 1) needs Σ w_i = d, and the internal times are c_i = Σ_j a_ij; both
 are checked when a tableau is made.  ``runge_kutta.explicit_rk_step`` runs a tableau on
-numpy arrays, ``fixedstep._explicit_rk`` the same tableau compiled.
+numpy arrays; ``fixedstep.render_explicit_steps`` writes the same step, compiled, into
+each model's generated module.
 
 The stability function of an explicit tableau, R(z) = 1 + z bᵀ (I − zA)⁻¹ 𝟙, is the
 growth per step of x' = λx at z = hλ; for RK4 it is 1 + z + z²/2 + z³/6 + z⁴/24 (Hairer
@@ -68,10 +69,6 @@ class Tableau:
         for i, row in enumerate(self.a):
             A[i, :i] = row
         return A
-
-    def arrays(self) -> tuple[np.ndarray, np.ndarray, float]:
-        """(a as an s × s array, the weights, the denominator): what the compiled stepper reads."""
-        return self.matrix(), np.array(self.weights, dtype=float), float(self.denominator)
 
     def stability(self, z):
         """R(z) = 1 + z bᵀ (I − zA)⁻¹ 𝟙 at each z (forward substitution: A is strictly lower)."""
