@@ -149,6 +149,17 @@ def test_one_tableau_step_is_the_classical_step(system):
     assert worst <= ROUNDING * EPS, f"{system}: {worst / EPS:.2f} ε"
 
 
+def test_the_step_comparison_sees_another_method():
+    """Planted: RK4 with its last stage taken from k2 and k3 (consistent, order below 4)."""
+    other = Tableau(
+        "planted", 3, ((), (0.5,), (0.0, 0.5), (0.0, 0.5, 0.5)), RK4.c, RK4.weights, 6.0, "planted"
+    )
+    f, _ = SYSTEMS["damped pendulum"]
+    x, t, h = np.array([0.4, -0.3]), 0.0, 0.05
+    expected = classical_rk4_step(f, t, x, t + h)
+    assert np.max(np.abs(explicit_rk_step(f, t, x, h, other) - expected)) > 1e3 * ROUNDING * EPS
+
+
 @pytest.mark.parametrize("system", sorted(SYSTEMS))
 def test_the_scene_driver_takes_the_classical_steps(system):
     """``simulation.integrate`` with rk4 (h = 5e-3 on its grid of 20 progress chunks, T = 0.5): each

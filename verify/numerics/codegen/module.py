@@ -47,5 +47,5 @@ def render(ex: Expressions, templates: bool = True) -> str:
     ]
     source = "\n".join(lines)
     if templates:
-        source += "\n" + copy(dop853, fixedstep) + "\n\n" + fixedstep.render_explicit_steps() + "\n\n"
+        source += "\n" + copy(dop853, fixedstep) + "\n\n" + fixedstep.render_explicit_runs() + "\n\n"
     return source + render_generic(ex)

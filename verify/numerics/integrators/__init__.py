@@ -11,8 +11,8 @@ step is ``x_new = explicit_rk_step(f, t, x, h, tableau, k1=None)``.
   numpy arrays (the scene driver ``pendverify.simulation.integrate`` and the stress suite's
   ``pendverify.stress.integrators`` step with it).
 * ``fixedstep``: the compiled fast path, numba templates copied into each model's generated
-  module: one step of each tableau written from it (``render_explicit_steps``), and the two implicit
-  symplectic methods; ``fixedstep_runner`` runs them.
+  module: the run of each tableau written from it (``render_explicit_runs``), and the two
+  implicit symplectic methods; ``fixedstep_runner`` runs them.
 * ``dop853``: scipy's adaptive DOP853 step for step, compiled the same way
   (``pendverify.numerics.fastpath`` runs it).
 * ``taylor``: the Taylor-series reference in high precision (``pendverify.numerics.reference``).

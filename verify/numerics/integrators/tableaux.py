@@ -9,7 +9,7 @@ the weights b_i = w_i / d written as whole numbers over one denominator d, the w
 methods are printed (RK4: 1, 2, 2, 1 over 6), so that the common factor h/d is rounded once.
 Consistency (order ≥ 1) needs Σ w_i = d, and the internal times are c_i = Σ_j a_ij; both
 are checked when a tableau is made.  ``runge_kutta.explicit_rk_step`` runs a tableau on
-numpy arrays; ``fixedstep.render_explicit_steps`` writes the same step, compiled, into
+numpy arrays; ``fixedstep.render_explicit_runs`` writes the same step, compiled, into
 each model's generated module.
 
 The stability function of an explicit tableau, R(z) = 1 + z bᵀ (I − zA)⁻¹ 𝟙, is the
