@@ -13,11 +13,13 @@ from pendverify.numerics.integrators.tableaux import Tableau
 
 
 def _weighted(coefficients, ks):
-    """Σ c_j k_j over the nonzero c_j, left to right; None when every c_j is zero."""
+    """Σ c_j k_j over the nonzero c_j, left to right (1·k_j as k_j, which is exact); None when
+    every c_j is zero."""
     total = None
     for c, k in zip(coefficients, ks, strict=False):
         if c:
-            total = c * k if total is None else total + c * k
+            term = k if c == 1 else c * k
+            total = term if total is None else total + term
     return total
 
 
