@@ -15,8 +15,9 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from pendverify.errors import FastPathError, PendverifyError
-from pendverify.numerics import fast_scene, fastpath, fixedstep_runner, taylor
+from pendverify.numerics import fast_scene, fastpath
 from pendverify.numerics.generate import GeneratedSystem
+from pendverify.numerics.integrators import fixedstep_runner, taylor
 from pendverify.simulation.dynamics import build_dynamics
 from pendverify.simulation.scene import load_scene, parse_scene
 

@@ -16,8 +16,9 @@ from scipy.integrate._ivp import dop853_coefficients
 from pendverify.analytic import MODELS
 from pendverify.bench.workprecision import make_problem
 from pendverify.errors import FastPathError
-from pendverify.numerics import fast_scene, fastpath, reference, taylor
+from pendverify.numerics import fast_scene, fastpath, reference
 from pendverify.numerics.generate import GeneratedSystem
+from pendverify.numerics.integrators import taylor
 from pendverify.simulation.dynamics import build_dynamics
 from pendverify.simulation.scene import load_scene, parse_scene
 

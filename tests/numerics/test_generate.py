@@ -367,7 +367,8 @@ seed = MODELS["double_pendulum"](load_parameter_file(default_parameter_file("dou
 cls = load_model_class(sys.argv[1])  # a plug-in: imported under a name salted per process
 plugin = cls(load_parameter_file(sys.argv[1][:-3] + ".toml", {cls.name: cls.params_type})[2])
 result = {}
-from pendverify.numerics import fastpath, fixedstep_runner, taylor
+from pendverify.numerics import fastpath
+from pendverify.numerics.integrators import fixedstep_runner, taylor
 for model in (seed, plugin):
     system = generate.GeneratedSystem.from_model(model)
     x = np.array([0.3, -0.2, 0.5, 0.1])

@@ -23,9 +23,10 @@ from pendverify.analytic import MODELS
 from pendverify.bench.workprecision import make_problem
 from pendverify.checks.sampling import sample_states
 from pendverify.errors import PendverifyError
-from pendverify.numerics import fast_scene, fastpath, fixedstep, fixedstep_runner, reference, taylor
+from pendverify.numerics import fast_scene, fastpath, reference
 from pendverify.numerics.codegen.expressions import expressions, momentum_rate
 from pendverify.numerics.generate import GeneratedSystem
+from pendverify.numerics.integrators import fixedstep, fixedstep_runner, taylor
 from pendverify.simulation.scene import load_scene
 
 from .test_generate import (

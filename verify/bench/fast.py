@@ -149,7 +149,7 @@ def ensemble_states(problem: Problem, config: Config) -> np.ndarray:
 
 def vectorised_rhs(fast, size: int):
     """fun(t, y) of the stacked ensemble, y = (x_1, …, x_m), with the closed form on numpy arrays."""
-    from pendverify.numerics.taylor import field, float_system
+    from pendverify.numerics.integrators.taylor import field, float_system
 
     system = float_system(fast)
     nx = 2 * fast.nv

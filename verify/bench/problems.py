@@ -43,7 +43,7 @@ import numpy as np
 
 from pendverify.errors import InputError, PendverifyError
 from pendverify.numerics.generate import GeneratedSystem
-from pendverify.numerics.taylor import energy_above_minimum, float_system
+from pendverify.numerics.integrators.taylor import energy_above_minimum, float_system
 from pendverify.simulation import engines
 from pendverify.simulation.dynamics import build_dynamics
 from pendverify.simulation.scene import Integrator, Scene, load_scene, parse_scene

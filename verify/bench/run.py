@@ -34,7 +34,8 @@ from pendverify.bench.workprecision import (
     scipy_sweep,
 )
 from pendverify.display import html_fields
-from pendverify.numerics import fastpath, fixedstep_runner
+from pendverify.numerics import fastpath
+from pendverify.numerics.integrators import fixedstep_runner
 from pendverify.numerics.reference import references
 
 

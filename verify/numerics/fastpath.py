@@ -15,7 +15,7 @@ What is compiled.
   (``pendverify.numerics.generate``: any ``ClosedFormModel``, seeds and plug-ins
   alike), under any time-invariant force law τ = B (u0 − K x) − D q̇;
 * ``_dop853``: scipy's DOP853 reproduced step for step
-  (``pendverify.numerics.dop853``, a template copied into each model's generated
+  (``pendverify.numerics.integrators.dop853``, a template copied into each model's generated
   module, where it calls that model's ``_rhs`` inlined and is compiled and cached
   with it); ``integrate`` runs the generated module's copy.
 * ``integrate_ensemble``: many initial states at once, one compiled DOP853 per
@@ -58,8 +58,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from pendverify.numerics.codegen.cache import record_compiled
-from pendverify.numerics.dop853 import MAX_STEPS, OK, STEP_TOO_SMALL, TOO_MANY_STEPS
 from pendverify.numerics.generate import GeneratedSystem, distinct_modules
+from pendverify.numerics.integrators.dop853 import MAX_STEPS, OK, STEP_TOO_SMALL, TOO_MANY_STEPS
 
 __all__ = ["FastResult", "integrate", "integrate_ensemble", "warm_up"]
 

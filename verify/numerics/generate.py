@@ -15,8 +15,8 @@ writes one Python module per model:
   t = 0; ``_hamilton(P, y, out)`` (q̇ and ṗ in canonical
   coordinates, derivation there) and ``_to_momentum``; common subexpressions
   eliminated (``sympy.cse``), floats as exact literals;
-* the DOP853 stepper of ``pendverify.numerics.dop853`` and the fixed-step methods of
-  ``pendverify.numerics.fixedstep``, copied from their templates so that they call this
+* the DOP853 stepper of ``pendverify.numerics.integrators.dop853`` and the fixed-step methods of
+  ``pendverify.numerics.integrators.fixedstep``, copied from their templates so that they call this
   model's functions inlined (``codegen.templates``, which says why copied);
 * plain-Python ``field``, ``energy`` and ``potential`` generic over the number type
   (float, numpy, mpmath, Decimal, Taylor series) for the high-precision references

@@ -1,6 +1,6 @@
 """High-precision reference solutions: Taylor series at two precisions, bounded, cached.
 
-Method.  ``pendverify.numerics.taylor`` integrates the ODE of the model's generated
+Method.  ``pendverify.numerics.integrators.taylor`` integrates the ODE of the model's generated
 ``field`` (the model's own closed forms, same parameters, same force law as the
 compiled back ends, initial state converted exactly) by a Taylor series method
 with automatic differentiation, in decimal arithmetic, with the order and step
@@ -46,7 +46,7 @@ import numpy as np
 from pendverify.atomic import write_atomic
 from pendverify.errors import FileAccessError
 from pendverify.numerics.codegen.folder import create_private
-from pendverify.numerics.taylor import (
+from pendverify.numerics.integrators.taylor import (
     GUARD_DIGITS,
     TaylorRun,
     energy_above_minimum,

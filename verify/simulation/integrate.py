@@ -1,8 +1,9 @@
 """Integrate a scene's dynamics, stopping at every breakpoint of its laws.
 
 Adaptive methods are scipy's ``solve_ivp`` (its accepted steps are kept, with a
-dense output for the samples).  ``rk4`` is the classical fixed-step method; its
-samples come from cubic Hermite interpolation between steps.  Integration is
+dense output for the samples).  A fixed-step method (``rk4``) is its tableau in
+``pendverify.numerics.integrators`` run by the one explicit stepper; its samples come
+from cubic Hermite interpolation between steps.  Integration is
 split at the laws' breakpoints (steps, pulses, table knots) and into chunks
 that drive the progress bar.
 
@@ -20,6 +21,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from pendverify.errors import IntegrationError
+from pendverify.numerics.integrators import TABLEAUX, explicit_rk_step
 from pendverify.progress import new_bar
 
 PROGRESS_CHUNKS = 20
@@ -45,14 +47,14 @@ def _progress(total: int, label: str):
     return new_bar(total, label, "seg", leave=False)
 
 
-def _finite(rhs, label: str):
+def _finite(rhs, label: str, method: str):
     """``rhs`` refusing a state that left double's range: a fixed step has no step-size control to stop it."""
 
     def guarded(t, x):
         if not np.all(np.isfinite(x)):
             raise IntegrationError(
                 label,
-                f"rk4 left double's range at t = {t:.6g} s (the state overflowed); the scene's values "
+                f"{method} left double's range at t = {t:.6g} s (the state overflowed); the scene's values "
                 "(gravity, damping, initial state) ask for a smaller step or are beyond double precision",
             )
         return rhs(t, x)
@@ -65,21 +67,18 @@ def _overflow_reported_as_failure():
     return np.errstate(over="ignore", invalid="ignore", divide="ignore")
 
 
-def _rk4_segment(rhs, t0, t1, x0, h):
+def _fixed_step_segment(rhs, t0, t1, x0, h, tableau):
+    """Steps of ``tableau`` from t0 to t1 (equal steps, at most h), with f at every step for the
+    Hermite samples; that f is the next step's first stage."""
     n = max(1, int(np.ceil((t1 - t0) / h - 1e-9)))
     ts = np.linspace(t0, t1, n + 1)
     xs, fs = [x0], [rhs(t0, x0)]
     x, nfev = x0, 1
     for a, b in pairwise(ts):
-        dt = b - a
-        k1 = fs[-1]
-        k2 = rhs(a + dt / 2, x + dt / 2 * k1)
-        k3 = rhs(a + dt / 2, x + dt / 2 * k2)
-        k4 = rhs(b, x + dt * k3)
-        x = x + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        x = explicit_rk_step(rhs, a, x, b - a, tableau, k1=fs[-1])
         xs.append(x)
         fs.append(rhs(b, x))
-        nfev += 4
+        nfev += tableau.stages
     return ts, np.array(xs), np.array(fs), nfev
 
 
@@ -183,7 +182,14 @@ def integrate(rhs, x0, duration, integrator, sample_times, breakpoints=(), label
                 samples_x.append(dense)
         else:
             with _overflow_reported_as_failure():
-                ts, xs, fs, n = _rk4_segment(_finite(rhs, label), a, b, x, integrator.step)
+                ts, xs, fs, n = _fixed_step_segment(
+                    _finite(rhs, label, integrator.method),
+                    a,
+                    b,
+                    x,
+                    integrator.step,
+                    TABLEAUX[integrator.method],
+                )
             nfev += n
             if inside.size:
                 samples_x.append(_hermite(ts, xs, fs, inside))

@@ -11,8 +11,9 @@ solutions dE/dt = −q̇ᵀ D q̇ ≤ 0.
 
 Methods
 -------
-* ``rk4``: classical fixed-step Runge–Kutta.  Stops at the first non-finite
-  state and reports the step (a blow-up, not an exception).
+* ``rk4``: classical fixed-step Runge–Kutta, the tableau ``RK4`` of
+  ``pendverify.numerics.integrators`` run by its one stepper.  Stops at the first
+  non-finite state and reports the step (a blow-up, not an exception).
 * ``rk45``: SciPy's adaptive Dormand–Prince; reports its step count.
 * ``implicit_euler``: backward Euler, x₊ = x + h F(x₊), by Newton with a
   central-difference Jacobian (L-stable: the stiff modes of heavy damping are
@@ -31,6 +32,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+
+from pendverify.numerics.integrators import RK4, explicit_rk_step
 
 EPS = float(np.finfo(float).eps)
 FIXED_POINT_MAX = 60  # iterations per implicit stage before giving up
@@ -95,20 +98,20 @@ class _Recorder:
 
 def rk4(model, q0, v0, h: float, n: int, record: int = 1) -> Trajectory:
     f = state_derivative_of(model)
+
+    def rhs(t, x):
+        return f(x)
+
     x = np.concatenate([q0, v0]).astype(float)
     rec = _Recorder(model.nv, x, record)
     evaluations = 0
     with np.errstate(all="ignore"):
         for i in range(1, n + 1):
             try:
-                k1 = f(x)
-                k2 = f(x + 0.5 * h * k1)
-                k3 = f(x + 0.5 * h * k2)
-                k4 = f(x + h * k3)
-                x = x + (h / 6) * (k1 + 2 * k2 + 2 * k3 + k4)
+                x = explicit_rk_step(rhs, (i - 1) * h, x, h, RK4)
             except (ValueError, OverflowError, np.linalg.LinAlgError):
                 x = np.full_like(x, np.nan)
-            evaluations += 4
+            evaluations += RK4.stages
             if not _finite(x):
                 return rec.trajectory(i, evaluations, blew_up_at=i, note=f"non-finite after {i} steps")
             rec.add(i, i * h, x, force=i == n)
@@ -173,9 +176,8 @@ def jacobian(f, x: np.ndarray) -> np.ndarray:
 
 
 def rk4_growth(J: np.ndarray, h: float) -> float:
-    """max |R(hλ)| over the eigenvalues λ of J, R(z) = 1 + z + z²/2 + z³/6 + z⁴/24."""
-    z = h * np.linalg.eigvals(J)
-    return float(np.max(np.abs(1 + z + z**2 / 2 + z**3 / 6 + z**4 / 24)))
+    """max |R(hλ)| over the eigenvalues λ of J, R the stability function of RK4's tableau."""
+    return float(np.max(np.abs(RK4.stability(h * np.linalg.eigvals(J)))))
 
 
 def implicit_euler(model, q0, v0, h: float, n: int, record: int = 1, tol: float = 1e-13) -> Trajectory:

@@ -50,8 +50,8 @@ from pendverify.numerics.codegen import module as _module
 SOURCES = (
     "pendverify.analytic.symbolic_reading",
     "pendverify.symbolic.zero_test",
-    "pendverify.numerics.dop853",
-    "pendverify.numerics.fixedstep",
+    "pendverify.numerics.integrators.dop853",
+    "pendverify.numerics.integrators.fixedstep",
     # the units reading (family ``units``) and the notation and entry labels its messages use
     "pendverify.checks.dimensions",
     "pendverify.checks.units",

@@ -1,7 +1,7 @@
 """The plain-Python part of a generated module: ``field``, ``energy`` and ``potential``.
 
 They are generic over the number type — float, numpy arrays, ``mpmath.mpf``,
-``Decimal`` and the Taylor ``Series`` of ``pendverify.numerics.taylor`` — so the
+``Decimal`` and the Taylor ``Series`` of ``pendverify.numerics.integrators.taylor`` — so the
 high-precision references and the mpmath energies run the model's own closed forms:
 
     field(p, x, N, sincos)    ẋ = (q̇, M(q)⁻¹ (τ − bias(q, q̇))) as a list,
@@ -9,7 +9,7 @@ high-precision references and the mpmath energies run the model's own closed for
     potential(p, q, N, sincos)  V(q),
 
 ``p`` the system's numbers in the caller's type (``{"params", "D", "B", "K",
-"u0"}``, ``pendverify.numerics.taylor.exact_system``), ``N`` that type's constructor
+"u0"}``, ``pendverify.numerics.integrators.taylor.exact_system``), ``N`` that type's constructor
 and ``sincos(u)`` the pair (sin u, cos u) in it.  Only +, −, ×, ÷ and one ``sincos``
 per distinct trigonometric argument are used: every sin/cos argument of the
 expressions is collected, ``s_k, c_k = sincos(arg_k)`` computed once, and the

@@ -1,7 +1,7 @@
 """Functions written once and copied into every generated module.
 
-The DOP853 stepper (``pendverify.numerics.dop853``) and the fixed-step methods
-(``pendverify.numerics.fixedstep``) are written there as plain Python functions
+The DOP853 stepper (``pendverify.numerics.integrators.dop853``) and the fixed-step methods
+(``pendverify.numerics.integrators.fixedstep``) are written there as plain Python functions
 marked ``@template(...)``, calling placeholders (``_rhs = placeholder("_rhs")``) for
 the model-specific functions.  ``copy`` reads their source with ``inspect`` and
 writes it into a generated module, decorated ``@njit(cache=True, error_model="numpy",

@@ -1,4 +1,4 @@
-"""Runs the fixed-step methods (``pendverify.numerics.fixedstep``) of a model's generated module.
+"""Runs the fixed-step methods (``pendverify.numerics.integrators.fixedstep``) of a model's generated module.
 
 The methods are templates copied into each generated module (``pendverify.numerics.generate``);
 ``integrate_fixed`` calls the copy of one ``GeneratedSystem``'s module with its packed
@@ -13,8 +13,8 @@ import numpy as np
 
 from pendverify.errors import PendverifyError
 from pendverify.numerics.codegen.cache import record_compiled
-from pendverify.numerics.fixedstep import METHOD_IDS, OK
 from pendverify.numerics.generate import GeneratedSystem, distinct_modules
+from pendverify.numerics.integrators.fixedstep import METHOD_IDS, OK
 
 
 def integrate_fixed(method: str, system: GeneratedSystem, x0, duration: float, steps: int, every: int = 1):
