@@ -394,6 +394,7 @@ def _plugin_sweep(tmp_path: Path) -> Path:
     return sweep
 
 
+@pytest.mark.sweep
 @pytest.mark.parametrize(
     ("write_sweep", "sets", "workers", "model_file"),
     [(_built_in_sweep, 3, "2", None), (_plugin_sweep, 2, "1", "hanging.py")],
