@@ -216,6 +216,7 @@ def _certify_single(tmp_path: Path, source: str = SINGLE_PENDULUM) -> tuple[int,
     return main(["certify", *paths, "-o", str(out), *FAST]), out / "single_pendulum-single.cert.json"
 
 
+@pytest.mark.slow
 def test_a_model_written_in_the_test_is_certified(tmp_path, capsys):
     status, cert_path = _certify_single(tmp_path)
     assert status == 0, capsys.readouterr().out
@@ -310,6 +311,7 @@ def _wrong_mass_matrix_in_a_copied_example(tmp_path: Path) -> list[str]:
     return args
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "planted",
     [

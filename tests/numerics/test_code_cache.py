@@ -250,6 +250,7 @@ def _certify_items(out: Path, env: dict) -> tuple[dict, str]:
     return {i["name"]: (i.get("engine"), i["passed"], i["samples"]) for i in items}, done.stderr
 
 
+@pytest.mark.slow
 def test_certify_with_an_unusable_cache_issues_the_same_items(tmp_path):
     """``PENDVERIFY_CACHE`` naming a file: every invariant on the engine of a normal run,
     ``invariant:gravity:engines`` included, and one line saying where the code went."""
