@@ -154,6 +154,7 @@ def certified(certificates):
     return certificates("double_pendulum")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", CERTIFIED_MODELS)
 def test_certificate_has_every_field(certificates, name):
     certified = certificates(name)
@@ -197,6 +198,7 @@ def test_certificate_has_every_field(certificates, name):
         assert "model_source" not in cert and not copy.exists()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", CERTIFIED_MODELS)
 def test_recheck_passes(certificates, name, capsys):
     certified = certificates(name)
@@ -229,6 +231,7 @@ def test_a_model_written_in_the_test_is_certified(tmp_path, capsys):
     assert main(["recheck", str(cert_path), "--run-embedded-code"]) == 0
 
 
+@pytest.mark.slow
 def test_edited_field_is_rejected_by_digest(certified, tmp_path, capsys):
     cert = json.loads(certified.read_text())
     cert["parameters"]["m1"] *= 1.01
@@ -239,6 +242,7 @@ def test_edited_field_is_rejected_by_digest(certified, tmp_path, capsys):
     assert f"{edited}: digest mismatch: recorded {cert['digest']['value']}, computed " in err
 
 
+@pytest.mark.slow
 def test_resigned_edit_names_the_differing_fields(certified, tmp_path, capsys):
     cert = json.loads(certified.read_text())
     cert["checks"][0]["error"] *= 3
@@ -253,6 +257,7 @@ def test_resigned_edit_names_the_differing_fields(certified, tmp_path, capsys):
     assert f"differs: {cert['checks'][1]['name']}.samples: recorded" in out
 
 
+@pytest.mark.slow
 def test_tampered_model_source_fails_recheck(certificates, tmp_path, capsys):
     cert = json.loads(certificates("cart_pole").read_text())
     capsys.readouterr()
@@ -268,6 +273,7 @@ def test_tampered_model_source_fails_recheck(certificates, tmp_path, capsys):
     assert "key 'model_source.text': the embedded model source does not match" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_existing_certificate_is_not_overwritten(certified, capsys):
     params = str(default_parameter_file("double_pendulum"))
     before = certified.read_text()
@@ -457,6 +463,7 @@ def test_near_singular_set_is_not_certified(tmp_path, capsys):
     assert not (out / "fragile.cert.json").exists()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", CERTIFIED_MODELS)
 def test_battery_covers_stress_cases(certificates, name):
     checks = json.loads(certificates(name).read_text())["checks"]

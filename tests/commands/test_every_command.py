@@ -85,8 +85,10 @@ COMMANDS = {
     ],
 }
 
-#: the bench's accuracy study on a model's scene takes ≈ 10 to 35 s (its fixed-step methods compiled)
-COMMAND_PARAMS = [pytest.param(c, marks=pytest.mark.slow) if c == "bench" else c for c in COMMANDS]
+#: the bench's accuracy study on a model's scene (≈ 10 to 35 s: its fixed-step methods compiled) and
+#: certify+recheck (≈ 5 to 25 s: the battery) are slow
+SLOW_COMMANDS = ("bench", "certify+recheck")
+COMMAND_PARAMS = [pytest.param(c, marks=pytest.mark.slow) if c in SLOW_COMMANDS else c for c in COMMANDS]
 
 WRITTEN_HERE = '''"""The cart-pole, written again in a file of this test: a user's own model."""
 
