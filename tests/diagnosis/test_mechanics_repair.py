@@ -20,6 +20,7 @@ import pendverify
 from pendverify.analytic.symbolic_reading import SymbolicModel
 from pendverify.api import load_model
 from pendverify.diagnosis.mechanics_source import source_items
+from tests.conftest import DIAGNOSIS_BOUND_S
 from tests.diagnosis.mechanics_plants import DECLARATION, derivation
 
 REPO = Path(__file__).resolve().parents[2]
@@ -147,7 +148,7 @@ def test_the_mechanics_class_of_the_corpus():
     sm = SymbolicModel.of(type(model))
     chosen = sample_plants(sm, 2)
     assert chosen and all(p.method == SOURCE for p in chosen)  # planted in the derivation
-    scores = score_model(label, model, system, chosen)
+    scores = score_model(label, model, system, chosen, DIAGNOSIS_BOUND_S)  # the bound for a loaded machine
     assert scores.clean
     detected = [s for s in scores.scores if s.detected]
     assert len(detected) >= 12
