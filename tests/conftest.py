@@ -11,6 +11,7 @@ cache for repeated runs).  Tests that need an empty cache of their own make one.
 
 from __future__ import annotations
 
+import importlib
 import importlib.util
 import os
 import sys

@@ -70,9 +70,19 @@ EXIT_STATUS = {
     # a model alone whose units agree is not verified against a robot
     ("docs/commands/check.md", "pendverify check --analytic examples/minimal_double_pendulum.py$"): 2,
 }
-#: pages whose steps take more than ~15 s of CPU on a first run (numba compiling; measured on 2 cores:
-#: certify ≈ 20 s, bench certify --quick ≈ 22 s, then ≈ 3 s and ≈ 4 s once the code cache is warm)
-SLOW = {"docs/certificates.md", "docs/commands/bench.md"}
+#: pages whose steps take more than ~5 s on a first run (numba compiling, SymPy reading, diagnoses;
+#: measured on 2 cores: certify ≈ 20 s, bench certify --quick ≈ 22 s, then ≈ 3 s and ≈ 4 s once the
+#: code cache is warm; diagnosis ≈ 22 s, models ≈ 12 s, getting-started ≈ 12 s, text-latex ≈ 9 s,
+#: README ≈ 8 s on a shared machine)
+SLOW = {
+    "docs/certificates.md",
+    "docs/commands/bench.md",
+    "docs/diagnosis.md",
+    "docs/models.md",
+    "docs/getting-started.md",
+    "docs/text-latex.md",
+    "README.md",
+}
 
 #: the path the manual names a worked example's file by → the examples that hold it, in catalogue order
 EXAMPLES_OF: dict[str, list[str]] = {}

@@ -25,7 +25,9 @@ COMMAND_PAGES = DOCS / "commands"
 
 SETUP_COMMANDS = (
     "python3 -m venv .venv && . .venv/bin/activate && pip install -e . && pendverify check",
-    "python3 -m venv .venv-test && . .venv-test/bin/activate && pip install -e '.[test]' && python -m pytest",
+    # -m "": every test (a plain run is the fast one for development, pyproject.toml's addopts)
+    "python3 -m venv .venv-test && . .venv-test/bin/activate && pip install -e '.[test]' "
+    '&& python -m pytest -m ""',
 )
 # user-facing text names the built-in systems "the two reference systems", never their origin
 FORBIDDEN = ("seed 000", "seed 001", "seed-000", "seed-001", "../shared", "source document", "issue-15")
@@ -80,6 +82,13 @@ def test_readme_keeps_the_two_setup_commands_verbatim():
     text = README.read_text(encoding="utf-8")
     for command in SETUP_COMMANDS:
         assert f"```sh\n{command}\n```" in text, command
+
+
+def test_ci_runs_the_readme_s_test_command():
+    """CI's last command is the pytest of the README's test command: every test, not the fast default."""
+    readme_pytest = SETUP_COMMANDS[1].rsplit(" && ", 1)[1]
+    last = (ROOT / ".ci" / "run").read_text(encoding="utf-8").strip().splitlines()[-1]
+    assert last.split("  #")[0] == readme_pytest, last
 
 
 @pytest.mark.parametrize("path", [README, *doc_pages()], ids=lambda p: str(p.relative_to(ROOT)))

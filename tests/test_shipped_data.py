@@ -77,6 +77,7 @@ def _copy_sources(target: Path) -> None:
         shutil.copytree(REPO / folder, target / folder, ignore=ignore)
 
 
+@pytest.mark.slow
 def test_a_wheel_carries_every_shipped_file(tmp_path):
     source, out = tmp_path / "src", tmp_path / "wheel"
     source.mkdir()

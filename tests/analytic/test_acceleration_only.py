@@ -125,6 +125,7 @@ def test_gymnasiums_accelerations_verify_by_aba_and_say_what_did_not_run(files, 
     assert "are the URDF's" in notes
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "files, definitions, name, old, new",
     [

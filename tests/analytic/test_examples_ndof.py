@@ -81,6 +81,7 @@ def test_check_passes_every_check(tmp_path, capsys, stem):
         assert r["samples"] == (0 if r["check"] == "units" else 110)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("stem", "entries"), [("triple_pendulum", 58), ("furuta_pendulum", 29)])
 def test_sympy_derives_every_closed_form(tmp_path, capsys, stem, entries):
     out = tmp_path / "sympy.json"
@@ -95,6 +96,7 @@ def test_sympy_derives_every_closed_form(tmp_path, capsys, stem, entries):
     assert sum(c["entries"] for c in comparisons.values()) == entries
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("stem", STEMS)
 def test_mutate_detects_every_non_equivalent_mutant(tmp_path, capsys, stem):
     model, urdf, params = _files(stem)
@@ -139,6 +141,7 @@ def test_furuta_product_of_inertia_dropped_from_c_fails_coriolis(tmp_path):
     assert {c for c, s in statuses.items() if s == "fail"} == {"rnea", "coriolis", "skew"}
 
 
+@pytest.mark.slow
 def test_triple_pendulum_with_a_relative_angle_map_is_diagnosed(tmp_path, capsys):
     planted = _planted(
         tmp_path,

@@ -124,6 +124,7 @@ def test_nesting_at_the_limit_is_read(tmp_path):
     assert result.returncode == 0, result.stderr
 
 
+@pytest.mark.slow
 def test_a_pasted_5000_term_sum_is_read_and_checked(tmp_path):
     terms = " + ".join(f"{i}*m1*theta1**{i % 7}*cos(theta2)**{i % 5}*l1**{i % 3}" for i in range(1, 5001))
     path = text_model(tmp_path, f"{terms} - ({terms})")

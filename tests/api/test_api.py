@@ -513,6 +513,7 @@ def test_import_pendverify_does_not_import_pinocchio_or_sympy():
     assert done.stdout.strip() == "ok"
 
 
+@pytest.mark.slow
 def test_certify_set_writes_a_bundle_that_recheck_accepts(tmp_path):
     from pendverify.analytic.params import default_parameter_file
     from pendverify.certify.issue import recheck

@@ -72,6 +72,7 @@ def bench(tmp_path_factory):
     return status, out, results
 
 
+@pytest.mark.slow
 def test_quick_run_writes_plot_csv_and_table(bench):
     status, out, results = bench
     assert status == 0
@@ -91,6 +92,7 @@ def _series(results, problem, method):
     return sorted(pts, key=lambda p: -p.setting)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["DOP853 (fast path)", "DOP853 (scipy)", "RK45 (scipy)", "LSODA (scipy)"])
 @pytest.mark.parametrize("problem", ["mild", "chaotic", "cart_lqr"])
 def test_errors_decrease_as_tolerances_tighten(bench, problem, method):
@@ -101,11 +103,13 @@ def test_errors_decrease_as_tolerances_tighten(bench, problem, method):
     assert all(b < a for a, b in itertools.pairwise(errors)), f"{problem=} {method=} {errors=}"
 
 
+@pytest.mark.slow
 def test_energy_error_of_the_long_run_falls_with_tolerance(bench):
     errors = [p.energy_max for p in _series(bench[2], "long", "DOP853 (fast path)")]
     assert all(b < a for a, b in itertools.pairwise(errors)), errors
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", sorted(workprecision.FIXED_METHODS))
 @pytest.mark.parametrize("problem", ["mild", "cart_lqr"])
 def test_observed_orders_match_theory(bench, problem, method):
@@ -114,11 +118,13 @@ def test_observed_orders_match_theory(bench, problem, method):
     assert abs(fit.observed - fit.theory) <= ORDER_TOLERANCE, f"{problem=} {method=} {fit=}"
 
 
+@pytest.mark.slow
 def test_references_are_a_thousand_times_more_accurate_than_any_error(bench):
     results = bench[2]
     assert results.smallest_error() / results.largest_reference_bound() >= REFERENCE_MARGIN
 
 
+@pytest.mark.slow
 def test_fast_path_and_scipy_dop853_agree_at_every_tolerance(bench):
     """Same algorithm, same steps: the fast path's errors are scipy DOP853's (the engine differs by rounding).
 
@@ -136,6 +142,7 @@ def test_fast_path_and_scipy_dop853_agree_at_every_tolerance(bench):
             )
 
 
+@pytest.mark.slow
 def test_ensemble_is_as_accurate_as_scipy_on_each_member(bench):
     """ "At the same accuracy": each member as accurate as scipy DOP853 + aba run on it alone."""
     rows = {row.variant: row for row in bench[2].ensemble}
@@ -149,6 +156,7 @@ def test_ensemble_is_as_accurate_as_scipy_on_each_member(bench):
         assert np.isfinite(row.max_error), row
 
 
+@pytest.mark.slow
 def test_fast_path_passes_the_invariants(bench):
     checked = bench[2].invariants
     assert {key for key, _, _ in checked} == {"mild", "chaotic", "cart_lqr"}

@@ -6,6 +6,8 @@ from __future__ import annotations
 import json
 import math
 
+import pytest
+
 from pendverify.analytic import MODELS
 from pendverify.bench.certify import SetCost
 from pendverify.bench.certify_report import rows, target_line
@@ -15,6 +17,7 @@ from pendverify.cli import main
 PARTS = ("checks", "stress", "invariants", "battery")
 
 
+@pytest.mark.slow
 def test_bench_certify_quick_prints_every_set_and_part(tmp_path, capsys):
     out = tmp_path / "certify.json"
     assert main(["bench", "certify", "--quick", "--json", str(out)]) == 0

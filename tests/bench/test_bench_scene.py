@@ -84,6 +84,7 @@ def bench(tmp_path_factory):
     return status, folder / "out", results
 
 
+@pytest.mark.slow
 def test_scene_run_writes_its_problems(bench):
     status, out, results = bench
     assert status == 0
@@ -98,6 +99,7 @@ def test_scene_run_writes_its_problems(bench):
     assert "cart_pole_swing" in (out / "work_precision.md").read_text()
 
 
+@pytest.mark.slow
 def test_every_method_family_has_points(bench):
     results = bench[2]
     for problem, methods in (
@@ -114,12 +116,14 @@ def test_every_method_family_has_points(bench):
     assert not [p for p in energy if "scipy" in p.method]
 
 
+@pytest.mark.slow
 def test_references_bound_below_the_smallest_error(bench):
     results = bench[2]
     assert set(results.references) == {"cart_pole_swing"}
     assert results.smallest_error() / results.largest_reference_bound() >= REFERENCE_MARGIN
 
 
+@pytest.mark.slow
 def test_anchor_studies_run_on_the_scene(bench):
     results = bench[2]
     assert results.single is not None and results.single.problem == "cart_pole_swing"

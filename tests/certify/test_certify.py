@@ -154,6 +154,7 @@ def certified(certificates):
     return certificates("double_pendulum")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", CERTIFIED_MODELS)
 def test_certificate_has_every_field(certificates, name):
     certified = certificates(name)
@@ -197,6 +198,7 @@ def test_certificate_has_every_field(certificates, name):
         assert "model_source" not in cert and not copy.exists()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", CERTIFIED_MODELS)
 def test_recheck_passes(certificates, name, capsys):
     certified = certificates(name)
@@ -216,6 +218,7 @@ def _certify_single(tmp_path: Path, source: str = SINGLE_PENDULUM) -> tuple[int,
     return main(["certify", *paths, "-o", str(out), *FAST]), out / "single_pendulum-single.cert.json"
 
 
+@pytest.mark.slow
 def test_a_model_written_in_the_test_is_certified(tmp_path, capsys):
     status, cert_path = _certify_single(tmp_path)
     assert status == 0, capsys.readouterr().out
@@ -228,6 +231,7 @@ def test_a_model_written_in_the_test_is_certified(tmp_path, capsys):
     assert main(["recheck", str(cert_path), "--run-embedded-code"]) == 0
 
 
+@pytest.mark.slow
 def test_edited_field_is_rejected_by_digest(certified, tmp_path, capsys):
     cert = json.loads(certified.read_text())
     cert["parameters"]["m1"] *= 1.01
@@ -238,6 +242,7 @@ def test_edited_field_is_rejected_by_digest(certified, tmp_path, capsys):
     assert f"{edited}: digest mismatch: recorded {cert['digest']['value']}, computed " in err
 
 
+@pytest.mark.slow
 def test_resigned_edit_names_the_differing_fields(certified, tmp_path, capsys):
     cert = json.loads(certified.read_text())
     cert["checks"][0]["error"] *= 3
@@ -252,6 +257,7 @@ def test_resigned_edit_names_the_differing_fields(certified, tmp_path, capsys):
     assert f"differs: {cert['checks'][1]['name']}.samples: recorded" in out
 
 
+@pytest.mark.slow
 def test_tampered_model_source_fails_recheck(certificates, tmp_path, capsys):
     cert = json.loads(certificates("cart_pole").read_text())
     capsys.readouterr()
@@ -267,6 +273,7 @@ def test_tampered_model_source_fails_recheck(certificates, tmp_path, capsys):
     assert "key 'model_source.text': the embedded model source does not match" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_existing_certificate_is_not_overwritten(certified, capsys):
     params = str(default_parameter_file("double_pendulum"))
     before = certified.read_text()
@@ -310,6 +317,7 @@ def _wrong_mass_matrix_in_a_copied_example(tmp_path: Path) -> list[str]:
     return args
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "planted",
     [
@@ -394,6 +402,7 @@ def _plugin_sweep(tmp_path: Path) -> Path:
     return sweep
 
 
+@pytest.mark.sweep
 @pytest.mark.parametrize(
     ("write_sweep", "sets", "workers", "model_file"),
     [(_built_in_sweep, 3, "2", None), (_plugin_sweep, 2, "1", "hanging.py")],
@@ -454,6 +463,7 @@ def test_near_singular_set_is_not_certified(tmp_path, capsys):
     assert not (out / "fragile.cert.json").exists()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", CERTIFIED_MODELS)
 def test_battery_covers_stress_cases(certificates, name):
     checks = json.loads(certificates(name).read_text())["checks"]

@@ -14,6 +14,8 @@ from pendverify.certify.issue import certification_input, issue
 from pendverify.certify.sweep import load_sweep
 from pendverify.cli import main
 
+pytestmark = pytest.mark.sweep  # every test certifies a set alone and in a sweep
+
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 PER_RUN = ("date", "digest")  # write_certificate's docstring names them
 SETTINGS = 'mode = "random"\ncount = 2\nseed = 11\nsamples = 50\nduration = 0.2\n'

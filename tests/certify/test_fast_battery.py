@@ -81,6 +81,7 @@ def test_every_battery_scene_runs_on_the_fast_path_and_records_it(name):
     assert all(i.passed for i in old.values())
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("planted", "why"),
     [(CoriolisSignFlip, "C not Christoffel-consistent with M"), (GravityNotGradient, "H not ∇V")],

@@ -17,6 +17,7 @@ import io
 import json
 import math
 
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -75,6 +76,7 @@ def _recheck(path) -> tuple[int, str]:
     return status, err.getvalue()
 
 
+@pytest.mark.slow
 @settings(
     max_examples=150,
     deadline=None,

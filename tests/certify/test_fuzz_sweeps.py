@@ -19,11 +19,14 @@ import contextlib
 import signal
 from concurrent.futures import ThreadPoolExecutor
 
+import pytest
 from hypothesis import HealthCheck, event, given, seed, settings
 from hypothesis import strategies as st
 
 from pendverify.certify import sweep_run
 from tests.commands.test_cli_fuzz import FUZZ_SEED, PARAMS, assert_contract, workdir
+
+pytestmark = pytest.mark.sweep  # every example certifies a fuzzed sweep file
 
 HARD_TIMEOUT_S = 120
 

@@ -205,6 +205,7 @@ def test_a_schema_1_certificate_is_rejected_saying_why(signed, tmp_path, capsys)
     )
 
 
+@pytest.mark.sweep
 def test_a_sweep_signs_each_set(keys, tmp_path, capsys):
     sweep = tmp_path / "sweep.toml"
     sweep.write_text(

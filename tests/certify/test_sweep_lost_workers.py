@@ -17,6 +17,8 @@ import pytest
 from pendverify.certify.certificate import verify_digest
 from tests.certify.test_sweep_interrupt import PARENT_FIELD, SWEEP, live_processes, pendverify_process
 
+pytestmark = pytest.mark.sweep  # every test runs a sweep (Dask or local workers) and kills a part of it
+
 SETS = 24
 TIMEOUT_S = 120  # a hard bound on every wait: a hang fails the test
 

@@ -15,6 +15,8 @@ from pendverify.certify.certificate import canonical_json, digest_of
 from pendverify.certify.signing import fingerprint, load_public_key
 from pendverify.cli import main
 
+pytestmark = pytest.mark.sweep  # every test certifies a sweep's sets (signed) and resumes it
+
 SWEEP = """
 model = "double_pendulum"
 count = 3

@@ -63,6 +63,7 @@ def test_no_shipped_model_gets_a_claim(model):
     assert reading["decided"] > reading["entries"] / 2, f"{model=}: too little decided: {reading}"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("system", "description"),
     [(name, d) for name, system in SYSTEMS.items() for d in descriptions(system)],
@@ -362,6 +363,7 @@ def test_a_model_alone_still_reads_its_parameter_file(tmp_path, capsys):
 KEEPS = ("sign", "drop", "duplicate", "factor 2", "factor ½", "parameter", "sin↔cos", "pivot", "swap θ")
 
 
+@pytest.mark.slow
 def test_no_claim_on_the_explain_corpus_but_where_a_plant_changes_a_dimension():
     """``bench explain``'s planted errors in every shipped model: every operator but a rate swap keeps
     each term's dimension (a sign, a dropped or doubled term, a factor, a parameter of the same kind,

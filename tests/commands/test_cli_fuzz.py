@@ -23,6 +23,7 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, given, seed, settings
 from hypothesis import strategies as st
 
@@ -293,6 +294,7 @@ def test_fuzz_check_model_file(model, as_dir):
     contract_with_file("mine.py", model, as_dir, lambda path, _: ["check", "--analytic", path, *rest])
 
 
+@pytest.mark.slow
 @fuzz(scene=SCENE_FILES, output=OUTPUTS, html=st.booleans())
 def test_fuzz_simulate(scene, output, html):
     def argv(path, folder):

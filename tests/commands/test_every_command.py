@@ -85,6 +85,10 @@ COMMANDS = {
     ],
 }
 
+#: the bench's accuracy study on a model's scene (≈ 10 to 35 s: its fixed-step methods compiled) and
+#: certify+recheck (≈ 5 to 25 s: the battery) are slow
+SLOW_COMMANDS = ("bench", "certify+recheck")
+COMMAND_PARAMS = [pytest.param(c, marks=pytest.mark.slow) if c in SLOW_COMMANDS else c for c in COMMANDS]
 
 WRITTEN_HERE = '''"""The cart-pole, written again in a file of this test: a user's own model."""
 
@@ -104,7 +108,7 @@ def _written_here(tmp_path: Path) -> Path:
     return path
 
 
-@pytest.mark.parametrize("command", list(COMMANDS))
+@pytest.mark.parametrize("command", COMMAND_PARAMS)
 @pytest.mark.parametrize("stem", [s for s in STEMS if s not in TEXT_ONLY])
 def test_each_command_on_each_example(command, stem, tmp_path, capsys):
     model = Model(EXAMPLES / f"{stem}.py", stem, tmp_path)
@@ -112,7 +116,7 @@ def test_each_command_on_each_example(command, stem, tmp_path, capsys):
         assert main(argv) == 0, (argv, capsys.readouterr())
 
 
-@pytest.mark.parametrize("command", list(COMMANDS))
+@pytest.mark.parametrize("command", COMMAND_PARAMS)
 def test_each_command_on_a_model_written_here(command, tmp_path, capsys):
     model = Model(_written_here(tmp_path), "cart_pole", tmp_path)
     for argv in COMMANDS[command](model):
@@ -136,7 +140,7 @@ TEXT_MODELS = {
 }
 
 
-@pytest.mark.parametrize("command", list(COMMANDS))
+@pytest.mark.parametrize("command", COMMAND_PARAMS)
 @pytest.mark.parametrize("kind", list(TEXT_MODELS))
 def test_each_command_on_a_text_model(kind, command, tmp_path, capsys):
     """A model written as text (TOML, SymPy syntax or LaTeX): every command takes it too."""

@@ -193,6 +193,7 @@ def test_a_file_in_place_of_the_folder_is_refused(tmp_path, capsys):
     assert target.read_text(encoding="utf-8") == "x\n"
 
 
+@pytest.mark.sweep
 def test_the_reference_systems_sweeps_are_copied_and_the_printed_sweep_certifies(tmp_path, capsys):
     """Every copied sweep reads; the printed ``certify --sweep`` runs on the copy (its count cut to 2)."""
     from pendverify.certify.sweep import load_sweep

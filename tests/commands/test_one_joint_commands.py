@@ -62,6 +62,8 @@ NOT_HERE = {
     # stress rewrites a URDF's numbers; an MJCF is refused (test_stress_refuses_an_mjcf)
     ("stress", "dm_pendulum"): "an MJCF is refused by stress",
 }
+#: the commands that certify or run the bench study (≈ 10 s each): marked slow
+SLOW_COMMANDS = ("certify+recheck", "bench")
 #: known failures outside the rendering and robot-summary code, left to their owners
 KNOWN: dict[tuple[str, str], str] = {}
 
@@ -73,6 +75,8 @@ def _cases():
                 continue
             known = KNOWN.get((command, robot))
             marks = [pytest.mark.xfail(reason=known, strict=True)] if known else []
+            if command in SLOW_COMMANDS:
+                marks.append(pytest.mark.slow)
             yield pytest.param(command, robot, marks=marks)
 
 

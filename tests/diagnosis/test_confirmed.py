@@ -169,6 +169,7 @@ def test_an_edit_of_what_no_check_compares_is_never_confirmed():
     assert "no check compares B with the robot" in repairs[0].message
 
 
+@pytest.mark.slow
 def test_coincident_corpus_no_wrong_repair_confirmed_and_the_rest_stated(capsys):
     targets = [t for t in class_targets() if t[0].endswith(f"({COINCIDENT})")]
     assert len(targets) >= 4

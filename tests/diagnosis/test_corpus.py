@@ -11,6 +11,8 @@ search or a parameter identification run on it anyway must find nothing.
 
 from __future__ import annotations
 
+import pytest
+
 from pendverify.bench.explain import corpus_targets, run_explain_bench
 from pendverify.bench.explain_report import table
 from pendverify.checks.batch import CheckBatch
@@ -22,6 +24,7 @@ from pendverify.diagnosis.repair import search_repair
 REPAIR_RATE = 0.9  # the target: the planted edit (or an equivalent one) for ≥ 90 %
 
 
+@pytest.mark.slow
 def test_planted_errors_are_named_and_repaired(capsys):
     bench = run_explain_bench(quick=True)
     with capsys.disabled():

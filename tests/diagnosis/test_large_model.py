@@ -95,6 +95,7 @@ LEFT_OUT = (
 )
 
 
+@pytest.mark.slow
 def test_a_40_link_chain_is_diagnosed_within_its_bound(tmp_path):
     findings = _diagnosis(tmp_path, N, 10.0)
     entries = [f for f in findings if f.kind == "entry"]
@@ -109,6 +110,7 @@ def test_a_40_link_chain_is_diagnosed_within_its_bound(tmp_path):
     assert f"the inertial {parameters}" in message or "the inertial parameters, " in message, message
 
 
+@pytest.mark.slow
 def test_a_trap_within_the_bounded_screen_is_named_on_a_40_link_chain(tmp_path):
     # a bound the steps fit in on any machine (about 5 s here): what the work bounds leave out, exactly
     findings = _diagnosis(tmp_path, N, 120.0, planted=False, flipped=True)

@@ -132,6 +132,7 @@ def test_the_items_of_a_derivation():
     assert source_items(pair.derivation, SymbolicModel.of(pair)) == []
 
 
+@pytest.mark.slow
 def test_the_mechanics_class_of_the_corpus():
     """The corpus's mechanics model (``examples/corpus_mechanics_double_pendulum.py``, Kane), its
     errors planted in the derivation's items, a seeded sample of two per operator as ``bench explain

@@ -123,6 +123,7 @@ def test_a_warm_cache_is_read_and_nothing_compiles_again(warm, cache):
     assert set(modes.values()) == {0o700}, modes
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("signature", ["unsigned", "another key"])
 def test_a_planted_module_with_a_matching_index_is_never_imported(cache, tmp_path, signature):
     marker = tmp_path / "MARKER"
@@ -135,6 +136,7 @@ def test_a_planted_module_with_a_matching_index_is_never_imported(cache, tmp_pat
     assert again["origin"] == "disk" and not marker.exists()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("breach", ["writable by others", "owned by another user"])
 def test_a_cache_folder_others_can_write_is_not_used(cache, tmp_path, breach):
     """Even with the user's own key copied in (a valid signature), a folder that is not private is
@@ -176,6 +178,7 @@ def test_a_planted_numba_index_pickle_is_never_loaded(warm, cache, tmp_path):
     assert (again["hits"], again["misses"]) == (1, 0), again
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("damage", ["truncated .nbc", "garbage .nbi", "unrecorded .nbc"])
 def test_damaged_numba_files_are_compiled_again(warm, cache, damage):
     generated = cache / "generated"
@@ -250,6 +253,7 @@ def _certify_items(out: Path, env: dict) -> tuple[dict, str]:
     return {i["name"]: (i.get("engine"), i["passed"], i["samples"]) for i in items}, done.stderr
 
 
+@pytest.mark.slow
 def test_certify_with_an_unusable_cache_issues_the_same_items(tmp_path):
     """``PENDVERIFY_CACHE`` naming a file: every invariant on the engine of a normal run,
     ``invariant:gravity:engines`` included, and one line saying where the code went."""

@@ -61,6 +61,7 @@ def test_compiled_forcing_is_the_simulators_closed_form(which):
         assert_close(system.forcing.at(t) + tau_fixed, tau_in, RHS_RTOL, f"{which} forcing at {t=}")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("which", ["sine", "sine+noise"])
 def test_each_stage_is_evaluated_at_its_own_time(which):
     """scipy's DOP853 on the compiled field fun(t, x) and the compiled DOP853 end together."""

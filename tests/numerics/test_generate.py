@@ -386,6 +386,7 @@ print(json.dumps(result))
 """
 
 
+@pytest.mark.slow
 def test_a_fresh_process_neither_generates_nor_compiles(fresh_cache):
     env = dict(os.environ, PENDVERIFY_CACHE=str(fresh_cache.parent))
 

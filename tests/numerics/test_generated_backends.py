@@ -160,6 +160,7 @@ def _fixed_errors(system, reference_system, method: str, x0, T: float) -> tuple[
     return float(np.max(np.abs(coarse[-1] - exact))), float(2 * estimate + slack)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", ["double_pendulum", "cart_double_pendulum", "cart_pole"])
 @pytest.mark.parametrize("method", tuple(STEPS))
 def test_fixed_step_methods_follow_the_models_flow(case, method):
@@ -170,6 +171,7 @@ def test_fixed_step_methods_follow_the_models_flow(case, method):
     assert err <= bound, f"{case} {method}: {err:.3g} > {bound:.3g}"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", tuple(STEPS))
 def test_planted_mass_matrix_changes_the_fixed_step_result(tmp_path, method):
     original = GeneratedSystem.from_model(_model("cart_pole"))
@@ -244,6 +246,7 @@ def test_generic_field_runs_on_float_numpy_decimal_and_mpf():
             )
 
 
+@pytest.mark.slow
 def test_a_function_other_than_sin_and_cos_is_refused_by_the_taylor_path_only():
     class RootPole(WheelPole):
         def gravity(self, q):

@@ -290,6 +290,7 @@ def test_a_shipped_mujoco_file_is_drawn_with_its_geoms_on_each_moving_body(case)
     assert set(range(1, visuals.system.model.njoints)) <= drawn, f"{case}: joints drawn {drawn}"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", CASES)
 def test_a_shipped_mujoco_file_is_certified_and_rechecked(tmp_path, case):
     """certify bundles the MJCF with its includes in place, and recheck reads that bundle back."""

@@ -226,6 +226,7 @@ def _sympy_cli(*args: str, env: dict | None = None) -> subprocess.CompletedProce
     )
 
 
+@pytest.mark.slow
 def test_a_dense_50_dof_model_is_refused_before_the_derivation_naming_the_limit(tmp_path):
     model = _dense_text_model(tmp_path / "dense.toml", 50)
     result = _sympy_cli("--analytic", str(model))
@@ -235,6 +236,7 @@ def test_a_dense_50_dof_model_is_refused_before_the_derivation_naming_the_limit(
     assert str(model) in err and f"limit of {DEFAULT_MAX_SYMBOLIC}" in err and MAX_SYMBOLIC_VARIABLE in err
 
 
+@pytest.mark.slow
 def test_the_symbolic_limit_is_overridden_from_the_environment(tmp_path):
     lowered = _sympy_cli("--model", "double_pendulum", env={MAX_SYMBOLIC_VARIABLE: "100"})
     assert lowered.returncode == 2 and "limit of 100" in lowered.stderr, lowered.stderr

@@ -60,10 +60,16 @@ MIN_MOVED_PIXELS = 300  # model-coloured pixels that change between the two shot
 
 CHROMIUM = find_chromium()
 # CI sets PENDVERIFY_REQUIRE_CHROMIUM=1: there a missing browser fails the tests instead of skipping them
-needs_chromium = pytest.mark.skipif(
+_skip_without_chromium = pytest.mark.skipif(
     CHROMIUM is None and not os.environ.get("PENDVERIFY_REQUIRE_CHROMIUM"),
     reason="no chromium binary on PATH (Debian package `chromium`; .ci/run installs it)",
 )
+
+
+def needs_chromium(test):
+    """A test that drives headless Chromium: marked ``browser`` (left out of the fast default run),
+    skipped where no Chromium exists unless CI requires it."""
+    return pytest.mark.browser(_skip_without_chromium(test))
 
 
 def short_scene(model: str, duration: float = 1.0, **extra) -> dict:
