@@ -64,3 +64,25 @@ def test_a_word_typed_for_another_is_replaced_in_the_users_own_text():
     # twice the term is no word of the text: the term rewritten, never a word that reads otherwise
     old, new = notation.entry_edit("gravity", 1, written, 2 * written)
     assert old == "-m_p g r\\sin\\theta" and new != old and "\\cos" not in new
+
+
+def test_a_minimal_edit_past_its_bound_prints_the_entry_whole(monkeypatch):
+    """A comparison larger than ``MAX_EDIT_OPS`` (a q̈ written out, whose one exact comparison took
+    19 s) or past ``EDIT_SECONDS`` of CPU time: the edited entry printed whole, in SymPy's LaTeX,
+    beside the user's text, never an edited string left unconfirmed."""
+    from pendverify.diagnosis import source_edit
+
+    cls = api.load_model(EXAMPLES / "cart_pole_latex.toml")
+    notation = Notation.of(cls)
+    mp, g, r, theta = (next(s for s in notation.names if s.name == n) for n in ("mp", "g", "r", "theta"))
+    written = -mp * g * r * sp.sin(theta)
+    whole = ("-m_p g r\\sin\\theta", notation.render(-written))  # the file's text, the edit whole
+    assert notation.entry_edit("gravity", 1, written, -written) == (
+        "-m_p g r\\sin\\theta",
+        "m_p g r\\sin\\theta",
+    )
+    monkeypatch.setattr(source_edit, "MAX_EDIT_OPS", -1)
+    assert notation.entry_edit("gravity", 1, written, -written) == whole
+    monkeypatch.setattr(source_edit, "MAX_EDIT_OPS", 10**9)
+    monkeypatch.setattr(source_edit, "EDIT_SECONDS", -1.0)
+    assert notation.entry_edit("gravity", 1, written, -written) == whole

@@ -35,6 +35,7 @@ from pendverify.analytic.latex_parse import LatexReader, SymbolTable
 from pendverify.analytic.params import read_toml
 from pendverify.analytic.text_expression import read_expression
 from pendverify.analytic.text_parse import CONSTANTS, FUNCTIONS
+from pendverify.diagnosis.clock import now
 from pendverify.errors import PendverifyError
 from pendverify.symbolic.zero_test import is_zero, probe
 
@@ -51,11 +52,24 @@ def plain(expr):
     return expr.xreplace({s: sp.Symbol(s.name) for s in expr.free_symbols})
 
 
+#: the CPU time a repair's minimal edit may take (``minimal_edit``): past it, or for an entry whose
+#: comparisons are larger than ``MAX_EDIT_OPS`` operations (a q̈ written out: 20,000, whose one exact
+#: comparison took 19 s), the entry is printed whole by the caller, in SymPy's syntax
+EDIT_SECONDS = 2.0
+MAX_EDIT_OPS = 2000
+
+
+class _OutOfTime(Exception):
+    """A minimal edit past its bound (``EDIT_SECONDS``, ``MAX_EDIT_OPS``)."""
+
+
 class SourceText:
     """The file's text of each entry and a reader for pieces of it (module docstring)."""
 
     def __init__(self, spec):
         self.spec = spec
+        #: the clock time (``pendverify.diagnosis.clock``) a minimal edit's comparisons stop at, or None
+        self.until: float | None = None
         self.latex = spec.notation == "latex"
         names = {s.name: s for g in "qvuwap" for s in spec.symbols.get(g, ())}
         self.names = names | FUNCTIONS | CONSTANTS
@@ -80,9 +94,16 @@ class SourceText:
 
     def same(self, a, b) -> bool:
         """Whether ``a`` and ``b`` are equal: most pieces of text tried are not, and a numeric probe
-        (``probe``, 50 digits) says so at once; the exact test decides the rest."""
+        (``probe``, 50 digits) says so at once; the exact test decides the rest.  Within a
+        ``minimal_edit`` (``until`` set), a comparison past its bound, or of an expression too large
+        to decide within it, raises ``_OutOfTime``."""
         try:
             difference = sp.sympify(a) - sp.sympify(b)
+        except UNREADABLE:
+            return False
+        if self.until is not None and (now() > self.until or sp.count_ops(difference) > MAX_EDIT_OPS):
+            raise _OutOfTime
+        try:
             return not probe(difference) and is_zero(difference, self.angles)
         except UNREADABLE:
             return False
@@ -223,7 +244,18 @@ def latex_style(latex: str) -> str:
 
 def minimal_edit(source: SourceText, text: str, old, new, render) -> str | None:
     """``text`` (which reads as ``old``) with the fewest of its terms changed so that it reads as
-    ``new``, checked by reading it (module docstring); ``render`` prints a SymPy term."""
+    ``new``, checked by reading it (module docstring); ``render`` prints a SymPy term.  None past
+    ``EDIT_SECONDS`` of CPU time or for comparisons beyond ``MAX_EDIT_OPS``."""
+    source.until = now() + EDIT_SECONDS
+    try:
+        return _minimal_edit(source, text, old, new, render)
+    except _OutOfTime:
+        return None
+    finally:
+        source.until = None
+
+
+def _minimal_edit(source: SourceText, text: str, old, new, render) -> str | None:
     spans = terms(text)
     values = []
     for sign, a, b in spans:
