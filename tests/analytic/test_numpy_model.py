@@ -31,49 +31,8 @@ DP_PARAMS = REPO / "examples" / "minimal_double_pendulum.toml"
 SAMPLES = ["--samples", "60"]
 
 # examples/minimal_double_pendulum.py's M, C, H, D, B as functions: θ1 from the horizontal,
-# θ2 relative to link 1, the URDF's joint angles
-DOUBLE_PENDULUM = """\
-import numpy as np
-
-
-def M(q, p):
-    alpha = p.I1 + p.I2 + p.m1 * p.r1**2 + p.m2 * (p.l1**2 + p.r2**2)
-    beta, delta = p.m2 * p.l1 * p.r2, p.I2 + p.m2 * p.r2**2
-    c2 = np.cos(q[1])
-    return np.array([[alpha + 2 * beta * c2, delta + beta * c2], [delta + beta * c2, delta]])
-
-
-def C(q, v, p):
-    h = p.m2 * p.l1 * p.r2 * np.sin(q[1])
-    return np.array([[-h * v[1], -h * (v[0] + v[1])], [h * v[0], 0.0]])
-
-
-def G(q, p):
-    c1, c12 = np.cos(q[0]), np.cos(q[0] + q[1])
-    return p.g * np.array([(p.m1 * p.r1 + p.m2 * p.l1) * c1 + p.m2 * p.r2 * c12, p.m2 * p.r2 * c12])
-
-
-def D(p):
-    return np.diag([p.b1, p.b2])
-
-
-def B(p):
-    return np.eye(2)
-
-
-DECLARATION = {
-    "name": "minimal_double_pendulum",
-    "coordinates": {"theta1": "angle", "theta2": "angle"},
-    "inputs": ["tau1", "tau2"],
-    "parameters": {
-        "m1": {"kind": "mass"}, "m2": {"kind": "mass"}, "l1": {"kind": "length"},
-        "r1": {"kind": "offset"}, "r2": {"kind": "offset"},
-        "I1": {"kind": "inertia"}, "I2": {"kind": "inertia"},
-        "b1": {"kind": "damping"}, "b2": {"kind": "damping"}, "g": {"kind": "gravity"},
-    },
-    "urdf": {"joints": ["joint1", "joint2"]},
-}
-"""
+# θ2 relative to link 1, the URDF's joint angles (the shipped corpus model, read as text)
+DOUBLE_PENDULUM = (REPO / "examples" / "corpus_double_pendulum_functions.py").read_text()
 
 # the bias written as C·q̇, and as h = C·q̇ + G (with G, and without it: then G = h(q, 0)), the
 # matrix C renamed so that the file gives no C
