@@ -106,8 +106,8 @@ def _coefficient_edits(slot: Slot, evaluate) -> list[Edit]:
     return out
 
 
-#: the largest denominator of the number a written number may be put right to: the fractions of
-#: hand derivations (½, ⅓, ¼, 1/12 of a rod's inertia)
+#: the largest denominator of a simple fraction, the numbers of hand derivations (½, ⅓, ¼, 1/12 of a
+#: rod's inertia): a written number put right, a constant entry, a coefficient matched to parameters
 NUMBER_DENOMINATOR = 12
 
 
@@ -204,7 +204,7 @@ def _matched(coefficient: float, monomials) -> sp.Expr | None:
     close = 1e-9 * abs(coefficient)
     for whole in (True, False):  # a product as it stands before one with a fraction
         for value, expr in monomials:
-            ratio = Fraction(abs(coefficient) / value).limit_denominator(12)
+            ratio = Fraction(abs(coefficient) / value).limit_denominator(NUMBER_DENOMINATOR)
             if (
                 (ratio == 1) is whole
                 and ratio in FRACTIONS
@@ -392,7 +392,7 @@ def _constant_edits(slot: Slot, monomials) -> list[Edit]:
     if slot.symbols or slot.target is None:
         return []
     value = float(np.mean(slot.target))
-    fraction = Fraction(value).limit_denominator(12)
+    fraction = Fraction(value).limit_denominator(NUMBER_DENOMINATOR)
     if abs(float(fraction) - value) <= 1e-9 * max(1.0, abs(value)):
         new = sp.Rational(fraction.numerator, fraction.denominator)
     else:
@@ -539,7 +539,7 @@ def equal_valued(value: float, monomials, limit: int = 4) -> list[sp.Expr]:
     out = []
     for whole in (True, False):
         for v, expr in monomials:
-            ratio = Fraction(abs(value) / v).limit_denominator(12)
+            ratio = Fraction(abs(value) / v).limit_denominator(NUMBER_DENOMINATOR)
             if (ratio == 1) is whole and ratio in FRACTIONS and abs(float(ratio) * v - abs(value)) <= close:
                 found = sp.sign(value) * sp.Rational(ratio.numerator, ratio.denominator) * expr
                 if found not in out:
