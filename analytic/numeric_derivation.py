@@ -83,7 +83,7 @@ DERIVED = (
 
 
 @dataclass(frozen=True)
-class Derivation:
+class NumericDerivation:
     """M, q̈(q, 0, 0) and the inputs' steps h at one configuration (``derive``)."""
 
     M: np.ndarray
@@ -119,7 +119,7 @@ def _mass(A, B, q, fail) -> np.ndarray:
     return M
 
 
-def derive(acceleration, q, B: np.ndarray, n_disturbances: int, fail) -> Derivation:
+def derive(acceleration, q, B: np.ndarray, n_disturbances: int, fail) -> NumericDerivation:
     """M(q) and q̈(q, 0, 0) from ``acceleration(q, v, u, w)`` and the declared B (module docstring).
 
     ``fail(message)`` raises: called when q̈ is not affine in u at q within its rounding, or
@@ -154,7 +154,7 @@ def derive(acceleration, q, B: np.ndarray, n_disturbances: int, fail) -> Derivat
                     f"{steps.tolist()}, beyond its rounding bound (scaled {bound:.2g}); "
                     "M = B (∂q̈/∂u)⁻¹ needs q̈ = M⁻¹(B u + …)"
                 )
-    return Derivation(M, rest, steps)
+    return NumericDerivation(M, rest, steps)
 
 
 def _step(rest: np.ndarray, column: np.ndarray) -> float:
