@@ -7,6 +7,9 @@
 * ``plots``     — energy and work-balance figures (matplotlib, SVG);
 * ``review``    — the review page ``index.html``;
 * ``browser``   — headless Chromium over the DevTools pipe, for screenshots and tests.
+
+Internal: nothing here is public (``__all__`` is empty); the public names are those of
+``pendverify.__all__``, ``pendverify.analytic.__all__`` and ``pendverify.api`` (docs/reference/api.md).
 """
 
 import warnings
@@ -14,3 +17,5 @@ import warnings
 with warnings.catch_warnings():  # meshcat's server module imports pyzmq's deprecated ioloop shim
     warnings.simplefilter("ignore", DeprecationWarning)
     import meshcat  # noqa: F401
+
+__all__: list[str] = []

@@ -1,1 +1,7 @@
-"""URDFs in Pinocchio: strict reading, coordinate maps, the reference systems' geometry, the writer."""
+"""URDFs in Pinocchio: strict reading, coordinate maps, the reference systems' geometry, the writer.
+
+Internal: nothing here is public (``__all__`` is empty); the public names are those of
+``pendverify.__all__``, ``pendverify.analytic.__all__`` and ``pendverify.api`` (docs/reference/api.md).
+"""
+
+__all__: list[str] = []

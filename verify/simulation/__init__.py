@@ -1,1 +1,7 @@
-"""Scenes: declared effects, right-hand sides, integrators and invariants."""
+"""Scenes: declared effects, right-hand sides, integrators and invariants.
+
+Internal: nothing here is public (``__all__`` is empty); the public names are those of
+``pendverify.__all__``, ``pendverify.analytic.__all__`` and ``pendverify.api`` (docs/reference/api.md).
+"""
+
+__all__: list[str] = []

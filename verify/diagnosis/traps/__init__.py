@@ -5,4 +5,9 @@ is one trap (``inertia``, ``damping``, ``conventions``), and ``fit`` holds the l
 and thresholds they share.  The convention search has three helpers: the maps the traps
 lead to (``convention_maps``), their vectorised screen (``convention_screen``) and their
 sentences (``convention_words``).
+
+Internal: nothing here is public (``__all__`` is empty); the public names are those of
+``pendverify.__all__``, ``pendverify.analytic.__all__`` and ``pendverify.api`` (docs/reference/api.md).
 """
+
+__all__: list[str] = []

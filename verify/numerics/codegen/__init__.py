@@ -14,4 +14,9 @@ generated and the packed layout).  The pieces:
 * ``folder``: the cache's folder, private to its user (else a temporary one);
 * ``signed``: the cache's index and module records, signed with the user's cache key;
 * ``numba_files``: numba's cache files of a module, recorded by digest and pruned before import.
+
+Internal: nothing here is public (``__all__`` is empty); the public names are those of
+``pendverify.__all__``, ``pendverify.analytic.__all__`` and ``pendverify.api`` (docs/reference/api.md).
 """
+
+__all__: list[str] = []
