@@ -8,8 +8,7 @@
 * ``review``    — the review page ``index.html``;
 * ``browser``   — headless Chromium over the DevTools pipe, for screenshots and tests.
 
-Internal: nothing here is public (``__all__`` is empty); the public names are those of
-``pendverify.__all__``, ``pendverify.analytic.__all__`` and ``pendverify.api`` (docs/reference/api.md).
+Internal (``__all__`` is empty): docs/reference/api.md lists what is public.
 """
 
 import warnings

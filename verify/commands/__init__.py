@@ -18,8 +18,7 @@ The global options, accepted before or after the command's name:
 * ``--json PATH`` (the commands that give ``json=WHAT``): the report as JSON to PATH,
   or to standard output for ``-`` (``write_json_report``); the text then goes to stderr.
 
-Internal: nothing here is public (``__all__`` is empty); the public names are those of
-``pendverify.__all__``, ``pendverify.analytic.__all__`` and ``pendverify.api`` (docs/reference/api.md).
+Internal (``__all__`` is empty): docs/reference/api.md lists what is public.
 """
 
 from __future__ import annotations

@@ -1,7 +1,6 @@
 """Hard cases that must stay numerically stable, or be refused.
 
-Internal: nothing here is public (``__all__`` is empty); the public names are those of
-``pendverify.__all__``, ``pendverify.analytic.__all__`` and ``pendverify.api`` (docs/reference/api.md).
+Internal (``__all__`` is empty): docs/reference/api.md lists what is public.
 """
 
 __all__: list[str] = []

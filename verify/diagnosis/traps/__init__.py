@@ -6,8 +6,7 @@ and thresholds they share.  The convention search has three helpers: the maps th
 lead to (``convention_maps``), their vectorised screen (``convention_screen``) and their
 sentences (``convention_words``).
 
-Internal: nothing here is public (``__all__`` is empty); the public names are those of
-``pendverify.__all__``, ``pendverify.analytic.__all__`` and ``pendverify.api`` (docs/reference/api.md).
+Internal (``__all__`` is empty): docs/reference/api.md lists what is public.
 """
 
 __all__: list[str] = []

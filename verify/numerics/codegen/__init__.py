@@ -15,8 +15,7 @@ generated and the packed layout).  The pieces:
 * ``signed``: the cache's index and module records, signed with the user's cache key;
 * ``numba_files``: numba's cache files of a module, recorded by digest and pruned before import.
 
-Internal: nothing here is public (``__all__`` is empty); the public names are those of
-``pendverify.__all__``, ``pendverify.analytic.__all__`` and ``pendverify.api`` (docs/reference/api.md).
+Internal (``__all__`` is empty): docs/reference/api.md lists what is public.
 """
 
 __all__: list[str] = []

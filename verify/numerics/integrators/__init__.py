@@ -20,9 +20,8 @@ step is ``x_new = explicit_rk_step(f, t, x, h, tableau, k1=None)``.
 scipy's ``solve_ivp`` (RK45, DOP853, Radau, BDF, LSODA, RK23) is called by the scene driver
 and by the stress suite's ``rk45``; none of its methods is written here.
 
-Internal: nothing here is public (``__all__`` is empty); the names imported below are the
-package's interface to the rest of pendverify.  The public names are those of
-``pendverify.__all__``, ``pendverify.analytic.__all__`` and ``pendverify.api`` (docs/reference/api.md).
+Internal (``__all__`` is empty): docs/reference/api.md lists what is public; the names imported
+below are this package's interface to the rest of pendverify.
 """
 
 from pendverify.numerics.integrators.runge_kutta import explicit_rk_step as explicit_rk_step
