@@ -22,7 +22,6 @@ from pendverify.cli import main
 from pendverify.errors import IllConditionedError, InputError
 from pendverify.stress import cases, framework, seed_params, sim_cases, trust_study
 from pendverify.stress import catalogue as stress
-from pendverify.stress import integrators as si
 from pendverify.validate import finite_state, model_state
 
 from ..conftest import default_params
@@ -332,46 +331,6 @@ def test_model_state_fills_zeros_and_checks_sizes():
     assert v.shape == (3,) and u.shape == (1,) and w.shape == (3,)
     with pytest.raises(InputError, match=r"<src>: key 'w\[2\]' = -inf"):
         model_state(model, [0, 0, 0], w=[0, 0, -math.inf], source="<src>")
-
-
-# --- the integrators ----------------------------------------------------------------------------
-def test_integrators_converge_at_their_order():
-    model = DoublePendulum(default_params("double_pendulum").replace(b1=0.0, b2=0.0))
-    q0, v0 = np.array([-1.0, 0.4]), np.zeros(2)
-    reference = si.rk4(model, q0, v0, 0.001, 3000).q[-1]
-
-    def error(method, h):
-        traj = method(model, q0, v0, h, round(3 / h))
-        assert traj.blew_up_at is None
-        return np.max(np.abs(traj.q[-1] - reference))
-
-    assert 3.6 < error(si.stormer_verlet, 0.02) / error(si.stormer_verlet, 0.01) < 4.4  # order 2
-    assert 12 < error(si.rk4, 0.02) / error(si.rk4, 0.01) < 20  # order 4
-    sv = si.stormer_verlet(model, q0, v0, 0.01, 300)
-    E0 = si.energy(model, q0, v0)
-    assert np.max(np.abs(si.energies(model, sv) - E0)) < 1e-3 * abs(E0)
-    assert si.momenta(model, sv).shape == (len(sv.t), 2)
-
-
-def test_rk4_reports_a_blow_up_and_backward_euler_does_not():
-    model = DoublePendulum(default_params("double_pendulum").replace(b1=1e4, b2=1e4))
-    q0, v0 = np.array([-1.0, 0.3]), np.zeros(2)
-    blown = si.rk4(model, q0, v0, 0.05, 50)
-    assert blown.blew_up_at is not None and blown.note.startswith("non-finite after")
-    stable = si.implicit_euler(model, q0, v0, 0.05, 20)
-    assert stable.blew_up_at is None
-    assert np.all(np.diff(si.energies(model, stable)) <= 0)
-
-
-def test_stormer_verlet_refuses_damped_models():
-    with pytest.raises(ValueError, match="conservative models only"):
-        si.stormer_verlet(DoublePendulum(default_params("double_pendulum")), np.zeros(2), np.zeros(2), 0.1, 1)
-
-
-def test_fit_slope():
-    t = np.linspace(0, 10, 11)
-    slope, r2 = si.fit_slope(t, 3 * t + 1)
-    assert slope == pytest.approx(3.0) and r2 == pytest.approx(1.0)
 
 
 @pytest.mark.parametrize(
