@@ -300,15 +300,33 @@ def test_zero_mass_aba_is_finite_nonsense_and_refused():
 
 
 def test_reference_matches_the_closed_form():
+    """The 50-digit M and q̈ (the generated generic code on mpf) are the closed form's, to its rounding."""
     import mpmath as mp
 
     for name, q in (("cart_double_pendulum", [0.1, 0.7, -1.2]), ("double_pendulum", [0.3, 1.1])):
-        params = default_params(name)
-        model = MODELS[name](params)
+        model = MODELS[name](default_params(name))
+        v, u, w = np.linspace(0.4, -0.9, model.nv), np.full(len(model.inputs), 0.5), np.ones(model.nv)
+        numbers = trust_study.reference_numbers(model, u, w[: len(model.disturbances)])
         with mp.workdps(trust_study.REFERENCE_DIGITS):
-            M = trust_study.reference_mass_matrix(params, q)
+            M = trust_study.reference_mass_matrix(numbers, q)
             ref = np.array([[float(M[i, j]) for j in range(M.cols)] for i in range(M.rows)])
+            accel = np.array([float(a) for a in trust_study.reference_acceleration(numbers, q, v)])
         np.testing.assert_allclose(model.mass_matrix(np.array(q)), ref, rtol=2e-15, atol=1e-16)
+        # the double q̈ is an LU solve with κ(M) ≤ 50 at these states: within ~50·ε of its terms
+        expected = model.acceleration(np.array(q), v, u, w[: len(model.disturbances)])
+        np.testing.assert_allclose(expected, accel, rtol=1e-13, atol=1e-13)
+
+
+def test_reference_acceleration_sees_the_input_and_the_disturbance():
+    """Planted: u and w left out of the reference (zero) move q̈ by M⁻¹ (B u + W w), far above rounding."""
+    import mpmath as mp
+
+    model = MODELS["cart_double_pendulum"](default_params("cart_double_pendulum"))
+    y, v, u, w = trust_study.study_states()["theta1=theta2=0, torque on rod 1"]
+    with mp.workdps(trust_study.REFERENCE_DIGITS):
+        right = trust_study.reference_acceleration(trust_study.reference_numbers(model, u, w), y, v)
+        wrong = trust_study.reference_acceleration(trust_study.reference_numbers(model), y, v)
+    assert trust_study._rel([float(a) for a in wrong], right) > 1e-3
 
 
 # --- validation -----------------------------------------------------------------------------------
