@@ -20,11 +20,12 @@ from pendverify.checks.batch import world_lever
 from pendverify.checks.trust import Conditioning, check_conditioning
 from pendverify.cli import main
 from pendverify.errors import IllConditionedError, InputError
-from pendverify.stress import cases, framework, seed_params, sim_cases, trust_study
 from pendverify.stress import catalogue as stress
+from pendverify.stress import framework, reference_cases, trust_study
+from pendverify.stress.catalogue import CART, DP, HardSet, hard_set_case
 from pendverify.validate import finite_state, model_state
 
-from ..conftest import default_params
+from ..conftest import default_params, system_for
 
 
 @pytest.fixture(scope="module")
@@ -128,7 +129,7 @@ def test_cli_unknown_case_is_exit_2(capsys):
 
 
 def test_cli_failure_is_exit_1(monkeypatch, capsys):
-    monkeypatch.setattr(cases, "model_state", lambda *a, **k: None)  # the NaN guard is gone
+    monkeypatch.setattr(reference_cases, "model_state", lambda *a, **k: None)  # the NaN guard is gone
     assert main(["stress", "--quick", "--case", "NaN, inf, negative, zero"]) == 1
     out = capsys.readouterr().out
     assert "FAIL" in out and "1 case(s) FAIL" in out
@@ -184,47 +185,44 @@ class CartPushed(CartDoublePendulum):
         return super().gravity(y) + np.array([1e-6, 0.0, 0.0])
 
 
+def _entry(name: str) -> HardSet:
+    return next(e for e in stress.CATALOGUE if e.name == name)
+
+
 @pytest.mark.parametrize(
-    "case",
+    ("entry", "planted"),
     [
-        framework.checks_case(
-            "planted β", "mass ratio", lambda: seed_params.dp_link_mass_ratio(1e-6), model_cls=BetaOff
+        (_entry("link1/link2 mass 1e-6"), BetaOff),
+        (_entry("cart rods 1e3 m"), CartCoriolisSignFlip),
+        (_entry("double pendulum lengths ×1e3 (km)"), BetaOff),
+        (_entry("double pendulum |θ| ≈ 1e6 rad"), NotPeriodic),
+        (_entry("double pendulum |q̇| ≤ 1e3"), NaNAtHighSpeed),
+        (
+            HardSet(
+                "planted pump",
+                "stiff damping",
+                CART,
+                {"d1": 1e4, "d2": 1e4, "d3": 1e4},
+                kind="stiff",
+                q0=(0.0, 3.0, 3.4),
+            ),
+            EnergyPump,
         ),
-        framework.checks_case(
-            "planted C", "length", lambda: seed_params.cart(l1=1e3, l2=1e3), model_cls=CartCoriolisSignFlip
-        ),
-        framework.checks_case(
-            "planted β km", "length", lambda: seed_params.dp_scaled(1e3), model_cls=BetaOff
-        ),
-        cases.large_angle_case("planted period", lambda: default_params("double_pendulum"), NotPeriodic),
-        cases.high_speed_case("planted NaN", lambda: default_params("double_pendulum"), NaNAtHighSpeed),
-        sim_cases.stiff_sim_case(
-            "planted pump", lambda: seed_params.cart(d1=1e4, d2=1e4, d3=1e4), (0.0, 3.0, 3.4), EnergyPump
-        ),
-        sim_cases.long_horizon_case("planted C long", model_cls=WrongCoriolis),
-        sim_cases.zero_gravity_sim_case(
-            "planted push",
-            lambda: seed_params.cart(g=0.0, d1=0.0, d2=0.0, d3=0.0),
-            (0, 0.3, -0.4),
-            (0.5, 1, -2),
-            0,
-            "p_q",
-            CartPushed,
-        ),
+        (_entry("double pendulum 1e4 s, conservative"), WrongCoriolis),
+        (_entry("cart g = 0: simulate"), CartPushed),
     ],
-    ids=lambda c: c.name,
+    ids=lambda x: getattr(x, "name", getattr(x, "__name__", "")),
 )
-def test_planted_error_fails_its_case(ctx, case):
-    result = stress.run_case(case, ctx)
-    assert not result.passed, f"{case.name} passed: {result}"
+def test_planted_error_fails_its_case(ctx, entry, planted):
+    """The catalogue's hard set (through the same entry point as the catalogue) on a planted model."""
+    result = stress.run_case(hard_set_case(entry, planted), ctx)
+    assert not result.passed, f"{entry.name} passed: {result}"
     assert result.verdict == "FAIL"
 
 
 def test_planted_large_angle_passes_at_small_angles(ctx):
     """The non-periodic term is invisible in the ordinary check: only the 2πk invariance sees it."""
-    case = framework.checks_case(
-        "small angles", "large angle", lambda: default_params("double_pendulum"), model_cls=NotPeriodic
-    )
+    case = hard_set_case(HardSet("small angles", "large angle", DP), NotPeriodic)
     assert stress.run_case(case, ctx).passed
 
 
@@ -261,7 +259,7 @@ def test_det_case_fails_on_a_cancelling_det(monkeypatch):
     monkeypatch.setattr(
         CartDoublePendulum, "det_mass_matrix", lambda self, y: float(np.linalg.det(self.mass_matrix(y)))
     )
-    result = cases.det_case(framework.Context(framework.QUICK), "det")
+    result = reference_cases.det_case(framework.Context(framework.QUICK), "det")
     assert not result.passed and result.error > 1e-10
 
 
@@ -287,7 +285,7 @@ def test_conditioning_levels_and_scaling():
 
 def test_term_amplification_grows_with_the_square_of_the_lever_arm():
     params = default_params("cart_double_pendulum").replace(l1=1e-3, l2=1e-3)
-    model, system = CartDoublePendulum(params), framework.system_for(params)
+    model, system = CartDoublePendulum(params), system_for(params)
     near, one, eight = (world_lever(model, system, np.array([x, 0.7, 0.7])) for x in (0.0, 1.0, 8.0))
     assert 1 <= near < 20  # a 1 mm pendulum at the origin: terms as large as the result
     assert 60 < eight / one < 68  # 1 mm rods 1 m and 8 m from the origin: (8/1)²
@@ -370,6 +368,6 @@ def test_compare_refuses_a_bad_state_by_name_among_good_ones(bad, key, rule):
     states = sample_states(model, 8, 1)
     states[5] = dataclasses.replace(states[5], **bad)
     with pytest.raises(InputError) as exc:
-        framework.compare("case", model, framework.system_for(model.params), states, 1)
+        framework.compare("case", model, system_for(model.params), states, 1)
     text = str(exc.value)
     assert f"<case: {states[5].label}>" in text and f"'{key}'" in text and rule in text, text

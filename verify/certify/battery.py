@@ -101,7 +101,10 @@ def stress_items(
     from pendverify.stress import cases, framework
     from pendverify.stress import catalogue as stress
 
+    from pendverify.robot.writer import urdf_for
+
     cls = model_class(model_cls)
+    urdf = urdf_for(params) if urdf is None else urdf
     ctx = framework.Context(framework.FULL, settings.seed, urdf=urdf, model_cls=cls)
     # at |θ| ≈ 1e6 rad a set with κ̃ in the hundreds is beyond the trust rule: such
     # states are refused and recorded, and every state that is compared must pass

@@ -1,7 +1,12 @@
 """The reference systems' stress catalogue: hard cases that must stay numerically stable, or be refused.
 
-These cases are about the two seed models (``pendverify stress`` without ``--analytic``);
-any model file gets the generic cases of ``pendverify.stress.generic``.
+The two reference systems (``pendverify stress`` without ``--analytic``) are two models the
+catalogue lists as data (``CATALOGUE``): which model, which parameter sets (the model's
+default set with values put in and factors multiplied in) and which hard states.  Each set
+runs as any model's does (``pendverify.stress.generic``): the model class, its robot
+description (the URDF the project writes for the set, ``robot.writer``) and the set, through
+``framework.on_description``.  The studies that are no parameter set (the cart's m1 → 0
+study, det M, bad input) are ``pendverify.stress.reference_cases``.
 
 Each case is a named function returning a ``StressResult``: the achieved
 relative error next to the tolerance used, κ(M) raw and after diagonal scaling
@@ -53,18 +58,16 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
+import numpy as np
+
+from pendverify.analytic import MODELS
+from pendverify.checks.sampling import State
 from pendverify.display import html_table, listed
-from pendverify.stress.cases import (
-    _aligned_states,
-    det_case,
-    dp_det_case,
-    high_speed_case,
-    invalid_input_case,
-    large_angle_case,
-    trust_case,
-)
+from pendverify.robot.writer import urdf_for
+from pendverify.stress.cases import high_speed_case, large_angle_case
 from pendverify.stress.framework import (
     FULL,
     SEED,
@@ -74,100 +77,223 @@ from pendverify.stress.framework import (
     Settings,
     StressResult,
     checks_case,
+    on_description,
 )
-from pendverify.stress.seed_params import cart, default, dp_link_lengths, dp_link_mass_ratio, dp_scaled
+from pendverify.stress.reference_cases import (
+    default,
+    det_case,
+    dp_det_case,
+    invalid_input_case,
+    trust_case,
+)
 from pendverify.stress.sim_cases import long_horizon_case, stiff_sim_case, zero_gravity_sim_case
-from pendverify.stress.trust_study import StudyResult
+from pendverify.stress.trust_study import StudyResult, study_states
+
+DP, CART = "double_pendulum", "cart_double_pendulum"
 
 
-# --- the catalogue ------------------------------------------------------------------------------
-def _const(fn, *args, **kw):
-    return lambda: fn(*args, **kw)
+# --- the catalogue, as data -----------------------------------------------------------------------
+@dataclass(frozen=True)
+class HardSet:
+    """One hard case of a reference system: a parameter set (``model``'s default set, ``values`` put
+    in, then ``factors`` multiplied in; a tuple of factors one after the other, as I·s·s), what is
+    run on it (``kind``) and with which states."""
+
+    name: str
+    group: str
+    model: str  # a reference system: a key of ``pendverify.analytic.MODELS``
+    values: Mapping[str, float] = field(default_factory=dict)
+    factors: Mapping[str, float | tuple[float, ...]] = field(default_factory=dict)
+    kind: str = "checks"  # a key of ``KINDS``
+    expect: str = "none"  # what the trust rule may refuse (``framework.EXPECT``)
+    states: str = ""  # hard states added to the sampled ones: a key of ``HARD_STATES``
+    q0: tuple[float, ...] = ()  # where a simulation starts
+    v0: tuple[float, ...] = ()
+    cyclic: int = 0  # zero gravity: the coordinate whose momentum is conserved, and its label
+    momentum: str = ""
+
+    def params(self):
+        p = default(self.model).replace(**self.values)
+        return p.replace(**{k: _times(getattr(p, k), f) for k, f in self.factors.items()})
+
+
+def _times(value: float, factors) -> float:
+    for f in factors if isinstance(factors, tuple) else (factors,):
+        value = value * f
+    return value
+
+
+def _dp_lengths(s1: float, s2: float) -> dict:
+    """Factors that make the double pendulum's link k s_k times longer: l_k, r_k × s_k, I_k × s_k²."""
+    return {"l1": s1, "r1": s1, "I1": s1**2, "l2": s2, "r2": s2, "I2": s2**2}
+
+
+def _dp_scaled(s: float) -> dict:
+    """Every length of the double pendulum × s, its inertias × s·s."""
+    return {"l1": s, "l2": s, "r1": s, "r2": s, "I1": (s, s), "I2": (s, s)}
+
+
+def _aligned(model) -> list[State]:
+    """The cart's aligned states, where det M ∝ m1 (the trust study's), and θ1 = θ2 = 0 at rest."""
+    zero_u, zero_w = np.zeros(len(model.inputs)), np.zeros(len(model.disturbances))
+    return [State(label, y, v, u, w) for label, (y, v, u, w) in study_states().items()] + [
+        State("theta1=theta2=0 at rest", np.zeros(3), np.zeros(3), zero_u, zero_w)
+    ]
+
+
+#: hard states a set adds to the sampled ones, by name
+HARD_STATES = {"aligned": _aligned}
+#: link 1 of the double pendulum m1/m2 = r: m1 and I1 × r·m2/m1 (default m1 = 1 kg, m2 = 0.8 kg)
+_DP_MASS_RATIO = 0.8
+_DAMPED = {"b1": STIFF_DAMPING, "b2": STIFF_DAMPING}
+_CART_DAMPED = {"d1": STIFF_DAMPING, "d2": STIFF_DAMPING, "d3": STIFF_DAMPING}
+
+CATALOGUE: tuple[HardSet | Case, ...] = (
+    HardSet("cart/bobs mass 1e-6", "mass ratio", CART, {"m": 1.25e-6}),
+    HardSet("cart/bobs mass 1e6", "mass ratio", CART, {"m": 1.25e6}),
+    HardSet("cart bob1/bob2 mass 1e-6", "mass ratio", CART, {"m1": 0.75e-6}, expect="any"),
+    HardSet("cart bob1/bob2 mass 1e6", "mass ratio", CART, {"m1": 0.75e6}),
+    HardSet(
+        "link1/link2 mass 1e-6",
+        "mass ratio",
+        DP,
+        factors={"m1": 1e-6 * _DP_MASS_RATIO, "I1": (1e-6, _DP_MASS_RATIO)},
+    ),
+    HardSet(
+        "link1/link2 mass 1e6",
+        "mass ratio",
+        DP,
+        factors={"m1": 1e6 * _DP_MASS_RATIO, "I1": (1e6, _DP_MASS_RATIO)},
+    ),
+    HardSet("double pendulum lengths ×1e-3 (mm)", "length", DP, factors=_dp_scaled(1e-3)),
+    HardSet("double pendulum lengths ×1e3 (km)", "length", DP, factors=_dp_scaled(1e3)),
+    HardSet("double pendulum l1 1e-2 m, l2 10 m", "length", DP, factors=_dp_lengths(0.02, 10 / 0.45)),
+    HardSet("double pendulum l1 10 m, l2 1e-2 m", "length", DP, factors=_dp_lengths(20.0, 0.01 / 0.45)),
+    HardSet(
+        "double pendulum l1 1e-3 m, l2 1e3 m",
+        "length",
+        DP,
+        factors=_dp_lengths(2e-3, 1e3 / 0.45),
+        expect="all",
+    ),
+    HardSet(
+        "double pendulum l1 1e3 m, l2 1e-3 m",
+        "length",
+        DP,
+        factors=_dp_lengths(2e3, 1e-3 / 0.45),
+        expect="all",
+    ),
+    HardSet("cart rods 1e-3 m", "length", CART, {"l1": 1e-3, "l2": 1e-3}, expect="any"),
+    HardSet("cart rods 1e3 m", "length", CART, {"l1": 1e3, "l2": 1e3}),
+    HardSet("cart rods 1e-2 m / 10 m", "length", CART, {"l1": 1e-2, "l2": 10.0}),
+    HardSet("cart rods 10 m / 1e-2 m", "length", CART, {"l1": 10.0, "l2": 1e-2}),
+    HardSet("cart rods 1e-3 m / 1e3 m", "length", CART, {"l1": 1e-3, "l2": 1e3}, expect="all"),
+    HardSet("cart rods 1e3 m / 1e-3 m", "length", CART, {"l1": 1e3, "l2": 1e-3}, expect="all"),
+    Case("cart m1 → 0: trust study", "near singular", trust_case),
+    Case("cart det M: closed form vs LU", "near singular", det_case),
+    Case("double pendulum det M: closed form vs LU", "near singular", dp_det_case),
+    HardSet("cart m1 = 1e-6 kg (warn)", "near singular", CART, {"m1": 1e-6}, expect="any", states="aligned"),
+    HardSet(
+        "cart m1 = 1e-12 kg (refuse aligned)",
+        "near singular",
+        CART,
+        {"m1": 1e-12},
+        expect="some",
+        states="aligned",
+    ),
+    HardSet("point masses (I1 = I2 = 0)", "point mass", DP, {"I1": 0.0, "I2": 0.0}),
+    HardSet("centres of mass at the joints (r = 0)", "point mass", DP, {"r1": 0.0, "r2": 0.0}),
+    HardSet("point mass link 1, r2 = 0", "point mass", DP, {"I1": 0.0, "r2": 0.0}),
+    HardSet("double pendulum |θ| ≈ 1e6 rad", "large angle", DP, kind="large angle"),
+    HardSet("cart |θ| ≈ 1e6 rad", "large angle", CART, kind="large angle"),
+    HardSet("double pendulum |q̇| ≤ 1e3", "high speed", DP, kind="high speed"),
+    HardSet("cart |q̇| ≤ 1e3", "high speed", CART, kind="high speed"),
+    HardSet("double pendulum b = 1e4", "stiff damping", DP, {"b1": 1e4, "b2": 1e4}),
+    HardSet("cart d = 1e4", "stiff damping", CART, {"d1": 1e4, "d2": 1e4, "d3": 1e4}),
+    HardSet(
+        "double pendulum b = 1e4: simulate",
+        "stiff damping",
+        DP,
+        _DAMPED,
+        kind="stiff",
+        q0=(-math.pi / 2 + 0.5, 0.3),
+    ),
+    HardSet(
+        "cart d = 1e4: simulate",
+        "stiff damping",
+        CART,
+        _CART_DAMPED,
+        kind="stiff",
+        q0=(0.0, math.pi - 0.5, math.pi + 0.3),
+    ),
+    # a mild, conservative double pendulum: the default scaled to l1 = 1 km (period ≈ 1 min), 0.5 rad
+    # from hanging, link 2 bent by 0.3 rad
+    HardSet(
+        "double pendulum 1e4 s, conservative",
+        "long horizon",
+        DP,
+        {"b1": 0.0, "b2": 0.0},
+        _dp_scaled(2000.0),
+        kind="long horizon",
+        q0=(-math.pi / 2 + 0.5, 0.3),
+    ),
+    HardSet("double pendulum g = 0", "zero gravity", DP, {"g": 0.0}),
+    HardSet("cart g = 0", "zero gravity", CART, {"g": 0.0}),
+    HardSet(
+        "double pendulum g = 0: simulate",
+        "zero gravity",
+        DP,
+        {"g": 0.0, "b1": 0.0, "b2": 0.0},
+        kind="zero gravity",
+        q0=(0.3, 0.5),
+        v0=(1.0, -2.0),
+        cyclic=0,
+        momentum="p_θ1",
+    ),
+    HardSet(
+        "cart g = 0: simulate",
+        "zero gravity",
+        CART,
+        {"g": 0.0, "d1": 0.0, "d2": 0.0, "d3": 0.0},
+        kind="zero gravity",
+        q0=(0.0, 0.3, -0.4),
+        v0=(0.5, 1.0, -2.0),
+        cyclic=0,
+        momentum="p_q",
+    ),
+    Case("NaN, inf, negative, zero", "invalid input", invalid_input_case),
+)
+
+#: what each kind of hard set runs: (name, the set, the model class, the entry) → Case
+KINDS = {
+    "checks": lambda e, params_fn, cls: checks_case(
+        e.name, e.group, params_fn, e.expect, HARD_STATES[e.states] if e.states else None, cls
+    ),
+    "large angle": lambda e, params_fn, cls: large_angle_case(e.name, params_fn, cls),
+    "high speed": lambda e, params_fn, cls: high_speed_case(e.name, params_fn, cls),
+    "stiff": lambda e, params_fn, cls: stiff_sim_case(e.name, params_fn, e.q0, lambda: default(e.model), cls),
+    "long horizon": lambda e, params_fn, cls: long_horizon_case(e.name, params_fn, e.q0, cls),
+    "zero gravity": lambda e, params_fn, cls: zero_gravity_sim_case(
+        e.name, params_fn, e.q0, e.v0, e.cyclic, e.momentum, cls
+    ),
+}
+
+
+def hard_set_case(entry: HardSet, model_cls=None) -> Case:
+    """The case of a hard set, run as any model's: ``model_cls`` (default: the reference system's
+    class; another plants an error) on the set's description and the set."""
+    cls = model_cls or MODELS[entry.model]
+
+    def run(ctx: Context, name: str) -> StressResult:
+        params = entry.params()
+        case = KINDS[entry.kind](entry, lambda: params, cls)
+        return on_description(case, urdf_for(params), cls).run(ctx, name)
+
+    return Case(entry.name, entry.group, run)
 
 
 def catalogue() -> list[Case]:
-    dp_default = default("double_pendulum")
-    cases = [
-        checks_case("cart/bobs mass 1e-6", "mass ratio", _const(cart, m=1.25e-6)),
-        checks_case("cart/bobs mass 1e6", "mass ratio", _const(cart, m=1.25e6)),
-        checks_case("cart bob1/bob2 mass 1e-6", "mass ratio", _const(cart, m1=0.75e-6), "any"),
-        checks_case("cart bob1/bob2 mass 1e6", "mass ratio", _const(cart, m1=0.75e6)),
-        checks_case("link1/link2 mass 1e-6", "mass ratio", _const(dp_link_mass_ratio, 1e-6)),
-        checks_case("link1/link2 mass 1e6", "mass ratio", _const(dp_link_mass_ratio, 1e6)),
-        checks_case("double pendulum lengths ×1e-3 (mm)", "length", _const(dp_scaled, 1e-3)),
-        checks_case("double pendulum lengths ×1e3 (km)", "length", _const(dp_scaled, 1e3)),
-        checks_case("double pendulum l1 1e-2 m, l2 10 m", "length", _const(dp_link_lengths, 0.02, 10 / 0.45)),
-        checks_case(
-            "double pendulum l1 10 m, l2 1e-2 m", "length", _const(dp_link_lengths, 20.0, 0.01 / 0.45)
-        ),
-        checks_case(
-            "double pendulum l1 1e-3 m, l2 1e3 m", "length", _const(dp_link_lengths, 2e-3, 1e3 / 0.45), "all"
-        ),
-        checks_case(
-            "double pendulum l1 1e3 m, l2 1e-3 m", "length", _const(dp_link_lengths, 2e3, 1e-3 / 0.45), "all"
-        ),
-        checks_case("cart rods 1e-3 m", "length", _const(cart, l1=1e-3, l2=1e-3), "any"),
-        checks_case("cart rods 1e3 m", "length", _const(cart, l1=1e3, l2=1e3)),
-        checks_case("cart rods 1e-2 m / 10 m", "length", _const(cart, l1=1e-2, l2=10.0)),
-        checks_case("cart rods 10 m / 1e-2 m", "length", _const(cart, l1=10.0, l2=1e-2)),
-        checks_case("cart rods 1e-3 m / 1e3 m", "length", _const(cart, l1=1e-3, l2=1e3), "all"),
-        checks_case("cart rods 1e3 m / 1e-3 m", "length", _const(cart, l1=1e3, l2=1e-3), "all"),
-        Case("cart m1 → 0: trust study", "near singular", trust_case),
-        Case("cart det M: closed form vs LU", "near singular", det_case),
-        Case("double pendulum det M: closed form vs LU", "near singular", dp_det_case),
-        checks_case(
-            "cart m1 = 1e-6 kg (warn)", "near singular", _const(cart, m1=1e-6), "any", _aligned_states
-        ),
-        checks_case(
-            "cart m1 = 1e-12 kg (refuse aligned)",
-            "near singular",
-            _const(cart, m1=1e-12),
-            "some",
-            _aligned_states,
-        ),
-        checks_case("point masses (I1 = I2 = 0)", "point mass", _const(dp_default.replace, I1=0.0, I2=0.0)),
-        checks_case(
-            "centres of mass at the joints (r = 0)", "point mass", _const(dp_default.replace, r1=0.0, r2=0.0)
-        ),
-        checks_case("point mass link 1, r2 = 0", "point mass", _const(dp_default.replace, I1=0.0, r2=0.0)),
-        large_angle_case("double pendulum |θ| ≈ 1e6 rad", _const(default, "double_pendulum")),
-        large_angle_case("cart |θ| ≈ 1e6 rad", _const(default, "cart_double_pendulum")),
-        high_speed_case("double pendulum |q̇| ≤ 1e3", _const(default, "double_pendulum")),
-        high_speed_case("cart |q̇| ≤ 1e3", _const(default, "cart_double_pendulum")),
-        checks_case("double pendulum b = 1e4", "stiff damping", _const(dp_default.replace, b1=1e4, b2=1e4)),
-        checks_case("cart d = 1e4", "stiff damping", _const(cart, d1=1e4, d2=1e4, d3=1e4)),
-        stiff_sim_case(
-            "double pendulum b = 1e4: simulate",
-            _const(dp_default.replace, b1=STIFF_DAMPING, b2=STIFF_DAMPING),
-            (-math.pi / 2 + 0.5, 0.3),
-        ),
-        stiff_sim_case(
-            "cart d = 1e4: simulate",
-            _const(cart, d1=STIFF_DAMPING, d2=STIFF_DAMPING, d3=STIFF_DAMPING),
-            (0.0, math.pi - 0.5, math.pi + 0.3),
-        ),
-        long_horizon_case("double pendulum 1e4 s, conservative"),
-        checks_case("double pendulum g = 0", "zero gravity", _const(dp_default.replace, g=0.0)),
-        checks_case("cart g = 0", "zero gravity", _const(cart, g=0.0)),
-        zero_gravity_sim_case(
-            "double pendulum g = 0: simulate",
-            _const(dp_default.replace, g=0.0, b1=0.0, b2=0.0),
-            (0.3, 0.5),
-            (1.0, -2.0),
-            0,
-            "p_θ1",
-        ),
-        zero_gravity_sim_case(
-            "cart g = 0: simulate",
-            _const(cart, g=0.0, d1=0.0, d2=0.0, d3=0.0),
-            (0.0, 0.3, -0.4),
-            (0.5, 1.0, -2.0),
-            0,
-            "p_q",
-        ),
-        Case("NaN, inf, negative, zero", "invalid input", invalid_input_case),
-    ]
-    return cases
+    return [hard_set_case(e) if isinstance(e, HardSet) else e for e in CATALOGUE]
 
 
 CASE_NAMES = tuple(c.name for c in catalogue())
