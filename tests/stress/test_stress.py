@@ -170,7 +170,7 @@ class EnergyPump(CartDoublePendulum):
 
 
 class WrongCoriolis(DoublePendulum):
-    """One Coriolis term flipped in both C and the seed's C: q̈ disagrees with the energy."""
+    """One Coriolis term flipped in both C and ``seed_coriolis_matrix`` (C + D): q̈ disagrees with the energy."""
 
     def seed_coriolis_matrix(self, q, v):
         C = super().seed_coriolis_matrix(q, v)
