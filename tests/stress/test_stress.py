@@ -170,7 +170,7 @@ class EnergyPump(CartDoublePendulum):
 
 
 class WrongCoriolis(DoublePendulum):
-    """One Coriolis term flipped in both C and ``seed_coriolis_matrix`` (C + D): q̈ disagrees with the energy."""
+    """One Coriolis term flipped in C and in ``seed_coriolis_matrix`` (C + D): q̈ disagrees with E."""
 
     def seed_coriolis_matrix(self, q, v):
         C = super().seed_coriolis_matrix(q, v)
@@ -204,7 +204,7 @@ def _entry(name: str) -> HardSet:
                 CART,
                 {"d1": 1e4, "d2": 1e4, "d3": 1e4},
                 kind="stiff",
-                q0=(0.0, 3.0, 3.4),
+                start=((0.0, 3.0, 3.4),),
             ),
             EnergyPump,
         ),

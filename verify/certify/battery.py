@@ -98,10 +98,9 @@ def stress_items(
     on ``urdf``, the URDF being certified (text, path or as read by ``load_description``; the
     project's own for the set if None).
     """
+    from pendverify.robot.writer import urdf_for
     from pendverify.stress import cases, framework
     from pendverify.stress import catalogue as stress
-
-    from pendverify.robot.writer import urdf_for
 
     cls = model_class(model_cls)
     urdf = urdf_for(params) if urdf is None else urdf

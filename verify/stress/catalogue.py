@@ -107,10 +107,8 @@ class HardSet:
     kind: str = "checks"  # a key of ``KINDS``
     expect: str = "none"  # what the trust rule may refuse (``framework.EXPECT``)
     states: str = ""  # hard states added to the sampled ones: a key of ``HARD_STATES``
-    q0: tuple[float, ...] = ()  # where a simulation starts
-    v0: tuple[float, ...] = ()
-    cyclic: int = 0  # zero gravity: the coordinate whose momentum is conserved, and its label
-    momentum: str = ""
+    start: tuple = ()  # a simulation's q0 (and q̇0; from rest without)
+    momentum: tuple = ()  # zero gravity: (the cyclic coordinate, its momentum's label)
 
     def params(self):
         p = default(self.model).replace(**self.values)
@@ -133,6 +131,11 @@ def _dp_scaled(s: float) -> dict:
     return {"l1": s, "l2": s, "r1": s, "r2": s, "I1": (s, s), "I2": (s, s)}
 
 
+def _dp_mass_ratio(r: float) -> dict:
+    """m1/m2 = r: m1 and I1 × r·m2/m1, from the default m1 = 1 kg, m2 = 0.8 kg."""
+    return {"m1": r * 0.8, "I1": (r, 0.8)}
+
+
 def _aligned(model) -> list[State]:
     """The cart's aligned states, where det M ∝ m1 (the trust study's), and θ1 = θ2 = 0 at rest."""
     zero_u, zero_w = np.zeros(len(model.inputs)), np.zeros(len(model.disturbances))
@@ -143,139 +146,76 @@ def _aligned(model) -> list[State]:
 
 #: hard states a set adds to the sampled ones, by name
 HARD_STATES = {"aligned": _aligned}
-#: link 1 of the double pendulum m1/m2 = r: m1 and I1 × r·m2/m1 (default m1 = 1 kg, m2 = 0.8 kg)
-_DP_MASS_RATIO = 0.8
-_DAMPED = {"b1": STIFF_DAMPING, "b2": STIFF_DAMPING}
-_CART_DAMPED = {"d1": STIFF_DAMPING, "d2": STIFF_DAMPING, "d3": STIFF_DAMPING}
+MASS, LENGTH, SINGULAR, POINT = "mass ratio", "length", "near singular", "point mass"
+STIFF, ZERO_G, ANGLE, SPEED = "stiff damping", "zero gravity", "large angle", "high speed"
+_B, _D = ("b1", "b2"), ("d1", "d2", "d3")
+_HANGING = (-math.pi / 2 + 0.5, 0.3)  # 0.5 rad from hanging, link 2 bent by 0.3 rad
+_CART_STIFF_Q0 = (0.0, math.pi - 0.5, math.pi + 0.3)
+_LONG = _dp_scaled(2000.0)  # a mild double pendulum: the default at l1 = 1 km (period ≈ 1 min)
 
 CATALOGUE: tuple[HardSet | Case, ...] = (
-    HardSet("cart/bobs mass 1e-6", "mass ratio", CART, {"m": 1.25e-6}),
-    HardSet("cart/bobs mass 1e6", "mass ratio", CART, {"m": 1.25e6}),
-    HardSet("cart bob1/bob2 mass 1e-6", "mass ratio", CART, {"m1": 0.75e-6}, expect="any"),
-    HardSet("cart bob1/bob2 mass 1e6", "mass ratio", CART, {"m1": 0.75e6}),
-    HardSet(
-        "link1/link2 mass 1e-6",
-        "mass ratio",
-        DP,
-        factors={"m1": 1e-6 * _DP_MASS_RATIO, "I1": (1e-6, _DP_MASS_RATIO)},
-    ),
-    HardSet(
-        "link1/link2 mass 1e6",
-        "mass ratio",
-        DP,
-        factors={"m1": 1e6 * _DP_MASS_RATIO, "I1": (1e6, _DP_MASS_RATIO)},
-    ),
-    HardSet("double pendulum lengths ×1e-3 (mm)", "length", DP, factors=_dp_scaled(1e-3)),
-    HardSet("double pendulum lengths ×1e3 (km)", "length", DP, factors=_dp_scaled(1e3)),
-    HardSet("double pendulum l1 1e-2 m, l2 10 m", "length", DP, factors=_dp_lengths(0.02, 10 / 0.45)),
-    HardSet("double pendulum l1 10 m, l2 1e-2 m", "length", DP, factors=_dp_lengths(20.0, 0.01 / 0.45)),
-    HardSet(
-        "double pendulum l1 1e-3 m, l2 1e3 m",
-        "length",
-        DP,
-        factors=_dp_lengths(2e-3, 1e3 / 0.45),
-        expect="all",
-    ),
-    HardSet(
-        "double pendulum l1 1e3 m, l2 1e-3 m",
-        "length",
-        DP,
-        factors=_dp_lengths(2e3, 1e-3 / 0.45),
-        expect="all",
-    ),
-    HardSet("cart rods 1e-3 m", "length", CART, {"l1": 1e-3, "l2": 1e-3}, expect="any"),
-    HardSet("cart rods 1e3 m", "length", CART, {"l1": 1e3, "l2": 1e3}),
-    HardSet("cart rods 1e-2 m / 10 m", "length", CART, {"l1": 1e-2, "l2": 10.0}),
-    HardSet("cart rods 10 m / 1e-2 m", "length", CART, {"l1": 10.0, "l2": 1e-2}),
-    HardSet("cart rods 1e-3 m / 1e3 m", "length", CART, {"l1": 1e-3, "l2": 1e3}, expect="all"),
-    HardSet("cart rods 1e3 m / 1e-3 m", "length", CART, {"l1": 1e3, "l2": 1e-3}, expect="all"),
-    Case("cart m1 → 0: trust study", "near singular", trust_case),
-    Case("cart det M: closed form vs LU", "near singular", det_case),
-    Case("double pendulum det M: closed form vs LU", "near singular", dp_det_case),
-    HardSet("cart m1 = 1e-6 kg (warn)", "near singular", CART, {"m1": 1e-6}, expect="any", states="aligned"),
-    HardSet(
-        "cart m1 = 1e-12 kg (refuse aligned)",
-        "near singular",
-        CART,
-        {"m1": 1e-12},
-        expect="some",
-        states="aligned",
-    ),
-    HardSet("point masses (I1 = I2 = 0)", "point mass", DP, {"I1": 0.0, "I2": 0.0}),
-    HardSet("centres of mass at the joints (r = 0)", "point mass", DP, {"r1": 0.0, "r2": 0.0}),
-    HardSet("point mass link 1, r2 = 0", "point mass", DP, {"I1": 0.0, "r2": 0.0}),
-    HardSet("double pendulum |θ| ≈ 1e6 rad", "large angle", DP, kind="large angle"),
-    HardSet("cart |θ| ≈ 1e6 rad", "large angle", CART, kind="large angle"),
-    HardSet("double pendulum |q̇| ≤ 1e3", "high speed", DP, kind="high speed"),
-    HardSet("cart |q̇| ≤ 1e3", "high speed", CART, kind="high speed"),
-    HardSet("double pendulum b = 1e4", "stiff damping", DP, {"b1": 1e4, "b2": 1e4}),
-    HardSet("cart d = 1e4", "stiff damping", CART, {"d1": 1e4, "d2": 1e4, "d3": 1e4}),
-    HardSet(
-        "double pendulum b = 1e4: simulate",
-        "stiff damping",
-        DP,
-        _DAMPED,
-        kind="stiff",
-        q0=(-math.pi / 2 + 0.5, 0.3),
-    ),
-    HardSet(
-        "cart d = 1e4: simulate",
-        "stiff damping",
-        CART,
-        _CART_DAMPED,
-        kind="stiff",
-        q0=(0.0, math.pi - 0.5, math.pi + 0.3),
-    ),
-    # a mild, conservative double pendulum: the default scaled to l1 = 1 km (period ≈ 1 min), 0.5 rad
-    # from hanging, link 2 bent by 0.3 rad
-    HardSet(
-        "double pendulum 1e4 s, conservative",
-        "long horizon",
-        DP,
-        {"b1": 0.0, "b2": 0.0},
-        _dp_scaled(2000.0),
-        kind="long horizon",
-        q0=(-math.pi / 2 + 0.5, 0.3),
-    ),
-    HardSet("double pendulum g = 0", "zero gravity", DP, {"g": 0.0}),
-    HardSet("cart g = 0", "zero gravity", CART, {"g": 0.0}),
-    HardSet(
-        "double pendulum g = 0: simulate",
-        "zero gravity",
-        DP,
-        {"g": 0.0, "b1": 0.0, "b2": 0.0},
-        kind="zero gravity",
-        q0=(0.3, 0.5),
-        v0=(1.0, -2.0),
-        cyclic=0,
-        momentum="p_θ1",
-    ),
-    HardSet(
-        "cart g = 0: simulate",
-        "zero gravity",
-        CART,
-        {"g": 0.0, "d1": 0.0, "d2": 0.0, "d3": 0.0},
-        kind="zero gravity",
-        q0=(0.0, 0.3, -0.4),
-        v0=(0.5, 1.0, -2.0),
-        cyclic=0,
-        momentum="p_q",
-    ),
+    HardSet("cart/bobs mass 1e-6", MASS, CART, {"m": 1.25e-6}),
+    HardSet("cart/bobs mass 1e6", MASS, CART, {"m": 1.25e6}),
+    HardSet("cart bob1/bob2 mass 1e-6", MASS, CART, {"m1": 0.75e-6}, expect="any"),
+    HardSet("cart bob1/bob2 mass 1e6", MASS, CART, {"m1": 0.75e6}),
+    HardSet("link1/link2 mass 1e-6", MASS, DP, {}, _dp_mass_ratio(1e-6)),
+    HardSet("link1/link2 mass 1e6", MASS, DP, {}, _dp_mass_ratio(1e6)),
+    HardSet("double pendulum lengths ×1e-3 (mm)", LENGTH, DP, {}, _dp_scaled(1e-3)),
+    HardSet("double pendulum lengths ×1e3 (km)", LENGTH, DP, {}, _dp_scaled(1e3)),
+    HardSet("double pendulum l1 1e-2 m, l2 10 m", LENGTH, DP, {}, _dp_lengths(0.02, 10 / 0.45)),
+    HardSet("double pendulum l1 10 m, l2 1e-2 m", LENGTH, DP, {}, _dp_lengths(20.0, 0.01 / 0.45)),
+    HardSet("double pendulum l1 1e-3 m, l2 1e3 m", LENGTH, DP, {}, _dp_lengths(2e-3, 1e3 / 0.45), "checks",
+            "all"),
+    HardSet("double pendulum l1 1e3 m, l2 1e-3 m", LENGTH, DP, {}, _dp_lengths(2e3, 1e-3 / 0.45), "checks",
+            "all"),
+    HardSet("cart rods 1e-3 m", LENGTH, CART, {"l1": 1e-3, "l2": 1e-3}, expect="any"),
+    HardSet("cart rods 1e3 m", LENGTH, CART, {"l1": 1e3, "l2": 1e3}),
+    HardSet("cart rods 1e-2 m / 10 m", LENGTH, CART, {"l1": 1e-2, "l2": 10.0}),
+    HardSet("cart rods 10 m / 1e-2 m", LENGTH, CART, {"l1": 10.0, "l2": 1e-2}),
+    HardSet("cart rods 1e-3 m / 1e3 m", LENGTH, CART, {"l1": 1e-3, "l2": 1e3}, expect="all"),
+    HardSet("cart rods 1e3 m / 1e-3 m", LENGTH, CART, {"l1": 1e3, "l2": 1e-3}, expect="all"),
+    Case("cart m1 → 0: trust study", SINGULAR, trust_case),
+    Case("cart det M: closed form vs LU", SINGULAR, det_case),
+    Case("double pendulum det M: closed form vs LU", SINGULAR, dp_det_case),
+    HardSet("cart m1 = 1e-6 kg (warn)", SINGULAR, CART, {"m1": 1e-6}, expect="any", states="aligned"),
+    HardSet("cart m1 = 1e-12 kg (refuse aligned)", SINGULAR, CART, {"m1": 1e-12}, expect="some",
+            states="aligned"),
+    HardSet("point masses (I1 = I2 = 0)", POINT, DP, {"I1": 0.0, "I2": 0.0}),
+    HardSet("centres of mass at the joints (r = 0)", POINT, DP, {"r1": 0.0, "r2": 0.0}),
+    HardSet("point mass link 1, r2 = 0", POINT, DP, {"I1": 0.0, "r2": 0.0}),
+    HardSet("double pendulum |θ| ≈ 1e6 rad", ANGLE, DP, kind=ANGLE),
+    HardSet("cart |θ| ≈ 1e6 rad", ANGLE, CART, kind=ANGLE),
+    HardSet("double pendulum |q̇| ≤ 1e3", SPEED, DP, kind=SPEED),
+    HardSet("cart |q̇| ≤ 1e3", SPEED, CART, kind=SPEED),
+    HardSet("double pendulum b = 1e4", STIFF, DP, dict.fromkeys(_B, 1e4)),
+    HardSet("cart d = 1e4", STIFF, CART, dict.fromkeys(_D, 1e4)),
+    HardSet("double pendulum b = 1e4: simulate", STIFF, DP, dict.fromkeys(_B, STIFF_DAMPING), kind="stiff",
+            start=(_HANGING,)),
+    HardSet("cart d = 1e4: simulate", STIFF, CART, dict.fromkeys(_D, STIFF_DAMPING), kind="stiff",
+            start=(_CART_STIFF_Q0,)),
+    HardSet("double pendulum 1e4 s, conservative", "long horizon", DP, dict.fromkeys(_B, 0.0), _LONG,
+            "long horizon", start=(_HANGING,)),
+    HardSet("double pendulum g = 0", ZERO_G, DP, {"g": 0.0}),
+    HardSet("cart g = 0", ZERO_G, CART, {"g": 0.0}),
+    HardSet("double pendulum g = 0: simulate", ZERO_G, DP, {"g": 0.0, **dict.fromkeys(_B, 0.0)}, kind=ZERO_G,
+            start=((0.3, 0.5), (1.0, -2.0)), momentum=(0, "p_θ1")),
+    HardSet("cart g = 0: simulate", ZERO_G, CART, {"g": 0.0, **dict.fromkeys(_D, 0.0)}, kind=ZERO_G,
+            start=((0.0, 0.3, -0.4), (0.5, 1.0, -2.0)), momentum=(0, "p_q")),
     Case("NaN, inf, negative, zero", "invalid input", invalid_input_case),
-)
+)  # fmt: skip
 
-#: what each kind of hard set runs: (name, the set, the model class, the entry) → Case
+#: what each kind of hard set runs: (the entry, the set, the model class) → Case
 KINDS = {
     "checks": lambda e, params_fn, cls: checks_case(
         e.name, e.group, params_fn, e.expect, HARD_STATES[e.states] if e.states else None, cls
     ),
-    "large angle": lambda e, params_fn, cls: large_angle_case(e.name, params_fn, cls),
-    "high speed": lambda e, params_fn, cls: high_speed_case(e.name, params_fn, cls),
-    "stiff": lambda e, params_fn, cls: stiff_sim_case(e.name, params_fn, e.q0, lambda: default(e.model), cls),
-    "long horizon": lambda e, params_fn, cls: long_horizon_case(e.name, params_fn, e.q0, cls),
-    "zero gravity": lambda e, params_fn, cls: zero_gravity_sim_case(
-        e.name, params_fn, e.q0, e.v0, e.cyclic, e.momentum, cls
+    ANGLE: lambda e, params_fn, cls: large_angle_case(e.name, params_fn, cls),
+    SPEED: lambda e, params_fn, cls: high_speed_case(e.name, params_fn, cls),
+    "stiff": lambda e, params_fn, cls: stiff_sim_case(
+        e.name, params_fn, *e.start, lambda: default(e.model), cls
     ),
+    "long horizon": lambda e, params_fn, cls: long_horizon_case(e.name, params_fn, *e.start, cls),
+    ZERO_G: lambda e, params_fn, cls: zero_gravity_sim_case(e.name, params_fn, *e.start, *e.momentum, cls),
 }
 
 
