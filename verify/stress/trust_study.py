@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 import mpmath as mp
 import numpy as np
 
-from pendverify.analytic import MODELS, CartDoublePendulum, CartDoublePendulumParams
+from pendverify.analytic import MODELS
 from pendverify.analytic.params import default_parameter_file, load_parameter_file
 from pendverify.checks import trust
 from pendverify.checks.trust import REFUSE_REL
@@ -142,7 +142,7 @@ class StudyResult:
 
 def _measure(params, label, y, v, u, w) -> StudyRow:
 
-    model = CartDoublePendulum(params)
+    model = MODELS[params.model](params)
     system = PinocchioSystem.for_params(params)
     verdict = trust.assess(model, y, system)
     root = np.sqrt(model.diagonal_scale(y))
@@ -187,7 +187,7 @@ def _limit(rows: list[StudyRow], ok) -> float:
     return limit
 
 
-def zero_mass_demo(base: CartDoublePendulumParams):
+def zero_mass_demo(base):
     """Pinocchio with m1 = 0 (set in the loaded model; a parameter set refuses it).
 
     Returns (ABA's q̈ at θ2 = θ1 + 1e-12, whether ``check_conditioning`` refused).
@@ -199,7 +199,7 @@ def zero_mass_demo(base: CartDoublePendulumParams):
     system.model.inertias[2] = pin.Inertia(0.0, inertia.lever, inertia.inertia)
     system.data = system.model.createData()
     y, v, u, _ = study_states()["theta2=theta1+1e-12"]
-    model = CartDoublePendulum(base)
+    model = MODELS[base.model](base)
     tau = model.input_matrix() @ u - model.damping_matrix() @ v
     with np.errstate(all="ignore"):
         accel = system.acceleration(y, v, tau)
@@ -210,7 +210,7 @@ def zero_mass_demo(base: CartDoublePendulumParams):
     return accel, False
 
 
-def trust_study(base: CartDoublePendulumParams, masses=STUDY_MASSES) -> StudyResult:
+def trust_study(base, masses=STUDY_MASSES) -> StudyResult:
     """The m1 → 0 sweep of the cart reference system at the study states."""
     rows = [
         _measure(base.replace(m1=m1), label, *state)
