@@ -24,10 +24,8 @@ ALLOWED = {
     "verify/robot/writer.py",  # the seeds' URDF writers (a registry entry each)
     "verify/robot/erd.py",  # example-robot-data's double pendulums are the double_pendulum seed
     # the reference systems' stress catalogue (``pendverify stress`` without --analytic: which model,
-    # which sets, which hard states, as data) and their own studies; every case runs as any model's
+    # which sets, which hard states, as data); every case takes its model and set from it
     "verify/stress/catalogue.py",
-    "verify/stress/reference_cases.py",
-    "verify/stress/trust_study.py",  # the cart's m1 → 0 study that measured the trust rule
     # the seeds' work–precision problems (``bench accuracy`` without --scene); any model's
     # problems are ``bench/problems.py`` (``--scene``)
     "verify/bench/seed_problems.py",

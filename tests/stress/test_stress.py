@@ -259,7 +259,7 @@ def test_det_case_fails_on_a_cancelling_det(monkeypatch):
     monkeypatch.setattr(
         CartDoublePendulum, "det_mass_matrix", lambda self, y: float(np.linalg.det(self.mass_matrix(y)))
     )
-    result = reference_cases.det_case(framework.Context(framework.QUICK), "det")
+    result = stress.run_case(_case("cart det M: closed form vs LU"), framework.Context(framework.QUICK))
     assert not result.passed and result.error > 1e-10
 
 

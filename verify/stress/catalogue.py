@@ -64,6 +64,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from pendverify.analytic import MODELS
+from pendverify.analytic.params import default_parameter_file, load_parameter_file
 from pendverify.checks.sampling import State
 from pendverify.display import html_table, listed
 from pendverify.robot.writer import urdf_for
@@ -79,17 +80,16 @@ from pendverify.stress.framework import (
     checks_case,
     on_description,
 )
-from pendverify.stress.reference_cases import (
-    default,
-    det_case,
-    dp_det_case,
-    invalid_input_case,
-    trust_case,
-)
+from pendverify.stress.reference_cases import det_case, dp_det_case, invalid_input_case, trust_case
 from pendverify.stress.sim_cases import long_horizon_case, stiff_sim_case, zero_gravity_sim_case
 from pendverify.stress.trust_study import StudyResult, study_states
 
 DP, CART = "double_pendulum", "cart_double_pendulum"
+
+
+def default(model: str):
+    """A reference system's default parameter set (its shipped TOML file)."""
+    return load_parameter_file(default_parameter_file(model))[2]
 
 
 # --- the catalogue, as data -----------------------------------------------------------------------
@@ -174,9 +174,11 @@ CATALOGUE: tuple[HardSet | Case, ...] = (
     HardSet("cart rods 10 m / 1e-2 m", LENGTH, CART, {"l1": 10.0, "l2": 1e-2}),
     HardSet("cart rods 1e-3 m / 1e3 m", LENGTH, CART, {"l1": 1e-3, "l2": 1e3}, expect="all"),
     HardSet("cart rods 1e3 m / 1e-3 m", LENGTH, CART, {"l1": 1e3, "l2": 1e-3}, expect="all"),
-    Case("cart m1 → 0: trust study", SINGULAR, trust_case),
-    Case("cart det M: closed form vs LU", SINGULAR, det_case),
-    Case("double pendulum det M: closed form vs LU", SINGULAR, dp_det_case),
+    Case("cart m1 → 0: trust study", SINGULAR, trust_case(lambda: default(CART))),
+    Case("cart det M: closed form vs LU", SINGULAR, det_case(lambda: default(CART))),
+    # point masses: det → m1 r1² m2 r2² at θ2 = 0
+    Case("double pendulum det M: closed form vs LU", SINGULAR,
+         dp_det_case(lambda: default(DP).replace(I1=0.0, I2=0.0))),
     HardSet("cart m1 = 1e-6 kg (warn)", SINGULAR, CART, {"m1": 1e-6}, expect="any", states="aligned"),
     HardSet("cart m1 = 1e-12 kg (refuse aligned)", SINGULAR, CART, {"m1": 1e-12}, expect="some",
             states="aligned"),
@@ -201,7 +203,8 @@ CATALOGUE: tuple[HardSet | Case, ...] = (
             start=((0.3, 0.5), (1.0, -2.0)), momentum=(0, "p_θ1")),
     HardSet("cart g = 0: simulate", ZERO_G, CART, {"g": 0.0, **dict.fromkeys(_D, 0.0)}, kind=ZERO_G,
             start=((0.0, 0.3, -0.4), (0.5, 1.0, -2.0)), momentum=(0, "p_q")),
-    Case("NaN, inf, negative, zero", "invalid input", invalid_input_case),
+    Case("NaN, inf, negative, zero", "invalid input",
+         invalid_input_case(lambda: (default(DP), default(CART)))),
 )  # fmt: skip
 
 #: what each kind of hard set runs: (the entry, the set, the model class) → Case

@@ -31,7 +31,7 @@ from pendverify.checks.verification import trusted
 from pendverify.errors import PendverifyError
 from pendverify.robot.description import LoadedDescription, load_description
 from pendverify.robot.system import PinocchioSystem
-from pendverify.stress.trust_study import StudyResult, cart_study
+from pendverify.stress.trust_study import StudyResult, trust_study
 from pendverify.validate import model_states
 
 SEED = DEFAULT_SEED
@@ -137,10 +137,11 @@ class Context:
             self.systems[params] = system
         return system
 
-    def trust_study(self) -> StudyResult:
-        """The cart reference system's m1 → 0 study (``pendverify.stress.trust_study``), run once."""
+    def trust_study(self, base) -> StudyResult:
+        """The m1 → 0 study of the set ``base`` (``pendverify.stress.trust_study``), run once per context:
+        the catalogue's cases that read it ask for the same set."""
         if self.study is None:
-            self.study = cart_study(self.settings.study_masses)
+            self.study = trust_study(base, self.settings.study_masses)
         return self.study
 
 

@@ -14,7 +14,6 @@ from collections.abc import Callable
 import numpy as np
 
 from pendverify.analytic import MODELS
-from pendverify.analytic.params import default_parameter_file, load_parameter_file
 from pendverify.checks.trust import EPS, KAPPA_K, REFUSE_REL, assess
 from pendverify.errors import PendverifyError
 from pendverify.stress.framework import DP_DET_MASSES, Context, StressResult
@@ -22,13 +21,12 @@ from pendverify.stress.trust_study import det_accuracy
 from pendverify.validate import finite_state, model_state
 
 
-def default(model: str):
-    """A reference system's default parameter set (its shipped TOML file)."""
-    return load_parameter_file(default_parameter_file(model))[2]
+def trust_case(base_fn) -> Callable[[Context, str], StressResult]:
+    """The trust study of the set ``base_fn()`` (m1 → 0) judged: the guard is conservative."""
+    return lambda ctx, name: _trust_result(ctx.trust_study(base_fn()), name)
 
 
-def trust_case(ctx: Context, name: str) -> StressResult:
-    study = ctx.trust_study()
+def _trust_result(study, name: str) -> StressResult:
     accepted = [r for r in study.rows if r.level != "refuse"]
     worst = max(accepted, key=lambda r: r.worst / r.bound)
     within = all(r.worst <= REFUSE_REL for r in accepted)
@@ -57,9 +55,13 @@ def trust_case(ctx: Context, name: str) -> StressResult:
     )
 
 
-def det_case(ctx: Context, name: str) -> StressResult:
-    """The cart's closed-form det (non-negative terms) stays at ε level even where LU fails."""
-    study = ctx.trust_study()
+def det_case(base_fn) -> Callable[[Context, str], StressResult]:
+    """The cart's closed-form det (non-negative terms) stays at ε level even where LU fails (the trust
+    study of ``base_fn()``)."""
+    return lambda ctx, name: _det_result(ctx.trust_study(base_fn()), name)
+
+
+def _det_result(study, name: str) -> StressResult:
     finite_m = [r for r in study.rows if r.kappa_scaled < 1 / EPS]  # M itself representable
     worst_cf = max(r.det_closed_form for r in finite_m)
     worst_lu = max(finite_m, key=lambda r: r.det_lu)
@@ -79,9 +81,13 @@ def det_case(ctx: Context, name: str) -> StressResult:
     )
 
 
-def dp_det_case(ctx: Context, name: str) -> StressResult:
-    """The double pendulum's closed-form det, αδ − δ² − β²cos²θ2, is a difference: no better than LU."""
-    base = default("double_pendulum").replace(I1=0.0, I2=0.0)  # point masses: det → m1 r1² m2 r2² at θ2 = 0
+def dp_det_case(base_fn) -> Callable[[Context, str], StressResult]:
+    """The double pendulum's closed-form det, αδ − δ² − β²cos²θ2, is a difference: no better than LU
+    (on ``base_fn()`` with m1 of ``DP_DET_MASSES``)."""
+    return lambda ctx, name: _dp_det_result(base_fn(), name)
+
+
+def _dp_det_result(base, name: str) -> StressResult:
     rows = []
     for m1 in DP_DET_MASSES:
         params = base.replace(m1=m1)
@@ -110,10 +116,14 @@ def dp_det_case(ctx: Context, name: str) -> StressResult:
 
 
 # --- invalid input ----------------------------------------------------------------------------
-def invalid_input_case(ctx: Context, name: str) -> StressResult:
+def invalid_input_case(sets_fn) -> Callable[[Context, str], StressResult]:
+    """Bad states, inputs and parameters of the two sets ``sets_fn()`` (the double pendulum's, the
+    cart's) each raise a PendverifyError."""
+    return lambda ctx, name: _invalid_input_result(*sets_fn(), name)
 
-    dp, cp = default("double_pendulum"), default("cart_double_pendulum")
-    model = MODELS["double_pendulum"](dp)
+
+def _invalid_input_result(dp, cp, name: str) -> StressResult:
+    model = MODELS[dp.model](dp)
     attempts: dict[str, Callable[[], object]] = {
         "NaN state": lambda: model_state(model, [math.nan, 0.0]),
         "infinite rate": lambda: model_state(model, [0.0, 0.0], [0.0, math.inf]),

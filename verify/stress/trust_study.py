@@ -31,7 +31,6 @@ import mpmath as mp
 import numpy as np
 
 from pendverify.analytic import MODELS
-from pendverify.analytic.params import default_parameter_file, load_parameter_file
 from pendverify.checks import trust
 from pendverify.checks.trust import REFUSE_REL
 from pendverify.errors import IllConditionedError
@@ -248,8 +247,3 @@ def det_accuracy(params, q) -> tuple[float, float]:
     with mp.workdps(REFERENCE_DIGITS):
         exact = mp.det(reference_mass_matrix(numbers, q))
         return _rel(model.det_mass_matrix(q), [exact]), _rel(system.det_mass_matrix(q), [exact])
-
-
-def cart_study(masses=STUDY_MASSES) -> StudyResult:
-    """``trust_study`` on the cart reference system's default parameter set."""
-    return trust_study(load_parameter_file(default_parameter_file("cart_double_pendulum"))[2], masses)
