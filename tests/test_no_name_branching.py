@@ -23,13 +23,9 @@ ALLOWED = {
     "verify/robot/seed_geometry.py",  # the seeds' URDF readers (a registry entry each)
     "verify/robot/writer.py",  # the seeds' URDF writers (a registry entry each)
     "verify/robot/erd.py",  # example-robot-data's double pendulums are the double_pendulum seed
-    # the seed-specific stress cases (``pendverify stress`` without --analytic) and their sets;
-    # any model's hard cases are ``stress/generic.py`` and ``stress/singular.py``
+    # the reference systems' stress catalogue (``pendverify stress`` without --analytic: which model,
+    # which sets, which hard states, as data); every case takes its model and set from it
     "verify/stress/catalogue.py",
-    "verify/stress/cases.py",
-    "verify/stress/sim_cases.py",
-    "verify/stress/seed_params.py",
-    "verify/stress/trust_study.py",  # the cart's m1 → 0 study that measured the trust rule
     # the seeds' work–precision problems (``bench accuracy`` without --scene); any model's
     # problems are ``bench/problems.py`` (``--scene``)
     "verify/bench/seed_problems.py",

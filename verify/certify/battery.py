@@ -98,10 +98,12 @@ def stress_items(
     on ``urdf``, the URDF being certified (text, path or as read by ``load_description``; the
     project's own for the set if None).
     """
+    from pendverify.robot.writer import urdf_for
     from pendverify.stress import cases, framework
     from pendverify.stress import catalogue as stress
 
     cls = model_class(model_cls)
+    urdf = urdf_for(params) if urdf is None else urdf
     ctx = framework.Context(framework.FULL, settings.seed, urdf=urdf, model_cls=cls)
     # at |θ| ≈ 1e6 rad a set with κ̃ in the hundreds is beyond the trust rule: such
     # states are refused and recorded, and every state that is compared must pass
