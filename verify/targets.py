@@ -146,6 +146,10 @@ def model_target(
         if read is not None:
             notes += parameter_differences(read, params)
     elif params is None:
+        if read is None and not is_builtin(cls):
+            raise PendverifyError(
+                f"{where(cls)}: give the parameter set ({PARAMS_HINT}): the model file gives no PARAMS"
+            )
         if read is None:
             raise PendverifyError(
                 f"{system.source}: give the parameter set ({PARAMS_HINT}): a {cls.name} URDF alone "
@@ -249,12 +253,21 @@ def _parameters_model(source) -> type[ClosedFormModel]:
     )
 
 
+def urdf_needed(model_cls: type[ClosedFormModel], why: str = "") -> PendverifyError:
+    """The error of a model file or class given without the URDF to compare it with (``why``: in brackets)."""
+    return PendverifyError(
+        f"{where(model_cls)}: give --urdf (urdf= in the Python API): the URDF to verify {model_cls.name} "
+        f"against{f' ({why})' if why else ''}"
+    )
+
+
 def select_targets(
     model_cls: type[ClosedFormModel] | None = None,
     urdf: str | Path | None = None,
     params=None,
     *,
     erd_urdfs: bool = True,
+    origin: str | None = None,
 ) -> Selection:
     """The targets ``pendverify check`` and ``pendverify.check`` verify, from their arguments.
 
@@ -272,7 +285,9 @@ def select_targets(
       default check labels ``erd:NAME``;
     * a URDF (or ``erd:NAME`` with another model or with parameters): the model against it, with
       the parameters given, or read off the URDF;
-    * parameters without a URDF: a built-in model's set against the URDF the project writes for it.
+    * parameters without a URDF: a built-in model's set against the URDF the project writes for it,
+      labelled by the parameter file's stem; ``origin`` names where a set given as values came
+      from (a scene), as a file's path does (default: the inline parameters).
 
     A model file or class needs a URDF; bad input raises ``PendverifyError``.
     """
@@ -285,10 +300,7 @@ def select_targets(
             return Selection([erd_target(stem, path)])
         urdf, name = path, f"erd_{stem}"
     if urdf is None and model_cls is not None and not is_builtin(model_cls):
-        raise PendverifyError(
-            f"{where(model_cls)}: give --urdf (urdf= in the Python API): "
-            f"the URDF to verify {model_cls.name} against"
-        )
+        raise urdf_needed(model_cls)
     values = None
     if params is not None:
         model_cls = model_cls or _parameters_model(params)
@@ -307,7 +319,9 @@ def select_targets(
             raise ParameterError(str(params), f"parameters.{exc.key}", exc.value, exc.rule) from None
     if values is not None:
         if isinstance(params, (str, Path)):
-            return Selection([params_target(values, Path(params).stem, str(params), model_cls)])
+            origin = str(params)
+        if origin is not None:
+            return Selection([params_target(values, Path(origin).stem, origin, model_cls)])
         return Selection([params_target(values, model_cls=model_cls)])
     names = [model_cls.name] if model_cls is not None else list(MODELS)
     selection = Selection([default_target(n) for n in names])
