@@ -1,8 +1,11 @@
 """What to verify: pairs of a closed-form model and a URDF loaded in Pinocchio.
 
-``select_targets`` is the one dispatcher: ``pendverify check`` and ``pendverify.check``
-turn their arguments (a model, a URDF or ``erd:NAME``, parameters, the erd flag) into
-targets through it, so the same arguments verify the same targets.  The targets are
+``select_targets`` is the one dispatcher: ``check`` (the command and ``pendverify.check``),
+``certify`` (``pendverify.certify.issue.certification_input``), ``mutate``, the scenes'
+Pinocchio side (``pendverify.simulation.dynamics``) and the review folder turn their arguments
+(a model, a URDF or ``erd:NAME``, parameters, the erd flag) into targets through it, so the same
+arguments verify the same targets and a mistake gets one sentence
+(``tests/test_one_target_dispatcher.py`` looks for a second).  The targets are
 
 * the default parameter sets against their committed URDFs (``urdf/``);
 * example-robot-data's double-pendulum URDFs against the double-pendulum reference system's
