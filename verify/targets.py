@@ -139,8 +139,7 @@ def model_target(
     is labelled ``{model}:{name}``; ``name`` defaults to the file's stem without its format's
     suffixes (``arm.urdf.xacro`` → ``arm``), or ``urdf-text`` for text.
     """
-    g = getattr(params, "g", None)
-    system = PinocchioSystem.for_model(cls, urdf, g)
+    system = target_system(cls, urdf, params)
     notes = []
     read = system.geometry.params
     if params is None and cls.default_params is not None:
@@ -208,8 +207,21 @@ def params_target(
         check_model_outputs(model)
     except ParameterError as exc:  # a value beyond double's range: name the file it came from
         raise ParameterError(origin, f"parameters.{exc.key}", exc.value, exc.rule) from None
-    system = PinocchioSystem.for_model(cls, urdf_for(params), params.g, f"<URDF of {origin}>")
+    system = target_system(cls, None, params, origin)
     return Target(f"{cls.name}:{name}", model, system, system.source)
+
+
+def target_system(
+    cls: type[ClosedFormModel], urdf, params: ParameterSet | None, origin: str | None = None
+) -> PinocchioSystem:
+    """Pinocchio's side of a target: ``urdf`` (as ``model_target`` takes it) seen in ``cls``'s
+    coordinates at the set's g, or, with no URDF, the URDF the project writes for the set
+    (``pendverify.robot.writer``), its source ``<URDF of {origin}>``.  A scene's engines take
+    theirs here too (``pendverify.simulation.dynamics``): the model itself is not evaluated."""
+    g = getattr(params, "g", None)
+    if urdf is not None:
+        return PinocchioSystem.for_model(cls, urdf, g)
+    return PinocchioSystem.for_model(cls, urdf_for(params), g, f"<URDF of {origin}>")
 
 
 def is_builtin(cls: type[ClosedFormModel]) -> bool:

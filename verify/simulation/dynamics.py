@@ -38,7 +38,7 @@ from pendverify.simulation.lqr import (
     pinocchio_linearisation,
 )
 from pendverify.simulation.scene import Scene
-from pendverify.targets import select_targets
+from pendverify.targets import target_system
 
 
 @dataclass
@@ -162,8 +162,7 @@ def _system(scene: Scene, params, urdf: str | None, needed_by: str) -> Pinocchio
             f"missing key: {what} on a URDF, and the model file {scene.model_file} has none "
             "the project can write (give urdf = FILE or --urdf)",
         )
-    (target,) = select_targets(scene.model_cls, urdf, params, erd_urdfs=False, origin=scene.name).targets
-    return target.system
+    return target_system(scene.model_cls, urdf, params, scene.name)
 
 
 def _prepare_lqr(law, model, system, scene) -> None:
