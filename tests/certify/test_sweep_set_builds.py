@@ -4,7 +4,9 @@ One set of a sweep goes through the whole battery (checks, stress cases, simulat
 ``sweep_task.certify_chunk``, the function a worker runs.  Counted while it runs: systems built
 from a description (``PinocchioSystem.for_model``), descriptions read
 (``robot.description.load_description``, counted at ``description_format``, which it calls
-once per read) and URDF texts parsed by urdfdom (``pinocchio.buildModelFromXML``).  The stress
+once per read), XML documents parsed with the strict readers' rules (``defusedxml``'s
+``fromstring`` in ``robot.xml_reading.parse_xml``) and URDF texts parsed by urdfdom
+(``pinocchio.buildModelFromXML``).  The stress
 cases at another g (zero gravity) derive their system from the set's
 (``PinocchioSystem.with_gravity``) instead of building one.
 """
@@ -20,7 +22,7 @@ import pytest
 
 from pendverify.certify.sweep import load_sweep
 from pendverify.certify.sweep_task import certify_chunk
-from pendverify.robot import description
+from pendverify.robot import description, xml_reading
 from pendverify.robot.system import PinocchioSystem
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
@@ -44,6 +46,7 @@ def _counting(monkeypatch) -> Counter:
     with_gravity = getattr(PinocchioSystem, "with_gravity", None)
     reads = description.description_format
     urdfdom = pin.buildModelFromXML
+    xml = xml_reading.DET.fromstring
 
     def counted(key, fn):
         def call(*args, **kwargs):
@@ -57,6 +60,7 @@ def _counting(monkeypatch) -> Counter:
         monkeypatch.setattr(PinocchioSystem, "with_gravity", counted("derived", with_gravity))
     monkeypatch.setattr(description, "description_format", counted("read", reads))
     monkeypatch.setattr(pin, "buildModelFromXML", counted("parsed", urdfdom))
+    monkeypatch.setattr(xml_reading.DET, "fromstring", counted("xml", xml))
     return counts
 
 
@@ -69,4 +73,4 @@ def test_a_sweep_set_builds_its_system_once_and_reads_its_urdf_once(tmp_path, mo
     (result,) = certify_chunk(sweep.model, sweep.sets[1:2], settings, sweep.urdf, sweep.base)
     assert result.passed, result
     assert {i.name.split(":")[0] for i in result.items} == {"check", "stress", "invariant"}, result.items
-    assert counts == Counter(built=1, read=1, parsed=1, derived=1), f"{plugin=} {counts=}"
+    assert counts == Counter(built=1, read=1, xml=1, parsed=1, derived=1), f"{plugin=} {counts=}"
