@@ -186,8 +186,8 @@ def _prepare(params_file: str, settings: BatterySettings) -> _SetRun:
     system = PinocchioSystem.for_model(cls, urdf, params.g, f"<URDF being certified: {cls.name}>")
     parts = {
         "checks": lambda: check_items(cls(params), system, settings),
-        "stress": lambda: stress_items(cls, params, settings, system.urdf, system),
-        "invariants": lambda: invariant_items(cls, params, urdf, settings, system=system),
+        "stress": lambda: stress_items(cls, params, settings, urdf),
+        "invariants": lambda: invariant_items(cls, params, urdf, settings),
     }
     floors, contexts = {}, {}
     for part in ("checks", "stress"):
