@@ -121,6 +121,9 @@ class Context:
     urdf: str | LoadedDescription | None = None
     #: the model class of the sets (``on_description`` sets it per case)
     model_cls: type | None = None
+    #: the system of ``urdf`` at one g, if the caller has it (the battery's): the cases' systems at
+    #: other g derive from it (``PinocchioSystem.with_gravity``) instead of reading ``urdf`` again
+    urdf_system: PinocchioSystem | None = field(default=None, repr=False, compare=False)
     #: the systems made so far, by parameter set (cases on the same set share one)
     systems: dict = field(default_factory=dict, repr=False, compare=False)
 
@@ -130,9 +133,14 @@ class Context:
             return self.systems[params]
         except (KeyError, TypeError):
             pass
-        if not isinstance(self.urdf, LoadedDescription):  # read once: the cases' sets differ in g only
-            self.urdf = load_description(self.urdf, "<URDF being compared>")
-        system = PinocchioSystem.for_model(self.model_cls, self.urdf, getattr(params, "g", None))
+        g = getattr(params, "g", None)
+        given = self.urdf_system
+        if given is not None:  # the URDF's system, built once: the cases' sets differ in g only
+            system = given if g is None or g == given.g else given.with_gravity(g)
+        else:
+            if not isinstance(self.urdf, LoadedDescription):  # read once: the cases' sets differ in g only
+                self.urdf = load_description(self.urdf, "<URDF being compared>")
+            system = PinocchioSystem.for_model(self.model_cls, self.urdf, g)
         with contextlib.suppress(TypeError):  # a set that cannot be a key is not kept
             self.systems[params] = system
         return system
