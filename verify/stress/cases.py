@@ -12,8 +12,10 @@ from collections.abc import Callable
 import numpy as np
 
 from pendverify.analytic import MODELS
+from pendverify.checks.evidence import Evidence
 from pendverify.checks.sampling import RATE_RANGE, State
 from pendverify.checks.trust import EPS, KAPPA_K, REFUSE_REL, assess
+from pendverify.checks.verdict import NOT_RUN
 from pendverify.errors import PendverifyError
 from pendverify.stress.framework import (
     ANGLE_SHIFT,
@@ -21,12 +23,12 @@ from pendverify.stress.framework import (
     HIGH_RATE,
     Case,
     Context,
-    StressResult,
     compare,
     judged_ratio,
     model_of,
     refusals_as_expected,
     sampled_states,
+    stress_evidence,
     stress_result,
     verified,
 )
@@ -72,11 +74,11 @@ def large_angle_case(
     result says so) rather than compare unshifted states and call that an invariance.
     """
 
-    def run(ctx: Context, name: str) -> StressResult:
+    def run(ctx: Context, name: str) -> Evidence:
         params = params_fn()
         model = model_of(params, model_cls)
         if not any(model.angular):
-            return StressResult(
+            return stress_evidence(
                 name,
                 "no angular coordinate",
                 None,
@@ -86,6 +88,7 @@ def large_angle_case(
                 None,
                 True,
                 "not run: no angle to shift",
+                level=NOT_RUN,
             )
         system = ctx.system(params)
         states = shifted_states(model, sampled_states(model, ctx), shift)
@@ -100,17 +103,17 @@ def large_angle_case(
             return stress_result(name, direct, expect, invariant, inv_ok, note)
         inv_worst = max(invariance.results, key=judged_ratio)
         invariant = (
-            f"2πk invariance (closed form at θ vs Pinocchio at θ mod 2π): {inv_worst.max_error:.2g} "
-            f"≤ {inv_worst.tolerance:.2g} ({inv_worst.check}); |θ| up to {angle:.3g} rad"
+            f"2πk invariance (closed form at θ vs Pinocchio at θ mod 2π): {inv_worst.error:.2g} "
+            f"≤ {inv_worst.tolerance:.2g} ({inv_worst.name}); |θ| up to {angle:.3g} rad"
         )
-        note = "" if inv_ok else f"FAIL invariance {inv_worst.check} at {inv_worst.worst_state['label']}"
+        note = "" if inv_ok else f"FAIL invariance {inv_worst.name} at {inv_worst.label}"
         return stress_result(name, direct, expect, invariant, inv_ok, note)
 
     return Case(name, "large angle", run)
 
 
 def high_speed_case(name: str, params_fn, model_cls=None) -> Case:
-    def run(ctx: Context, name: str) -> StressResult:
+    def run(ctx: Context, name: str) -> Evidence:
 
         params = params_fn()
         model = model_of(params, model_cls)
@@ -119,7 +122,7 @@ def high_speed_case(name: str, params_fn, model_cls=None) -> Case:
             dataclasses.replace(s, v=s.v * (HIGH_RATE / RATE_RANGE)) for s in sampled_states(model, ctx)
         ]
         comp = compare(name, model, system, states, ctx.seed)
-        finite = all(np.isfinite(r.max_abs_error) for r in comp.results)
+        finite = all(np.isfinite(r.extras["max_abs_error"]) for r in comp.results)
         rate = max(float(np.max(np.abs(s.v))) for s in states)
         invariant = f"|q̇| up to {rate:.3g}; all quantities finite: {'yes' if finite else 'NO'}"
         return stress_result(name, comp, "none", invariant, finite)
@@ -135,7 +138,7 @@ def _aligned_states(model) -> list[State]:
     ]
 
 
-def trust_case(ctx: Context, name: str) -> StressResult:
+def trust_case(ctx: Context, name: str) -> Evidence:
     study = ctx.trust_study()
     accepted = [r for r in study.rows if r.level != "refuse"]
     worst = max(accepted, key=lambda r: r.worst / r.bound)
@@ -150,7 +153,7 @@ def trust_case(ctx: Context, name: str) -> StressResult:
     notes = [study.zero_mass_note, *study.violations]
     if not conservative:
         notes.append("the guard accepts m1 below the measured trust limit")
-    return StressResult(
+    return stress_evidence(
         case=name,
         quantity=f"det, q̈, M⁻¹ vs 50-digit mpmath ({len(study.rows)} rows), worst accepted",
         error=worst.worst,
@@ -165,14 +168,14 @@ def trust_case(ctx: Context, name: str) -> StressResult:
     )
 
 
-def det_case(ctx: Context, name: str) -> StressResult:
+def det_case(ctx: Context, name: str) -> Evidence:
     """The cart's closed-form det (non-negative terms) stays at ε level even where LU fails."""
     study = ctx.trust_study()
     finite_m = [r for r in study.rows if r.kappa_scaled < 1 / EPS]  # M itself representable
     worst_cf = max(r.det_closed_form for r in finite_m)
     worst_lu = max(finite_m, key=lambda r: r.det_lu)
     tol = KAPPA_K * EPS
-    return StressResult(
+    return stress_evidence(
         case=name,
         quantity="closed-form det M vs 50 digits (LU of CRBA alongside)",
         error=worst_cf,
@@ -187,7 +190,7 @@ def det_case(ctx: Context, name: str) -> StressResult:
     )
 
 
-def dp_det_case(ctx: Context, name: str) -> StressResult:
+def dp_det_case(ctx: Context, name: str) -> Evidence:
     """The double pendulum's closed-form det, αδ − δ² − β²cos²θ2, is a difference: no better than LU."""
     base = default("double_pendulum").replace(I1=0.0, I2=0.0)  # point masses: det → m1 r1² m2 r2² at θ2 = 0
     rows = []
@@ -205,7 +208,7 @@ def dp_det_case(ctx: Context, name: str) -> StressResult:
         for m1, t2, c, lu, _ in rows
         if m1 <= 1e-6
     )
-    return StressResult(
+    return stress_evidence(
         case=name,
         quantity="max(closed-form det, LU det) error vs 50 digits, over K·ε·κ̃",
         error=max(worst[2], worst[3]),
@@ -218,7 +221,7 @@ def dp_det_case(ctx: Context, name: str) -> StressResult:
 
 
 # --- invalid input ----------------------------------------------------------------------------
-def invalid_input_case(ctx: Context, name: str) -> StressResult:
+def invalid_input_case(ctx: Context, name: str) -> Evidence:
 
     dp, cp = default("double_pendulum"), default("cart_double_pendulum")
     model = MODELS["double_pendulum"](dp)
@@ -241,7 +244,7 @@ def invalid_input_case(ctx: Context, name: str) -> StressResult:
             messages.append(f"{label}: {exc}")
         else:
             silent.append(label)
-    return StressResult(
+    return stress_evidence(
         case=name,
         quantity=f"{len(attempts)} bad inputs, each must raise a PendverifyError",
         error=float(len(silent)),

@@ -3,8 +3,8 @@
 These cases are about the two seed models (``pendverify stress`` without ``--analytic``);
 any model file gets the generic cases of ``pendverify.stress.generic``.
 
-Each case is a named function returning a ``StressResult``: the achieved
-relative error next to the tolerance used, κ(M) raw and after diagonal scaling
+Each case is a named function returning an ``Evidence`` (``pendverify.checks.evidence``): the
+achieved relative error next to the tolerance used, κ(M) raw and after diagonal scaling
 (the worst over the case's states), the simulation invariant where the case
 simulates, and pass/fail.  Seeds are fixed (``SEED``) and recorded.
 
@@ -55,6 +55,7 @@ import math
 import time
 from dataclasses import dataclass, field
 
+from pendverify.checks.evidence import Evidence
 from pendverify.display import html_table, listed
 from pendverify.stress.cases import (
     _aligned_states,
@@ -72,7 +73,6 @@ from pendverify.stress.framework import (
     Case,
     Context,
     Settings,
-    StressResult,
     checks_case,
 )
 from pendverify.stress.seed_params import cart, default, dp_link_lengths, dp_link_mass_ratio, dp_scaled
@@ -177,7 +177,7 @@ CASE_NAMES = tuple(c.name for c in catalogue())
 class StressReport:
     settings: Settings
     seed: int
-    results: list[StressResult] = field(default_factory=list)
+    results: list[Evidence] = field(default_factory=list)
     study: StudyResult | None = None
     elapsed_s: float = 0.0
     #: what the cases did not vary, and why (generic cases on a model file)
@@ -187,10 +187,11 @@ class StressReport:
 
     @property
     def passed(self) -> bool:
-        return all(r.passed for r in self.results)
+        """Whether no case failed (a case refused or not run, as it expects, does not fail)."""
+        return not any(r.failed for r in self.results)
 
     def __repr__(self) -> str:
-        failed = [r.case for r in self.results if not r.passed]
+        failed = [r.name for r in self.results if r.failed]
         head = (
             f"<StressReport {'pass' if self.passed else 'FAIL'}: {len(self.results)} cases, seed {self.seed}"
         )
@@ -199,22 +200,22 @@ class StressReport:
     def _repr_html_(self) -> str:
         """One row per case: its quantity, error, tolerance and verdict."""
         rows = [
-            (r.case, r.quantity, _figure(r.error), _figure(r.tolerance), "pass" if r.passed else "FAIL")
+            (r.name, r.detail, _figure(r.error), _figure(r.tolerance), "FAIL" if r.failed else "pass")
             for r in self.results
         ]
         caption = f"stress: {'pass' if self.passed else 'FAIL'}, seed {self.seed}"
         header = ("case", "quantity", "error", "tolerance", "result")
-        return html_table(header, rows, caption, [not r.passed for r in self.results])
+        return html_table(header, rows, caption, [r.failed for r in self.results])
 
 
 def _figure(value: float | None) -> str:
     return "—" if value is None else f"{value:.2e}"
 
 
-def run_case(case: Case, ctx: Context) -> StressResult:
+def run_case(case: Case, ctx: Context) -> Evidence:
     started = time.perf_counter()
     result = case.run(ctx, case.name)
-    result.seconds = time.perf_counter() - started
+    result.extras["seconds"] = time.perf_counter() - started
     result.seed = ctx.seed
     return result
 

@@ -28,12 +28,13 @@ import time
 
 from pendverify.checks.applicability import derived_notes
 from pendverify.checks.catalogue import skipped_notes
+from pendverify.checks.evidence import Evidence
 from pendverify.errors import PendverifyError, UnknownNameError
 from pendverify.robot.description import urdf_text
 from pendverify.robot.rebind import Binding
 from pendverify.stress.cases import high_speed_case, large_angle_case
 from pendverify.stress.catalogue import StressReport, run_case
-from pendverify.stress.framework import SEED, Case, Context, Settings, StressResult, checks_case
+from pendverify.stress.framework import SEED, Case, Context, Settings, checks_case, stress_evidence
 from pendverify.stress.singular import near_singular_case
 from pendverify.targets import plugin_target
 
@@ -58,11 +59,11 @@ NOT_VARIED = {
 def _on(case: Case, urdf: str, model_cls) -> Case:
     """``case`` compared with ``urdf`` seen through ``model_cls``."""
 
-    def run(ctx: Context, name: str) -> StressResult:
+    def run(ctx: Context, name: str) -> Evidence:
         try:
             return case.run(dataclasses.replace(ctx, urdf=urdf, model_cls=model_cls), name)
         except PendverifyError as exc:
-            return StressResult(name, "not run", None, None, None, None, None, False, f"FAIL {exc}")
+            return stress_evidence(name, "not run", None, None, None, None, None, False, f"FAIL {exc}")
 
     return Case(case.name, case.group, run)
 

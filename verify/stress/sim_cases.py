@@ -7,6 +7,7 @@ import math
 import numpy as np
 
 from pendverify.analytic import MODELS, DoublePendulumParams
+from pendverify.checks.evidence import Evidence
 from pendverify.checks.trust import EPS, conditioning
 from pendverify.stress import integrators as si
 from pendverify.stress.framework import (
@@ -19,8 +20,9 @@ from pendverify.stress.framework import (
     RK4_UNSTABLE,
     Case,
     Context,
-    StressResult,
     model_of,
+    stress_evidence,
+    stress_status,
 )
 from pendverify.stress.seed_params import default, dp_scaled
 
@@ -37,7 +39,7 @@ def _kappa(model, q):
 
 
 def stiff_sim_case(name: str, params_fn, q0, model_cls=None) -> Case:
-    def run(ctx: Context, name: str) -> StressResult:
+    def run(ctx: Context, name: str) -> Evidence:
 
         st = ctx.settings
         params = params_fn()
@@ -50,7 +52,7 @@ def stiff_sim_case(name: str, params_fn, q0, model_cls=None) -> Case:
         stable = implicit.blew_up_at is None and bool(np.all(np.isfinite(E)))
         monotone = stable and rise <= ENERGY_INCREASE_TOL
         c = _kappa(model, q0_)
-        result = StressResult(
+        result = stress_evidence(
             case=name,
             quantity="per-step energy rise, backward Euler (relative to |T|+|V| bound)",
             error=max(rise, 0.0) if stable else math.inf,
@@ -66,7 +68,7 @@ def stiff_sim_case(name: str, params_fn, q0, model_cls=None) -> Case:
             level=c.level,
         )
         if not monotone:
-            result.note = "; ".join(filter(None, [result.note, "explicit methods skipped"]))
+            result.notes.append("explicit methods skipped")
             return result
         growth = si.rk4_growth(
             si.jacobian(si.state_derivative_of(model), np.concatenate([q0_, v0])), st.stiff_step
@@ -76,16 +78,17 @@ def stiff_sim_case(name: str, params_fn, q0, model_cls=None) -> Case:
         adaptive = si.rk45(model, q0_, v0, st.explicit_horizon)
         light = si.rk45(MODELS[params.model](default(params.model)), q0_, v0, st.explicit_horizon)
         per_horizon = adaptive.steps * st.stiff_horizon / st.explicit_horizon
-        result.invariant += (
+        result.extras["invariant"] += (
             f"; RK4 at h={st.stiff_step:g}: "
             + (f"blows up after {explicit.blew_up_at} steps" if observed else "stays finite")
             + f" (predicted growth ×{growth:.1e}/step); RK45 needs {adaptive.steps} steps for "
             f"{st.explicit_horizon:g} s (≈{per_horizon:.1e} for {st.stiff_horizon:g} s) vs "
             f"{light.steps} at default damping"
         )
-        result.passed = predicted == observed and adaptive.blew_up_at is None and adaptive.steps > 0
+        passed = predicted == observed and adaptive.blew_up_at is None and adaptive.steps > 0
+        result.status = stress_status(passed, c.level)
         if predicted != observed:
-            result.note = (
+            result.notes.append(
                 f"RK4 stability predicted {'a blow-up' if predicted else 'none'}, observed the opposite"
             )
         return result
@@ -102,7 +105,7 @@ LONG_HORIZON_Q0 = (-math.pi / 2 + 0.5, 0.3)  # 0.5 rad from hanging, link 2 bent
 
 
 def long_horizon_case(name: str, params_fn=long_horizon_params, model_cls=None) -> Case:
-    def run(ctx: Context, name: str) -> StressResult:
+    def run(ctx: Context, name: str) -> Evidence:
 
         st = ctx.settings
         params = params_fn()
@@ -146,7 +149,7 @@ def long_horizon_case(name: str, params_fn=long_horizon_params, model_cls=None) 
             notes.append(
                 f"RK4 drift not a clean order-4 line (R² {min(r2_rk, r2_half):.2f}, ratio {ratio:.1f})"
             )
-        return StressResult(
+        return stress_evidence(
             case=name,
             quantity=f"Störmer–Verlet |ΔE|/E over {T:g} s: second half vs first half",
             error=late,
@@ -162,7 +165,7 @@ def long_horizon_case(name: str, params_fn=long_horizon_params, model_cls=None) 
 
 
 def zero_gravity_sim_case(name: str, params_fn, q0, v0, cyclic: int, label: str, model_cls=None) -> Case:
-    def run(ctx: Context, name: str) -> StressResult:
+    def run(ctx: Context, name: str) -> Evidence:
 
         st = ctx.settings
         params = params_fn()
@@ -176,7 +179,7 @@ def zero_gravity_sim_case(name: str, params_fn, q0, v0, cyclic: int, label: str,
         dE = si.energies(model, traj)
         e_rel = float(np.max(np.abs(dE - dE[0]))) / energy_scale(model, q0_, v0_)
         c = _kappa(model, q0_)
-        return StressResult(
+        return stress_evidence(
             case=name,
             quantity=f"momentum {label} drift / |p|, Störmer–Verlet",
             error=drift,
