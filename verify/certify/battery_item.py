@@ -10,16 +10,11 @@ invariants; the stress cases keep only their worst ratio, so it is None there)."
 
 from __future__ import annotations
 
-from pendverify.checks.verdict import REFUSED
+from pendverify.checks.evidence import item_verdict
 from pendverify.display import html_table
 
 #: the columns of a notebook's table of battery items (``items_html``)
 ITEM_HEADER = ("item", "kind", "error", "tolerance", "at", "result")
-
-
-def item_verdict(item) -> str:
-    """An item's result in a table: pass (a warning included), refused or FAIL."""
-    return "pass" if item.passed else ("refused" if item.status == REFUSED else "FAIL")
 
 
 def items_html(items, caption: str) -> str:

@@ -32,7 +32,8 @@ sentences the user must read.  ``model``, ``samples`` and ``seed`` say what it r
   ``invariant`` (a sentence, or None), ``refused`` (states refused), ``seconds``.
 
 The reports and certificates users read keep their own key names; ``check_record``,
-``invariant_record``, ``stress_record`` and ``item_record`` write them.  There the key
+``invariant_record``, ``stress_record`` and ``item_record`` write them (``stress_verdict`` and
+``item_verdict`` the result columns of the stress and battery tables).  There the key
 ``max_error`` of a check's JSON entry is the error at the worst ratio, while in an
 invariant's entry and a certificate item it is the largest error (``largest_error`` here).
 """
@@ -191,6 +192,11 @@ def stress_record(e: Evidence) -> dict:
         "seconds": x.get("seconds", 0.0),
         "verdict": stress_verdict(e),
     }
+
+
+def item_verdict(e: Evidence) -> str:
+    """A battery item's result in a table: pass (a warning included), refused or FAIL."""
+    return "pass" if e.passed else ("refused" if e.status == REFUSED else "FAIL")
 
 
 def item_record(e: Evidence) -> dict:

@@ -108,7 +108,7 @@ def register(sub) -> None:
 
 
 def _print_items(items) -> None:
-    from pendverify.certify.battery_item import item_verdict
+    from pendverify.checks.evidence import item_verdict
 
     width = max(len(i.name) for i in items)
     print(f"{''.ljust(width)}  {'largest':>9}  {'worst error/tolerance':^20}")
