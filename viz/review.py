@@ -47,7 +47,7 @@ class SceneReview:
     source: str  # the scene file's name, relative to the folder of scenes
     animation: str  # path of the animation, relative to index.html
     plot: str  # path of the energy plot, relative to index.html
-    invariants: list  # pendverify.simulation.invariants.InvariantResult
+    invariants: list  # pendverify.checks.evidence.Evidence, one per invariant
     passed: bool
     model: str = ""
     duration_s: float = 0.0
@@ -84,17 +84,17 @@ def _breakable(name: str) -> str:
 def check_matrix(report) -> str:
     """One row per check, one column per model: error / tolerance and the verdict."""
     models = list(dict.fromkeys(r.model for r in report.results))
-    checks = list(dict.fromkeys(r.check for r in report.results))
-    cell = {(r.check, r.model): r for r in report.results}
+    checks = list(dict.fromkeys(r.name for r in report.results))
+    cell = {(r.name, r.model): r for r in report.results}
 
     def td(check: str, model: str) -> str:
         r = cell.get((check, model))
         if r is None:
             return "<td></td>"
         verdict = "pass" if r.passed else "fail"
-        tip = f"worst state {_state(r.worst_state)}"
+        tip = f"worst state {_state(r.at)}"
         return (
-            f'<td class="num {verdict}" title="{_e(tip)}">{r.max_error:.1e} / {r.tolerance:.1e} '
+            f'<td class="num {verdict}" title="{_e(tip)}">{r.error:.1e} / {r.tolerance:.1e} '
             f"{'✓' if r.passed else '✗ FAIL'}</td>"
         )
 
@@ -128,9 +128,9 @@ def check_table(report) -> str:
     """
     rows = "\n".join(
         "<tr>"
-        f"<td>{_e(r.model)}</td><td>{_e(r.check)}</td>"
-        f'<td class="num">{r.max_error:.2e}</td><td class="num">{r.tolerance:.2e}</td>'
-        f"<td>{_e(_state(r.worst_state))}</td><td>{_verdict(r.passed)}</td>"
+        f"<td>{_e(r.model)}</td><td>{_e(r.name)}</td>"
+        f'<td class="num">{r.error:.2e}</td><td class="num">{r.tolerance:.2e}</td>'
+        f"<td>{_e(_state(r.at))}</td><td>{_verdict(r.passed)}</td>"
         "</tr>"
         for r in report.results
     )

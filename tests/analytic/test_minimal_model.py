@@ -60,7 +60,7 @@ def test_the_minimal_model_passes_and_the_report_says_what_was_derived(capsys):
     assert "aba: q̈ is derived from the model's M, C, H, D, B, W, not hand-written" in out
     report = pendverify.check(MODEL, URDF, PARAMS, samples=60)
     assert report.passed
-    checks = {r.check for r in report.results}
+    checks = {r.name for r in report.results}
     assert {"units", "crba", "rnea", "gravity", "coriolis", "skew", "aba", "energy", "damping"} == checks
 
 
@@ -86,7 +86,7 @@ def test_a_planted_error_in_the_minimal_m_still_fails_crba():
             return M + np.array([[0.0, 0.0], [0.0, 1e-4 * self.params.m2]])  # a stray m2·(0.01)²
 
     report = pendverify.check(Planted, URDF, PARAMS, samples=20)
-    failed = {r.check for r in report.failures()}
+    failed = {r.name for r in report.failures()}
     assert "crba" in failed
 
 

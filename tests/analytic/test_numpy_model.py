@@ -150,7 +150,7 @@ def test_a_given_v_is_checked_by_energy(factor, status, tmp_path):
     model = _file(tmp_path, _changed(PENDULUM.read_text(), "def D(p):", v + "def D(p):"))
     report = pendverify.check(model, PENDULUM_URDF, samples=60)
     assert "energy" in report.checks and report.status == status, report
-    assert [r.check for r in report.results if r.status == "fail"] == ([] if status == "pass" else ["energy"])
+    assert [r.name for r in report.results if r.status == "fail"] == ([] if status == "pass" else ["energy"])
 
 
 def test_p_gives_the_parameters_by_attribute_and_by_key(tmp_path):
@@ -243,7 +243,7 @@ def test_commands_that_read_closed_forms_with_sympy_refuse_in_one_line(tmp_path,
 
 def test_stress_and_simulate_take_the_files_params(tmp_path):
     report = stress(PENDULUM, PENDULUM_URDF, quick=True, cases=["nominal", "g = 0"])
-    assert [r.case for r in report.results] == ["nominal", "g = 0"]
+    assert [r.name for r in report.results] == ["nominal", "g = 0"]
     assert all(r.passed for r in report.results), report.results
     dp = _file(tmp_path, DOUBLE_PENDULUM + "PARAMS = " + repr(_values()) + "\n")
     run = simulate(load_scene(_scene(tmp_path, dp, DP_URDF, engine="both")))

@@ -297,10 +297,10 @@ def _params_file(tmp_path: Path, values: dict) -> Path:
 def test_stress_runs_without_the_near_singular_case_and_says_why(tmp_path):
     model, urdf, values = files(tmp_path, "cart-pole")
     report = stress(model, urdf, _params_file(tmp_path, values), quick=True)
-    names = [r.case for r in report.results]
+    names = [r.name for r in report.results]
     assert "nominal" in names and not any("near-singular" in n for n in names), names
     assert "no near-singular case: GymCartPole gives q̈ alone, no M" in " ".join(report.notes)
-    assert next(r for r in report.results if r.case == "nominal").passed
+    assert next(r for r in report.results if r.name == "nominal").passed
 
 
 def test_simulate_refuses_a_model_without_M_in_one_line(tmp_path):

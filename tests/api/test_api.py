@@ -21,6 +21,7 @@ import pendverify
 from pendverify.analytic import DoublePendulum, DoublePendulumParams
 from pendverify.analytic.params import default_parameter_file, load_parameter_file, read_toml
 from pendverify.analytic.plugin import validate_model_class
+from pendverify.checks.evidence import check_record
 from pendverify.checks.report import Report
 from pendverify.cli import main
 from pendverify.errors import PendverifyError
@@ -64,11 +65,11 @@ def test_check_builtin_name_gives_the_cli_table(capsys):
     assert report.passed and report.status == "pass"
     assert str(report) == report.table()
     # the evidence: every check, its error within its tolerance, where it was worst
-    assert {r.check for r in report.results} >= {"crba", "rnea", "coriolis", "aba", "energy"}
+    assert {r.name for r in report.results} >= {"crba", "rnea", "coriolis", "aba", "energy"}
     for r in report.results:
         assert r.model == "double_pendulum" and r.status == "pass"
-        assert 0 <= r.max_error <= r.tolerance < 1e-11, r
-        assert r.worst_state["label"]
+        assert 0 <= r.error <= r.tolerance < 1e-11, r
+        assert r.label
     assert report.states == {"double_pendulum": 410} and report.seed == 20260301
 
     status, cli = cli_table(capsys, "--model", "double_pendulum", "--no-erd")
@@ -138,7 +139,7 @@ def test_the_api_and_the_cli_check_the_same_targets_with_the_same_numbers(capsys
     assert document["states"] == report.states and document["skipped"] == report.skipped
     fields = ("model", "check", "max_error", "tolerance", "max_abs_error", "status")
     assert [tuple(r[f] for f in fields) for r in document["results"]] == [
-        tuple(getattr(r, f) for f in fields) for r in report.results
+        tuple(check_record(r)[f] for f in fields) for r in report.results
     ]
 
 
@@ -165,8 +166,8 @@ def test_a_built_in_name_checks_what_check_model_checks():
     # an erd:NAME target alone is the very row of the default check
     alone = pendverify.check(ERD_SIMPLE, samples=FEW)
     assert alone.models == (ERD_SIMPLE,) == pendverify.check(urdf=ERD_SIMPLE, samples=FEW).models
-    assert [(r.check, r.max_error) for r in alone.results] == [
-        (r.check, r.max_error) for r in with_erd.results if r.model == ERD_SIMPLE
+    assert [(r.name, r.error) for r in alone.results] == [
+        (r.name, r.error) for r in with_erd.results if r.model == ERD_SIMPLE
     ]
 
 
@@ -185,8 +186,8 @@ def test_plugin_file_with_its_urdf_and_parameters_passes_as_on_the_cli(capsys):
     assert pendverify.load_model(cls) is cls
     values = read_toml(CART_POLE[2])["parameters"]
     again = pendverify.check(cls, str(CART_POLE[1]), values, samples=FEW)
-    assert [(r.check, r.max_error, r.status) for r in again.results] == [
-        (r.check, r.max_error, r.status) for r in report.results
+    assert [(r.name, r.error, r.status) for r in again.results] == [
+        (r.name, r.error, r.status) for r in report.results
     ]
 
 
@@ -201,7 +202,7 @@ def test_builtin_with_parameters_from_a_file_a_mapping_or_urdf_text():
     assert isinstance(params, DoublePendulumParams)
     by_text = pendverify.check(DoublePendulum, urdf_for(params), params, samples=FEW)
     assert by_text.passed and list(by_text.states) == ["double_pendulum:urdf-text"]
-    assert [r.max_error for r in by_mapping.results] == [r.max_error for r in by_file.results]
+    assert [r.error for r in by_mapping.results] == [r.error for r in by_file.results]
 
 
 def test_targets_are_labelled_by_file_stem_by_urdf_text_or_by_the_callers_name():
@@ -289,7 +290,7 @@ def test_a_planted_coriolis_sign_error_fails_and_assert_verified_shows_the_table
 
     report = pendverify.check(SignFlip, urdf, values, samples=FEW)
     assert not report.passed and report.status == "fail"
-    failed = {r.check for r in report.failures()}
+    failed = {r.name for r in report.failures()}
     assert {"rnea", "aba"} <= failed
     assert "crba" not in failed and "gravity" not in failed
     assert "FAIL" in report.table()

@@ -16,8 +16,8 @@ from pendverify.analytic.interface import BiasOnlyModel
 from pendverify.analytic.module_names import NAMESPACE, module_name
 from pendverify.analytic.params import default_parameter_file, load_parameter_file
 from pendverify.analytic.plugin import load_model_class
+from pendverify.checks.evidence import Evidence
 from pendverify.checks.report import CheckRows, Report
-from pendverify.checks.result import CheckResult
 from pendverify.cli import main
 from pendverify.display import REPR_LIMIT, shortened
 from pendverify.robot.system import PinocchioSystem
@@ -78,7 +78,7 @@ def test_report_repr_is_short_and_says_verdict_size_and_models(report):
     # erd's mesh URDFs put link 1's centre of mass 2 µm off the joint line: a model-form term
     # within its threshold, which passes with a warning (the verdict "warn")
     assert text.startswith("<CheckReport warn: 46 checks on 4 model(s), ")
-    assert {r.status for r in report.results if r.check == "model-form"} == {"warn"}
+    assert {r.status for r in report.results if r.name == "model-form"} == {"warn"}
     assert f"{sum(report.states.values())} states, seed 20260301" in text
     assert "erd:double_pendulum_simple" in text
     assert len(repr(report.results)) > 10 * REPR_LIMIT  # what it replaces: the whole evidence
@@ -136,11 +136,10 @@ def test_report_item_access_by_check_name(report):
     assert rows.models == report.models and len(rows) == 4
     assert rows.models[0] == "double_pendulum" and rows.models[3] == "erd:double_pendulum_simple"
     one = rows["erd:double_pendulum"]
-    assert isinstance(one, CheckResult) and (one.model, one.check) == ("erd:double_pendulum", "crba")
+    assert isinstance(one, Evidence) and (one.model, one.name) == ("erd:double_pendulum", "crba")
     assert one is report["erd:double_pendulum", "crba"] is rows[1]
     assert rows.passed and rows.status == "pass"
-    assert rows.worst is max(rows, key=lambda r: r.max_error / r.tolerance)
-    assert (rows.max_error, rows.tolerance) == (rows.worst.max_error, rows.worst.tolerance)
+    assert rows.worst is max(rows, key=lambda r: r.error / r.tolerance)
     # checks a model does not run are not in its rows: the cart has no damping row
     assert report.checks[-1] == "model-form" and report["model-form"].models == (
         "erd:double_pendulum",
@@ -169,8 +168,8 @@ def test_check_rows_and_results_have_short_reprs_and_html(report):
     assert "worst 7.4" in text and "(erd:double_pendulum" in text  # the mesh URDFs' model-form term
     result = report["double_pendulum", "crba"]
     text = short(repr(result))
-    assert text.startswith("<CheckResult double_pendulum crba: pass, error ")
-    assert f"{result.max_error:.2e} vs tolerance {result.tolerance:.2e}" in text
+    assert text.startswith("<Evidence check double_pendulum crba: pass, error ")
+    assert f"{result.error:.2e} vs tolerance {result.tolerance:.2e}" in text
     parsed = cells(report["aba"]._repr_html_())
     assert [row[0] for row in parsed.rows[1:]] == list(report.models)
 
@@ -211,10 +210,12 @@ def test_scene_and_invariant_reprs_are_short_and_say_what_they_hold(run):
     )
     invariant = run.invariants[0]
     text = short(repr(invariant))
-    assert text.startswith(f"<InvariantResult {invariant.name!r}: error {invariant.error:.3g}, tolerance ")
-    assert text.endswith(": holds>")
-    failed = dataclasses.replace(invariant, passed=False)
-    assert repr(failed).endswith(": FAILS>")
+    assert text.startswith(
+        f"<Evidence invariant {invariant.name[:60]}: pass, error {invariant.error:.2e} vs "
+    )
+    assert text.endswith(f" at {invariant.label}>")
+    failed = dataclasses.replace(invariant, status="fail")
+    assert f": fail, error {invariant.error:.2e}" in repr(failed)
 
 
 def test_run_html_lists_every_invariant(run):
@@ -322,7 +323,7 @@ PUBLIC = [
     *(getattr(pendverify, name) for name in pendverify.__all__ if name != "__version__"),
     Report,
     CheckRows,
-    CheckResult,
+    Evidence,
     Run,
     PinocchioSystem,
     ClosedFormModel,

@@ -25,7 +25,7 @@ from pendverify.diagnosis.corpus import ModelScores
 from pendverify.display import REPR_LIMIT
 from pendverify.shipped import shipped_file
 from pendverify.stress.catalogue import StressReport
-from pendverify.stress.framework import QUICK, StressResult
+from pendverify.stress.framework import QUICK, stress_evidence
 from pendverify.symbolic.mutation_report import MutationReport, Outcome
 from pendverify.viz.review_folder import ReviewFolder
 
@@ -45,19 +45,21 @@ def objects(tmp_path_factory) -> dict[str, object]:
     issued = pendverify.certify_set(
         tmp / "certs", str(default_parameter_file("double_pendulum")), samples=FEW
     )
-    failed = Issued([dataclasses.replace(i, passed=False, name=i.name * 5) for i in issued.items])
-    many = [StressResult(f"case {i} " * 8, "M", 1e-15, 1e-13, 10.0, 2.0, None, i % 2 == 0) for i in range(60)]
+    failed = Issued([dataclasses.replace(i, status="fail", name=i.name * 5) for i in issued.items])
+    many = [
+        stress_evidence(f"case {i} " * 8, "M", 1e-15, 1e-13, 10.0, 2.0, None, i % 2 == 0) for i in range(60)
+    ]
     outcomes = [Outcome("mass_matrix", "swap", f"mutant {i} " * 6, "survived") for i in range(80)]
     return {
         "CheckReport": report,
         "CheckRows": report["crba"],
-        "CheckResult": report["crba"][0],
+        "Evidence (check)": report["crba"][0],
         "Run": run,
         "ImpliedParameters": implied,
         "Combination": implied.combinations[0],
         "Issued (certified)": issued,
         "Issued (not certified)": failed,
-        "BatteryItem": issued.items[0],
+        "Evidence (battery item)": issued.items[0],
         "Rechecked": pendverify.api.recheck(issued.path),
         "Trajectory": api.trajectory(run),
         "ModelReading": api.read_model("double_pendulum"),
@@ -75,13 +77,13 @@ def objects(tmp_path_factory) -> dict[str, object]:
 RESULTS = (
     "CheckReport",
     "CheckRows",
-    "CheckResult",
+    "Evidence (check)",
     "Run",
     "ImpliedParameters",
     "Combination",
     "Issued (certified)",
     "Issued (not certified)",
-    "BatteryItem",
+    "Evidence (battery item)",
     "Rechecked",
     "Trajectory",
     "ModelReading",
@@ -187,11 +189,11 @@ def test_a_plug_ins_row_is_found_by_the_models_name():
     report = pendverify.check(*CART_POLE, samples=FEW)
     assert report.models == ("cart_pole:cart_pole",)
     assert report["crba"]["cart_pole"] is report["crba"]["cart_pole:cart_pole"]
-    assert report["cart_pole", "aba"].check == "aba"
+    assert report["cart_pole", "aba"].name == "aba"
     with pytest.raises(KeyError, match=r"'cart_pole' is a model: report\[CHECK\]\['cart_pole'\]"):
         report["cart_pole"]
     rows = report["crba"]
-    assert isinstance(rows, CheckRows) and np.isfinite(rows.max_error)
+    assert isinstance(rows, CheckRows) and np.isfinite(rows.worst.error)
 
 
 # --- the guide's examples ---------------------------------------------------------------------------

@@ -11,11 +11,11 @@ from __future__ import annotations
 from pathlib import Path
 
 from pendverify.certify.battery import BatteryRun, BatterySettings
-from pendverify.certify.battery_item import BatteryItem
 from pendverify.certify.certificate import build_certificate, certificate_text, digest_of, summary_of
 from pendverify.certify.model_source import ModelSource, sha256_text
 from pendverify.certify.names import envelope_name
 from pendverify.certify.signing import envelope_line, fingerprint, statement
+from pendverify.checks.evidence import Evidence
 from pendverify.robot.writer import urdf_for
 
 from ..conftest import default_params
@@ -25,7 +25,11 @@ SETTINGS = BatterySettings(samples=2, sim_duration=0.02)
 
 def make_certificate(name: str = "double_pendulum", key=None) -> dict:
     params = default_params("double_pendulum")
-    items = [BatteryItem("check:crba", "check", 1e-15, 1e-9, 2, SETTINGS.seed, True, max_error=1e-15)]
+    items = [
+        Evidence(
+            "check", "check:crba", "pass", 1e-15, 1e-9, largest_error=1e-15, samples=2, seed=SETTINGS.seed
+        )
+    ]
     keyid = fingerprint(key.public_key()) if key is not None else None
     battery = BatteryRun(items, notes=[])
     return build_certificate(

@@ -49,4 +49,5 @@ def test_the_large_angle_case_says_it_is_not_run_without_an_angle(tmp_path):
     params = load_params(cls, r.params)
     ctx = Context(QUICK, urdf=str(r.robot), model_cls=cls)
     result = run_case(large_angle_case("large angles", lambda: params, cls), ctx)
-    assert result.note == "not run: no angle to shift" and result.error is None
+    assert result.notes == ["not run: no angle to shift"] and result.error is None
+    assert result.status == "not run"

@@ -14,6 +14,7 @@ from pendverify.certify.certificate import build_certificate, certificate_text, 
 from pendverify.certify.issue import recheck
 from pendverify.certify.model_source import ModelSource
 from pendverify.certify.simulations import ABA, COMPILED, CROSS_CHECK_STATES, invariant_items
+from pendverify.checks.evidence import item_record
 from pendverify.numerics import fast_scene
 from pendverify.numerics.energies import GeneratedEnergies
 from pendverify.robot.writer import urdf_for
@@ -70,13 +71,13 @@ def _items(model_cls, params, engines=None):
 def test_every_battery_scene_runs_on_the_fast_path_and_records_it(name):
     params = default_params(name)
     items = _items(MODELS[name], params)
-    assert {i.engine for i in items.values()} == {COMPILED}, items
+    assert {i.extras["engine"] for i in items.values()} == {COMPILED}, items
     assert all(i.passed for i in items.values()), [(i.name, i.error, i.tolerance) for i in items.values()]
     cross = items["invariant:gravity:engines"]
     assert cross.samples == CROSS_CHECK_STATES and "ABA on the URDF" in cross.detail
-    assert all(i.kind == "invariant" and i.as_dict()["engine"] == COMPILED for i in items.values())
+    assert all(i.kind == "invariant" and item_record(i)["engine"] == COMPILED for i in items.values())
     old = _items(MODELS[name], params, dict.fromkeys(EFFECTS, ABA))
-    assert {i.engine for i in old.values()} == {ABA} and "invariant:gravity:engines" not in old
+    assert {i.extras["engine"] for i in old.values()} == {ABA} and "invariant:gravity:engines" not in old
     assert set(old) == set(items) - {"invariant:gravity:engines"}
     assert all(i.passed for i in old.values())
 
@@ -91,7 +92,7 @@ def test_a_planted_error_in_the_closed_form_fails_an_invariant_on_the_fast_path(
     Pinocchio's, which conserve whatever the closed form says: there the same item passes."""
     params = default_params("double_pendulum")
     fast = _items(planted, params)
-    assert fast["invariant:gravity:energy"].engine == COMPILED
+    assert fast["invariant:gravity:energy"].extras["engine"] == COMPILED
     assert not fast["invariant:gravity:energy"].passed, why
     assert not fast["invariant:gravity:engines"].passed, why  # the generated code is not the URDF's
     aba = _items(planted, params, dict.fromkeys(EFFECTS, ABA))
@@ -111,7 +112,7 @@ def test_a_certificate_without_engines_is_rechecked_on_aba(tmp_path):
     path.write_text(certificate_text(cert))
     result = recheck(str(path))
     assert result.passed, result.differences
-    assert {i.engine for i in result.items if i.kind == "invariant"} == {ABA}
+    assert {i.extras["engine"] for i in result.items if i.kind == "invariant"} == {ABA}
     # an item recording the compiled engine runs there: its figures are not ABA's
     last = cert["checks"][-1]
     assert last["name"] == "invariant:actuation:work–energy"
@@ -119,14 +120,14 @@ def test_a_certificate_without_engines_is_rechecked_on_aba(tmp_path):
     cert["digest"]["value"] = digest_of(cert)
     path.write_text(certificate_text(cert))
     again = recheck(str(path))
-    assert {i.name: i.engine for i in again.items}[last["name"]] == COMPILED
+    assert next(i for i in again.items if i.name == last["name"]).extras["engine"] == COMPILED
     assert again.differences and all(d.startswith(last["name"]) for d in again.differences), again.differences
 
 
 def test_a_model_sympy_cannot_read_runs_on_aba_and_says_so():
     """``math.cos`` is not readable by SymPy: no generated code, so each scene falls back to ABA."""
     items = _items(WrongCosineInH, default_params("double_pendulum"))
-    assert {i.engine for i in items.values()} == {ABA} and "invariant:gravity:engines" not in items
+    assert {i.extras["engine"] for i in items.values()} == {ABA} and "invariant:gravity:engines" not in items
     assert all("Pinocchio's ABA" in i.detail for i in items.values())
 
 

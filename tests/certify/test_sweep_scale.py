@@ -14,11 +14,11 @@ import pytest
 
 from pendverify.certify import sweep_run
 from pendverify.certify.battery import BatteryRun
-from pendverify.certify.battery_item import BatteryItem
 from pendverify.certify.sweep import load_sweep
 from pendverify.certify.sweep_run import MAX_CHUNK, chunk_size, run_sweep
 from pendverify.certify.sweep_summary import FAILURES_SHOWN, SweepSummary
 from pendverify.certify.sweep_task import SetResult
+from pendverify.checks.evidence import Evidence
 
 SWEEP = """
 model = "double_pendulum"
@@ -89,7 +89,8 @@ def _fake_chunk(model, sets, settings, base_urdf, base_values):
     out = []
     for name, values in sets:
         k = int(name.rsplit("-", 1)[1])
-        item = BatteryItem("check:x", "check", float(k % 10), 10.0, 1, 0, k % 7 != 3)
+        status = "pass" if k % 7 != 3 else "fail"
+        item = Evidence("check", "check:x", status, float(k % 10), 10.0, largest_error=None, samples=1)
         out.append(SetResult(name, values, BatteryRun([item], notes=[])))
     return out
 
@@ -151,7 +152,9 @@ def test_chunks_are_small_enough_to_share_the_work():
 
 
 def _result(k: int, passed: bool, ratio: float) -> SetResult:
-    item = BatteryItem("check:x", "check", ratio, 1.0, 1, 0, passed)
+    item = Evidence(
+        "check", "check:x", "pass" if passed else "fail", ratio, 1.0, largest_error=None, samples=1
+    )
     return SetResult(f"m-{k:03d}", {}, BatteryRun([item], notes=[]))
 
 

@@ -11,9 +11,9 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+from pendverify.checks.evidence import Evidence
 from pendverify.checks.junit import to_junit
 from pendverify.checks.report import Report
-from pendverify.checks.result import CheckResult
 from pendverify.checks.verdict import FAIL, PASS, REFUSED, WARN
 from pendverify.cli import main
 
@@ -56,10 +56,9 @@ def test_a_planted_error_is_a_failure_carrying_the_table_row(tmp_path, capsys):
     assert int(ET.parse(out).getroot().get("failures")) >= 1
 
 
-def _result(check: str, status: str, note: str = "") -> CheckResult:
-    r = CheckResult("m<&>", check, "d", 1e-3, 1e-15, 1e-3, 1, 1, {"label": "s", "q": []}, status != FAIL)
-    r.status, r.notes = status, [note] if note else []
-    return r
+def _result(check: str, status: str, note: str = "") -> Evidence:
+    notes = [note] if note else []
+    return Evidence("check", check, status, 1e-3, 1e-15, {"label": "s", "q": []}, notes=notes, model="m<&>")
 
 
 def test_refused_and_warned_checks_and_escaping():

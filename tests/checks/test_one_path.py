@@ -80,12 +80,12 @@ def test_a_state_has_the_same_figures_in_a_batch_of_1_7_and_2000_in_any_order(na
     forward = run_checks(name, target.model, target.system, states, settings.seed)
     backward = run_checks(name, target.model, target.system, states[::-1], settings.seed)
     for f, b in zip(forward, backward, strict=True):
-        assert (f.check, f.passed, f.status) == (b.check, b.passed, b.status)
-        pairs = [(f.max_error, b.max_error), (f.max_abs_error, b.max_abs_error)]
-        if f.worst_state["label"] == b.worst_state["label"]:  # the tolerance is the worst state's
+        assert (f.name, f.passed, f.status) == (b.name, b.passed, b.status)
+        pairs = [(f.error, b.error), (f.extras["max_abs_error"], b.extras["max_abs_error"])]
+        if f.label == b.label:  # the tolerance is the worst state's
             pairs.append((f.tolerance, b.tolerance))
         for x, y in pairs:
-            assert abs(x - y) <= ULPS * EPS * max(x, y), (f.check, x, y)
+            assert abs(x - y) <= ULPS * EPS * max(x, y), (f.name, x, y)
 
 
 def test_large_angles_refused_and_reduced_alike_in_any_batch():
@@ -135,5 +135,5 @@ def test_a_closed_form_sympy_cannot_read_runs_in_python_and_the_report_says_so()
 
 def test_a_planted_error_in_a_closed_form_run_in_python_is_caught():
     report = _report(BranchingTypo)
-    energy = next(r for r in report.results if r.check == "energy")
-    assert not energy.passed and energy.max_error > 1e-3
+    energy = next(r for r in report.results if r.name == "energy")
+    assert not energy.passed and energy.error > 1e-3

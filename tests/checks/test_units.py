@@ -238,9 +238,9 @@ def _cart_pole_check(model: Path, **kwargs):
 def test_the_row_comes_first_fails_and_is_carried_by_json_and_junit(tmp_path):
     model = _planted(tmp_path, ("p.I + p.mp * p.r**2]", "p.I + p.mp * p.r]"))
     report = _cart_pole_check(model, explain=False)
-    assert report.results[0].check == "units" and report.status == "fail"
+    assert report.results[0].name == "units" and report.status == "fail"
     row = report["units"][0]
-    assert row.status == "fail" and row.max_error == 1.0 and row.worst_state["label"] == "M[2,2]"
+    assert row.status == "fail" and row.error == 1.0 and row.label == "M[2,2]"
     (note,) = row.notes
     assert note == (
         "M[2,2]: the term mp*r has kg·m but I has kg·m² (an entry of M for the angle theta alone is kg·m²) "
@@ -264,7 +264,7 @@ def test_a_dimension_error_fails_where_every_value_agrees(tmp_path):
     urdf = module.cart_pole_urdf(module.CartPoleParams(**values))
     model = _planted(tmp_path, ("p.I + p.mp * p.r**2", "p.I + p.mp * p.r"), count=-1)
     report = pendverify.check(model, urdf, values, samples=SAMPLES)
-    others = [r for r in report.results if r.check != "units"]
+    others = [r for r in report.results if r.name != "units"]
     assert others and all(r.status == "pass" for r in others), report.table()
     assert report["units"][0].status == "fail" and report.status == "fail" and not report.diagnoses
     assert report.passed is False
@@ -273,7 +273,7 @@ def test_a_dimension_error_fails_where_every_value_agrees(tmp_path):
 def test_sound_model_gets_a_passing_first_row(tmp_path):
     report = _cart_pole_check(CART_POLE)
     row = report.results[0]
-    assert (row.check, row.status, row.max_error, row.worst_state["label"]) == (
+    assert (row.name, row.status, row.error, row.label) == (
         "units", "pass", 0.0, "14 of 18 entries"
     )  # fmt: skip
     assert report.passed
@@ -323,7 +323,7 @@ def test_a_warm_code_cache_answers_without_sympy(tmp_path):
     code = (  # the built-in model: a plug-in leaving a tolerance scale to be derived loads SymPy for it
         "import sys, pendverify; "
         "r = pendverify.check('double_pendulum', erd=False, samples=5); "
-        "print(r.results[0].check, r.results[0].worst_state['label'], 'sympy' in sys.modules)"
+        "print(r.results[0].name, r.results[0].label, 'sympy' in sys.modules)"
     )
     env = {**os.environ, "PENDVERIFY_CACHE": str(tmp_path / "cache")}
     runs = [

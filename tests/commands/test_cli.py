@@ -84,11 +84,11 @@ def test_bad_parameter_file_is_exit_2(tmp_path, capsys):
 
 def test_json_reports_are_standard_json_even_with_an_infinite_error():
     """A det check that fails on a non-positive det M has an infinite error: written as "inf"."""
+    from pendverify.checks.evidence import Evidence
     from pendverify.checks.report import Report
-    from pendverify.checks.result import CheckResult
 
-    failed = CheckResult(
-        "m", "det", "d", float("inf"), 1e-15, float("inf"), 1, 1, {"label": "s", "q": []}, False
+    failed = Evidence(
+        "check", "det", "fail", float("inf"), 1e-15, {"label": "s", "q": []}, model="m", samples=1, seed=1
     )
     text = Report(seed=1, states={"m": 1}, results=[failed]).to_json()
 

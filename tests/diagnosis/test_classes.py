@@ -133,9 +133,9 @@ def test_a_christoffel_c_with_an_error_is_repaired_back_to_the_christoffel_c(tmp
 def test_the_untouched_non_christoffel_model_passes_with_its_warning_and_gets_no_repair():
     model, system = _target("acrobot_tedrake")
     batch, results = _results(model, system)
-    assert {r.check for r in results if not r.passed} == {"coriolis", "skew"}  # before the verdict
+    assert {r.name for r in results if not r.passed} == {"coriolis", "skew"}  # before the verdict
     assert passes(results)
-    assert {r.check: r.status for r in results}["coriolis"] == "warn"
+    assert {r.name: r.status for r in results}["coriolis"] == "warn"
     repairs, why = search_repair(batch, 10.0)
     assert repairs == [] and "no single entry" in why
 
@@ -146,7 +146,7 @@ def test_a_wrong_c_qdot_is_not_accepted_as_the_non_christoffel_warning(tmp_path)
     model, system = load_target(planted, *TEDRAKE_ARGS[1::2])
     _, results = _results(model, system)
     assert not passes(results)
-    assert {r.check for r in results if not r.passed} >= {"rnea", "coriolis", "skew"}
+    assert {r.name for r in results if not r.passed} >= {"rnea", "coriolis", "skew"}
 
 
 # --- q̈ alone -----------------------------------------------------------------------------------
@@ -203,7 +203,7 @@ def test_an_error_in_a_model_given_by_qddot_is_repaired_in_its_qddot(
 def test_the_untouched_qddot_model_passes_and_gets_no_repair():
     model, system = _target("acrobot_gym_qddot")
     batch, results = _results(model, system)
-    assert [r.check for r in results] == ["aba"] and passes(results)
+    assert [r.name for r in results] == ["aba"] and passes(results)
     repairs, why = search_repair(batch, 10.0)
     assert repairs == [] and "no single entry" in why
 

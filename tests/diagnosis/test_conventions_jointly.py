@@ -77,7 +77,7 @@ def _planted(system, T, theta0):
 
 def _failing(model, system) -> set[str]:
     results = run_checks("planted", model, system, sample_states(model, 30, SEED), SEED)
-    return {r.check for r in results if not r.passed}
+    return {r.name for r in results if not r.passed}
 
 
 def _finding(model, system):

@@ -117,7 +117,7 @@ CASES = {
 
 
 def statuses(report) -> dict[str, str]:
-    return {row.check: row.status for row in report.results}
+    return {row.name: row.status for row in report.results}
 
 
 def test_gymnasiums_pole_offset_is_the_hand_models():
@@ -137,8 +137,8 @@ def test_a_shipped_mujoco_file_verifies_against_its_hand_model(case):
         assert found[check] == "pass", f"{case}: {found}"
     if case == "gym-inverted-double-pendulum":  # gravity 1e-5 0 −9.81: a tilt within the threshold
         assert found["model-form"] == "warn", found
-        (row,) = [r for r in report.results if r.check == "model-form"]
-        assert "tilted" in row.notes[0] and row.max_error == pytest.approx(1e-5 / 9.81)
+        (row,) = [r for r in report.results if r.name == "model-form"]
+        assert "tilted" in row.notes[0] and row.error == pytest.approx(1e-5 / 9.81)
     else:
         assert "model-form" not in found
 
@@ -174,7 +174,7 @@ def test_gravity_tilted_ten_degrees_fails_saying_the_files_gravity_is_not_the_mo
     path = tmp_path / "tilted.xml"
     path.write_text(text.replace('gravity="1e-5 0 -9.81"', f'gravity="{tilt!r} 0 -9.81"'))
     report = api.check(GymCartDoublePole, str(path), cart_double_pole_params(path), explain=False)
-    (row,) = [r for r in report.results if r.check == "model-form"]
+    (row,) = [r for r in report.results if r.name == "model-form"]
     assert row.status == "fail"
     assert "the file's gravity is not the model's" in row.notes[0]
     assert not report.passed

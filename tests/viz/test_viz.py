@@ -24,8 +24,8 @@ import umsgpack
 from PIL import Image
 
 from pendverify.analytic import MODELS
+from pendverify.checks.evidence import Evidence
 from pendverify.checks.report import Report
-from pendverify.checks.result import CheckResult
 from pendverify.cli import main
 from pendverify.errors import TrajectoryError
 from pendverify.robot.writer import COLOURS, urdf_for
@@ -293,7 +293,7 @@ def eight_model_report() -> Report:
     models = [f"model_number_{k}_with_a_long_name" for k in range(8)]
     state = {"label": "random 7", "q": [0.123456, -1.2345, 2.34567]}
     results = [
-        CheckResult(m, c, c, 1.2e-13, 5.7e-11, 1e-13, 60, 1, state, True)
+        Evidence("check", c, "pass", 1.2e-13, 5.7e-11, state, detail=c, model=m, samples=60, seed=1)
         for c in ("crba", "rnea", "gravity", "aba", "energy", "M inverse")
         for m in models
     ]

@@ -266,8 +266,8 @@ def _invariant_section(results: Results) -> list[str]:
     for key, invariants, steps in results.invariants:
         for i in invariants:
             lines.append(
-                f"| {key} | {i.name} | {i.error:.2e} | {i.tolerance:.2e} | {i.max_error:.2e} "
-                f"(t = {i.max_error_t:.3g} s) | {'pass' if i.passed else 'FAIL'} ({steps} steps) |"
+                f"| {key} | {i.name} | {i.error:.2e} | {i.tolerance:.2e} | {i.largest_error:.2e} "
+                f"(t = {i.largest_at['t']:.3g} s) | {'pass' if i.passed else 'FAIL'} ({steps} steps) |"
             )
     return [*lines, ""]
 

@@ -50,7 +50,7 @@ class Results:
     engines: list = field(default_factory=list)  # fastbench.EngineRow
     single: object = None  # fastbench.SingleRatio
     ensemble: list = field(default_factory=list)  # fastbench.EnsembleRow
-    invariants: list = field(default_factory=list)  # (problem, InvariantResult)
+    invariants: list = field(default_factory=list)  # (problem, invariants' Evidence)
     engine_tolerance: float = math.nan  # rtol = atol of the engine and ensemble studies
     compile_seconds: float = 0.0
     reference_seconds: float = 0.0

@@ -26,10 +26,10 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
-from pendverify.certify.battery_item import BatteryItem
 from pendverify.certify.simulations import invariant_items, invariants_not_run
+from pendverify.checks.evidence import Evidence, stress_verdict
 from pendverify.checks.sampling import sample_states
-from pendverify.checks.verdict import REFUSED
+from pendverify.checks.verdict import FAIL, REFUSED
 from pendverify.checks.verification import guarded_checks
 from pendverify.progress import bar
 from pendverify.robot.description import LoadedDescription, load_description
@@ -54,7 +54,7 @@ class BatteryRun:
     ``not_run``: one sentence per part of the battery that does not apply to the model, why
     (``invariants_not_run``), also among ``notes``."""
 
-    items: list[BatteryItem]
+    items: list[Evidence]
     notes: list[str]
     not_run: tuple[str, ...] = ()
 
@@ -64,21 +64,22 @@ class BatteryRun:
         return all(i.passed for i in self.items)
 
 
-def check_items(model, system, settings: BatterySettings) -> list[BatteryItem]:
+def check_items(model, system, settings: BatterySettings) -> list[Evidence]:
     states = sample_states(model, settings.samples, settings.seed)
     return [
-        BatteryItem(
-            f"check:{r.check}",
+        Evidence(
             "check",
-            r.max_error,
-            r.tolerance,
-            r.samples,
-            r.seed,
-            r.passed,
-            f"{REFUSED}: {r.notes[0]}" if r.status == REFUSED else r.worst_state["label"],
-            at=r.worst_state["label"],
-            max_error=None if np.isnan(r.largest_error) else r.largest_error,  # nan: nothing judged
-            max_error_at=r.largest_state.get("label", ""),
+            f"check:{r.name}",
+            r.status,
+            error=r.error,
+            tolerance=r.tolerance,
+            at={"label": r.label},
+            largest_error=None if np.isnan(r.largest_error) else r.largest_error,  # nan: nothing judged
+            largest_tolerance=r.largest_tolerance,
+            largest_at={"label": r.largest_at.get("label", "")},
+            detail=f"{REFUSED}: {r.notes[0]}" if r.status == REFUSED else r.label,
+            samples=r.samples,
+            seed=r.seed,
         )
         for r in guarded_checks(model.name, model, system, states, settings.seed)[0]
     ]
@@ -90,7 +91,7 @@ def stress_items(
     settings: BatterySettings,
     urdf: str | LoadedDescription | None = None,
     system: PinocchioSystem | None = None,
-) -> list[BatteryItem]:
+) -> list[Evidence]:
     """The stress cases that apply to any parameter set, run on this one.
 
     Large angles (|θ| ≈ 1e6 rad, with the θ + 2πk invariance; states beyond the
@@ -127,17 +128,21 @@ def stress_items(
     for case in cases:
         r = stress.run_case(case, ctx)
         refusals_allowed = case.name == "large angles"
-        passed = r.passed and (refusals_allowed or r.refused == 0) and r.level != "refuse"
+        refused = r.status == REFUSED or (r.extras["refused"] and not refusals_allowed)
+        invariant, note = r.extras.get("invariant"), "; ".join(r.notes)
         items.append(
-            BatteryItem(
-                f"stress:{case.name.replace(' ', '-')}",
+            Evidence(
                 "stress",
-                float(r.error or 0.0),
-                float(r.tolerance or 1.0),
-                ctx.settings.random_states,
-                settings.seed,
-                bool(passed),
-                r.verdict + (f"; {r.invariant}" if r.invariant else "") + (f"; {r.note}" if r.note else ""),
+                f"stress:{case.name.replace(' ', '-')}",
+                FAIL if r.failed else (REFUSED if refused else r.status),
+                error=float(r.error or 0.0),
+                tolerance=float(r.tolerance or 1.0),
+                largest_error=None,  # a stress case keeps its worst ratio only
+                detail=stress_verdict(r)
+                + (f"; {invariant}" if invariant else "")
+                + (f"; {note}" if note else ""),
+                samples=ctx.settings.random_states,
+                seed=settings.seed,
             )
         )
     return items

@@ -62,10 +62,10 @@ from datetime import datetime, timezone
 
 from pendverify.analytic import ParameterSet
 from pendverify.certify.battery import BatteryRun, BatterySettings
-from pendverify.certify.battery_item import BatteryItem
 from pendverify.certify.model_source import ModelSource, source_problem
 from pendverify.certify.names import envelope_name
 from pendverify.certify.simulations import UNRECORDED
+from pendverify.checks.evidence import Evidence, item_record
 from pendverify.errors import CertificateError
 from pendverify.jsonio import plain, to_json, versions
 
@@ -129,7 +129,7 @@ def build_certificate(
 ) -> dict:
     """The certificate of a set and its battery's evidence (items and notes, made dicts here,
     once); with ``keyid`` (the signing key's fingerprint) it names its envelope."""
-    checks = [item.as_dict() for item in battery.items]
+    checks = [item_record(item) for item in battery.items]
     cert = {
         "schema": SCHEMA,
         "name": name,
@@ -188,23 +188,24 @@ def figures_agree(a: float, b: float, rtol: float) -> bool:
     return abs(a - b) <= rtol * max(abs(a), abs(b))
 
 
-def compare_items(recorded: list[dict], fresh: list[BatteryItem]) -> list[str]:
-    """Names of the fields whose values differ between a certificate and a re-run."""
+def compare_items(recorded: list[dict], fresh: list[Evidence]) -> list[str]:
+    """Names of the fields whose values differ between a certificate and a re-run (each fresh
+    item as the certificate would record it, ``item_record``)."""
     differences = []
-    by_name = {item.name: item for item in fresh}
+    by_name = {item.name: item_record(item) for item in fresh}
     for old in recorded:
         new = by_name.pop(old["name"], None)
         if new is None:
             differences.append(f"{old['name']}: not produced by the re-run")
             continue
         for key in ("kind", "samples", "seed", "passed"):
-            if old[key] != getattr(new, key):
-                differences.append(f"{old['name']}.{key}: recorded {old[key]!r}, now {getattr(new, key)!r}")
+            if old[key] != new[key]:
+                differences.append(f"{old['name']}.{key}: recorded {old[key]!r}, now {new[key]!r}")
         engine = old.get("engine", UNRECORDED if old["kind"] == "invariant" else "")
-        if engine != new.engine:
-            differences.append(f"{old['name']}.engine: recorded {engine!r}, now {new.engine!r}")
+        if engine != new.get("engine", ""):
+            differences.append(f"{old['name']}.engine: recorded {engine!r}, now {new.get('engine', '')!r}")
         for key in ("error", "tolerance", "max_error"):
-            a, b = old[key], getattr(new, key)
+            a, b = old[key], new[key]
             if a is None or b is None:
                 if (a is None) != (b is None):
                     differences.append(f"{old['name']}.{key}: recorded {a!r}, now {b!r}")

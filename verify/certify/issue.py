@@ -24,7 +24,7 @@ from pathlib import Path
 from pendverify.analytic import ParameterSet
 from pendverify.analytic.params import load_parameter_file
 from pendverify.certify.battery import BatteryRun, BatterySettings, run_battery
-from pendverify.certify.battery_item import BatteryItem, items_html
+from pendverify.certify.battery_item import items_html
 from pendverify.certify.bundle import check_files_beside, refuse_existing, verify_signature, write_bundle
 from pendverify.certify.certificate import build_certificate, compare_items, derived_constants, verify_digest
 from pendverify.certify.model_source import ModelSource
@@ -34,6 +34,7 @@ from pendverify.certify.schema import check_derived, check_schema
 from pendverify.certify.signing import fingerprint
 from pendverify.certify.simulations import recorded_engines
 from pendverify.certify.sweep_task import SetResult
+from pendverify.checks.evidence import Evidence
 from pendverify.display import REPR_LIMIT, html_lines, listed, shortened
 from pendverify.errors import CertificateError, ParameterError, PendverifyError
 from pendverify.robot.description import LoadedDescription
@@ -124,7 +125,7 @@ class Issued:
     of them pass, the certificate written and its path; ``not_run``: why a part of the battery
     did not apply to the model (``BatteryRun.not_run``)."""
 
-    items: list[BatteryItem]
+    items: list[Evidence]
     certificate: dict | None = None
     path: Path | None = None
     not_run: tuple[str, ...] = ()
@@ -208,7 +209,7 @@ def write_sweep_certificates(sweep, results: list[SetResult], output, force: boo
 @dataclass(frozen=True)
 class Rechecked:
     certificate: dict
-    items: list[BatteryItem]
+    items: list[Evidence]
     differences: list[str]
     signature: str = ""  # what was established about the signature, in words
 

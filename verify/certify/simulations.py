@@ -41,8 +41,9 @@ from dataclasses import replace
 
 import numpy as np
 
-from pendverify.certify.battery_item import BatteryItem
 from pendverify.certify.scenes import effect_scenes
+from pendverify.checks.evidence import Evidence
+from pendverify.checks.verdict import FAIL
 from pendverify.errors import FastPathError, FileAccessError, PendverifyError
 
 COMPILED, ABA = "compiled", "aba"
@@ -182,29 +183,31 @@ def cross_check(run, system):
     for i, rounding in evidence.refused:
         tolerances[i] = rounding
     name = f"engines agree: compiled q̈ vs ABA on the URDF at {len(rows)} of the run's {len(steps_t)} states"
-    result = figures_of(name, errors, tolerances, steps_t[rows], 1.0, "as the aba check")
-    return replace(result, scale=float("nan"))  # each state's error is relative to its own scale
+    # each state's error is relative to its own scale: no common one
+    return figures_of(name, errors, tolerances, steps_t[rows], float("nan"), "as the aba check")
 
 
 def _item(name: str, inv, samples: int, settings, engine: str, failure: str = ""):
-    """A battery item from an ``InvariantResult`` (or a failed run's message, ``inv`` None)."""
+    """A battery item from an invariant's ``Evidence`` (or a failed run's message, ``inv`` None)."""
     if inv is None:
-        return BatteryItem(
-            name, "invariant", np.inf, 0.0, 0, settings.seed, False, failure, max_error=np.inf, engine=engine
+        return Evidence(
+            "invariant",
+            name,
+            FAIL,
+            error=np.inf,
+            tolerance=0.0,
+            largest_error=np.inf,
+            detail=failure,
+            seed=settings.seed,
+            extras={"engine": engine},
         )
-    return BatteryItem(
-        name,
-        "invariant",
-        inv.error,
-        inv.tolerance,
-        samples,
-        settings.seed,
-        inv.passed,
-        f"{inv.name} [{BATTERY_ENGINES[engine]}]",
-        at=f"t = {inv.worst_t:.6g} s",
-        max_error=inv.max_error,
-        max_error_at=f"t = {inv.max_error_t:.6g} s",
-        engine=engine,
+    return replace(
+        inv,
+        name=name,
+        detail=f"{inv.name} [{BATTERY_ENGINES[engine]}]",
+        samples=samples,
+        seed=settings.seed,
+        extras={**inv.extras, "engine": engine},
     )
 
 

@@ -40,7 +40,7 @@ class SweepSummary:
         self.passed += result.passed
         index = _index(result.name)
         for item in result.items:
-            entry = (item.margin, -index, result.name)
+            entry = (item.ratio, -index, result.name)
             if item.name not in self.worst or entry > self.worst[item.name]:
                 self.worst[item.name] = entry
         if not result.passed:

@@ -18,8 +18,8 @@ import functools
 from dataclasses import dataclass
 
 from pendverify.certify.battery import BatteryRun, BatterySettings, run_battery
-from pendverify.certify.battery_item import BatteryItem
 from pendverify.certify.model_source import ModelSource
+from pendverify.checks.evidence import Evidence
 from pendverify.errors import PendverifyError
 from pendverify.progress import quiet
 from pendverify.robot.rebind import Binding
@@ -53,7 +53,7 @@ class SetResult:
     error: str | None = None
 
     @property
-    def items(self) -> list[BatteryItem]:
+    def items(self) -> list[Evidence]:
         return self.battery.items if self.battery is not None else []
 
     @property

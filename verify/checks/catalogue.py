@@ -47,8 +47,9 @@ from pendverify.checks.applicability import (
     needs_urdf_damping,
 )
 from pendverify.checks.batch import CheckBatch
+from pendverify.checks.evidence import Evidence
 from pendverify.checks.judge import collect, conclude
-from pendverify.checks.result import Check, CheckResult
+from pendverify.checks.result import Check
 
 __all__ = [
     "CHECKS",
@@ -127,7 +128,7 @@ CHECKS: tuple[Check, ...] = (
 CHECK_NAMES = tuple(c.name for c in CHECKS)
 
 
-def run_check(check: Check, label: str, model, system, states, seed: int, batch=None) -> CheckResult:
+def run_check(check: Check, label: str, model, system, states, seed: int, batch=None) -> Evidence:
     """One check on every state, evaluated over all states at once.
 
     A state whose own rounding tolerance K·ε·((1 + |θ|)·c_T + (A − 1)) exceeds the trust
@@ -162,7 +163,7 @@ def applicable_checks(model, system=None) -> tuple[str, ...]:
     return tuple(name for name in CHECK_NAMES if name not in skipped)
 
 
-def run_checks(label, model, system, states, seed, names=CHECK_NAMES, batch=None) -> list[CheckResult]:
+def run_checks(label, model, system, states, seed, names=CHECK_NAMES, batch=None) -> list[Evidence]:
     """The named checks that apply to ``model`` and ``system``, each on every state.
 
     The checks share one batch of the states (``batch``, if given, must hold these states).

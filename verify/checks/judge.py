@@ -5,10 +5,10 @@
 K·ε·((1 + |θ|max)·c_T + (A − 1)) (plus the rounding of forms the model derives from its q̈,
 ``Measure.derived``), the relative error e/s and the relative tolerance
 rounding + a/s (the argument for them is in ``pendverify.checks.catalogue``): the
-``Evidence``.  A state whose rounding tolerance exceeds the trust limit is refused, not
+``Measured``.  A state whose rounding tolerance exceeds the trust limit is refused, not
 judged.  ``conclude`` re-judges failing states with the closed forms in high precision
 (``pendverify.checks.precision``), picks the worst and the largest state and writes the
-``CheckResult``.
+check's ``Evidence`` (``pendverify.checks.evidence``).
 """
 
 from __future__ import annotations
@@ -19,10 +19,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from pendverify.checks.batch import CheckBatch
-from pendverify.checks.result import Check, CheckResult
+from pendverify.checks.evidence import Evidence
+from pendverify.checks.result import Check
 from pendverify.checks.sampling import State
 from pendverify.checks.trust import EPS, REFUSE_REL
-from pendverify.checks.verdict import REFUSED, WARN
+from pendverify.checks.verdict import FAIL, PASS, REFUSED, WARN
 
 
 @dataclass(frozen=True)
@@ -39,7 +40,7 @@ class Judged:
 
 
 @dataclass
-class Evidence:
+class Measured:
     """What a check found, state by state, before its verdict.
 
     ``judged`` holds the indices (into the states) of the judged states in order, with
@@ -62,7 +63,7 @@ def rounding_tolerance(check: Check, angle, c_T: float, lever):
     return check.K * EPS * ((1.0 + angle) * c_T + (lever - 1.0))
 
 
-def collect(check: Check, batch) -> Evidence:
+def collect(check: Check, batch) -> Measured:
     """The check at every state of ``batch`` (``pendverify.checks.batch.CheckBatch``): its evidence."""
     n = len(batch)
     with np.errstate(all="ignore"):
@@ -100,10 +101,10 @@ def collect(check: Check, batch) -> Evidence:
             "derived numerically from the model's q̈ (pendverify.analytic.numeric_derivation): the "
             f"tolerance includes the derivation's rounding bound, at most {np.max(derived):.2g}"
         )
-    return Evidence(judged, r.copy(), np.where(nan, np.inf, rel_err), rel_tol, error.copy(), refused, notes)
+    return Measured(judged, r.copy(), np.where(nan, np.inf, rel_err), rel_tol, error.copy(), refused, notes)
 
 
-def rejudge_precisely(check: Check, batch, failing: list[int], ev: Evidence) -> tuple[dict[int, Judged], str]:
+def rejudge_precisely(check: Check, batch, failing: list[int], ev: Measured) -> tuple[dict[int, Judged], str]:
     """Failing states judged again with the closed forms in high precision (``checks.precision``).
 
     ``failing``: positions in ``ev`` of the failing states.  Worst first; stops at the
@@ -149,7 +150,7 @@ def _python_max(values: np.ndarray) -> float:
     return float(np.nanmax(values))
 
 
-def conclude(check: Check, label: str, batch, seed: int, ev: Evidence) -> CheckResult:
+def conclude(check: Check, label: str, batch, seed: int, ev: Measured) -> Evidence:
     """The verdict on one check from its evidence at the states of ``batch``.
 
     Failing states are judged again in high precision: if all then pass, the check is a
@@ -195,25 +196,25 @@ def conclude(check: Check, label: str, batch, seed: int, ev: Evidence) -> CheckR
         )
         if worst is None:
             worst = (state, float("nan"), rounding)
-        if worst_ratio <= 1.0:
-            status = REFUSED
+    # a failing state fails the check; else a refused state refuses it; else it passes (or warns)
+    status = FAIL if not worst_ratio <= 1.0 else (REFUSED if ev.refused else status or PASS)
     state, worst_err, worst_tol = worst
-    return CheckResult(
-        model=label,
-        check=check.name,
-        description=f"{check.pinocchio} vs {check.closed_form}",
-        max_error=float(worst_err),
+    return Evidence(
+        "check",
+        check.name,
+        status,
+        error=float(worst_err),
         tolerance=float(worst_tol),
-        max_abs_error=max_abs,
-        samples=len(states),
-        seed=seed,
-        worst_state=state.as_dict(),
+        at=state.as_dict(),
         largest_error=float(rel_err[largest]) if largest is not None else float("nan"),
         largest_tolerance=float(rel_tol[largest]) if largest is not None else float("nan"),
-        largest_state=states[ev.judged[largest]].as_dict() if largest is not None else {},
-        passed=bool(worst_ratio <= 1.0) and not ev.refused,
+        largest_at=states[ev.judged[largest]].as_dict() if largest is not None else {},
+        detail=f"{check.pinocchio} vs {check.closed_form}",
         notes=notes,
-        status=status,
+        model=label,
+        samples=len(states),
+        seed=seed,
+        extras={"max_abs_error": max_abs},
     )
 
 

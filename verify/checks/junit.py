@@ -19,12 +19,12 @@ from pendverify.checks.verdict import FAIL, REFUSED, WARN
 
 
 def _row(r) -> str:
-    state = r.worst_state.get("label", "")
-    return f"{r.check}: error {r.max_error:.3e}, tolerance {r.tolerance:.3e}, worst state {state}"
+    state = r.label
+    return f"{r.name}: error {r.error:.3e}, tolerance {r.tolerance:.3e}, worst state {state}"
 
 
 def _case(r, seconds: float, diagnosis: list[str]) -> ET.Element:
-    case = ET.Element("testcase", classname=r.model, name=r.check, time=f"{seconds:.3f}")
+    case = ET.Element("testcase", classname=r.model, name=r.name, time=f"{seconds:.3f}")
     notes = "\n".join(r.notes)
     if r.status == FAIL:
         text = "\n".join([*r.notes, *(f"diagnosis: {line}" for line in diagnosis)])

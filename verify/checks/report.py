@@ -3,7 +3,7 @@
 ``Report`` is what ``build_report`` returns; ``CheckReport``, what ``pendverify.check``
 returns, is the same report printing as the CLI's table (``format_table``).  A report reads
 like a mapping from check name to that check's rows: ``report["crba"]`` is a ``CheckRows``
-(one ``CheckResult`` per model), ``report["crba"]["double_pendulum"]`` or
+(one ``Evidence`` per model), ``report["crba"]["double_pendulum"]`` or
 ``report["double_pendulum", "crba"]`` one result; a model is named by its label
 (``cart_pole:cart_pole``) or, when that names one, by the model's name or the URDF's alone.
 In a notebook a report shows as an HTML table with the CLI table's rows (``_repr_html_``).
@@ -16,7 +16,7 @@ import html
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 
-from pendverify.checks.result import CheckResult
+from pendverify.checks.evidence import Evidence, check_record
 from pendverify.checks.verdict import FAIL, LABELS, PASS, REFUSED, WARN, worst
 from pendverify.diagnosis.finding import text_lines
 from pendverify.display import REPR_LIMIT, html_lines, html_table, listed
@@ -26,9 +26,9 @@ from pendverify.jsonio import to_json, versions
 HEADER = ("model", "check", "error", "tolerance", "worst state", "result")
 
 
-def _ratio(result: CheckResult) -> float:
+def _ratio(result: Evidence) -> float:
     """error/tolerance of a row (NaN, a refused row, sorts below every number)."""
-    ratio = result.max_error / result.tolerance if result.tolerance else float("inf")
+    ratio = result.ratio
     return ratio if ratio == ratio else -1.0
 
 
@@ -48,16 +48,16 @@ def model_label(labels: tuple[str, ...], key: str, where: str) -> str:
 
 @dataclass(frozen=True)
 class CheckRows:
-    """The rows of one check in a report: one ``CheckResult`` per model, in the table's order.
+    """The rows of one check in a report: one ``Evidence`` per model, in the table's order.
 
     ``report["crba"]`` gives it.  ``rows["double_pendulum"]`` (a model's label) or ``rows[0]``
     is one result; ``len``, iteration, ``models``; ``status`` and ``passed`` are the worst
-    row's verdict; ``worst`` is the row with the largest error/tolerance, and ``max_error``
-    and ``tolerance`` are that row's.
+    row's verdict; ``worst`` is the row with the largest error/tolerance (its ``error`` and
+    ``tolerance`` are the check's figures).
     """
 
     check: str
-    results: tuple[CheckResult, ...]
+    results: tuple[Evidence, ...]
 
     @property
     def models(self) -> tuple[str, ...]:
@@ -75,27 +75,17 @@ class CheckRows:
         return all(r.passed for r in self.results)
 
     @property
-    def worst(self) -> CheckResult:
+    def worst(self) -> Evidence:
         """The row whose error is the largest fraction of its tolerance."""
         return max(self.results, key=_ratio)
-
-    @property
-    def max_error(self) -> float:
-        """The error of the ``worst`` row (relative, at that row's worst state)."""
-        return self.worst.max_error
-
-    @property
-    def tolerance(self) -> float:
-        """The tolerance of the ``worst`` row, at the same state."""
-        return self.worst.tolerance
 
     def __len__(self) -> int:
         return len(self.results)
 
-    def __iter__(self) -> Iterator[CheckResult]:
+    def __iter__(self) -> Iterator[Evidence]:
         return iter(self.results)
 
-    def __getitem__(self, key: str | int) -> CheckResult:
+    def __getitem__(self, key: str | int) -> Evidence:
         """``rows[0]``; ``rows["cart_pole:cart_pole"]`` (a label), or the model's name or the URDF's
         (parameter set's) name alone when it names one row: ``rows["cart_pole"]``."""
         if isinstance(key, int):
@@ -107,7 +97,7 @@ class CheckRows:
         top = self.worst
         return (
             f"<CheckRows {self.check}: {self.status} on {len(self)} model(s) "
-            f"({listed(self.models, 120)}); worst {top.max_error:.2e} vs tolerance {top.tolerance:.2e} "
+            f"({listed(self.models, 120)}); worst {top.error:.2e} vs tolerance {top.tolerance:.2e} "
             f"({top.model})>"
         )
 
@@ -122,7 +112,7 @@ class CheckRows:
 class Report:
     seed: int
     states: dict[str, int]
-    results: list[CheckResult]
+    results: list[Evidence]
     notes: dict[str, list[str]] = field(default_factory=dict)
     sources: dict[str, str] = field(default_factory=dict)
     elapsed_s: float = 0.0
@@ -152,27 +142,27 @@ class Report:
     @property
     def robot_compared(self) -> bool:
         """Whether any check compared the model with a robot (a model alone gets its ``units`` row only)."""
-        return any(r.check != "units" for r in self.results)
+        return any(r.name != "units" for r in self.results)
 
-    def failures(self) -> list[CheckResult]:
+    def failures(self) -> list[Evidence]:
         """The results that fail."""
         return [r for r in self.results if r.status == FAIL]
 
-    def refusals(self) -> list[CheckResult]:
+    def refusals(self) -> list[Evidence]:
         """The results refused by the trust rule (states beyond double precision's reach: not verified)."""
         return [r for r in self.results if r.status == REFUSED]
 
     @property
     def checks(self) -> tuple[str, ...]:
         """The names of the checks in the report, in the table's order of first appearance."""
-        return tuple(dict.fromkeys(r.check for r in self.results))
+        return tuple(dict.fromkeys(r.name for r in self.results))
 
     @property
     def models(self) -> tuple[str, ...]:
         """The labels of the models (targets) in the report, in the table's order."""
         return tuple(dict.fromkeys([*self.states, *(r.model for r in self.results)]))
 
-    def __getitem__(self, key: str | tuple[str, str]) -> CheckRows | CheckResult:
+    def __getitem__(self, key: str | tuple[str, str]) -> CheckRows | Evidence:
         """``report["crba"]``: that check's rows (``CheckRows``, one per model);
         ``report["double_pendulum", "crba"]``: one model's result.  An unknown name is a
         ``KeyError`` listing the valid ones."""
@@ -181,7 +171,7 @@ class Report:
                 raise KeyError(f"a report's key is a check name or (model, check); got {key!r}")
             model, check = key
             return self[check][model]
-        rows = tuple(r for r in self.results if r.check == key)
+        rows = tuple(r for r in self.results if r.name == key)
         if not rows:
             model = (
                 ""
@@ -237,7 +227,7 @@ class Report:
             "diagnoses": {label: [f.as_dict() for f in found] for label, found in self.diagnoses.items()},
             "warnings": self.warnings,
             "skipped": self.skipped,
-            "results": [r.as_dict() for r in self.results],
+            "results": [check_record(r) for r in self.results],
         }
 
     def to_json(self) -> str:
@@ -260,14 +250,14 @@ def _state_text(state: dict) -> str:
     return f"{state['label']} q=({q})"
 
 
-def table_row(r: CheckResult) -> tuple[str, ...]:
+def table_row(r: Evidence) -> tuple[str, ...]:
     """One row of the check table: ``HEADER``'s cells as text."""
     return (
         r.model,
-        r.check,
-        f"{r.max_error:.2e}",
+        r.name,
+        f"{r.error:.2e}",
         f"{r.tolerance:.2e}",
-        _state_text(r.worst_state),
+        _state_text(r.at),
         LABELS[r.status],
     )
 
@@ -286,7 +276,7 @@ def trailing_lines(report: Report) -> list[str]:
             out.append(f"warning [{model}]: {sentence}")
     for r in report.failures():
         for note in r.notes:
-            out.append(f"fail [{r.model} {r.check}]: {note}")
+            out.append(f"fail [{r.model} {r.name}]: {note}")
     for model, findings in report.diagnoses.items():
         for line in text_lines(findings):
             out.append(f"diagnosis [{model}]: {line}")
@@ -294,8 +284,8 @@ def trailing_lines(report: Report) -> list[str]:
     if judged:
         top = max(judged, key=lambda r: r.largest_error)
         out.append(
-            f"largest relative error: {top.largest_error:.2e} ({top.model} {top.check} at "
-            f"{_state_text(top.largest_state)}, where its tolerance is {top.largest_tolerance:.2e}); "
+            f"largest relative error: {top.largest_error:.2e} ({top.model} {top.name} at "
+            f"{_state_text(top.largest_at)}, where its tolerance is {top.largest_tolerance:.2e}); "
             "the table's error is at each check's worst error/tolerance"
         )
     total = sum(report.states.values())
@@ -341,8 +331,8 @@ def verdict_sentence(report: Report) -> str:
 class CheckReport(Report):
     """The report of ``check``: a ``pendverify.checks.report.Report`` that prints as the CLI's table.
 
-    The evidence is in the fields of ``Report``: ``results`` (one ``CheckResult`` per model and
-    check: ``max_error``, ``tolerance``, ``max_abs_error``, ``worst_state``, ``status``, ``notes``),
+    The evidence is in the fields of ``Report``: ``results`` (one ``Evidence`` per model and
+    check: ``error``, ``tolerance``, ``at``, ``largest_error``, ``status``, ``notes``),
     ``notes``, ``warnings`` and ``diagnoses`` (per model label), ``states``, ``sources``, ``seed``,
     ``strict``, ``elapsed_s``, ``skipped``; ``passed``, ``status``, ``failures()``, ``refusals()``,
     ``as_dict()`` and ``to_json()`` (the document ``check --json`` writes).  ``report["crba"]``

@@ -29,7 +29,8 @@ whose code cache is warm neither imports SymPy nor reads the model again.
 from __future__ import annotations
 
 from pendverify.analytic.source_file import where
-from pendverify.checks.result import CheckResult
+from pendverify.checks.evidence import Evidence
+from pendverify.checks.verdict import FAIL, PASS
 from pendverify.numerics.codegen.cache import Family, kernel
 
 NAME = "units"
@@ -54,7 +55,7 @@ def units_reading(model_cls) -> dict:
     return kernel(model_cls, family=FAMILY).module.UNITS
 
 
-def units_check(label: str, model_cls, seed: int) -> tuple[CheckResult | None, list[str]]:
+def units_check(label: str, model_cls, seed: int) -> tuple[Evidence | None, list[str]]:
     """(the ``units`` row of ``model_cls`` labelled ``label``, or None when it is not run; the notes
     to print with the model: why it is not run, or which closed forms SymPy could not read)."""
     reading = units_reading(model_cls)
@@ -70,18 +71,18 @@ def units_check(label: str, model_cls, seed: int) -> tuple[CheckResult | None, l
         return None, [f"{NAME} not run: {reason}", *notes]
     source = where(model_cls)
     first = findings[0]["label"] if findings else f"{decided} of {entries} entries"
-    row = CheckResult(
-        model=label,
-        check=NAME,
-        description=DESCRIPTION,
-        max_error=float(len(findings)),
+    row = Evidence(
+        "check",
+        NAME,
+        FAIL if findings else PASS,
+        error=float(len(findings)),
         tolerance=0.0,
-        max_abs_error=float(len(findings)),
-        samples=0,
-        seed=seed,
-        worst_state={"label": first, "q": []},
-        passed=not findings,
+        at={"label": first, "q": []},
+        detail=DESCRIPTION,
         notes=[f"{f['message']} ({source}, {f['location']}, entry {f['label']})" for f in findings]
         or [f"{decided} of the {entries} non-zero entries have a decided dimension, each its place's"],
+        model=label,
+        seed=seed,
+        extras={"max_abs_error": float(len(findings))},
     )
     return row, notes

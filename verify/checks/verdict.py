@@ -1,6 +1,7 @@
 """Verdict levels, and the rules that move a check between them.
 
-Every check result, and so every target and report, has one of four levels:
+Every piece of evidence (``pendverify.checks.evidence``: a check result, an invariant, a
+stress case, a battery item), and so every target and report, has one of these levels:
 
 ``pass``
     the error is within its tolerance on every state.
@@ -19,6 +20,9 @@ Every check result, and so every target and report, has one of four levels:
     some state lies beyond the trust limit of ``pendverify.checks.trust``:
     rounding alone could exceed a relative 1e-6 there, so agreement would prove
     nothing and disagreement could be rounding.  Nothing is compared there.
+``not run``
+    the comparison does not apply (a stress case with no parameter to vary); never
+    ranked among the others, as a check that does not apply has no result.
 
 A target's level is its worst result's (fail > refused > warn > pass).  The
 exit status of ``pendverify check`` is 0 for pass and warn (1 for warn with
@@ -27,7 +31,8 @@ exit status of ``pendverify check`` is 0 for pass and warn (1 for warn with
 
 from __future__ import annotations
 
-PASS, WARN, FAIL, REFUSED = "pass", "warn", "fail", "refused"
+PASS, WARN, FAIL, REFUSED, NOT_RUN = "pass", "warn", "fail", "refused", "not run"
+VERDICTS = (PASS, WARN, FAIL, REFUSED, NOT_RUN)
 SEVERITY = {PASS: 0, WARN: 1, REFUSED: 2, FAIL: 3}
 LABELS = {PASS: "pass", WARN: "pass (warn)", FAIL: "FAIL", REFUSED: "refused"}
 
@@ -56,9 +61,9 @@ def non_christoffel_c(results) -> str:
     than the two that compare C itself passes.  A C·q̇ that is wrong fails
     ``rnea`` and keeps every failure.
     """
-    by_name = {r.check: r for r in results}
+    by_name = {r.name: r for r in results}
     differing = [by_name[n] for n in MATRIX_C_CHECKS if n in by_name and by_name[n].status == FAIL]
-    others = [r for r in results if r.check not in MATRIX_C_CHECKS]
+    others = [r for r in results if r.name not in MATRIX_C_CHECKS]
     if (
         not differing
         or not all(n in by_name for n in BIAS_CHECKS)
@@ -68,12 +73,12 @@ def non_christoffel_c(results) -> str:
     skew = by_name.get("skew")
     finding = NON_CHRISTOFFEL if skew is not None and skew.status == FAIL else CHRISTOFFEL_CONSISTENT
     sizes = "; ".join(
-        f"{r.check}: {r.max_error:.3g} relative ({r.max_error / r.tolerance:.3g}× its tolerance, "
-        f"{r.max_abs_error:.3g} absolute)"
+        f"{r.name}: {r.error:.3g} relative ({r.ratio:.3g}× its tolerance, "
+        f"{r.extras['max_abs_error']:.3g} absolute)"
         for r in differing
     )
     for r in differing:
-        r.status, r.passed = WARN, True
+        r.status = WARN
     return (
         f"{finding} — C differs from Pinocchio's Coriolis matrix by {sizes}; "
         "C·q̇ agrees (rnea, aba, energy pass)"
@@ -84,4 +89,4 @@ def apply_strict(results) -> None:
     """``--strict``: every warning becomes a failure."""
     for r in results:
         if r.status == WARN:
-            r.status, r.passed = FAIL, False
+            r.status = FAIL

@@ -27,8 +27,8 @@ import numpy as np
 from pendverify.checks.applicability import derived_notes
 from pendverify.checks.batch import CheckBatch
 from pendverify.checks.catalogue import applicable_checks, run_checks, skipped_notes
+from pendverify.checks.evidence import Evidence
 from pendverify.checks.report import Report
-from pendverify.checks.result import CheckResult
 from pendverify.checks.sampling import sample_states
 from pendverify.checks.trust import REFUSE_REL, Verdicts, check_conditioning
 from pendverify.checks.units import NAME as UNITS
@@ -58,29 +58,29 @@ def trusted(label: str, batch: CheckBatch) -> tuple[list[int], list[str], Verdic
     return sorted(kept), refused, verdicts
 
 
-def model_form_result(target, seed: int) -> CheckResult | None:
+def model_form_result(target, seed: int) -> Evidence | None:
     """The ``model-form`` row: a URDF term outside the closed form's family, against its threshold."""
     form = target.system.model_form
     if form is None:
         return None
     rtol = target.system.model_form_rtol
-    return CheckResult(
-        model=target.label,
-        check="model-form",
-        description="URDF terms the closed form cannot express, relative to the quantity they enter",
-        max_error=form.relative,
+    return Evidence(
+        "check",
+        "model-form",
+        # within the threshold the checks allow for the term: a pass that says so (a warning)
+        WARN if form.within(rtol) else FAIL,
+        error=form.relative,
         tolerance=rtol,
-        max_abs_error=float(np.max(form.allowance)),
-        samples=1,
-        seed=seed,
-        worst_state={"label": "URDF geometry", "q": []},
+        at={"label": "URDF geometry", "q": []},
         largest_error=form.relative,
         largest_tolerance=rtol,
-        largest_state={"label": "URDF geometry", "q": []},
-        passed=form.within(rtol),
-        # within the threshold the checks allow for the term: a pass that says so (a warning)
-        status=WARN if form.within(rtol) else FAIL,
+        largest_at={"label": "URDF geometry", "q": []},
+        detail="URDF terms the closed form cannot express, relative to the quantity they enter",
         notes=[form.sentence(rtol)],
+        model=target.label,
+        samples=1,
+        seed=seed,
+        extras={"max_abs_error": float(np.max(form.allowance))},
     )
 
 
@@ -93,7 +93,7 @@ def coulomb_warnings(target) -> list[str]:
     ]
 
 
-def _refuse(results: list[CheckResult], refused: list[str], total: int) -> None:
+def _refuse(results: list[Evidence], refused: list[str], total: int) -> None:
     """Checks that could not be judged on every state are refused, unless a trusted state failed.
 
     With no trusted state at all, every check is refused: a failure there may be rounding.
@@ -101,13 +101,13 @@ def _refuse(results: list[CheckResult], refused: list[str], total: int) -> None:
     all_refused = len(refused) == total
     for r in results:
         if all_refused or r.status != FAIL:
-            r.status, r.passed = REFUSED, False
+            r.status = REFUSED
             r.notes.insert(0, f"{len(refused)} of {total} states refused, e.g. {refused[0]}")
 
 
 def guarded_checks(
     label: str, model, system, states, seed: int
-) -> tuple[list[CheckResult], list[str], dict[str, str], CheckBatch]:
+) -> tuple[list[Evidence], list[str], dict[str, str], CheckBatch]:
     """The checks that apply, on the states the trust rule accepts; checks refused where it refuses.
 
     The one way every caller (``check``, the certification battery) runs the checks on
@@ -168,14 +168,14 @@ def verify_target(report: Report, target, samples: int, seed: int) -> None:
         results.append(form)
     warnings = coulomb_warnings(target)
     # a closed form right in high precision but not in double (pendverify.checks.precision)
-    warnings += [f"{r.check}: {r.notes[0]}" for r in results if r.status == WARN and r.notes]
+    warnings += [f"{r.name}: {r.notes[0]}" for r in results if r.status == WARN and r.notes]
     sentence = non_christoffel_c(results)
     if sentence:
         warnings.append(sentence)
     if report.strict:
         apply_strict(results)
     # the diagnosis compares values with Pinocchio's: the URDF's own terms and the units are not values
-    failing = [r for r in results if r.status == FAIL and r.check not in ("model-form", UNITS)]
+    failing = [r for r in results if r.status == FAIL and r.name not in ("model-form", UNITS)]
     if failing and kept and report.explain:
         # SymPy and the searches are loaded only when a model fails (a passing run starts faster)
         from pendverify.diagnosis.explain import explain

@@ -108,13 +108,14 @@ def register(sub) -> None:
 
 
 def _print_items(items) -> None:
+    from pendverify.checks.evidence import item_verdict
+
     width = max(len(i.name) for i in items)
     print(f"{''.ljust(width)}  {'largest':>9}  {'worst error/tolerance':^20}")
     print(f"{'battery item'.ljust(width)}  {'error':>9}  {'error':>9}  {'tolerance':>9}  result")
     for i in items:
-        largest = f"{i.max_error:9.2e}" if i.max_error is not None else f"{'—':>9}"
-        verdict = "pass" if i.passed else ("refused" if i.detail.startswith("refused:") else "FAIL")
-        print(f"{i.name.ljust(width)}  {largest}  {i.error:9.2e}  {i.tolerance:9.2e}  {verdict}")
+        largest = f"{i.largest_error:9.2e}" if i.largest_error is not None else f"{'—':>9}"
+        print(f"{i.name.ljust(width)}  {largest}  {i.error:9.2e}  {i.tolerance:9.2e}  {item_verdict(i)}")
 
 
 def run_certify(args: argparse.Namespace) -> int:
@@ -156,6 +157,7 @@ def run_certify(args: argparse.Namespace) -> int:
 
 
 def _certify_json(issued) -> str:
+    from pendverify.checks.evidence import item_record
     from pendverify.jsonio import to_json, versions
 
     return to_json(
@@ -164,7 +166,7 @@ def _certify_json(issued) -> str:
             "certified": issued.certified,
             "certificate": str(issued.path) if issued.path else None,
             "digest": issued.certificate["digest"]["value"] if issued.certified else None,
-            "items": [i.as_dict() for i in issued.items],
+            "items": [item_record(i) for i in issued.items],
         }
     )
 
@@ -262,6 +264,7 @@ def run_recheck(args: argparse.Namespace) -> int:
 
 
 def _recheck_json(path: str, result) -> str:
+    from pendverify.checks.evidence import item_record
     from pendverify.jsonio import to_json, versions
 
     return to_json(
@@ -272,6 +275,6 @@ def _recheck_json(path: str, result) -> str:
             "signature": result.signature,
             "passed": result.passed,
             "differences": result.differences,
-            "items": [i.as_dict() for i in result.items],
+            "items": [item_record(i) for i in result.items],
         }
     )

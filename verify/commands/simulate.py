@@ -39,6 +39,8 @@ def register(sub) -> None:
 
 
 def summary(run) -> str:
+    from pendverify.checks.evidence import largest_abs
+
     s, integ = run.scene, run.integration
     engine = "both (ABA integrated; closed form compared)" if run.engine_comparison else run.dynamics.engine
     lines = [
@@ -49,7 +51,7 @@ def summary(run) -> str:
         f"{integ.nfev} right-hand-side evaluations, {s.duration:g} s, {len(run.t)} samples",
         "dynamics    " + "\n            ".join(run.dynamics.terms),
     ]
-    checks = [*run.invariants, *([run.engine_comparison] if run.engine_comparison else [])]
+    checks = run.checks
     width = max(len(c.name) for c in checks)
     lines.append("")
     lines.append(f"{''.ljust(width)}  {'largest error':^30}  {'worst error/tolerance':^32}".rstrip())
@@ -60,8 +62,9 @@ def summary(run) -> str:
     for c in checks:
         verdict = "pass" if c.passed else "FAIL"
         lines.append(
-            f"{c.name.ljust(width)}  {c.max_error:9.2e}  {_joules(c.max_error_abs)}  {c.max_error_t:8.4g}  "
-            f"{c.error:9.2e}  {c.tolerance:9.2e}  {c.worst_t:8.4g}  {verdict}  ({c.detail})"
+            f"{c.name.ljust(width)}  {c.largest_error:9.2e}  {_joules(largest_abs(c))}  "
+            f"{c.largest_at['t']:8.4g}  {c.error:9.2e}  {c.tolerance:9.2e}  {c.at['t']:8.4g}  {verdict}  "
+            f"({c.detail})"
         )
     lines += [f"note: {n}" for n in run.notes]
     lines.append("all invariants hold" if run.passed else "an invariant FAILS")
@@ -114,9 +117,10 @@ def run(args: argparse.Namespace) -> int:
 
 def _json(run) -> str:
     """The run's metadata (scene, model, engine, integrator, invariants), engine comparison, notes."""
+    from pendverify.checks.evidence import invariant_record
     from pendverify.jsonio import to_json
 
-    comparison = run.engine_comparison.as_dict() if run.engine_comparison else None
+    comparison = invariant_record(run.engine_comparison) if run.engine_comparison else None
     return to_json({**run.metadata(), "engine_comparison": comparison, "notes": run.notes})
 
 

@@ -54,20 +54,21 @@ def _num(x, fmt=".2e") -> str:
 
 
 def format_table(report) -> str:
+    from pendverify.checks.evidence import stress_verdict
     from pendverify.checks.report import text_table
 
     header = ("case", "quantity", "error", "tolerance", "ratio", "κ(M)", "κ̃(M)", "refused", "result")
     rows = [
         (
-            r.case,
-            r.quantity,
+            r.name,
+            r.detail,
             _num(r.error),
             _num(r.tolerance),
             _num(_margin(r), ".2g"),
-            _num(r.kappa_raw, ".1e"),
-            _num(r.kappa_scaled, ".1e"),
-            str(r.refused),
-            r.verdict,
+            _num(r.extras["kappa_raw"], ".1e"),
+            _num(r.extras["kappa_scaled"], ".1e"),
+            str(r.extras["refused"]),
+            stress_verdict(r),
         )
         for r in report.results
     ]
@@ -77,16 +78,16 @@ def format_table(report) -> str:
         "error and tolerance are relative, in diagonally scaled coordinates; κ̃(M) is κ(M) after "
         "diagonal scaling (worst over the case's states)."
     )
-    invariants = [r for r in report.results if r.invariant]
+    invariants = [r for r in report.results if r.extras["invariant"]]
     if invariants:
         out.append("")
         out.append("invariants:")
-        out += [f"  {r.case}: {r.invariant}" for r in invariants]
-    notes = [r for r in report.results if r.note]
+        out += [f"  {r.name}: {r.extras['invariant']}" for r in invariants]
+    notes = [r for r in report.results if r.notes]
     if notes:
         out.append("")
         out.append("notes:")
-        out += [f"  {'FAIL ' if not r.passed else ''}{r.case}: {r.note}" for r in notes]
+        out += [f"  {'FAIL ' if r.failed else ''}{r.name}: {'; '.join(r.notes)}" for r in notes]
     if report.evidence:
         out.append("")
         out.append("evidence:")
@@ -100,8 +101,9 @@ def format_table(report) -> str:
         worst = max(compared, key=_margin)
         out.append("")
         out.append(
-            f"worst error/tolerance {_margin(worst):.2g} ({worst.case}); largest error "
-            f"{max(r.error for r in compared):.2e}; {sum(r.refused for r in report.results)} state(s) refused"
+            f"worst error/tolerance {_margin(worst):.2g} ({worst.name}); largest error "
+            f"{max(r.error for r in compared):.2e}; {sum(r.extras['refused'] for r in report.results)} "
+            "state(s) refused"
         )
     return "\n".join(out)
 
@@ -154,6 +156,7 @@ def format_study(study) -> str:
 def report_dict(report) -> dict:
     import dataclasses
 
+    from pendverify.checks.evidence import stress_record
     from pendverify.jsonio import versions
 
     study = None
@@ -174,7 +177,7 @@ def report_dict(report) -> dict:
         "settings": dataclasses.asdict(report.settings),
         "elapsed_s": round(report.elapsed_s, 3),
         "passed": report.passed,
-        "results": [r.as_dict() for r in report.results],
+        "results": [stress_record(r) for r in report.results],
         "near_singular": study,
         "evidence": report.evidence,
         "not_varied": report.notes,
@@ -212,7 +215,7 @@ def run(args: argparse.Namespace) -> int:
             print(format_study(report.study))
         print()
     elapsed = time.perf_counter() - args.started
-    failures = [r for r in report.results if not r.passed]
+    failures = [r for r in report.results if r.failed]
     verdict = "all cases pass" if not failures else f"{len(failures)} case(s) FAIL"
     print(
         f"{len(report.results)} stress cases ({'quick' if args.quick else 'full'}, seed {seed}), "

@@ -40,7 +40,7 @@ TRAP_MIN_ERROR = 1e-6  # smallest relative failure a convention or inertia trap 
 
 
 def _largest_failure(results) -> float:
-    return max((r.max_error for r in results if not r.passed), default=0.0)
+    return max((r.error for r in results if not r.passed), default=0.0)
 
 
 HYPOTHESES = (pivot_inertia, missing_damping, coordinate_conventions)
@@ -51,7 +51,7 @@ BOUNDED = (coordinate_conventions,)
 def diagnose(model, system, results, unsearched: list | None = None) -> list[Finding]:
     """One finding per known trap that explains the failing checks; its message says how well it fits.
     What a bounded search left out is added to ``unsearched``, in words."""
-    failing = {r.check for r in results if not r.passed}
+    failing = {r.name for r in results if not r.passed}
     if not failing or not model.has_mass_matrix:  # every trap compares M or H: q̈ alone gives neither
         return []
     # a convention or inertia trap changes M or H by O(1): never blame one for a rounding-size failure

@@ -66,7 +66,7 @@ def explain(batch, results, deadline_s: float = REPAIR_DEADLINE_S) -> list[Findi
     def late() -> bool:
         return now() - start > deadline_s - FINISHING_S
 
-    failing = {r.check for r in results if not r.passed}
+    failing = {r.name for r in results if not r.passed}
     findings: list[Finding] = []
     skipped: list[str] = []
     # quantities of any size reach here (a damping of 1e300 is valid input): overflow in a fit

@@ -23,20 +23,22 @@ step error is estimated by Richardson extrapolation against a run at half the
 step: |r_h − r_{h/2}|·16/15.  Errors are reported relative to E_scale, the
 largest kinetic energy plus the potential energy's range.
 
-Two figures, never one for the other.  Each invariant reports the **largest error**
-over the run (``max_error``, relative, with ``max_error_abs`` in J and the time
-``max_error_t``) and, separately, the **worst ratio** error/tolerance: the error and
-the tolerance at the step where that ratio is largest (``error``, ``tolerance``,
-``worst_t``), which decides the verdict.  The bound grows along the run, so the two
-usually fall at different steps: on the chaotic scene the largest energy error is
-1.2e-8 J at the end, while the worst ratio is at an early step.
+Two figures, never one for the other.  Each invariant's ``Evidence``
+(``pendverify.checks.evidence``) reports the **largest error** over the run
+(``largest_error``, relative, in J ``largest_abs``, at the time ``largest_at["t"]``) and,
+separately, the **worst ratio** error/tolerance: the error and the tolerance at the step
+where that ratio is largest (``error``, ``tolerance``, at ``at["t"]``), which decides the
+verdict.  ``extras["scale"]`` is the energy scale (J) the errors are relative to.  The bound
+grows along the run, so the two usually fall at different steps: on the chaotic scene the
+largest energy error is 1.2e-8 J at the end, while the worst ratio is at an early step.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
+
+from pendverify.checks.evidence import Evidence, largest_abs
+from pendverify.checks.verdict import FAIL, PASS
 
 SAFETY = 4.0
 ROUNDING = 64.0
@@ -44,64 +46,41 @@ EPS = float(np.finfo(float).eps)
 GRADIENT_STEP = 1e-7
 
 
-@dataclass(frozen=True)
-class InvariantResult:
-    """One invariant: its largest error and, apart, its worst error/tolerance ratio.
-
-    Errors are relative to ``scale`` (the energy scale, J); times in s.
-    """
-
-    name: str
-    error: float  # relative, at the step with the worst error/tolerance ratio
-    tolerance: float  # relative, at that same step
-    passed: bool
-    detail: str = ""
-    max_error: float = 0.0  # relative: the largest error over the run
-    max_error_t: float = 0.0  # s: where the largest error is
-    worst_t: float = 0.0  # s: where the worst error/tolerance ratio is
-    scale: float = 1.0  # J: what the errors are relative to (nan: each state's own scale)
-
-    @property
-    def max_error_abs(self) -> float:
-        """The largest error in J (nan when each state's error is relative to its own scale)."""
-        return self.max_error * self.scale
-
-    @property
-    def ratio(self) -> float:
-        return self.error / self.tolerance if self.tolerance > 0 else float("inf")
-
-    def __repr__(self) -> str:
-        verdict = "holds" if self.passed else "FAILS"
-        figures = f"error {self.error:.3g}, tolerance {self.tolerance:.3g}"
-        return f"<InvariantResult {self.name!r}: {figures}: {verdict}>"
-
-    def as_dict(self) -> dict:
-        return {**self.__dict__, "max_error_abs": self.max_error_abs}
-
-    def figures(self) -> str:
-        """The two figures in words: the largest error and the worst ratio, each with where."""
-        absolute = f" ({self.max_error_abs:.3g} J)" if np.isfinite(self.scale) else ""
-        return (
-            f"largest {self.max_error:.3g}{absolute} at t = {self.max_error_t:.4g} s; "
-            f"worst ratio {self.error:.3g}/{self.tolerance:.3g} at t = {self.worst_t:.4g} s"
-        )
+def figures(inv: Evidence) -> str:
+    """The two figures in words: the largest error and the worst ratio, each with where."""
+    absolute = f" ({largest_abs(inv):.3g} J)" if np.isfinite(inv.extras["scale"]) else ""
+    return (
+        f"largest {inv.largest_error:.3g}{absolute} at t = {inv.largest_at['t']:.4g} s; "
+        f"worst ratio {inv.error:.3g}/{inv.tolerance:.3g} at t = {inv.at['t']:.4g} s"
+    )
 
 
-def figures_of(name: str, errors: np.ndarray, bounds: np.ndarray, times, scale: float, detail: str):
-    """An InvariantResult from per-step errors and bounds (absolute) at ``times``."""
+def time_place(t) -> dict:
+    """A place along a run: its label and the time ``t`` in s."""
+    return {"label": f"t = {float(t):.6g} s", "t": float(t)}
+
+
+def figures_of(
+    name: str, errors: np.ndarray, bounds: np.ndarray, times, scale: float, detail: str
+) -> Evidence:
+    """An invariant's evidence from per-step errors and bounds (absolute) at ``times``, relative
+    to ``scale`` (J; NaN: the errors are already relative, each to its own state's scale)."""
     errors, bounds = np.asarray(errors, dtype=float), np.asarray(bounds, dtype=float)
+    divisor = scale if np.isfinite(scale) else 1.0
     worst = int(np.argmax(errors / bounds))
     largest = int(np.argmax(errors))
-    return InvariantResult(
+    return Evidence(
+        "invariant",
         name,
-        float(errors[worst] / scale),
-        float(bounds[worst] / scale),
-        bool(np.all(errors <= bounds)),
-        detail,
-        max_error=float(errors[largest] / scale),
-        max_error_t=float(times[largest]),
-        worst_t=float(times[worst]),
-        scale=float(scale),
+        PASS if np.all(errors <= bounds) else FAIL,
+        error=float(errors[worst] / divisor),
+        tolerance=float(bounds[worst] / divisor),
+        at=time_place(times[worst]),
+        largest_error=float(errors[largest] / divisor),
+        largest_tolerance=float(bounds[largest] / divisor),
+        largest_at=time_place(times[largest]),
+        detail=detail,
+        extras={"scale": float(scale)},
     )
 
 
@@ -187,7 +166,7 @@ def richardson_bound(r_h: np.ndarray, r_half_at_steps: np.ndarray, scale: float)
     return SAFETY * estimate + ROUNDING * EPS * scale * steps
 
 
-def evaluate(dyn, scene, steps_t, steps_x, bound: np.ndarray, scale: float) -> list[InvariantResult]:
+def evaluate(dyn, scene, steps_t, steps_x, bound: np.ndarray, scale: float) -> list[Evidence]:
     E, r = residual(dyn, steps_x)
     has_work = scene.actuation is not None or scene.disturbance is not None
     if scene.conservative:

@@ -10,10 +10,11 @@ separate for reasons that are not model errors, so they are never diffed).
 from __future__ import annotations
 
 import io
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
+from pendverify.checks.evidence import Evidence, invariant_record
 from pendverify.checks.scaling import norm2, rate_scale, scaled_matrix, weights_at
 from pendverify.checks.trust import EPS
 from pendverify.display import html_table, shortened
@@ -22,7 +23,6 @@ from pendverify.jsonio import to_json, versions
 from pendverify.simulation.dynamics import Dynamics, build_dynamics
 from pendverify.simulation.integrate import Integration, integrate
 from pendverify.simulation.invariants import (
-    InvariantResult,
     adaptive_bound,
     energy_scale,
     evaluate,
@@ -41,8 +41,8 @@ class Run:
 
     ``t`` (s, the scene's sample times), ``q``, ``v`` (one row per sample, the model's
     coordinates), ``u``, ``w`` (inputs and disturbances), ``energy`` (J) are arrays;
-    ``invariants`` holds one ``InvariantResult`` per invariant (name, error, tolerance,
-    passed, detail), ``engine_comparison`` the ABA-vs-closed-form comparison (engine
+    ``invariants`` holds one ``Evidence`` per invariant (``pendverify.checks.evidence``: name,
+    error, tolerance, status, detail), ``engine_comparison`` the ABA-vs-closed-form comparison (engine
     ``both``), ``notes`` what the run noticed.  ``passed`` is every invariant (and the
     comparison) passing.  ``scene``, ``dynamics`` and ``integration`` are what was run and how.
     ``metadata()``, ``to_npz_bytes()`` and ``to_csv()`` are the files ``pendverify simulate``
@@ -58,12 +58,12 @@ class Run:
     u: np.ndarray
     w: np.ndarray
     energy: np.ndarray
-    invariants: list[InvariantResult]
-    engine_comparison: InvariantResult | None = None
+    invariants: list[Evidence]
+    engine_comparison: Evidence | None = None
     notes: list[str] = field(default_factory=list)
 
     @property
-    def checks(self) -> list[InvariantResult]:
+    def checks(self) -> list[Evidence]:
         """The invariants and, with engine ``both``, the engines' comparison."""
         return [*self.invariants, *([self.engine_comparison] if self.engine_comparison else [])]
 
@@ -98,7 +98,7 @@ class Run:
                 c.name,
                 f"{c.error:.2e}",
                 f"{c.tolerance:.2e}",
-                f"{c.worst_t:.4g}",
+                f"{c.at['t']:.4g}",
                 "pass" if c.passed else "FAIL",
                 c.detail,
             )
@@ -122,7 +122,7 @@ class Run:
             "steps": int(len(self.integration.steps_t) - 1),
             "rhs_evaluations": int(self.integration.nfev),
             "terms": self.dynamics.terms,
-            "invariants": [i.as_dict() for i in self.invariants],
+            "invariants": [invariant_record(i) for i in self.invariants],
             "passed": self.passed,
             "versions": versions(),
         }
@@ -186,7 +186,7 @@ def relative_differences(differences, scales) -> np.ndarray:
         return np.where(differences == 0.0, 0.0, differences / scales)
 
 
-def _engine_comparison(dyn: Dynamics, steps_t, steps_x) -> InvariantResult:
+def _engine_comparison(dyn: Dynamics, steps_t, steps_x) -> Evidence:
     """ABA against the closed-form right-hand side at the trajectory's own states."""
     n, model = dyn.nv, dyn.model
     differences, scales, tolerances = [], [], []
@@ -206,15 +206,14 @@ def _engine_comparison(dyn: Dynamics, steps_t, steps_x) -> InvariantResult:
         scales.append(Minv * (forces + M * np.max(np.abs(a_pin / weights))))
         differences.append(np.max(np.abs((a_pin - a_cf) / weights)))
         tolerances.append(ENGINE_K * EPS * (1 + np.max(np.abs(q[np.array(model.angular)]), initial=0.0)))
-    result = figures_of(
+    return figures_of(  # each state's error is relative to its own scale: no common one
         "engines agree: ABA vs closed-form q̈ at the same states",
         relative_differences(differences, scales),
         np.array(tolerances),
         steps_t,
-        1.0,
+        float("nan"),
         f"over {len(steps_t)} states",
     )
-    return replace(result, scale=float("nan"))  # each state's error is relative to its own scale
 
 
 def run_scene(scene: Scene, engine: str | None = None, urdf: str | None = None) -> Run:

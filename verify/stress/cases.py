@@ -7,18 +7,20 @@ import math
 
 import numpy as np
 
+from pendverify.checks.evidence import Evidence
 from pendverify.checks.sampling import RATE_RANGE, State
+from pendverify.checks.verdict import NOT_RUN
 from pendverify.stress.framework import (
     ANGLE_SHIFT,
     HIGH_RATE,
     Case,
     Context,
-    StressResult,
     compare,
     judged_ratio,
     model_of,
     refusals_as_expected,
     sampled_states,
+    stress_evidence,
     stress_result,
     verified,
 )
@@ -61,11 +63,11 @@ def large_angle_case(
     result says so) rather than compare unshifted states and call that an invariance.
     """
 
-    def run(ctx: Context, name: str) -> StressResult:
+    def run(ctx: Context, name: str) -> Evidence:
         params = params_fn()
         model = model_of(params, model_cls, ctx)
         if not any(model.angular):
-            return StressResult(
+            return stress_evidence(
                 name,
                 "no angular coordinate",
                 None,
@@ -75,6 +77,7 @@ def large_angle_case(
                 None,
                 True,
                 "not run: no angle to shift",
+                level=NOT_RUN,
             )
         system = ctx.system(params)
         states = shifted_states(model, sampled_states(model, ctx), shift)
@@ -89,17 +92,17 @@ def large_angle_case(
             return stress_result(name, direct, expect, invariant, inv_ok, note)
         inv_worst = max(invariance.results, key=judged_ratio)
         invariant = (
-            f"2πk invariance (closed form at θ vs Pinocchio at θ mod 2π): {inv_worst.max_error:.2g} "
-            f"≤ {inv_worst.tolerance:.2g} ({inv_worst.check}); |θ| up to {angle:.3g} rad"
+            f"2πk invariance (closed form at θ vs Pinocchio at θ mod 2π): {inv_worst.error:.2g} "
+            f"≤ {inv_worst.tolerance:.2g} ({inv_worst.name}); |θ| up to {angle:.3g} rad"
         )
-        note = "" if inv_ok else f"FAIL invariance {inv_worst.check} at {inv_worst.worst_state['label']}"
+        note = "" if inv_ok else f"FAIL invariance {inv_worst.name} at {inv_worst.label}"
         return stress_result(name, direct, expect, invariant, inv_ok, note)
 
     return Case(name, "large angle", run)
 
 
 def high_speed_case(name: str, params_fn, model_cls=None) -> Case:
-    def run(ctx: Context, name: str) -> StressResult:
+    def run(ctx: Context, name: str) -> Evidence:
 
         params = params_fn()
         model = model_of(params, model_cls, ctx)
@@ -108,7 +111,7 @@ def high_speed_case(name: str, params_fn, model_cls=None) -> Case:
             dataclasses.replace(s, v=s.v * (HIGH_RATE / RATE_RANGE)) for s in sampled_states(model, ctx)
         ]
         comp = compare(name, model, system, states, ctx.seed)
-        finite = all(np.isfinite(r.max_abs_error) for r in comp.results)
+        finite = all(np.isfinite(r.extras["max_abs_error"]) for r in comp.results)
         rate = max(float(np.max(np.abs(s.v))) for s in states)
         invariant = f"|q̇| up to {rate:.3g}; all quantities finite: {'yes' if finite else 'NO'}"
         return stress_result(name, comp, "none", invariant, finite)

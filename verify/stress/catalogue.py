@@ -8,8 +8,8 @@ description (the URDF the project writes for the set, ``robot.writer``) and the 
 ``framework.on_description``.  The studies that are no parameter set (the cart's m1 → 0
 study, det M, bad input) are ``pendverify.stress.reference_cases``.
 
-Each case is a named function returning a ``StressResult``: the achieved
-relative error next to the tolerance used, κ(M) raw and after diagonal scaling
+Each case is a named function returning an ``Evidence`` (``pendverify.checks.evidence``): the
+achieved relative error next to the tolerance used, κ(M) raw and after diagonal scaling
 (the worst over the case's states), the simulation invariant where the case
 simulates, and pass/fail.  Seeds are fixed (``SEED``) and recorded.
 
@@ -65,6 +65,7 @@ import numpy as np
 
 from pendverify.analytic import MODELS
 from pendverify.analytic.params import default_parameter_file, load_parameter_file
+from pendverify.checks.evidence import Evidence
 from pendverify.checks.sampling import State
 from pendverify.display import html_table, listed
 from pendverify.robot.writer import urdf_for
@@ -76,7 +77,6 @@ from pendverify.stress.framework import (
     Case,
     Context,
     Settings,
-    StressResult,
     checks_case,
     on_description,
 )
@@ -227,7 +227,7 @@ def hard_set_case(entry: HardSet, model_cls=None) -> Case:
     class; another plants an error) on the set's description and the set."""
     cls = model_cls or MODELS[entry.model]
 
-    def run(ctx: Context, name: str) -> StressResult:
+    def run(ctx: Context, name: str) -> Evidence:
         params = entry.params()
         case = KINDS[entry.kind](entry, lambda: params, cls)
         return on_description(case, urdf_for(params), cls).run(ctx, name)
@@ -246,7 +246,7 @@ CASE_NAMES = tuple(c.name for c in catalogue())
 class StressReport:
     settings: Settings
     seed: int
-    results: list[StressResult] = field(default_factory=list)
+    results: list[Evidence] = field(default_factory=list)
     study: StudyResult | None = None
     elapsed_s: float = 0.0
     #: what the cases did not vary, and why (generic cases on a model file)
@@ -256,10 +256,11 @@ class StressReport:
 
     @property
     def passed(self) -> bool:
-        return all(r.passed for r in self.results)
+        """Whether no case failed (a case refused or not run, as it expects, does not fail)."""
+        return not any(r.failed for r in self.results)
 
     def __repr__(self) -> str:
-        failed = [r.case for r in self.results if not r.passed]
+        failed = [r.name for r in self.results if r.failed]
         head = (
             f"<StressReport {'pass' if self.passed else 'FAIL'}: {len(self.results)} cases, seed {self.seed}"
         )
@@ -268,22 +269,22 @@ class StressReport:
     def _repr_html_(self) -> str:
         """One row per case: its quantity, error, tolerance and verdict."""
         rows = [
-            (r.case, r.quantity, _figure(r.error), _figure(r.tolerance), "pass" if r.passed else "FAIL")
+            (r.name, r.detail, _figure(r.error), _figure(r.tolerance), "FAIL" if r.failed else "pass")
             for r in self.results
         ]
         caption = f"stress: {'pass' if self.passed else 'FAIL'}, seed {self.seed}"
         header = ("case", "quantity", "error", "tolerance", "result")
-        return html_table(header, rows, caption, [not r.passed for r in self.results])
+        return html_table(header, rows, caption, [r.failed for r in self.results])
 
 
 def _figure(value: float | None) -> str:
     return "—" if value is None else f"{value:.2e}"
 
 
-def run_case(case: Case, ctx: Context) -> StressResult:
+def run_case(case: Case, ctx: Context) -> Evidence:
     started = time.perf_counter()
     result = case.run(ctx, case.name)
-    result.seconds = time.perf_counter() - started
+    result.extras["seconds"] = time.perf_counter() - started
     result.seed = ctx.seed
     return result
 

@@ -1,4 +1,4 @@
-"""The stress framework: results, settings, the guarded comparison, and a case on a description.
+"""The stress framework: each case's evidence, settings, the guarded comparison, and a case on a description.
 
 The comparison guards every state with the trust rule and then runs the core
 checks exactly as ``pendverify check`` does: one tolerance model
@@ -24,9 +24,10 @@ import numpy as np
 
 from pendverify.checks.batch import CheckBatch
 from pendverify.checks.catalogue import applicable_checks, run_checks
+from pendverify.checks.evidence import Evidence
 from pendverify.checks.sampling import DEFAULT_SEED, State, sample_states
 from pendverify.checks.trust import WARN_REL
-from pendverify.checks.verdict import REFUSED, WARN
+from pendverify.checks.verdict import FAIL, NOT_RUN, PASS, REFUSED, WARN
 from pendverify.checks.verification import trusted
 from pendverify.errors import PendverifyError
 from pendverify.robot.description import LoadedDescription, load_description
@@ -48,41 +49,50 @@ DP_DET_MASSES = (1e-3, 1e-6, 1e-9)  # kg, m1 of the point-mass double pendulum i
 ORDER_FRACTION = 0.2  # share of the long horizon over which RK4 at h/2 measures its slope
 
 
-@dataclass
-class StressResult:
-    """One row of the catalogue: the evidence of one hard case."""
+#: the trust rule's level over a case's states → the case's verdict, when the case holds
+LEVEL_STATUS = {"ok": PASS, "warn": WARN, "refuse": REFUSED, NOT_RUN: NOT_RUN}
 
-    case: str
-    quantity: str
-    error: float | None
-    tolerance: float | None
-    kappa_raw: float | None
-    kappa_scaled: float | None
-    invariant: str | None
-    passed: bool
-    note: str = ""
-    #: worst conditioning verdict over the accepted states: ok, warn (fewer digits)
-    level: str = "ok"
-    refused: int = 0
-    seed: int = SEED
-    seconds: float = 0.0
 
-    @property
-    def verdict(self) -> str:
-        """FAIL; refused (as the case expects: no state could be verified); or pass, with qualifiers."""
-        if not self.passed:
-            return "FAIL"
-        if self.level == "refuse":
-            return "refused"
-        extra = (["warn"] if self.level == "warn" else []) + (
-            [f"{self.refused} refused"] if self.refused else []
-        )
-        return f"pass ({', '.join(extra)})" if extra else "pass"
+def stress_status(passed: bool, level: str = "ok") -> str:
+    """A stress case's verdict: fail unless what the case expects held (``passed``); else the
+    trust rule's level over its states (``LEVEL_STATUS``): pass, warn (fewer digits), refused (as
+    the case expects, no state could be verified) or not run."""
+    return LEVEL_STATUS[level] if passed else FAIL
 
-    def as_dict(self) -> dict:
-        d = dataclasses.asdict(self)
-        d["verdict"] = self.verdict
-        return d
+
+def stress_evidence(
+    case: str,
+    quantity: str,
+    error: float | None,
+    tolerance: float | None,
+    kappa_raw: float | None,
+    kappa_scaled: float | None,
+    invariant: str | None,
+    passed: bool,
+    note: str = "",
+    level: str = "ok",
+    refused: int = 0,
+) -> Evidence:
+    """One row of the catalogue: the evidence of one hard case (``stress_status`` gives its verdict;
+    ``refused``: how many of its states the trust rule refused)."""
+    extras = {
+        "kappa_raw": kappa_raw,
+        "kappa_scaled": kappa_scaled,
+        "invariant": invariant,
+        "refused": refused,
+    }
+    return Evidence(
+        "stress",
+        case,
+        stress_status(passed, level),
+        error=error,
+        tolerance=tolerance,
+        largest_error=None,  # a stress case keeps its worst ratio only
+        detail=quantity,
+        notes=[note] if note else [],
+        seed=SEED,
+        extras=extras,
+    )
 
 
 @dataclass(frozen=True)
@@ -157,31 +167,29 @@ class Context:
 class Case:
     name: str
     group: str
-    run: Callable[[Context, str], StressResult]
+    run: Callable[[Context, str], Evidence]
 
 
 def on_description(case: Case, urdf, model_cls) -> Case:
     """``case`` compared with the robot description ``urdf`` seen through ``model_cls``; a case
     that cannot run there (a PendverifyError) fails, saying why."""
 
-    def run(ctx: Context, name: str) -> StressResult:
+    def run(ctx: Context, name: str) -> Evidence:
         try:
             return case.run(dataclasses.replace(ctx, urdf=urdf, model_cls=model_cls), name)
         except PendverifyError as exc:
-            return StressResult(name, "not run", None, None, None, None, None, False, f"FAIL {exc}")
+            return stress_evidence(name, "not run", None, None, None, None, None, False, f"FAIL {exc}")
 
     return Case(case.name, case.group, run)
 
 
 # --- comparing closed form and Pinocchio --------------------------------------------------------
-def error_ratio(r) -> float:
-    return r.max_error / r.tolerance if r.tolerance > 0 else math.inf
 
 
 def judged_ratio(r) -> float:
-    """``error_ratio``, or −inf for a check refused at every state (no error judged, NaN): the
-    worst of a case's checks is a judged one, whose figures are numbers."""
-    ratio = error_ratio(r)
+    """error / tolerance (``Evidence.ratio``), or −inf for a check refused at every state (no error
+    judged, NaN): the worst of a case's checks is a judged one, whose figures are numbers."""
+    ratio = r.ratio
     return -math.inf if math.isnan(ratio) else ratio
 
 
@@ -259,29 +267,29 @@ def stress_result(
 ):
     notes = [note] if note else []
     failed = [r for r in comp.results if not verified(r, expect)]
-    refused = [r.check for r in comp.results if r.status == REFUSED]
+    refused = [r.name for r in comp.results if r.status == REFUSED]
     if refused:
         notes.append(
             f"{', '.join(refused)} refused at some states (the check's rounding bound above the trust limit)"
         )
     if comp.results:
         worst = max(comp.results, key=judged_ratio)
-        error, tolerance = worst.max_error, worst.tolerance
-        quantity = f"{worst.check} (worst of {len(comp.results)} checks, {comp.kept} states)"
+        error, tolerance = worst.error, worst.tolerance
+        quantity = f"{worst.name} (worst of {len(comp.results)} checks, {comp.kept} states)"
         if failed:
             notes.append(
                 "FAIL "
                 + ", ".join(
-                    f"{r.check} refused"
+                    f"{r.name} refused"
                     if r.status == REFUSED
-                    else f"{r.check} {r.max_error:.2g} > {r.tolerance:.2g} at {r.worst_state['label']}"
+                    else f"{r.name} {r.error:.2g} > {r.tolerance:.2g} at {r.label}"
                     for r in failed
                 )
             )
         warned = [r for r in comp.results if r.status == WARN]
         if warned:
             first = next((r.notes[0] for r in warned if r.notes), "")
-            notes.append(f"warn {', '.join(r.check for r in warned)}: {first}")
+            notes.append(f"warn {', '.join(r.name for r in warned)}: {first}")
     else:
         error = tolerance = None
         quantity = "no state verified"
@@ -295,7 +303,7 @@ def stress_result(
         notes.append(
             f"refusals: expected {expect!r}, got {len(comp.refused)} of {len(comp.refused) + comp.kept}"
         )
-    return StressResult(
+    return stress_evidence(
         case=name,
         quantity=quantity,
         error=error,
@@ -325,7 +333,7 @@ def checks_case(
     if expect not in EXPECT:
         raise ValueError(f"expect must be one of {EXPECT}")
 
-    def run(ctx: Context, name: str) -> StressResult:
+    def run(ctx: Context, name: str) -> Evidence:
         params = params_fn()
         model = model_of(params, model_cls, ctx)
         states = sampled_states(model, ctx) + (extra_states(model) if extra_states else [])

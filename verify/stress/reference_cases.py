@@ -14,19 +14,20 @@ from collections.abc import Callable
 import numpy as np
 
 from pendverify.analytic import MODELS
+from pendverify.checks.evidence import Evidence
 from pendverify.checks.trust import EPS, KAPPA_K, REFUSE_REL, assess
 from pendverify.errors import PendverifyError
-from pendverify.stress.framework import DP_DET_MASSES, Context, StressResult
+from pendverify.stress.framework import DP_DET_MASSES, Context, stress_evidence
 from pendverify.stress.trust_study import det_accuracy
 from pendverify.validate import finite_state, model_state
 
 
-def trust_case(base_fn) -> Callable[[Context, str], StressResult]:
+def trust_case(base_fn) -> Callable[[Context, str], Evidence]:
     """The trust study of the set ``base_fn()`` (m1 → 0) judged: the guard is conservative."""
     return lambda ctx, name: _trust_result(ctx.trust_study(base_fn()), name)
 
 
-def _trust_result(study, name: str) -> StressResult:
+def _trust_result(study, name: str) -> Evidence:
     accepted = [r for r in study.rows if r.level != "refuse"]
     worst = max(accepted, key=lambda r: r.worst / r.bound)
     within = all(r.worst <= REFUSE_REL for r in accepted)
@@ -40,7 +41,7 @@ def _trust_result(study, name: str) -> StressResult:
     notes = [study.zero_mass_note, *study.violations]
     if not conservative:
         notes.append("the guard accepts m1 below the measured trust limit")
-    return StressResult(
+    return stress_evidence(
         case=name,
         quantity=f"det, q̈, M⁻¹ vs 50-digit mpmath ({len(study.rows)} rows), worst accepted",
         error=worst.worst,
@@ -55,18 +56,18 @@ def _trust_result(study, name: str) -> StressResult:
     )
 
 
-def det_case(base_fn) -> Callable[[Context, str], StressResult]:
+def det_case(base_fn) -> Callable[[Context, str], Evidence]:
     """The cart's closed-form det (non-negative terms) stays at ε level even where LU fails (the trust
     study of ``base_fn()``)."""
     return lambda ctx, name: _det_result(ctx.trust_study(base_fn()), name)
 
 
-def _det_result(study, name: str) -> StressResult:
+def _det_result(study, name: str) -> Evidence:
     finite_m = [r for r in study.rows if r.kappa_scaled < 1 / EPS]  # M itself representable
     worst_cf = max(r.det_closed_form for r in finite_m)
     worst_lu = max(finite_m, key=lambda r: r.det_lu)
     tol = KAPPA_K * EPS
-    return StressResult(
+    return stress_evidence(
         case=name,
         quantity="closed-form det M vs 50 digits (LU of CRBA alongside)",
         error=worst_cf,
@@ -81,13 +82,13 @@ def _det_result(study, name: str) -> StressResult:
     )
 
 
-def dp_det_case(base_fn) -> Callable[[Context, str], StressResult]:
+def dp_det_case(base_fn) -> Callable[[Context, str], Evidence]:
     """The double pendulum's closed-form det, αδ − δ² − β²cos²θ2, is a difference: no better than LU
     (on ``base_fn()`` with m1 of ``DP_DET_MASSES``)."""
     return lambda ctx, name: _dp_det_result(base_fn(), name)
 
 
-def _dp_det_result(base, name: str) -> StressResult:
+def _dp_det_result(base, name: str) -> Evidence:
     rows = []
     for m1 in DP_DET_MASSES:
         params = base.replace(m1=m1)
@@ -103,7 +104,7 @@ def _dp_det_result(base, name: str) -> StressResult:
         for m1, t2, c, lu, _ in rows
         if m1 <= 1e-6
     )
-    return StressResult(
+    return stress_evidence(
         case=name,
         quantity="max(closed-form det, LU det) error vs 50 digits, over K·ε·κ̃",
         error=max(worst[2], worst[3]),
@@ -116,13 +117,13 @@ def _dp_det_result(base, name: str) -> StressResult:
 
 
 # --- invalid input ----------------------------------------------------------------------------
-def invalid_input_case(sets_fn) -> Callable[[Context, str], StressResult]:
+def invalid_input_case(sets_fn) -> Callable[[Context, str], Evidence]:
     """Bad states, inputs and parameters of the two sets ``sets_fn()`` (the double pendulum's, the
     cart's) each raise a PendverifyError."""
     return lambda ctx, name: _invalid_input_result(*sets_fn(), name)
 
 
-def _invalid_input_result(dp, cp, name: str) -> StressResult:
+def _invalid_input_result(dp, cp, name: str) -> Evidence:
     model = MODELS[dp.model](dp)
     attempts: dict[str, Callable[[], object]] = {
         "NaN state": lambda: model_state(model, [math.nan, 0.0]),
@@ -143,7 +144,7 @@ def _invalid_input_result(dp, cp, name: str) -> StressResult:
             messages.append(f"{label}: {exc}")
         else:
             silent.append(label)
-    return StressResult(
+    return stress_evidence(
         case=name,
         quantity=f"{len(attempts)} bad inputs, each must raise a PendverifyError",
         error=float(len(silent)),

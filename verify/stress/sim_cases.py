@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 
+from pendverify.checks.evidence import Evidence
 from pendverify.checks.trust import EPS, conditioning
 from pendverify.numerics.integrators import model_runs as runs
 from pendverify.numerics.integrators.tableaux import RK4
@@ -19,8 +20,9 @@ from pendverify.stress.framework import (
     RK4_UNSTABLE,
     Case,
     Context,
-    StressResult,
     model_of,
+    stress_evidence,
+    stress_status,
 )
 
 
@@ -68,7 +70,7 @@ def stiff_sim_case(name: str, params_fn, q0, light_params_fn, model_cls=None) ->
     """Backward Euler from rest at ``q0`` on the stiff set; RK4 and RK45 beside it, RK45's step
     count next to its count on ``light_params_fn``'s set (the model at ordinary damping)."""
 
-    def run(ctx: Context, name: str) -> StressResult:
+    def run(ctx: Context, name: str) -> Evidence:
 
         st = ctx.settings
         params = params_fn()
@@ -81,7 +83,7 @@ def stiff_sim_case(name: str, params_fn, q0, light_params_fn, model_cls=None) ->
         stable = implicit.blew_up_at is None and bool(np.all(np.isfinite(E)))
         monotone = stable and rise <= ENERGY_INCREASE_TOL
         c = _kappa(model, q0_)
-        result = StressResult(
+        result = stress_evidence(
             case=name,
             quantity="per-step energy rise, backward Euler (relative to |T|+|V| bound)",
             error=max(rise, 0.0) if stable else math.inf,
@@ -97,7 +99,7 @@ def stiff_sim_case(name: str, params_fn, q0, light_params_fn, model_cls=None) ->
             level=c.level,
         )
         if not monotone:
-            result.note = "; ".join(filter(None, [result.note, "explicit methods skipped"]))
+            result.notes.append("explicit methods skipped")
             return result
         growth = rk4_growth(
             runs.jacobian(runs.state_derivative_of(model), np.concatenate([q0_, v0])), st.stiff_step
@@ -107,16 +109,17 @@ def stiff_sim_case(name: str, params_fn, q0, light_params_fn, model_cls=None) ->
         adaptive = runs.rk45(model, q0_, v0, st.explicit_horizon)
         light = runs.rk45(model_of(light_params_fn(), model_cls, ctx), q0_, v0, st.explicit_horizon)
         per_horizon = adaptive.steps * st.stiff_horizon / st.explicit_horizon
-        result.invariant += (
+        result.extras["invariant"] += (
             f"; RK4 at h={st.stiff_step:g}: "
             + (f"blows up after {explicit.blew_up_at} steps" if observed else "stays finite")
             + f" (predicted growth ×{growth:.1e}/step); RK45 needs {adaptive.steps} steps for "
             f"{st.explicit_horizon:g} s (≈{per_horizon:.1e} for {st.stiff_horizon:g} s) vs "
             f"{light.steps} at default damping"
         )
-        result.passed = predicted == observed and adaptive.blew_up_at is None and adaptive.steps > 0
+        passed = predicted == observed and adaptive.blew_up_at is None and adaptive.steps > 0
+        result.status = stress_status(passed, c.level)
         if predicted != observed:
-            result.note = (
+            result.notes.append(
                 f"RK4 stability predicted {'a blow-up' if predicted else 'none'}, observed the opposite"
             )
         return result
@@ -128,7 +131,7 @@ def long_horizon_case(name: str, params_fn, start, model_cls=None) -> Case:
     """A mild, conservative set from rest at ``start`` over the long horizon: Störmer–Verlet's energy
     error stays bounded, RK4's drifts as an order-4 method's should."""
 
-    def run(ctx: Context, name: str) -> StressResult:
+    def run(ctx: Context, name: str) -> Evidence:
 
         st = ctx.settings
         params = params_fn()
@@ -175,7 +178,7 @@ def long_horizon_case(name: str, params_fn, start, model_cls=None) -> Case:
             notes.append(
                 f"RK4 drift not a clean order-4 line (R² {min(r2_rk, r2_half):.2f}, ratio {ratio:.1f})"
             )
-        return StressResult(
+        return stress_evidence(
             case=name,
             quantity=f"Störmer–Verlet |ΔE|/E over {T:g} s: second half vs first half",
             error=late,
@@ -191,7 +194,7 @@ def long_horizon_case(name: str, params_fn, start, model_cls=None) -> Case:
 
 
 def zero_gravity_sim_case(name: str, params_fn, q0, v0, cyclic: int, label: str, model_cls=None) -> Case:
-    def run(ctx: Context, name: str) -> StressResult:
+    def run(ctx: Context, name: str) -> Evidence:
 
         st = ctx.settings
         params = params_fn()
@@ -205,7 +208,7 @@ def zero_gravity_sim_case(name: str, params_fn, q0, v0, cyclic: int, label: str,
         dE = energies(model, traj)
         e_rel = float(np.max(np.abs(dE - dE[0]))) / energy_scale(model, q0_, v0_)
         c = _kappa(model, q0_)
-        return StressResult(
+        return stress_evidence(
             case=name,
             quantity=f"momentum {label} drift / |p|, Störmer–Verlet",
             error=drift,

@@ -38,12 +38,14 @@ import math
 
 import numpy as np
 
+from pendverify.checks.evidence import Evidence
 from pendverify.checks.sampling import State, sample_states
 from pendverify.checks.trust import EPS, REFUSE_REL, assess, conditioning
+from pendverify.checks.verdict import NOT_RUN
 from pendverify.errors import PendverifyError
 from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.xml_reading import parse_xml
-from pendverify.stress.framework import Case, Context, StressResult, compare, error_ratio
+from pendverify.stress.framework import Case, Context, compare, stress_evidence
 
 WALK_EXPONENTS = tuple(range(0, 17, 2))  # the parameter × 10^-k
 SEARCH_KINDS = ("mass", "length", "offset")  # alone; inertias go with their link's mass
@@ -167,11 +169,13 @@ def _search(model_cls, params, binding, states: list[State]):
 
 
 def near_singular_case(model_cls, params, binding, name: str = "near-singular M") -> Case:
-    def run(ctx: Context, name: str) -> StressResult:
+    def run(ctx: Context, name: str) -> Evidence:
         states = sample_states(model_cls(params), ctx.settings.random_states, ctx.seed)
         best = _search(model_cls, params, binding, states)
         if best is None:
-            return StressResult(name, "no parameter to vary", None, None, None, None, None, True, "not run")
+            return stress_evidence(
+                name, "no parameter to vary", None, None, None, None, None, True, level=NOT_RUN
+            )
         key, names, sign, state, _ = best
         at_rest = dataclasses.replace(state, label=f"{state.label}, at rest", v=np.zeros_like(state.v))
         walk, stop = walk_steps(params, names, sign, binding)
@@ -191,7 +195,7 @@ def near_singular_case(model_cls, params, binding, name: str = "near-singular M"
         verified = [k for k, kept, _, _ in steps if kept]
         refusing = [k for k, _, n, _ in steps if n]
         passed = not failed and steps[0][1] > 0 and (refusing or not crossed)
-        worst = max(results, key=error_ratio) if results else None
+        worst = max(results, key=lambda r: r.ratio) if results else None
         walk = (
             f"{key} × 10^{'-' if sign < 0 else ''}k at q = {np.array2string(state.q, precision=3)}: "
             "verified at k = "
@@ -202,13 +206,13 @@ def near_singular_case(model_cls, params, binding, name: str = "near-singular M"
             walk += f"; {stop}"
         if not crossed:
             walk += f"; the rounding bound stays ≤ {REFUSE_REL:g}: M never comes near singular"
-        notes = [f"FAIL {r.check} at {r.worst_state['label']}" for r in failed]
+        notes = [f"FAIL {r.name} at {r.label}" for r in failed]
         if crossed and not refusing:
             notes.append("the bound crossed the refusal limit but no state was refused")
-        return StressResult(
+        return stress_evidence(
             case=name,
-            quantity=f"{worst.check} (worst over the walk)" if worst else "no state verified",
-            error=worst.max_error if worst else None,
+            quantity=f"{worst.name} (worst over the walk)" if worst else "no state verified",
+            error=worst.error if worst else None,
             tolerance=worst.tolerance if worst else None,
             kappa_raw=kappa_raw or None,
             kappa_scaled=kappa_scaled or None,

@@ -64,7 +64,7 @@ def _discrepancy(model, system, states) -> tuple[float, bool]:
     """(largest relative error of crba and gravity, whether every applicable check passes)."""
     quick_names = ("crba", "gravity")
     quick = run_checks("diagnosis", model, system, states, DIAGNOSIS_SEED, names=quick_names)
-    largest = max(r.max_error for r in quick)
+    largest = max(r.error for r in quick)
     if not all(r.passed for r in quick):
         return largest, False
     rest = [n for n in applicable_checks(model, system) if n not in quick_names]  # crba, gravity done
