@@ -30,9 +30,6 @@ ALLOWED = {
     "verify/stress/sim_cases.py",
     "verify/stress/seed_params.py",
     "verify/stress/trust_study.py",  # the cart's m1 → 0 study that measured the trust rule
-    # the seeds' work–precision problems (``bench accuracy`` without --scene); any model's
-    # problems are ``bench/problems.py`` (``--scene``)
-    "verify/bench/seed_problems.py",
 }
 SCANNED = ("verify", "viz")
 

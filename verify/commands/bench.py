@@ -4,8 +4,8 @@
 ``pendverify bench explain [--quick]``: how well the diagnosis names and repairs planted errors,
 and its cost (``pendverify.bench.explain``).
 
-Without ``--scene``, the two reference systems' problems (``pendverify.bench.seed_problems``); with it, a
-user's scene, any model (``pendverify.bench.problems.scene_problems`` says which problems
+Without ``--scene``, the two reference systems' problems (the shipped scenes ``scenes/bench``,
+``pendverify.bench.problems.shipped_problems``); with it, a user's scene, any model (``pendverify.bench.problems.scene_problems`` says which problems
 and refuses what the benchmark cannot run, exit status 2).
 
 Writes DIR/work_precision.png (the plot), DIR/work_precision.csv (every point)
