@@ -20,8 +20,6 @@ SEED_NAMES = {"double_pendulum", "cart_double_pendulum"}
 SEED_CLASSES = {"DoublePendulum", "CartDoublePendulum", "DoublePendulumParams", "CartDoublePendulumParams"}
 #: where the seeds may be named: their definitions and the code that exists only for them
 ALLOWED = {
-    "verify/robot/seed_geometry.py",  # the seeds' URDF readers (a registry entry each)
-    "verify/robot/writer.py",  # the seeds' URDF writers (a registry entry each)
     "verify/robot/erd.py",  # example-robot-data's double pendulums are the double_pendulum seed
     # the seed-specific stress cases (``pendverify stress`` without --analytic) and their sets;
     # any model's hard cases are ``stress/generic.py`` and ``stress/singular.py``

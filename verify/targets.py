@@ -32,7 +32,7 @@ from pendverify.analytic.source_file import where
 from pendverify.errors import ParameterError, PendverifyError, UnknownNameError
 from pendverify.robot import erd
 from pendverify.robot.description import LoadedDescription, description_stem, is_description_text
-from pendverify.robot.seed_geometry import DEFAULT_G
+from pendverify.robot.geometry import DEFAULT_G
 from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
 

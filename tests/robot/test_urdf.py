@@ -133,8 +133,9 @@ def test_non_finite_states_are_refused_not_propagated(call, key):
 
 def test_a_model_without_a_urdf_writer_is_a_clear_error():
     from pendverify.analytic.plugin import load_model_class, plugin_parameters
+    from pendverify.analytic.reference_urdfs import WRITERS
     from pendverify.errors import PendverifyError
-    from pendverify.robot.writer import WRITERS, urdf_for
+    from pendverify.robot.writer import urdf_for
 
     examples = Path(__file__).resolve().parents[2] / "examples"
     cls = load_model_class(examples / "cart_pole.py")

@@ -5,8 +5,9 @@
 and its cost (``pendverify.bench.explain``).
 
 Without ``--scene``, the two reference systems' problems (the shipped scenes ``scenes/bench``,
-``pendverify.bench.problems.shipped_problems``); with it, a user's scene, any model (``pendverify.bench.problems.scene_problems`` says which problems
-and refuses what the benchmark cannot run, exit status 2).
+``pendverify.bench.problems.shipped_problems``); with it, a user's scene, any model
+(``pendverify.bench.problems.scene_problems`` says which problems and refuses what the benchmark
+cannot run, exit status 2).
 
 Writes DIR/work_precision.png (the plot), DIR/work_precision.csv (every point)
 and DIR/work_precision.md (the tables), and prints the tables.  BLAS is limited

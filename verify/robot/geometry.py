@@ -6,8 +6,8 @@ parameters read off the URDF where the model's family fixes them, notes, and a
 ``ModelForm`` for a term of the URDF the closed form cannot express.
 
 Readers are looked up in a registry, never chosen by a model's name: a model
-class names its reader in ``geometry_reader`` (the reference systems' readers live in
-``pendverify.robot.seed_geometry``); a model without one declares its map
+class names its reader in ``geometry_reader`` (the reference systems' readers live beside them,
+in ``pendverify.analytic.reference_geometry``); a model without one declares its map
 (``urdf_joints``, ``joint_transform``, ``joint_offset``; ``pendverify.robot.joint_map``).
 """
 
@@ -28,6 +28,7 @@ from pendverify.robot.coordinates import CoordinateMap
 #: centres of mass rounded at the micrometre (example-robot-data: 7.6e-6) and fails
 #: a 0.1 mm offset on a 0.5 m pendulum; ``pendverify check --model-form-rtol`` sets it.
 MODEL_FORM_RTOL = 1e-4
+DEFAULT_G = 9.81  # m/s², Pinocchio's default, used when a URDF alone is given
 
 
 @dataclass

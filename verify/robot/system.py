@@ -24,17 +24,15 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from pendverify.analytic import MODELS
+from pendverify.analytic import MODELS, reference_geometry  # noqa: F401  (registers the reference systems' readers)
 from pendverify.display import listed, shortened
-from pendverify.robot import seed_geometry  # noqa: F401  (registers the reference systems' readers)
 from pendverify.robot.batch import PinocchioBatch, finite_rows
 from pendverify.robot.coordinates import CoordinateMap
 from pendverify.robot.description import LoadedDescription, load_description
 from pendverify.robot.finite_terms import check_finite_terms
-from pendverify.robot.geometry import MODEL_FORM_RTOL, ModelForm, UrdfGeometry, combined, reader
+from pendverify.robot.geometry import DEFAULT_G, MODEL_FORM_RTOL, ModelForm, UrdfGeometry, combined, reader
 from pendverify.robot.gravity_tilt import tilt_form
 from pendverify.robot.joint_map import declared_geometry
-from pendverify.robot.seed_geometry import DEFAULT_G
 from pendverify.robot.writer import urdf_for
 from pendverify.validate import finite_state
 

@@ -18,7 +18,8 @@ centre of mass seen from joint 2.  For the cart, θi is the direction of rod i
 towards the rail's axis.
 
 Both register themselves (``pendverify.robot.geometry``) under the name of their
-model, which names them in its ``geometry_reader``.
+model, which names them in its ``geometry_reader``; ``pendverify.robot.system`` imports this module
+so that they are registered wherever a model meets a URDF.
 """
 
 from __future__ import annotations
@@ -28,13 +29,12 @@ import math
 import numpy as np
 import pinocchio as pin
 
-from pendverify.analytic import DoublePendulumParams
+from pendverify.analytic.double_pendulum import DoublePendulumParams
 from pendverify.errors import ParameterError, UrdfShapeError
 from pendverify.robot.coordinates import CoordinateMap
-from pendverify.robot.geometry import ModelForm, UrdfGeometry, register_reader
+from pendverify.robot.geometry import DEFAULT_G, ModelForm, UrdfGeometry, register_reader
 
 PARALLEL_TOL = 1e-9  # |sin| of the angle between axes that count as parallel
-DEFAULT_G = 9.81  # m/s², Pinocchio's default, used when a URDF alone is given
 
 _REVOLUTE = {"JointModelRX", "JointModelRY", "JointModelRZ", "JointModelRevoluteUnaligned"}
 _CONTINUOUS = {
