@@ -103,7 +103,7 @@ def erd_target(stem: str, path: Path) -> Target:
 
 def erd_targets() -> list[Target]:
     """Every double-pendulum URDF example-robot-data ships (an error when it is not installed)."""
-    return [erd_target(stem, path) for stem, path in erd.double_pendulum_urdfs().items()]
+    return [erd_target(stem, path) for stem, path in erd.family_urdfs().items()]
 
 
 def erd_selection() -> Selection:
