@@ -189,6 +189,12 @@ def add_sampling_options(parser: argparse.ArgumentParser, samples_default: int |
     )
 
 
+def add_model_option(parser, default: str = "both reference systems") -> None:
+    """``--model NAME``: one of the built-in models (``pendverify.analytic.MODELS``, whose names this
+    help lists for the reader); ``default`` says what runs without it."""
+    parser.add_argument("--model", help=f"double_pendulum or cart_double_pendulum (default: {default})")
+
+
 def add_analytic_option(parser, what: str) -> None:
     """``--analytic FILE``: a model file, as ``check --analytic`` takes it; ``what`` says what it does."""
     parser.add_argument(
