@@ -22,8 +22,9 @@ naming q).
 
 Rounding bound
 --------------
-All in the checks' scaled coordinates (``pendverify.checks.scaling``): w = 1/√S, M̃ = W M W,
-forces W f, accelerations q̈̃ = q̈/w, B̃ = W B (steps of 1 in the inputs), n coordinates.
+All in the checks' scaled coordinates (``pendverify.checks.scaling``): weights = 1/√S,
+M̃ = diag(weights) M diag(weights), forces weights·f, accelerations q̈̃ = q̈/weights, B̃ = diag(weights) B
+(steps of 1 in the inputs), n coordinates.
 
 What differs between the derivation's calls.  Every call at a configuration has the same q (the
 same bits), q̇ = 0 and w = 0; only u changes.  Whatever the code computes from q alone — cos θ,
@@ -83,7 +84,7 @@ DERIVED = (
 
 
 @dataclass(frozen=True)
-class Derivation:
+class NumericDerivation:
     """M, q̈(q, 0, 0) and the inputs' steps h at one configuration (``derive``)."""
 
     M: np.ndarray
@@ -101,8 +102,8 @@ def one_rounding(M: np.ndarray, angle: float) -> float:
 
     For the affinity test of ``derive``, which judges the code's own q̈ before any Pinocchio
     quantity is at hand: wide, so that only code that is not affine in u is refused."""
-    w = 1.0 / np.sqrt(np.abs(np.diag(M)))
-    norm, inv = _norms(M * np.outer(w, w))
+    weights = 1.0 / np.sqrt(np.abs(np.diag(M)))
+    norm, inv = _norms(M * np.outer(weights, weights))
     return K_CODE * EPS * (1.0 + angle) * inv * (1.0 + norm * inv)
 
 
@@ -119,7 +120,7 @@ def _mass(A, B, q, fail) -> np.ndarray:
     return M
 
 
-def derive(acceleration, q, B: np.ndarray, n_disturbances: int, fail) -> Derivation:
+def derive(acceleration, q, B: np.ndarray, n_disturbances: int, fail) -> NumericDerivation:
     """M(q) and q̈(q, 0, 0) from ``acceleration(q, v, u, w)`` and the declared B (module docstring).
 
     ``fail(message)`` raises: called when q̈ is not affine in u at q within its rounding, or
@@ -134,27 +135,27 @@ def derive(acceleration, q, B: np.ndarray, n_disturbances: int, fail) -> Derivat
     eye = np.eye(n)
     rest = at(np.zeros(n))
     unit = np.stack([at(eye[j]) - rest for j in range(n)], axis=1)
-    wts = 1.0 / np.sqrt(np.abs(np.diag(_mass(unit, B, q, fail))))
-    steps = np.array([_step(rest / wts, unit[:, j] / wts) for j in range(n)])
+    weights = 1.0 / np.sqrt(np.abs(np.diag(_mass(unit, B, q, fail))))
+    steps = np.array([_step(rest / weights, unit[:, j] / weights) for j in range(n)])
     pushed = [at(steps[j] * eye[j]) for j in range(n)]
     A = np.stack([(p - rest) / h for p, h in zip(pushed, steps, strict=True)], axis=1)
     M = _mass(A, B, q, fail)
-    wts = 1.0 / np.sqrt(np.abs(np.diag(M)))
+    weights = 1.0 / np.sqrt(np.abs(np.diag(M)))
     rho = one_rounding(M, float(np.max(np.abs(q), initial=0.0)))
-    gravity = float(np.linalg.norm(wts * (M @ rest)))
+    gravity = float(np.linalg.norm(weights * (M @ rest)))
     for j in range(n):
         for k in range(j, n):
             u = steps[j] * eye[j] + steps[k] * eye[k]
-            residual = (at(u) - pushed[j] - pushed[k] + rest) / wts
-            bound = 4.0 * rho * (gravity + float(np.linalg.norm(wts * (B @ u))))
+            residual = (at(u) - pushed[j] - pushed[k] + rest) / weights
+            bound = 4.0 * rho * (gravity + float(np.linalg.norm(weights * (B @ u))))
             if not float(np.linalg.norm(residual)) <= bound:
                 fail(
                     f"q̈ is not affine in the inputs at q = {q.tolist()}: q̈(u{j + 1} + u{k + 1}) − "
-                    f"q̈(u{j + 1}) − q̈(u{k + 1}) + q̈(0) = {(residual * wts).tolist()} for steps "
+                    f"q̈(u{j + 1}) − q̈(u{k + 1}) + q̈(0) = {(residual * weights).tolist()} for steps "
                     f"{steps.tolist()}, beyond its rounding bound (scaled {bound:.2g}); "
                     "M = B (∂q̈/∂u)⁻¹ needs q̈ = M⁻¹(B u + …)"
                 )
-    return Derivation(M, rest, steps)
+    return NumericDerivation(M, rest, steps)
 
 
 def _step(rest: np.ndarray, column: np.ndarray) -> float:
@@ -175,21 +176,21 @@ def rounding_bounds(M, S, B, gravity_scale, steps, H, force, scale) -> tuple[np.
     """
     M, S = np.asarray(M, dtype=float), np.asarray(S, dtype=float)
     n = M.shape[-1]
-    w = 1.0 / np.sqrt(S)
-    Mt = M * (w[:, :, None] * w[:, None, :])
+    weights = 1.0 / np.sqrt(S)
+    Mt = M * (weights[:, :, None] * weights[:, None, :])
     s = np.linalg.svd(Mt, compute_uv=False)
     norm, inv = s[:, 0], 1.0 / s[:, -1]
     kappa = norm * inv
-    Bt = w[:, :, None] * np.asarray(B, dtype=float)[None]
+    Bt = weights[:, :, None] * np.asarray(B, dtype=float)[None]
     sb = np.linalg.svd(Bt, compute_uv=False)
     b_inv, kappa_b = 1.0 / sb[:, -1], sb[:, 0] / sb[:, -1]
-    F0 = np.max(w * np.asarray(gravity_scale, dtype=float), axis=-1)
+    F0 = np.max(weights * np.asarray(gravity_scale, dtype=float), axis=-1)
     h = np.asarray(steps, dtype=float)
 
     def one(F, size, k=(slice(None),)):  # 1. one call's rounding: forces' terms F, ‖q̈̃‖ = size
         return K_CODE * EPS * (inv[k] * F + kappa[k] * size)
 
-    rest = np.linalg.solve(Mt, (-w * np.asarray(H, dtype=float))[..., None])[..., 0]
+    rest = np.linalg.solve(Mt, (-weights * np.asarray(H, dtype=float))[..., None])[..., 0]
     rest_size = np.linalg.norm(rest, axis=-1)
     columns = np.swapaxes(np.linalg.solve(Mt, Bt), -1, -2)  # row j: column j of Ã = M̃⁻¹B̃
     gravity_terms = np.sqrt(n) * F0
@@ -203,7 +204,7 @@ def rounding_bounds(M, S, B, gravity_scale, steps, H, force, scale) -> tuple[np.
     dA = np.sqrt(np.sum(((pushed + at_rest[:, None]) / h) ** 2, axis=-1))  # 2.
     dM = norm**2 * b_inv * dA + K_CODE * EPS * kappa * kappa_b**2 * norm  # 3.
     gravity = _relative(dM * rest_size + norm * at_rest, F0)  # 4.
-    moving = np.linalg.solve(Mt, (w * np.asarray(force, dtype=float))[..., None])[..., 0]
+    moving = np.linalg.solve(Mt, (weights * np.asarray(force, dtype=float))[..., None])[..., 0]
     moving_size, scale = np.linalg.norm(moving, axis=-1), np.asarray(scale, dtype=float)
     rnea = _relative(dM * moving_size + norm * one(np.sqrt(n) * scale, moving_size), scale)
     return dM, gravity, rnea

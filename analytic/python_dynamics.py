@@ -58,7 +58,7 @@ import numpy as np
 
 from pendverify.analytic.forms import NUMERIC_MATH
 from pendverify.analytic.interface import AccelerationOnlyModel
-from pendverify.analytic.numeric_derivation import DERIVED, Derivation, derive
+from pendverify.analytic.numeric_derivation import DERIVED, NumericDerivation, derive
 from pendverify.display import shortened
 from pendverify.errors import PendverifyError, UserCodeError
 
@@ -160,7 +160,7 @@ class DerivedPythonDynamicsModel(PythonDynamicsModel):
 
     mass_from_acceleration: ClassVar[str] = DERIVED
 
-    def _derived(self, q) -> Derivation:
+    def _derived(self, q) -> NumericDerivation:
         q = np.asarray(q, dtype=float)
         cache = self.__dict__.setdefault("_derivations", {})
         key = q.tobytes()

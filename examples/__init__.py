@@ -1,1 +1,6 @@
-"""Data shipped with pendverify: the examples folder (read with importlib.resources)."""
+"""Data shipped with pendverify: the examples folder (read with importlib.resources).
+
+Nothing here is public API (``__all__`` is empty).
+"""
+
+__all__: list[str] = []

@@ -50,7 +50,7 @@ from typing import ClassVar
 import numpy as np
 
 from pendverify import ClosedFormModel, Energies, ParameterSet, quantity
-from pendverify.analytic.forms import STANDARD_CLOSED_FORMS, ClosedForm
+from pendverify.analytic import STANDARD_CLOSED_FORMS, ClosedForm
 
 
 @dataclasses.dataclass(frozen=True)
@@ -211,9 +211,9 @@ def cart_pole_urdf(p: CartPoleParams) -> str:
 
 
 if __name__ == "__main__":  # regenerate examples/cart_pole.urdf from examples/cart_pole.toml
-    from pendverify.analytic.params import load_parameter_file
+    import pendverify
 
     here = Path(__file__).resolve().parent
-    _, _, params = load_parameter_file(here / "cart_pole.toml", {CartPole.name: CartPoleParams})
+    params = pendverify.load_params(CartPole, here / "cart_pole.toml")
     (here / "cart_pole.urdf").write_text(cart_pole_urdf(params))
     sys.exit(0)

@@ -105,7 +105,7 @@ from typing import ClassVar
 import numpy as np
 
 from pendverify import ClosedFormModel, Energies, ParameterSet, quantity
-from pendverify.analytic.forms import STANDARD_CLOSED_FORMS, ClosedForm
+from pendverify.analytic import STANDARD_CLOSED_FORMS, ClosedForm
 
 
 @dataclasses.dataclass(frozen=True)
@@ -319,10 +319,9 @@ def furuta_pendulum_urdf(p: FurutaPendulumParams) -> str:
 
 
 if __name__ == "__main__":  # regenerate examples/furuta_pendulum.urdf from examples/furuta_pendulum.toml
-    from pendverify.analytic.params import load_parameter_file
+    import pendverify
 
     here = Path(__file__).resolve().parent
-    registry = {FurutaPendulum.name: FurutaPendulumParams}
-    _, _, params = load_parameter_file(here / "furuta_pendulum.toml", registry)
+    params = pendverify.load_params(FurutaPendulum, here / "furuta_pendulum.toml")
     (here / "furuta_pendulum.urdf").write_text(furuta_pendulum_urdf(params))
     sys.exit(0)

@@ -45,8 +45,7 @@ from typing import ClassVar
 import numpy as np
 
 from pendverify import ClosedFormModel, Energies, ParameterSet, quantity
-from pendverify.analytic import DoublePendulumParams
-from pendverify.analytic.forms import STANDARD_CLOSED_FORMS, ClosedForm
+from pendverify.analytic import STANDARD_CLOSED_FORMS, ClosedForm, DoublePendulumParams
 
 
 @dataclasses.dataclass(frozen=True)
@@ -193,10 +192,9 @@ def hanging_double_pendulum_urdf(p: HangingDoublePendulumParams) -> str:
 
 
 if __name__ == "__main__":  # regenerate the URDF from the TOML next to this file
-    from pendverify.analytic.params import load_parameter_file
+    import pendverify
 
     here = Path(__file__).resolve().parent
-    registry = {HangingDoublePendulum.name: HangingDoublePendulumParams}
-    _, _, params = load_parameter_file(here / "hanging_double_pendulum.toml", registry)
+    params = pendverify.load_params(HangingDoublePendulum, here / "hanging_double_pendulum.toml")
     (here / "hanging_double_pendulum.urdf").write_text(hanging_double_pendulum_urdf(params))
     sys.exit(0)

@@ -97,7 +97,7 @@ from typing import ClassVar
 import numpy as np
 
 from pendverify import ClosedFormModel, Energies, ParameterSet, quantity
-from pendverify.analytic.forms import STANDARD_CLOSED_FORMS, ClosedForm
+from pendverify.analytic import STANDARD_CLOSED_FORMS, ClosedForm
 
 
 @dataclasses.dataclass(frozen=True)
@@ -377,11 +377,9 @@ def triple_pendulum_urdf(p: TriplePendulumParams) -> str:
 
 
 if __name__ == "__main__":  # regenerate examples/triple_pendulum.urdf from examples/triple_pendulum.toml
-    from pendverify.analytic.params import load_parameter_file
+    import pendverify
 
     here = Path(__file__).resolve().parent
-    _, _, params = load_parameter_file(
-        here / "triple_pendulum.toml", {TriplePendulum.name: TriplePendulumParams}
-    )
+    params = pendverify.load_params(TriplePendulum, here / "triple_pendulum.toml")
     (here / "triple_pendulum.urdf").write_text(triple_pendulum_urdf(params))
     sys.exit(0)

@@ -7,6 +7,8 @@
 * ``plots``     — energy and work-balance figures (matplotlib, SVG);
 * ``review``    — the review page ``index.html``;
 * ``browser``   — headless Chromium over the DevTools pipe, for screenshots and tests.
+
+Internal (``__all__`` is empty): docs/reference/api.md lists what is public.
 """
 
 import warnings
@@ -14,3 +16,5 @@ import warnings
 with warnings.catch_warnings():  # meshcat's server module imports pyzmq's deprecated ioloop shim
     warnings.simplefilter("ignore", DeprecationWarning)
     import meshcat  # noqa: F401
+
+__all__: list[str] = []

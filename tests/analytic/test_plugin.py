@@ -233,12 +233,9 @@ def _bias_only_source() -> str:
         GOOD.replace(matrix, force)
         .replace("(ClosedFormModel):", "(BiasOnlyModel):")
         .replace("**STANDARD_CLOSED_FORMS,", "**BiasOnlyModel.closed_forms,")
-        .replace(
-            "from pendverify.analytic.forms import",
-            "from pendverify.analytic.interface import BiasOnlyModel\nfrom pendverify.analytic.forms import",
-        )
+        .replace("from pendverify.analytic import ", "from pendverify.analytic import BiasOnlyModel, ", 1)
     )
-    assert "coriolis_matrix" not in text
+    assert "coriolis_matrix" not in text and "import BiasOnlyModel, " in text
     return text
 
 

@@ -32,7 +32,7 @@ def test_generated_energies_are_the_closed_forms(name):
     run = fast_scene.simulate_compiled(load_scene(REPO / "scenes" / f"{name}.toml"))
     xs = run.result.steps_x
     fast = GeneratedEnergies.of(run.dynamics, run.system)
-    slow = invariants.Energies(run.dynamics)
+    slow = invariants.TrajectoryEnergies(run.dynamics)
     assert isinstance(fast, GeneratedEnergies)
     n = run.dynamics.nv
     Q, V = xs[:, :n], xs[:, n : 2 * n]

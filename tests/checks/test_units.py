@@ -27,7 +27,7 @@ import sympy as sp
 
 import pendverify
 from pendverify.analytic import MODELS
-from pendverify.checks.dimensions import KIND_DIMENSIONS, Reader, read_units, required, unit_text
+from pendverify.checks.dimensions import KIND_DIMENSIONS, DimensionReader, read_units, required, unit_text
 from pendverify.checks.junit import to_junit
 from pendverify.cli import main
 from pendverify.worked_examples import EXAMPLES
@@ -155,7 +155,7 @@ DIMS.update({b: KIND_DIMENSIONS["damping"], theta: _kg()})  # k: no declared kin
 
 
 def _clashes(expr, symbols=DIMS) -> list[str]:
-    reader = Reader(dict(symbols))
+    reader = DimensionReader(dict(symbols))
     reader.agree(expr, sp.Add.make_args(expr), top=True)
     return reader.clashes
 
@@ -380,7 +380,7 @@ def test_no_claim_on_the_explain_corpus_but_where_a_plant_changes_a_dimension():
     caught, planted = 0, 0
     for label, model, _, _ in shipped_targets():
         sm = SymbolicModel.of(type(model))
-        reader, forms = Reader(symbol_dimensions(sm), kinds=dict(sm.kinds)), sm.closed_forms
+        reader, forms = DimensionReader(symbol_dimensions(sm), kinds=dict(sm.kinds)), sm.closed_forms
         position_rates = {f"d{c}" for c, a in zip(model.coordinates, model.angular, strict=True) if not a}
         for plant in plants(sm):
             shape = getattr(forms[plant.method], "shape", None)

@@ -1,1 +1,6 @@
-"""The certification battery, certificates and sweeps."""
+"""The certification battery, certificates and sweeps.
+
+Internal (``__all__`` is empty): docs/reference/api.md lists what is public.
+"""
+
+__all__: list[str] = []

@@ -150,7 +150,7 @@ def unit_text(d: Dim) -> str:
 
 
 @dataclasses.dataclass
-class Reader:
+class DimensionReader:
     """The dimension of a model's expressions (module docstring), collecting the clashes it meets."""
 
     symbols: dict[sp.Symbol, Dim | None]
@@ -351,7 +351,7 @@ def read_units(model_cls) -> dict:
     except PendverifyError as exc:
         return {"not_run": f"SymPy cannot read the model ({_without_file(model_cls, exc)})"}
     notation = Notation.of(model_cls)
-    reader = Reader(symbol_dimensions(sm), notation.render, dict(sm.kinds))
+    reader = DimensionReader(symbol_dimensions(sm), notation.render, dict(sm.kinds))
     names = tuple(reader.term(q) for q in sm.symbols["q"])  # in the model's notation
     out: dict = {"entries": 0, "decided": 0, "unread": {}, "findings": []}
     for method, form in model_cls.written_closed_forms().items():
@@ -382,7 +382,9 @@ def read_units(model_cls) -> dict:
     return out
 
 
-def entry_dimension(reader: Reader, expr, need: Dim | None, place: str) -> tuple[Dim | None, list[str]]:
+def entry_dimension(
+    reader: DimensionReader, expr, need: Dim | None, place: str
+) -> tuple[Dim | None, list[str]]:
     """(the dimension of one entry, or None where undecided; its clashes: terms that disagree, and a
     decided dimension other than ``need``, the entry's place's as ``required`` gives it with ``place``)."""
     reader.clashes = []
@@ -392,4 +394,4 @@ def entry_dimension(reader: Reader, expr, need: Dim | None, place: str) -> tuple
     return d, reader.clashes
 
 
-__all__ = ["KIND_DIMENSIONS", "Reader", "entry_dimension", "read_units", "required", "unit_text"]
+__all__ = ["KIND_DIMENSIONS", "DimensionReader", "entry_dimension", "read_units", "required", "unit_text"]

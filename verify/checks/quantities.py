@@ -10,7 +10,7 @@ passes a state when e ≤ K·ε·((1 + |θ|max)·c_T + (A − 1))·s + a.
 
 The scales:
 
-* ``crba``: 1 (M̃ has entries of order one); ``gravity``: max w·(Σ|terms| of H).
+* ``crba``: 1 (M̃ has entries of order one); ``gravity``: max weights·(Σ|terms| of H).
 * ``rnea``: (rates + max|D̃|)·Σ|ż| + the gravity scale: a hand C written with friction
   inside (C + D, as the double pendulum's derivation) rounds at the size of D̃ too.
 * ``coriolis``, ``skew``: max(rates + max|D̃|, 1); Ṁ for ``skew`` comes from Pinocchio's
@@ -124,9 +124,9 @@ class Terms:
 
     @cached_property
     def rnea_scale(self):
-        """The size of the terms rnea compares at each state: rates times Σ|q̇ᵢ/wᵢ|, plus gravity's."""
-        gravity = np.max(self.w * self.g_scale, axis=-1)
-        return (self.rate + self.d_rate) * total(np.abs(self.v / self.w)) + gravity
+        """The size of the terms rnea compares at each state: rates times Σ|q̇ᵢ/weightsᵢ|, plus gravity's."""
+        gravity = np.max(self.weights * self.g_scale, axis=-1)
+        return (self.rate + self.d_rate) * total(np.abs(self.v / self.weights)) + gravity
 
     @cached_property
     def D_urdf(self):
@@ -223,7 +223,7 @@ class Terms:
 
     # --- derived scales ---------------------------------------------------------------
     @cached_property
-    def w(self):
+    def weights(self):
         return weights_of(self.S)
 
     @cached_property
@@ -232,7 +232,7 @@ class Terms:
 
     @cached_property
     def d_rate(self):
-        return damping_rate_of(self.D, self.w)
+        return damping_rate_of(self.D, self.weights)
 
     def norm2(self, A):
         """``norms2(A)``, once per matrix content (minverse, aba and energy share theirs)."""
@@ -254,45 +254,45 @@ def _at_least_one(x):
 
 # --- the measures ----------------------------------------------------------------------------
 def measure_crba(t):
-    entries = np.abs(scaled_matrix(t.M_pin - t.M_hand, t.w))
+    entries = np.abs(scaled_matrix(t.M_pin - t.M_hand, t.weights))
     return Measure(_max2(entries), 1.0, entries=entries, derived=t.derivation[0])
 
 
 def measure_rnea(t):
-    w = t.w
-    entries = w * np.abs(t.bias_pin - t.bias_hand)
+    weights = t.weights
+    entries = weights * np.abs(t.bias_pin - t.bias_hand)
     return Measure(
         np.max(entries, axis=-1),
         t.rnea_scale,
-        np.max(w * t.allowance, axis=-1),
+        np.max(weights * t.allowance, axis=-1),
         entries=entries,
         derived=t.derivation[2],
     )
 
 
 def measure_gravity(t):
-    w = t.w
-    entries = w * np.abs(t.H_pin - t.H_hand)
+    weights = t.weights
+    entries = weights * np.abs(t.H_pin - t.H_hand)
     return Measure(
         np.max(entries, axis=-1),
-        np.max(w * t.g_scale, axis=-1),
-        np.max(w * t.allowance, axis=-1),
+        np.max(weights * t.g_scale, axis=-1),
+        np.max(weights * t.allowance, axis=-1),
         entries=entries,
         derived=t.derivation[1],
     )
 
 
 def measure_coriolis(t):
-    w = t.w
-    entries = np.abs(scaled_matrix(t.C_pin - t.C_hand, w))
+    weights = t.weights
+    entries = np.abs(scaled_matrix(t.C_pin - t.C_hand, weights))
     return Measure(_max2(entries), _at_least_one(t.rate + t.d_rate), entries=entries)
 
 
 def measure_skew(t):
-    w = t.w
+    weights = t.weights
     N = t.Mdot_pin - 2 * t.C_hand
     return Measure(
-        _max2(np.abs(scaled_matrix(N + np.swapaxes(N, -1, -2), w))), _at_least_one(t.rate + t.d_rate)
+        _max2(np.abs(scaled_matrix(N + np.swapaxes(N, -1, -2), weights))), _at_least_one(t.rate + t.d_rate)
     )
 
 
@@ -309,7 +309,7 @@ def measure_det(t):
 
 
 def measure_minverse(t):
-    sqrt_s = 1.0 / t.w
+    sqrt_s = 1.0 / t.weights
     diff = t.Minv_pin - t.Minv_hand
     Minv_norm = t.norm2(scaled_matrix(t.Minv_hand, sqrt_s))
     # δ(M⁻¹) = −M⁻¹ δM M⁻¹ with |δM̃| ~ ε‖M̃‖
@@ -319,25 +319,25 @@ def measure_minverse(t):
 
 
 def measure_aba(t):
-    w = t.w
+    weights = t.weights
     a_pin = t.a_pin
     a_hand = t.a_hand
-    Minv_norm = t.norm2(scaled_matrix(t.Minv_hand, 1.0 / w))
-    M_norm = t.norm2(scaled_matrix(t.M_hand, w))
-    forces = force_scale_of(t.rate, t.v, w, t.g_scale, t.B, t.W, t.D, t.u, t.w_in)
-    scale = Minv_norm * (forces + M_norm * np.max(np.abs(a_pin / w), axis=-1))
-    allowance = Minv_norm * np.max(w * t.allowance, axis=-1)
-    entries = np.abs((a_pin - a_hand) / w)
+    Minv_norm = t.norm2(scaled_matrix(t.Minv_hand, 1.0 / weights))
+    M_norm = t.norm2(scaled_matrix(t.M_hand, weights))
+    forces = force_scale_of(t.rate, t.v, weights, t.g_scale, t.B, t.W, t.D, t.u, t.w_in)
+    scale = Minv_norm * (forces + M_norm * np.max(np.abs(a_pin / weights), axis=-1))
+    allowance = Minv_norm * np.max(weights * t.allowance, axis=-1)
+    entries = np.abs((a_pin - a_hand) / weights)
     return Measure(np.max(entries, axis=-1), scale, allowance, entries=entries)
 
 
 def measure_energy(t):
-    w = t.w
+    weights = t.weights
     kinetic = np.abs(t.KE_pin - t.KE_hand)
     # potential energies agree up to a constant: compare differences from θ = 0
     dv_pin = t.V_pin - t.V_pin0
     dv_hand = t.V_hand - t.V_hand0
-    kinetic_scale = 0.5 * total((t.v / w) ** 2) * t.norm2(scaled_matrix(t.M_hand, w))
+    kinetic_scale = 0.5 * total((t.v / weights) ** 2) * t.norm2(scaled_matrix(t.M_hand, weights))
     potential_scale = float(np.max(t.g_scale))
     allowance = t.energy_allowance
     return Measure(kinetic + np.abs(dv_pin - dv_hand), kinetic_scale + potential_scale, allowance)
@@ -349,10 +349,10 @@ def measure_damping(t):
     Pinocchio keeps the damping but none of its algorithms applies it, so no other
     check can see a URDF whose damping disagrees with the hand model's D.
     """
-    w = t.w
+    weights = t.weights
     D_urdf, D = t.D_urdf, t.D
-    diff = np.abs(scaled_matrix(D_urdf - D, w))
-    own, urdf = _max2(np.abs(scaled_matrix(D, w))), _max2(np.abs(scaled_matrix(D_urdf, w)))
+    diff = np.abs(scaled_matrix(D_urdf - D, weights))
+    own, urdf = _max2(np.abs(scaled_matrix(D, weights))), _max2(np.abs(scaled_matrix(D_urdf, weights)))
     err = _max2(diff)
 
     def describe(index):

@@ -5,7 +5,7 @@ S_i the model's inertia scale of coordinate i (``diagonal_scale``), so that a
 cart in kg and a rod in kg·m² are judged on one footing and raw κ(M), which
 mostly reflects units, does not inflate tolerances.  In these coordinates
 M̃ = S^{-½} M S^{-½} has entries of order one (``scaled_matrix(M, weights)``, with
-weights w_i = 1/√S_i), forces scale by S^{-½} (w·f) and accelerations by S^{½} (a/w).
+weights_i = 1/√S_i), forces scale by S^{-½} (weights·f) and accelerations by S^{½} (a/weights).
 
 Rates are measured in 1/s (``rate_scale``): angular rates as they are, linear rates
 over a radius of gyration.  The checks (``pendverify.checks.quantities``) build each
@@ -25,17 +25,17 @@ from pendverify.checks.spectral import norms2
 
 
 def weights_of(S):
-    """w = 1/√S, the scaled coordinates' weights (S with optional leading batch axes)."""
+    """1/√S, the scaled coordinates' weights (S with optional leading batch axes)."""
     return 1.0 / np.sqrt(S)
 
 
-def weights(model, q):
+def weights_at(model, q):
     return weights_of(model_value(model, "diagonal_scale", q))
 
 
-def scaled_matrix(A, w):
-    """A·(w wᵀ) (= A * np.outer(w, w) for one state; leading batch axes allowed)."""
-    return A * (w[..., :, None] * w[..., None, :])
+def scaled_matrix(A, weights):
+    """A·(weights weightsᵀ) (= A * np.outer(weights, weights) for one state; leading batch axes allowed)."""
+    return A * (weights[..., :, None] * weights[..., None, :])
 
 
 def mv(A, x):
@@ -72,14 +72,14 @@ def norm2(A) -> float:
     return float(norms2(A))
 
 
-def force_scale_of(rate, v, w, g_scale, B, W, D, u, w_in):
+def force_scale_of(rate, v, weights, g_scale, B, W, D, u, w_in):
     """Size of the generalized forces acting, in scaled units (sum of |terms|), per state."""
-    coriolis = rate * total(np.abs(v / w))
-    gravity = np.max(w * g_scale, axis=-1)
-    applied = w * (mv(np.abs(B), np.abs(u)) + mv(np.abs(W), np.abs(w_in)) + mv(np.abs(D), np.abs(v)))
+    coriolis = rate * total(np.abs(v / weights))
+    gravity = np.max(weights * g_scale, axis=-1)
+    applied = weights * (mv(np.abs(B), np.abs(u)) + mv(np.abs(W), np.abs(w_in)) + mv(np.abs(D), np.abs(v)))
     return coriolis + gravity + np.max(applied, axis=-1, initial=0.0)
 
 
-def damping_rate_of(D, w):
+def damping_rate_of(D, weights):
     """max |D̃| in 1/s per state: a hand C with friction inside (C + D) rounds at this size."""
-    return np.max(np.abs(scaled_matrix(D, w)), axis=(-2, -1), initial=0.0)
+    return np.max(np.abs(scaled_matrix(D, weights)), axis=(-2, -1), initial=0.0)

@@ -17,6 +17,8 @@ The global options, accepted before or after the command's name:
 * ``--quiet`` (the commands that give ``quiet=True``): only the verdict line and errors;
 * ``--json PATH`` (the commands that give ``json=WHAT``): the report as JSON to PATH,
   or to standard output for ``-`` (``write_json_report``); the text then goes to stderr.
+
+Internal (``__all__`` is empty): docs/reference/api.md lists what is public.
 """
 
 from __future__ import annotations
@@ -241,3 +243,6 @@ def builtin_models(model: str | None, analytic: str | None) -> list[str]:
         if name not in MODELS:
             raise UnknownNameError("model", name, tuple(MODELS))
     return names
+
+
+__all__: list[str] = []

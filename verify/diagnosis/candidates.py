@@ -178,16 +178,22 @@ def monomials_for(sm: SymbolicModel, params: dict, quantity: str) -> tuple[list,
 
 
 @functools.lru_cache(maxsize=256)
-def _products(symbols: tuple, values: tuple) -> list:
-    """(value, expression) of every product of at most ``DEGREE`` of ``symbols`` (with repetition),
-    kept for the process: the same parameter set meets every planted error of a model."""
+def parameter_products(symbols: tuple, values: tuple, most: int) -> tuple[tuple[float, sp.Expr, tuple], ...]:
+    """(value, expression, factors) of every nonzero finite product of at most ``most`` of ``symbols``
+    (with repetition; ``factors`` the indices multiplied), kept for the process: the same parameter
+    set meets every planted error of a model."""
     out = []
-    for degree in range(1, DEGREE + 1):
+    for degree in range(1, most + 1):
         for combo in itertools.combinations_with_replacement(range(len(symbols)), degree):
             value = float(np.prod([values[i] for i in combo]))
             if value != 0 and np.isfinite(value):
-                out.append((value, sp.Mul(*[symbols[i] for i in combo])))
-    return out
+                out.append((value, sp.Mul(*[symbols[i] for i in combo]), combo))
+    return tuple(out)
+
+
+def _products(symbols: tuple, values: tuple) -> list:
+    """(value, expression) of every product of at most ``DEGREE`` of ``symbols`` (``parameter_products``)."""
+    return [(value, expr) for value, expr, _ in parameter_products(symbols, values, DEGREE)]
 
 
 FRACTIONS = tuple(

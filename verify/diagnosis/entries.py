@@ -40,7 +40,7 @@ class Compared:
 
 
 def _cqdot_errors(t, m):
-    return t.w * np.abs((t.bias_pin - t.H_pin) - (t.bias_hand - t.H_hand))
+    return t.weights * np.abs((t.bias_pin - t.H_pin) - (t.bias_hand - t.H_hand))
 
 
 def _every_state(t, constant):

@@ -17,17 +17,17 @@ stacked against the hand model's M, C·q̇ (friction excluded) and H at the same
 
 Weights and the rounding level
 ------------------------------
-Each row is divided by the scale its check judges it against (``pendverify.checks.
-quantities``: M̃ = W M W with w = 1/√S for M, max w·g_scale for H, (rate + damping rate)·Σ|q̇/w|
-for C·q̇) and by the state's rounding growth f = (1 + |θ|max)·c_T + (A − 1)
-(``pendverify.checks.catalogue``), so that a correct model's row differs from the URDF's by
-at most K·ε, K = 16 the largest constant of the checks of these quantities (crba 8, rnea 16,
-gravity 16).  Rows with a zero scale carry nothing (C·q̇ at rest, H without gravity) and
-are left out.  Over R rows the rounding is then ‖e‖₂ ≤ √R·K·ε = ``tolerance``, and a least
-squares residual is the data projected on the complement of the regressor's range, which
-does not enlarge it: a fit whose residual is within ``tolerance`` reproduces the hand
-model's equations to rounding on every sampled state.  Householder QR adds a backward error
-of order ε·‖b‖ ≤ ε·√R (each row is at most one after the scaling), well inside it.
+Each row is divided by the scale its check judges it against (``pendverify.checks.quantities``:
+M̃ = diag(weights) M diag(weights) with weights = 1/√S for M, max weights·g_scale for H, (rate +
+damping rate)·Σ|q̇/weights| for C·q̇) and by the state's rounding growth f = (1 + |θ|max)·c_T +
+(A − 1) (``pendverify.checks.catalogue``), so that a correct model's row differs from the URDF's
+by at most K·ε, K = 16 the largest constant of the checks of these quantities (crba 8, rnea 16,
+gravity 16).  Rows with a zero scale carry nothing (C·q̇ at rest, H without gravity) and are
+left out.  Over R rows the rounding is then ‖e‖₂ ≤ √R·K·ε = ``tolerance``, and a least squares
+residual is the data projected on the complement of the regressor's range, which does not
+enlarge it: a fit whose residual is within ``tolerance`` reproduces the hand model's equations
+to rounding on every sampled state.  Householder QR adds a backward error of order ε·‖b‖ ≤ ε·√R
+(each row is at most one after the scaling), well inside it.
 
 Identifiable combinations
 -------------------------
@@ -127,18 +127,21 @@ def stacked_rows(batch) -> Rows:
     t, pinb = batch.terms, batch.pin
     n = batch.model.nv
     Y = _regressors(batch.system, pinb.q, pinb.v)
-    w = np.broadcast_to(t.w, (len(batch), n))
+    weights = np.broadcast_to(t.weights, (len(batch), n))
     growth = (1.0 + batch.angle) * batch.c_T + (batch.lever - 1.0)
-    g_scale = np.max(w * t.g_scale, axis=-1)
-    c_scale = (t.rate + t.d_rate) * total(np.abs(batch.V / w))
+    g_scale = np.max(weights * t.g_scale, axis=-1)
+    c_scale = (t.rate + t.d_rate) * total(np.abs(batch.V / weights))
     # per state: M's n² rows (row i, column j), then C·q̇'s n, then H's n
     Y_rows = np.concatenate(
         [np.swapaxes(Y[:, 1 : n + 1], 1, 2).reshape(len(batch), n * n, -1), Y[:, n + 1], Y[:, 0]], 1
     )
     b_rows = np.concatenate([t.M_hand.reshape(len(batch), n * n), _hand_coriolis_force(batch), t.H_hand], 1)
-    weight_M = (w[:, :, None] * w[:, None, :]).reshape(len(batch), n * n)
+    weight_M = (weights[:, :, None] * weights[:, None, :]).reshape(len(batch), n * n)
     with np.errstate(divide="ignore", invalid="ignore"):
-        weight = np.concatenate([weight_M, w / c_scale[:, None], w / g_scale[:, None]], 1) / growth[:, None]
+        weight = (
+            np.concatenate([weight_M, weights / c_scale[:, None], weights / g_scale[:, None]], 1)
+            / growth[:, None]
+        )
     labels = [f"M[{i + 1},{j + 1}]" for i in range(n) for j in range(n)]
     labels += [f"C·q̇[{i + 1}]" for i in range(n)] + [f"H[{i + 1}]" for i in range(n)]
     keep = np.isfinite(weight) & (weight > 0) & np.isfinite(b_rows) & np.all(np.isfinite(Y_rows), axis=-1)

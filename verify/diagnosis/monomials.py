@@ -26,14 +26,13 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import itertools
 from fractions import Fraction
 
 import numpy as np
 import sympy as sp
 
 from pendverify.checks.dimensions import LENGTH, NONE, SECOND, inverse, mul, power, required
-from pendverify.diagnosis.candidates import DIMENSIONS, FRACTIONS
+from pendverify.diagnosis.candidates import DIMENSIONS, FRACTIONS, NUMBER_DENOMINATOR, parameter_products
 
 DEGREE = 4
 FLOOR = 1e-12
@@ -55,14 +54,13 @@ def fixed_parameters(params) -> tuple[tuple[str, float, tuple], ...]:
 @functools.lru_cache(maxsize=64)
 def products_of(parameters: tuple, dimension: tuple) -> tuple[tuple[float, sp.Expr], ...]:
     """(value, expression) of every product of at most ``DEGREE`` parameters with ``dimension``."""
-    out = []
-    for degree in range(1, DEGREE + 1):
-        for combo in itertools.combinations_with_replacement(range(len(parameters)), degree):
-            total = tuple(int(x) for x in np.sum([parameters[i][2] for i in combo], axis=0))
-            if total == dimension:
-                value = float(np.prod([parameters[i][1] for i in combo]))
-                out.append((value, sp.Mul(*[sp.Symbol(parameters[i][0]) for i in combo])))
-    return tuple(out)
+    symbols = tuple(sp.Symbol(name) for name, _, _ in parameters)
+    values = tuple(value for _, value, _ in parameters)
+    return tuple(
+        (value, expr)
+        for value, expr, combo in parameter_products(symbols, values, DEGREE)
+        if tuple(int(x) for x in np.sum([parameters[i][2] for i in combo], axis=0)) == dimension
+    )
 
 
 #: the quantity of an entry → (its method, the number of rates a basis function of its difference has)
@@ -109,7 +107,7 @@ def written_coefficient(c: float, uncertainty: float, dimension: tuple, paramete
         quotient = abs(c) / value
         if not np.isfinite(quotient):  # (a coefficient of 1e300: no product of these values)
             continue
-        ratio = Fraction(quotient).limit_denominator(12)
+        ratio = Fraction(quotient).limit_denominator(NUMBER_DENOMINATOR)
         if ratio in FRACTIONS and abs(float(ratio) * value - abs(c)) <= window:
             fits.add(sp.Rational(ratio.numerator, ratio.denominator) * expr)
     if len(fits) != 1:

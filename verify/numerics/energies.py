@@ -20,14 +20,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from pendverify.simulation.invariants import Energies
+from pendverify.simulation.invariants import TrajectoryEnergies
 
 
 def _float_sincos(u):
     return np.sin(u), np.cos(u)
 
 
-class GeneratedEnergies(Energies):
+class GeneratedEnergies(TrajectoryEnergies):
     """E, M q̇ and T of a ``GeneratedSystem``'s model, vectorised over the rows."""
 
     def __init__(self, dyn, system):
@@ -37,9 +37,9 @@ class GeneratedEnergies(Energies):
         self._P = system.packed()
 
     @classmethod
-    def of(cls, dyn, system) -> Energies:
+    def of(cls, dyn, system) -> TrajectoryEnergies:
         """The vectorised view, or the per-state one when the generated energy is not there."""
-        return Energies(dyn) if system.module.ENERGY_ERROR else cls(dyn, system)
+        return TrajectoryEnergies(dyn) if system.module.ENERGY_ERROR else cls(dyn, system)
 
     def energy(self, Q: np.ndarray, V: np.ndarray) -> np.ndarray:
         columns = [*np.asarray(Q, float).T, *np.asarray(V, float).T]

@@ -105,7 +105,7 @@ def figures_of(name: str, errors: np.ndarray, bounds: np.ndarray, times, scale: 
     )
 
 
-class Energies:
+class TrajectoryEnergies:
     """E, M q̇ and T at the rows of a trajectory, and H's scale, for the invariants: per state.
 
     This one evaluates a ``Dynamics`` state by state (``energy``: Pinocchio's under ABA, the
@@ -134,9 +134,9 @@ class Energies:
         return np.asarray(self.dyn.model.gravity_scale(), dtype=float)
 
 
-def energies_of(dyn) -> Energies:
-    """``dyn`` itself when it is an ``Energies``, else the per-state view of a ``Dynamics``."""
-    return dyn if isinstance(dyn, Energies) else Energies(dyn)
+def energies_of(dyn) -> TrajectoryEnergies:
+    """``dyn`` itself when it is a ``TrajectoryEnergies``, else the per-state view of a ``Dynamics``."""
+    return dyn if isinstance(dyn, TrajectoryEnergies) else TrajectoryEnergies(dyn)
 
 
 def residual(dyn, xs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from pendverify.checks.scaling import norm2, rate_scale, scaled_matrix, weights
+from pendverify.checks.scaling import norm2, rate_scale, scaled_matrix, weights_at
 from pendverify.checks.trust import EPS
 from pendverify.display import html_table, shortened
 from pendverify.errors import IntegrationError
@@ -196,13 +196,15 @@ def _engine_comparison(dyn: Dynamics, steps_t, steps_x) -> InvariantResult:
         tau = tau_in + tau_diss
         a_pin = dyn.acceleration(q, v, tau, "aba")
         a_cf = dyn.acceleration(q, v, tau, "closed_form")
-        w = weights(model, q)
-        Minv = norm2(scaled_matrix(model.inverse_mass_matrix(q), 1 / w))
-        M = norm2(scaled_matrix(model.mass_matrix(q), w))
-        forces = rate_scale(model, q, v) * np.sum(np.abs(v / w)) + np.max(w * model.gravity_scale())
-        forces += np.max(w * (np.abs(tau_in) + np.abs(tau_diss)))
-        scales.append(Minv * (forces + M * np.max(np.abs(a_pin / w))))
-        differences.append(np.max(np.abs((a_pin - a_cf) / w)))
+        weights = weights_at(model, q)
+        Minv = norm2(scaled_matrix(model.inverse_mass_matrix(q), 1 / weights))
+        M = norm2(scaled_matrix(model.mass_matrix(q), weights))
+        forces = rate_scale(model, q, v) * np.sum(np.abs(v / weights)) + np.max(
+            weights * model.gravity_scale()
+        )
+        forces += np.max(weights * (np.abs(tau_in) + np.abs(tau_diss)))
+        scales.append(Minv * (forces + M * np.max(np.abs(a_pin / weights))))
+        differences.append(np.max(np.abs((a_pin - a_cf) / weights)))
         tolerances.append(ENGINE_K * EPS * (1 + np.max(np.abs(q[np.array(model.angular)]), initial=0.0)))
     result = figures_of(
         "engines agree: ABA vs closed-form q̈ at the same states",

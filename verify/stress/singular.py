@@ -78,7 +78,7 @@ def lightest_changed(urdf_text: str, nominal: list[float]) -> float:
 
 
 @dataclasses.dataclass(frozen=True)
-class Step:
+class WalkStep:
     """One step of the walk: the parameters scaled by ``factor`` (log10 ``exponent``), and its URDF."""
 
     exponent: float
@@ -87,13 +87,13 @@ class Step:
     urdf: str
 
 
-def walk_steps(params, names, sign: int, binding) -> tuple[list[Step], str]:
+def walk_steps(params, names, sign: int, binding) -> tuple[list[WalkStep], str]:
     """The walk's steps, 10^(sign·k) for k in ``WALK_EXPONENTS``, kept where Pinocchio's inertia
     sums are exact (every link mass the walk changes 0 or ≥ ``MASS_FLOOR``, module docstring; the
     masses the URDF is given with are the nominal case's to judge); and what ended it
     early ("" when it ran to the end).  The first step past the floor becomes the factor that
     puts the lightest link at ``LIMIT_MARGIN``·``MASS_FLOOR``, the walk's last step."""
-    steps: list[Step] = []
+    steps: list[WalkStep] = []
     nominal = link_masses(binding.rewrite(params))
     for k in WALK_EXPONENTS:
         factor = 10.0 ** (sign * k)
@@ -101,14 +101,14 @@ def walk_steps(params, names, sign: int, binding) -> tuple[list[Step], str]:
         urdf = binding.rewrite(changed)
         light = lightest_changed(urdf, nominal)
         if light >= MASS_FLOOR or k == 0:  # the given URDF's own masses are the nominal case's
-            steps.append(Step(sign * k, factor, changed, urdf))
+            steps.append(WalkStep(sign * k, factor, changed, urdf))
             continue
         limit = factor * LIMIT_MARGIN * MASS_FLOOR / light  # the changed masses scale with the factor
         if limit < steps[-1].factor:
             changed = _scaled(params, names, limit)
             urdf = binding.rewrite(changed)
             if lightest_changed(urdf, nominal) >= MASS_FLOOR:
-                steps.append(Step(math.log10(limit), limit, changed, urdf))
+                steps.append(WalkStep(math.log10(limit), limit, changed, urdf))
         stop = (
             f"stopped at ×{steps[-1].factor:.3g}: further, a link would weigh {light:.3g} kg < ε = "
             f"{MASS_FLOOR:.3g} kg, where Pinocchio's inertia sums clamp the mass (its own M is wrong)"

@@ -18,9 +18,9 @@ c = 0 where the coefficients are not all within ``inertia.COEFF_TOL`` of such in
 
 A candidate's error is the one the ``crba`` and ``gravity`` checks measure
 (``pendverify.checks.quantities``), the larger of the two over the states: the largest
-entry of (M' − Σ_b c_b K'_b − M_hand)·(w wᵀ), w = S^{-½} the scaled coordinates' weights,
-and max_i w_i |H'_i − H_hand,i| over max_i w_i·(gravity scale)_i.  Its residual is that
-error over the declared map's (the first candidate, without a fit).
+entry of (M' − Σ_b c_b K'_b − M_hand)·(weights weightsᵀ), weights = S^{-½} the scaled
+coordinates' weights, and max_i weights_i |H'_i − H_hand,i| over max_i weights_i·(gravity scale)_i.
+Its residual is that error over the declared map's (the first candidate, without a fit).
 
 Bounded work: H is compared first, for every candidate (K gravity evaluations each, no fit);
 a candidate whose H alone leaves a residual beyond the caller's cutoff fails the screen whatever
@@ -77,13 +77,13 @@ def _congruence(T, A):
 
 @dataclass(frozen=True)
 class _Hand:
-    """The hand model at the screen's states: θ (K, n), M and H, the weights w w and gravity scales."""
+    """The hand model at the screen's states: θ (K, n), M, H, the weights, their products, g scales."""
 
     theta: np.ndarray
     M: np.ndarray
     H: np.ndarray
-    w: np.ndarray
-    ww: np.ndarray
+    weights: np.ndarray
+    pair_weights: np.ndarray
     g_scale: np.ndarray
 
 
@@ -99,7 +99,7 @@ def _gravity_errors(hand: _Hand, joint, T, theta0) -> np.ndarray:
     H = np.swapaxes(T, -1, -2)[:, None] @ joint.at(_configurations(hand, T, theta0)).gravity().reshape(
         C, K, n, 1
     )
-    return np.max(np.max(hand.w * np.abs(H[..., 0] - hand.H), axis=-1) / hand.g_scale, axis=-1)
+    return np.max(np.max(hand.weights * np.abs(H[..., 0] - hand.H), axis=-1) / hand.g_scale, axis=-1)
 
 
 def _mass_errors(hand: _Hand, joint, shifts, T, theta0):
@@ -107,11 +107,13 @@ def _mass_errors(hand: _Hand, joint, shifts, T, theta0):
     C, (K, n) = len(T), hand.theta.shape
     q = _configurations(hand, T, theta0)
     M = _congruence(T, joint.at(q).mass_matrix().reshape(C, K, n, n))
-    dM = ((M - hand.M) * hand.ww).reshape(C, K * n * n)  # scaled
+    dM = ((M - hand.M) * hand.pair_weights).reshape(C, K * n * n)  # scaled
     bare = np.max(np.abs(dM), axis=-1)
     if not shifts:
         return bare, bare, np.zeros((C, 0))
-    terms = [_congruence(T, only.at(q).mass_matrix().reshape(C, K, n, n)) * hand.ww for _, only in shifts]
+    terms = [
+        _congruence(T, only.at(q).mass_matrix().reshape(C, K, n, n)) * hand.pair_weights for _, only in shifts
+    ]
     A = np.stack(terms, axis=-1).reshape(C, K * n * n, len(shifts))  # (C, K n², nb)
     coefficients = integer_coefficients((np.linalg.pinv(A) @ dM[..., None])[..., 0])
     left = dM - (A @ coefficients[..., None])[..., 0]
@@ -136,11 +138,13 @@ def screen(model, system, candidates, states, cutoff: float = np.inf) -> Screen 
     terms = CheckBatch(model, system, states).terms
     if not (np.all(np.isfinite(terms.M_hand)) and np.all(np.isfinite(terms.H_hand))):
         return None
-    w = terms.w  # (K, n)
-    g_scale = np.max(w * terms.g_scale, axis=-1)  # (K,)
+    weights = terms.weights  # (K, n)
+    g_scale = np.max(weights * terms.g_scale, axis=-1)  # (K,)
     # a model without gravity (scale 0): H compared in scaled units as they are
     g_scale = np.where(g_scale > 0, g_scale, 1.0)
-    hand = _Hand(terms.q, terms.M_hand, terms.H_hand, w, w[:, :, None] * w[:, None, :], g_scale)
+    hand = _Hand(
+        terms.q, terms.M_hand, terms.H_hand, weights, weights[:, :, None] * weights[:, None, :], g_scale
+    )
     joint = system.with_map(CoordinateMap(np.eye(n), np.zeros(n), system.cmap.joint_nq))
     shifts = parallel_axis_systems(joint)
     T = np.array([c.T for c in candidates])  # (C, n, n)

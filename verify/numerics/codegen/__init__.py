@@ -14,4 +14,8 @@ generated and the packed layout).  The pieces:
 * ``folder``: the cache's folder, private to its user (else a temporary one);
 * ``signed``: the cache's index and module records, signed with the user's cache key;
 * ``numba_files``: numba's cache files of a module, recorded by digest and pruned before import.
+
+Internal (``__all__`` is empty): docs/reference/api.md lists what is public.
 """
+
+__all__: list[str] = []

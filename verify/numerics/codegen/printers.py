@@ -58,10 +58,10 @@ def numpy_printer():
     """SymPy's NumPy printer with exact numbers; it raises on a function NumPy has no ufunc for."""
     from sympy.printing.numpy import NumPyPrinter
 
-    class Printer(ExactNumbers, NumPyPrinter):
+    class ExactNumPyPrinter(ExactNumbers, NumPyPrinter):
         pass
 
-    return Printer({"strict": True})
+    return ExactNumPyPrinter({"strict": True})
 
 
 def numba_printer():
@@ -69,7 +69,7 @@ def numba_printer():
     from sympy.printing.precedence import PRECEDENCE, precedence
     from sympy.printing.pycode import PythonCodePrinter
 
-    class Printer(ExactNumbers, PythonCodePrinter):
+    class NumbaPrinter(ExactNumbers, PythonCodePrinter):
         def _print_Pow(self, expr, rational=False):
             done = _power(self, expr, "1.0", sqrt=True)
             if done is not None:
@@ -79,7 +79,7 @@ def numba_printer():
                 f"{self.parenthesize(base, precedence(expr))}**{self.parenthesize(exp, PRECEDENCE['Atom'])}"
             )
 
-    return Printer({"fully_qualified_modules": True, "standard": "python3"})
+    return NumbaPrinter({"fully_qualified_modules": True, "standard": "python3"})
 
 
 def generic_printer():
@@ -88,7 +88,7 @@ def generic_printer():
     from sympy.printing.precedence import PRECEDENCE
     from sympy.printing.pycode import PythonCodePrinter
 
-    class Printer(PythonCodePrinter):
+    class GenericPrinter(PythonCodePrinter):
         def _print_Float(self, expr):
             return f"N({float(expr)!r})"
 
@@ -134,4 +134,4 @@ def generic_printer():
         def emptyPrinter(self, expr):
             raise Unsupported(f"{type(expr).__name__} {expr}")
 
-    return Printer({"standard": "python3"})
+    return GenericPrinter({"standard": "python3"})

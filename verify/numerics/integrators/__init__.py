@@ -19,9 +19,15 @@ step is ``x_new = explicit_rk_step(f, t, x, h, tableau, k1=None)``.
 
 scipy's ``solve_ivp`` (RK45, DOP853, Radau, BDF, LSODA, RK23) is called by the scene driver
 and by the stress suite's ``rk45``; none of its methods is written here.
+
+Internal (``__all__`` is empty): docs/reference/api.md lists what is public; the names imported
+below are this package's interface to the rest of pendverify.
 """
 
-from pendverify.numerics.integrators.runge_kutta import explicit_rk_step
-from pendverify.numerics.integrators.tableaux import EULER, RK4, TABLEAUX, Tableau
+from pendverify.numerics.integrators.runge_kutta import explicit_rk_step as explicit_rk_step
+from pendverify.numerics.integrators.tableaux import EULER as EULER
+from pendverify.numerics.integrators.tableaux import RK4 as RK4
+from pendverify.numerics.integrators.tableaux import TABLEAUX as TABLEAUX
+from pendverify.numerics.integrators.tableaux import Tableau as Tableau
 
-__all__ = ["EULER", "RK4", "TABLEAUX", "Tableau", "explicit_rk_step"]
+__all__: list[str] = []
