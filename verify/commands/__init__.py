@@ -25,6 +25,11 @@ from __future__ import annotations
 
 import argparse
 
+#: the files the help's examples name, where ``pendverify example double_pendulum double_pendulum``
+#: copies them (one place for the paths several commands cite)
+EXAMPLE_SCENE = "double_pendulum/damped_double_pendulum.toml"
+EXAMPLE_PARAMS = "double_pendulum/double_pendulum.toml"
+
 #: what each global option does, as its help says it
 GLOBAL_HELP = {
     "debug": "on an internal error, print the traceback as well (default: off)",
