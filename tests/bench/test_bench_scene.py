@@ -182,6 +182,7 @@ def test_the_default_problems_are_unchanged():
     mild, chaotic, cart, long = problems
     assert mild.x0.tolist() == long.x0.tolist() == [-math.pi / 2 + 0.5, 0.3, 0.0, 0.0]
     assert mild.scene.model == long.scene.model and mild.scene.params == long.scene.params
+    assert mild.fast.packed().tolist() == long.fast.packed().tolist()  # the same field and force law
     assert chaotic.x0.tolist() == [2.0, 2.5, 0.0, 0.0] and chaotic.conservative
     assert cart.x0.tolist() == [0.0, 0.1, -0.05, 0.2, 0.0, 0.3]
     assert [p.title for p in problems] == [
