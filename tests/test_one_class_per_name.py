@@ -15,14 +15,8 @@ from pathlib import Path
 
 from tests.test_import_graph import REPO, installed_modules
 
-#: names two classes may still share, each with the reason; empty once every rename has landed
-ALLOWED = {
-    # the stress suite's own Trajectory and Comparison (verify/stress/integrators.py and
-    # verify/stress/framework.py) are renamed by the stress-suite restructuring (helper `stressref`);
-    # drop these two entries when it is merged
-    "Trajectory": 2,
-    "Comparison": 2,
-}
+#: names two classes may still share (name → how many), each with its reason; empty: none may
+ALLOWED: dict[str, int] = {}
 
 
 def class_homes(modules: dict[str, Path]) -> dict[str, list[str]]:

@@ -559,26 +559,6 @@ def review(
 
 
 # --- the symbolic tools ----------------------------------------------------------------------------
-def _model_targets(model: str | Path | None, urdf: str | Path | None, params: str | Path | None) -> list:
-    """Targets of ``mutate``: every built-in model's default set (None), a built-in model's
-    (its name), or a model file with its URDF and parameter file."""
-    from pendverify.targets import default_target, plugin_target
-
-    if model is None or (isinstance(model, str) and model in MODELS):
-        if urdf is not None or params is not None:
-            raise PendverifyError(
-                "urdf and params go with a model file; built-in models use their default set and URDF"
-            )
-        return [default_target(name) for name in ([model] if model else MODELS)]
-    return [
-        plugin_target(
-            str(model),
-            None if urdf is None else _urdf_file_arg(urdf, "mutate"),
-            None if params is None else str(params),
-        )
-    ]
-
-
 def mutate(
     model: str | Path | None = None,
     urdf: str | Path | None = None,
@@ -603,7 +583,15 @@ def mutate(
     samples = DEFAULT_MUTATION_STATES if samples is None else _count("samples", samples)
     seed, all_checks = _count("seed", seed), _flag("all_checks", all_checks)
     methods = None if methods is None else tuple(methods)
-    return [run_mutation(t, samples, seed, all_checks, methods) for t in _model_targets(model, urdf, params)]
+    model_cls = None if model is None else load_model(model)
+    if (model_cls is None or is_builtin(model_cls)) and (urdf is not None or params is not None):
+        raise PendverifyError(
+            "urdf and params go with a model file; built-in models use their default set and URDF"
+        )
+    urdf = None if urdf is None else _urdf_file_arg(urdf, "mutate")
+    params = None if params is None else str(params)
+    targets = select_targets(model_cls, urdf, params, erd_urdfs=False).targets
+    return [run_mutation(t, samples, seed, all_checks, methods) for t in targets]
 
 
 def compare_symbolic(model: ModelLike | None = None) -> list[SymbolicReport]:

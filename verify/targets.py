@@ -1,8 +1,11 @@
 """What to verify: pairs of a closed-form model and a URDF loaded in Pinocchio.
 
-``select_targets`` is the one dispatcher: ``pendverify check`` and ``pendverify.check``
-turn their arguments (a model, a URDF or ``erd:NAME``, parameters, the erd flag) into
-targets through it, so the same arguments verify the same targets.  The targets are
+``select_targets`` is the one dispatcher: ``check`` (the command and ``pendverify.check``),
+``certify`` (``pendverify.certify.issue.certification_input``), ``mutate``, the scenes'
+Pinocchio side (``pendverify.simulation.dynamics``) and the review folder turn their arguments
+(a model, a URDF or ``erd:NAME``, parameters, the erd flag) into targets through it, so the same
+arguments verify the same targets and a mistake gets one sentence
+(``tests/test_one_target_dispatcher.py`` looks for a second).  The targets are
 
 * the default parameter sets against their committed URDFs (``urdf/``);
 * example-robot-data's double-pendulum URDFs against the double-pendulum reference system's
@@ -136,8 +139,7 @@ def model_target(
     is labelled ``{model}:{name}``; ``name`` defaults to the file's stem without its format's
     suffixes (``arm.urdf.xacro`` → ``arm``), or ``urdf-text`` for text.
     """
-    g = getattr(params, "g", None)
-    system = PinocchioSystem.for_model(cls, urdf, g)
+    system = target_system(cls, urdf, params)
     notes = []
     read = system.geometry.params
     if params is None and cls.default_params is not None:
@@ -146,6 +148,10 @@ def model_target(
         if read is not None:
             notes += parameter_differences(read, params)
     elif params is None:
+        if read is None and not is_builtin(cls):
+            raise PendverifyError(
+                f"{where(cls)}: give the parameter set ({PARAMS_HINT}): the model file gives no PARAMS"
+            )
         if read is None:
             raise PendverifyError(
                 f"{system.source}: give the parameter set ({PARAMS_HINT}): a {cls.name} URDF alone "
@@ -201,8 +207,21 @@ def params_target(
         check_model_outputs(model)
     except ParameterError as exc:  # a value beyond double's range: name the file it came from
         raise ParameterError(origin, f"parameters.{exc.key}", exc.value, exc.rule) from None
-    system = PinocchioSystem.for_model(cls, urdf_for(params), params.g, f"<URDF of {origin}>")
+    system = target_system(cls, None, params, origin)
     return Target(f"{cls.name}:{name}", model, system, system.source)
+
+
+def target_system(
+    cls: type[ClosedFormModel], urdf, params: ParameterSet | None, origin: str | None = None
+) -> PinocchioSystem:
+    """Pinocchio's side of a target: ``urdf`` (as ``model_target`` takes it) seen in ``cls``'s
+    coordinates at the set's g, or, with no URDF, the URDF the project writes for the set
+    (``pendverify.robot.writer``), its source ``<URDF of {origin}>``.  A scene's engines take
+    theirs here too (``pendverify.simulation.dynamics``): the model itself is not evaluated."""
+    g = getattr(params, "g", None)
+    if urdf is not None:
+        return PinocchioSystem.for_model(cls, urdf, g)
+    return PinocchioSystem.for_model(cls, urdf_for(params), g, f"<URDF of {origin}>")
 
 
 def is_builtin(cls: type[ClosedFormModel]) -> bool:
@@ -249,12 +268,21 @@ def _parameters_model(source) -> type[ClosedFormModel]:
     )
 
 
+def urdf_needed(model_cls: type[ClosedFormModel], why: str = "") -> PendverifyError:
+    """The error of a model file or class given without the URDF to compare it with (``why``: in brackets)."""
+    return PendverifyError(
+        f"{where(model_cls)}: give --urdf (urdf= in the Python API): the URDF to verify {model_cls.name} "
+        f"against{f' ({why})' if why else ''}"
+    )
+
+
 def select_targets(
     model_cls: type[ClosedFormModel] | None = None,
     urdf: str | Path | None = None,
     params=None,
     *,
     erd_urdfs: bool = True,
+    origin: str | None = None,
 ) -> Selection:
     """The targets ``pendverify check`` and ``pendverify.check`` verify, from their arguments.
 
@@ -272,7 +300,9 @@ def select_targets(
       default check labels ``erd:NAME``;
     * a URDF (or ``erd:NAME`` with another model or with parameters): the model against it, with
       the parameters given, or read off the URDF;
-    * parameters without a URDF: a built-in model's set against the URDF the project writes for it.
+    * parameters without a URDF: a built-in model's set against the URDF the project writes for it,
+      labelled by the parameter file's stem; ``origin`` names where a set given as values came
+      from (a scene), as a file's path does (default: the inline parameters).
 
     A model file or class needs a URDF; bad input raises ``PendverifyError``.
     """
@@ -285,10 +315,7 @@ def select_targets(
             return Selection([erd_target(stem, path)])
         urdf, name = path, f"erd_{stem}"
     if urdf is None and model_cls is not None and not is_builtin(model_cls):
-        raise PendverifyError(
-            f"{where(model_cls)}: give --urdf (urdf= in the Python API): "
-            f"the URDF to verify {model_cls.name} against"
-        )
+        raise urdf_needed(model_cls)
     values = None
     if params is not None:
         model_cls = model_cls or _parameters_model(params)
@@ -307,7 +334,9 @@ def select_targets(
             raise ParameterError(str(params), f"parameters.{exc.key}", exc.value, exc.rule) from None
     if values is not None:
         if isinstance(params, (str, Path)):
-            return Selection([params_target(values, Path(params).stem, str(params), model_cls)])
+            origin = str(params)
+        if origin is not None:
+            return Selection([params_target(values, Path(origin).stem, origin, model_cls)])
         return Selection([params_target(values, model_cls=model_cls)])
     names = [model_cls.name] if model_cls is not None else list(MODELS)
     selection = Selection([default_target(n) for n in names])

@@ -48,8 +48,7 @@ from pendverify.targets import (
     Target,
     default_target,
     erd_selection,
-    model_target,
-    params_target,
+    select_targets,
 )
 from pendverify.viz.animation import Trajectory, animation_page
 from pendverify.viz.plots import energy_plot_svg
@@ -87,11 +86,11 @@ def _is_default(scene: Scene) -> bool:
 
 
 def _target(scene: Scene) -> Target:
-    if scene.urdf is not None:
-        return model_target(scene.model_cls, scene.urdf, scene.params)
-    if _is_default(scene):
+    """A scene's target: its default set against the committed URDF, else as ``check`` chooses it."""
+    if scene.urdf is None and _is_default(scene):
         return default_target(scene.model)
-    return params_target(scene.params, Path(scene.params_source).stem, scene.params_source, scene.model_cls)
+    urdf, params, origin = scene.urdf, scene.params, scene.params_source
+    return select_targets(scene.model_cls, urdf, params, erd_urdfs=False, origin=origin).targets[0]
 
 
 def scene_targets(scenes: list[Scene], erd: bool = True) -> Selection:

@@ -540,9 +540,8 @@ def test_certify_set_takes_a_model_file_and_a_missing_urdf_is_named_in_api_words
     )
     assert issued.certified and issued.certificate["model_source"]["text"].startswith('"""')
     assert recheck(str(issued.path), run_embedded_code=True).passed
-    with pytest.raises(
-        pendverify.PendverifyError, match=r"give the URDF to certify cart_pole against \(--urdf, urdf=\)"
-    ):
+    sentence = r"give --urdf \(urdf= in the Python API\): the URDF to verify cart_pole against"
+    with pytest.raises(pendverify.PendverifyError, match=sentence):
         pendverify.certify_set(
             tmp_path / "b", analytic=examples / "cart_pole.py", urdf_params=examples / "cart_pole.toml"
         )

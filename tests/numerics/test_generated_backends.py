@@ -221,6 +221,30 @@ def test_generic_field_on_mpmath_is_the_models_closed_form(case):
         assert worst_planted > 1.0, f"g off by 1e-9 is not seen: {worst_planted:.3g} β"
 
 
+@pytest.mark.parametrize("case", [*CASES, "furuta_pendulum"])
+def test_generic_mass_on_mpmath_is_the_models_mass_matrix(case):
+    """The generated ``mass`` in 40-digit mpmath is the model's M to its float rounding (M's entries
+    are sums of a few products of parameters and cosines: ≤ 16 ε of the largest entry); the
+    numbers of another parameter set (every parameter × (1 + 1e-6)) are far off."""
+    model = _model(case)
+    system = GeneratedSystem.from_model(model)
+
+    def mass(system, q):
+        with mpmath.workdps(40):
+            numbers = taylor.exact_system(system)
+            rows = system.module.mass(
+                numbers, [mpmath.mpf(float(v)) for v in q], mpmath.mpf, taylor.series_sincos
+            )
+            return np.array([[float(m) for m in row] for row in rows])
+
+    moved = dataclasses.replace(system, params=system.params * (1 + 1e-6))
+    for state in sample_states(model, 8, SEED):
+        M = model.mass_matrix(state.q)
+        scale = np.max(np.abs(M))
+        assert np.max(np.abs(mass(system, state.q) - M)) <= 16 * EPS * scale, f"{case} {state.label}"
+        assert np.max(np.abs(mass(moved, state.q) - M)) > 1e-8 * scale, f"{case} {state.label}"
+
+
 def test_generic_field_runs_on_float_numpy_decimal_and_mpf():
     """The same code on every number type: float and numpy agree with mpmath to 1e-12 relative (a
     few hundred roundings of a well-conditioned state), Decimal at 30 digits to 1e-25."""

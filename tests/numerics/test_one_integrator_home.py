@@ -1,5 +1,6 @@
 """One home for the integrators: RK4 is defined once (its tableau), and every RK4 in the package is
-that tableau run by the one stepper, giving the numbers the hand-written method gave.
+that tableau run by the one stepper, giving the numbers the hand-written method gave; Störmer–Verlet
+and backward Euler are written once, in ``numerics.integrators.model_runs``.
 
 Tolerances.  The tableau-driven step performs, operation for operation, the classical
 x + h/6 (k1 + 2 k2 + 2 k3 + k4) with x + ½h k_i formed as h·(½ k_i) — the same rounding, a
@@ -22,16 +23,24 @@ import pytest
 
 from pendverify.analytic import MODELS
 from pendverify.numerics.generate import GeneratedSystem
-from pendverify.numerics.integrators import EULER, RK4, TABLEAUX, Tableau, explicit_rk_step, fixedstep_runner
+from pendverify.numerics.integrators import (
+    EULER,
+    RK4,
+    TABLEAUX,
+    Tableau,
+    explicit_rk_step,
+    fixedstep_runner,
+    model_runs,
+)
 from pendverify.simulation.integrate import integrate
 from pendverify.simulation.scene import Integrator
-from pendverify.stress import integrators as si
 
 from ..conftest import SEED, default_params
 
 REPO = Path(__file__).resolve().parents[2]
 PACKAGE = ("verify", "analytic", "viz")
 HOME = REPO / "verify" / "numerics" / "integrators" / "tableaux.py"
+RUNS_HOME = REPO / "verify" / "numerics" / "integrators" / "model_runs.py"
 EPS = float(np.finfo(float).eps)
 ROUNDING = 4
 
@@ -46,33 +55,72 @@ RK4_SIGNS = (
 )
 
 
-def rk4_definitions(roots) -> list[str]:
-    """``path:line: text`` of every line under ``roots`` (Python files) bearing a sign of RK4."""
+#: what a hand-written Störmer–Verlet leaves: a function named for it, its half-step momentum, its
+#: half kick p − ½h·∂H/∂q
+STORMER_VERLET_SIGNS = (
+    re.compile(r"def\s+\w*(verlet|leapfrog)\w*\s*\(", re.IGNORECASE),
+    re.compile(r"\bp_?(half|½)\b"),
+    re.compile(r"-\s*0\.5\s*\*\s*h\s*\*"),
+)
+#: what a hand-written backward Euler leaves: a function named for it, its residual y − x − h·f(y)
+IMPLICIT_EULER_SIGNS = (
+    re.compile(r"def\s+\w*(implicit|backward)_euler\w*\s*\(", re.IGNORECASE),
+    re.compile(r"\b(\w+)\s*-\s*\w+\s*-\s*h\s*\*\s*\w+\(\1\)"),
+)
+
+
+def definitions(roots, signs=RK4_SIGNS) -> list[str]:
+    """``path:line: text`` of every line under ``roots`` (Python files) bearing one of ``signs``."""
     found = []
     for root in roots:
         for path in sorted(Path(root).rglob("*.py")):
             for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
-                if any(sign.search(line) for sign in RK4_SIGNS):
+                if any(sign.search(line) for sign in signs):
                     found.append(f"{path}:{number}: {line.strip()}")
     return found
 
 
 def test_rk4_is_defined_once_by_its_tableau():
-    found = rk4_definitions(REPO / name for name in PACKAGE)
+    found = definitions(REPO / name for name in PACKAGE)
     assert len(found) == 1 and found[0].startswith(f"{HOME}:"), "RK4 written out again:\n" + "\n".join(found)
 
 
 def test_the_search_finds_a_hand_written_rk4(tmp_path):
     """Planted: the classical method as the stress suite and the scene driver had it."""
     (tmp_path / "clean.py").write_text("x = x + h * f(x)\n")
-    assert rk4_definitions([tmp_path]) == []
+    assert definitions([tmp_path]) == []
     (tmp_path / "stepper.py").write_text(
         "k1 = f(x)\nk2 = f(x + 0.5 * h * k1)\nk3 = f(x + 0.5 * h * k2)\nk4 = f(x + h * k3)\n"
         "x = x + (h / 6) * (k1 + 2 * k2 + 2 * k3 + k4)\n"
     )
-    assert len(rk4_definitions([tmp_path])) == 2  # the fourth stage and the update
+    assert len(definitions([tmp_path])) == 2  # the fourth stage and the update
     (tmp_path / "stepper.py").write_text("B = np.array([1 / 6, 1 / 3, 1 / 3, 1 / 6])\n")
-    assert len(rk4_definitions([tmp_path])) == 1
+    assert len(definitions([tmp_path])) == 1
+
+
+@pytest.mark.parametrize(
+    "signs", [STORMER_VERLET_SIGNS, IMPLICIT_EULER_SIGNS], ids=["Störmer–Verlet", "implicit Euler"]
+)
+def test_stormer_verlet_and_implicit_euler_are_written_once(signs):
+    found = definitions((REPO / name for name in PACKAGE), signs)
+    assert found, "the search no longer finds the method in its home"
+    elsewhere = [line for line in found if not line.startswith(f"{RUNS_HOME}:")]
+    assert not elsewhere, "written again outside numerics/integrators/model_runs.py:\n" + "\n".join(elsewhere)
+
+
+def test_the_search_finds_a_hand_written_stormer_verlet_and_implicit_euler(tmp_path):
+    """Planted: the two methods as the stress suite had them, each under another name."""
+    (tmp_path / "clean.py").write_text("x = x + h * f(x)\nq_new = q + h * v\n")
+    assert definitions([tmp_path], STORMER_VERLET_SIGNS + IMPLICIT_EULER_SIGNS) == []
+    (tmp_path / "leap.py").write_text(
+        "def step(q, p):\n    ph = p - 0.5 * h * grad(q)\n    q = q + h * solve(M(q), ph)\n"
+        "    return q, ph - 0.5 * h * grad(q)\n"
+    )
+    assert len(definitions([tmp_path], STORMER_VERLET_SIGNS)) == 2  # the two half kicks
+    (tmp_path / "backward.py").write_text("def advance(x):\n    G = z - x - h * rhs(z)\n")
+    assert len(definitions([tmp_path], IMPLICIT_EULER_SIGNS)) == 1
+    (tmp_path / "named.py").write_text("def backward_euler(f, x, h):\n    pass\n")
+    assert len(definitions([tmp_path], IMPLICIT_EULER_SIGNS)) == 2
 
 
 # --- the tableaux -----------------------------------------------------------------------------
@@ -174,11 +222,11 @@ def test_the_scene_driver_takes_the_classical_steps(system):
         assert error <= ROUNDING * EPS * max(1.0, np.max(np.abs(expected))), f"{system} step {i}"
 
 
-def test_the_stress_suites_rk4_takes_the_classical_steps():
+def test_the_model_runs_rk4_takes_the_classical_steps():
     model = MODELS["double_pendulum"](default_params("double_pendulum"))
-    f = si.state_derivative_of(model)
+    f = model_runs.state_derivative_of(model)
     q0, v0, h, n = np.array([0.4, -0.3]), np.array([0.2, 0.1]), 2e-3, 250
-    run = si.rk4(model, q0, v0, h, n)
+    run = model_runs.rk4(model, q0, v0, h, n)
     xs = np.column_stack([run.q, run.v])
     assert len(xs) == n + 1 and run.evaluations == RK4.stages * n
     for i in range(n):

@@ -20,12 +20,12 @@ from pendverify.checks.batch import world_lever
 from pendverify.checks.trust import Conditioning, check_conditioning
 from pendverify.cli import main
 from pendverify.errors import IllConditionedError, InputError
-from pendverify.stress import cases, framework, seed_params, sim_cases, trust_study
 from pendverify.stress import catalogue as stress
-from pendverify.stress import integrators as si
+from pendverify.stress import framework, reference_cases, trust_study
+from pendverify.stress.catalogue import CART, DP, HardSet, hard_set_case
 from pendverify.validate import finite_state, model_state
 
-from ..conftest import default_params
+from ..conftest import default_params, system_for
 
 
 @pytest.fixture(scope="module")
@@ -129,7 +129,7 @@ def test_cli_unknown_case_is_exit_2(capsys):
 
 
 def test_cli_failure_is_exit_1(monkeypatch, capsys):
-    monkeypatch.setattr(cases, "model_state", lambda *a, **k: None)  # the NaN guard is gone
+    monkeypatch.setattr(reference_cases, "model_state", lambda *a, **k: None)  # the NaN guard is gone
     assert main(["stress", "--quick", "--case", "NaN, inf, negative, zero"]) == 1
     out = capsys.readouterr().out
     assert "FAIL" in out and "1 case(s) FAIL" in out
@@ -170,7 +170,7 @@ class EnergyPump(CartDoublePendulum):
 
 
 class WrongCoriolis(DoublePendulum):
-    """One Coriolis term flipped in both C and the seed's C: q̈ disagrees with the energy."""
+    """One Coriolis term flipped in C and in ``seed_coriolis_matrix`` (C + D): q̈ disagrees with E."""
 
     def seed_coriolis_matrix(self, q, v):
         C = super().seed_coriolis_matrix(q, v)
@@ -185,47 +185,44 @@ class CartPushed(CartDoublePendulum):
         return super().gravity(y) + np.array([1e-6, 0.0, 0.0])
 
 
+def _entry(name: str) -> HardSet:
+    return next(e for e in stress.CATALOGUE if e.name == name)
+
+
 @pytest.mark.parametrize(
-    "case",
+    ("entry", "planted"),
     [
-        framework.checks_case(
-            "planted β", "mass ratio", lambda: seed_params.dp_link_mass_ratio(1e-6), model_cls=BetaOff
+        (_entry("link1/link2 mass 1e-6"), BetaOff),
+        (_entry("cart rods 1e3 m"), CartCoriolisSignFlip),
+        (_entry("double pendulum lengths ×1e3 (km)"), BetaOff),
+        (_entry("double pendulum |θ| ≈ 1e6 rad"), NotPeriodic),
+        (_entry("double pendulum |q̇| ≤ 1e3"), NaNAtHighSpeed),
+        (
+            HardSet(
+                "planted pump",
+                "stiff damping",
+                CART,
+                {"d1": 1e4, "d2": 1e4, "d3": 1e4},
+                kind="stiff",
+                start=((0.0, 3.0, 3.4),),
+            ),
+            EnergyPump,
         ),
-        framework.checks_case(
-            "planted C", "length", lambda: seed_params.cart(l1=1e3, l2=1e3), model_cls=CartCoriolisSignFlip
-        ),
-        framework.checks_case(
-            "planted β km", "length", lambda: seed_params.dp_scaled(1e3), model_cls=BetaOff
-        ),
-        cases.large_angle_case("planted period", lambda: default_params("double_pendulum"), NotPeriodic),
-        cases.high_speed_case("planted NaN", lambda: default_params("double_pendulum"), NaNAtHighSpeed),
-        sim_cases.stiff_sim_case(
-            "planted pump", lambda: seed_params.cart(d1=1e4, d2=1e4, d3=1e4), (0.0, 3.0, 3.4), EnergyPump
-        ),
-        sim_cases.long_horizon_case("planted C long", model_cls=WrongCoriolis),
-        sim_cases.zero_gravity_sim_case(
-            "planted push",
-            lambda: seed_params.cart(g=0.0, d1=0.0, d2=0.0, d3=0.0),
-            (0, 0.3, -0.4),
-            (0.5, 1, -2),
-            0,
-            "p_q",
-            CartPushed,
-        ),
+        (_entry("double pendulum 1e4 s, conservative"), WrongCoriolis),
+        (_entry("cart g = 0: simulate"), CartPushed),
     ],
-    ids=lambda c: c.name,
+    ids=lambda x: getattr(x, "name", getattr(x, "__name__", "")),
 )
-def test_planted_error_fails_its_case(ctx, case):
-    result = stress.run_case(case, ctx)
-    assert not result.passed, f"{case.name} passed: {result}"
+def test_planted_error_fails_its_case(ctx, entry, planted):
+    """The catalogue's hard set (through the same entry point as the catalogue) on a planted model."""
+    result = stress.run_case(hard_set_case(entry, planted), ctx)
+    assert not result.passed, f"{entry.name} passed: {result}"
     assert result.verdict == "FAIL"
 
 
 def test_planted_large_angle_passes_at_small_angles(ctx):
     """The non-periodic term is invisible in the ordinary check: only the 2πk invariance sees it."""
-    case = framework.checks_case(
-        "small angles", "large angle", lambda: default_params("double_pendulum"), model_cls=NotPeriodic
-    )
+    case = hard_set_case(HardSet("small angles", "large angle", DP), NotPeriodic)
     assert stress.run_case(case, ctx).passed
 
 
@@ -262,7 +259,7 @@ def test_det_case_fails_on_a_cancelling_det(monkeypatch):
     monkeypatch.setattr(
         CartDoublePendulum, "det_mass_matrix", lambda self, y: float(np.linalg.det(self.mass_matrix(y)))
     )
-    result = cases.det_case(framework.Context(framework.QUICK), "det")
+    result = stress.run_case(_case("cart det M: closed form vs LU"), framework.Context(framework.QUICK))
     assert not result.passed and result.error > 1e-10
 
 
@@ -288,7 +285,7 @@ def test_conditioning_levels_and_scaling():
 
 def test_term_amplification_grows_with_the_square_of_the_lever_arm():
     params = default_params("cart_double_pendulum").replace(l1=1e-3, l2=1e-3)
-    model, system = CartDoublePendulum(params), framework.system_for(params)
+    model, system = CartDoublePendulum(params), system_for(params)
     near, one, eight = (world_lever(model, system, np.array([x, 0.7, 0.7])) for x in (0.0, 1.0, 8.0))
     assert 1 <= near < 20  # a 1 mm pendulum at the origin: terms as large as the result
     assert 60 < eight / one < 68  # 1 mm rods 1 m and 8 m from the origin: (8/1)²
@@ -301,15 +298,33 @@ def test_zero_mass_aba_is_finite_nonsense_and_refused():
 
 
 def test_reference_matches_the_closed_form():
+    """The 50-digit M and q̈ (the generated generic code on mpf) are the closed form's, to its rounding."""
     import mpmath as mp
 
     for name, q in (("cart_double_pendulum", [0.1, 0.7, -1.2]), ("double_pendulum", [0.3, 1.1])):
-        params = default_params(name)
-        model = MODELS[name](params)
+        model = MODELS[name](default_params(name))
+        v, u, w = np.linspace(0.4, -0.9, model.nv), np.full(len(model.inputs), 0.5), np.ones(model.nv)
+        numbers = trust_study.reference_numbers(model, u, w[: len(model.disturbances)])
         with mp.workdps(trust_study.REFERENCE_DIGITS):
-            M = trust_study.reference_mass_matrix(params, q)
+            M = trust_study.reference_mass_matrix(numbers, q)
             ref = np.array([[float(M[i, j]) for j in range(M.cols)] for i in range(M.rows)])
+            accel = np.array([float(a) for a in trust_study.reference_acceleration(numbers, q, v)])
         np.testing.assert_allclose(model.mass_matrix(np.array(q)), ref, rtol=2e-15, atol=1e-16)
+        # the double q̈ is an LU solve with κ(M) ≤ 50 at these states: within ~50·ε of its terms
+        expected = model.acceleration(np.array(q), v, u, w[: len(model.disturbances)])
+        np.testing.assert_allclose(expected, accel, rtol=1e-13, atol=1e-13)
+
+
+def test_reference_acceleration_sees_the_input_and_the_disturbance():
+    """Planted: u and w left out of the reference (zero) move q̈ by M⁻¹ (B u + W w), far above rounding."""
+    import mpmath as mp
+
+    model = MODELS["cart_double_pendulum"](default_params("cart_double_pendulum"))
+    y, v, u, w = trust_study.study_states()["theta1=theta2=0, torque on rod 1"]
+    with mp.workdps(trust_study.REFERENCE_DIGITS):
+        right = trust_study.reference_acceleration(trust_study.reference_numbers(model, u, w), y, v)
+        wrong = trust_study.reference_acceleration(trust_study.reference_numbers(model), y, v)
+    assert trust_study._rel([float(a) for a in wrong], right) > 1e-3
 
 
 # --- validation -----------------------------------------------------------------------------------
@@ -334,46 +349,6 @@ def test_model_state_fills_zeros_and_checks_sizes():
         model_state(model, [0, 0, 0], w=[0, 0, -math.inf], source="<src>")
 
 
-# --- the integrators ----------------------------------------------------------------------------
-def test_integrators_converge_at_their_order():
-    model = DoublePendulum(default_params("double_pendulum").replace(b1=0.0, b2=0.0))
-    q0, v0 = np.array([-1.0, 0.4]), np.zeros(2)
-    reference = si.rk4(model, q0, v0, 0.001, 3000).q[-1]
-
-    def error(method, h):
-        traj = method(model, q0, v0, h, round(3 / h))
-        assert traj.blew_up_at is None
-        return np.max(np.abs(traj.q[-1] - reference))
-
-    assert 3.6 < error(si.stormer_verlet, 0.02) / error(si.stormer_verlet, 0.01) < 4.4  # order 2
-    assert 12 < error(si.rk4, 0.02) / error(si.rk4, 0.01) < 20  # order 4
-    sv = si.stormer_verlet(model, q0, v0, 0.01, 300)
-    E0 = si.energy(model, q0, v0)
-    assert np.max(np.abs(si.energies(model, sv) - E0)) < 1e-3 * abs(E0)
-    assert si.momenta(model, sv).shape == (len(sv.t), 2)
-
-
-def test_rk4_reports_a_blow_up_and_backward_euler_does_not():
-    model = DoublePendulum(default_params("double_pendulum").replace(b1=1e4, b2=1e4))
-    q0, v0 = np.array([-1.0, 0.3]), np.zeros(2)
-    blown = si.rk4(model, q0, v0, 0.05, 50)
-    assert blown.blew_up_at is not None and blown.note.startswith("non-finite after")
-    stable = si.implicit_euler(model, q0, v0, 0.05, 20)
-    assert stable.blew_up_at is None
-    assert np.all(np.diff(si.energies(model, stable)) <= 0)
-
-
-def test_stormer_verlet_refuses_damped_models():
-    with pytest.raises(ValueError, match="conservative models only"):
-        si.stormer_verlet(DoublePendulum(default_params("double_pendulum")), np.zeros(2), np.zeros(2), 0.1, 1)
-
-
-def test_fit_slope():
-    t = np.linspace(0, 10, 11)
-    slope, r2 = si.fit_slope(t, 3 * t + 1)
-    assert slope == pytest.approx(3.0) and r2 == pytest.approx(1.0)
-
-
 @pytest.mark.parametrize(
     "bad, key, rule",
     [
@@ -393,6 +368,6 @@ def test_compare_refuses_a_bad_state_by_name_among_good_ones(bad, key, rule):
     states = sample_states(model, 8, 1)
     states[5] = dataclasses.replace(states[5], **bad)
     with pytest.raises(InputError) as exc:
-        framework.compare("case", model, framework.system_for(model.params), states, 1)
+        framework.compare("case", model, system_for(model.params), states, 1)
     text = str(exc.value)
     assert f"<case: {states[5].label}>" in text and f"'{key}'" in text and rule in text, text

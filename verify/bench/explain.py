@@ -78,13 +78,10 @@ CORPUS_CATALOGUE = "diagnosis_corpus.toml"
 
 def _target(model_file, urdf, params_file):
     """(model, system) of a model file checked against ``urdf`` with the parameters of ``params_file``."""
-    from pendverify.analytic.plugin import load_model_class
-    from pendverify.robot.system import PinocchioSystem
-    from pendverify.targets import parameter_values
+    from pendverify.targets import plugin_target
 
-    cls = load_model_class(str(model_file))
-    params = parameter_values(cls, params_file)
-    return cls(params), PinocchioSystem.for_model(cls, urdf, getattr(params, "g", None))
+    target = plugin_target(str(model_file), str(urdf), str(params_file))
+    return target.model, target.system
 
 
 def shipped_targets():

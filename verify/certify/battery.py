@@ -85,7 +85,11 @@ def check_items(model, system, settings: BatterySettings) -> list[BatteryItem]:
 
 
 def stress_items(
-    model_cls, params, settings: BatterySettings, urdf: str | LoadedDescription | None = None
+    model_cls,
+    params,
+    settings: BatterySettings,
+    urdf: str | LoadedDescription | None = None,
+    system: PinocchioSystem | None = None,
 ) -> list[BatteryItem]:
     """The stress cases that apply to any parameter set, run on this one.
 
@@ -96,13 +100,16 @@ def stress_items(
     ``pendverify.checks.trust`` over the sampled states: a set whose
     comparisons would need refusing (near-singular M) is not certified.  They run
     on ``urdf``, the URDF being certified (text, path or as read by ``load_description``; the
-    project's own for the set if None).
+    project's own for the set if None); ``system``: ``urdf``'s system at the set's g, if the caller
+    has it (the cases at another g derive theirs from it).
     """
+    from pendverify.robot.writer import urdf_for
     from pendverify.stress import cases, framework
     from pendverify.stress import catalogue as stress
 
     cls = model_class(model_cls)
-    ctx = framework.Context(framework.FULL, settings.seed, urdf=urdf, model_cls=cls)
+    urdf = urdf_for(params) if urdf is None else urdf
+    ctx = framework.Context(framework.FULL, settings.seed, urdf=urdf, model_cls=cls, urdf_system=system)
     # at |θ| ≈ 1e6 rad a set with κ̃ in the hundreds is beyond the trust rule: such
     # states are refused and recorded, and every state that is compared must pass
     angles = (
@@ -155,7 +162,7 @@ def run_battery(
     not_run = invariants_not_run(cls)
     parts = (
         lambda: check_items(cls(params), system, settings),
-        lambda: stress_items(cls, params, settings, loaded),
+        lambda: stress_items(cls, params, settings, loaded, system),
         (lambda: []) if not_run else (lambda: invariant_items(cls, params, urdf, settings, engines, system)),
     )
     items = []

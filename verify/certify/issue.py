@@ -23,7 +23,6 @@ from pathlib import Path
 
 from pendverify.analytic import ParameterSet
 from pendverify.analytic.params import load_parameter_file
-from pendverify.analytic.plugin import plugin_parameters
 from pendverify.certify.battery import BatteryRun, BatterySettings, run_battery
 from pendverify.certify.battery_item import BatteryItem, items_html
 from pendverify.certify.bundle import check_files_beside, refuse_existing, verify_signature, write_bundle
@@ -37,12 +36,11 @@ from pendverify.certify.simulations import recorded_engines
 from pendverify.certify.sweep_task import SetResult
 from pendverify.display import REPR_LIMIT, html_lines, listed, shortened
 from pendverify.errors import CertificateError, ParameterError, PendverifyError
-from pendverify.robot.description import LoadedDescription, load_description
+from pendverify.robot.description import LoadedDescription
 from pendverify.robot.erd import resolve_urdf
 from pendverify.robot.pinocchio_model import certified_text
-from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
-from pendverify.targets import PARAMS_HINT
+from pendverify.targets import select_targets
 
 
 @dataclass(frozen=True)
@@ -61,83 +59,57 @@ def certification_input(
     analytic: str | None = None,
 ) -> CertificationInput:
     """The set to certify, from a parameter file, a URDF with a parameter file or a model name,
-    or a model file (``analytic``; a ``model`` ending in .py counts as one) with a URDF and parameters."""
+    or a model file (``analytic``; a ``model`` ending in .py counts as one) with a URDF and parameters.
+
+    The target is chosen as ``check`` chooses it (``pendverify.targets.select_targets``, the
+    same errors); what certify adds is the bundle's name, checked where it is read, the URDF
+    text the certificate embeds, and a gravity parameter."""
     if analytic is None and model is not None and str(model).endswith((".py", ".toml")):
         analytic, model = model, None
-    if analytic is not None:
-        if model is not None:
-            raise PendverifyError(f"{analytic}: give a model file or a built-in model name, not both")
-        return _plugin_input(analytic, urdf, urdf_params or params_file)
-    if urdf:
-        path, name, text = _urdf_input(urdf)
-        if urdf_params:
-            model_name, _, params = load_parameter_file(urdf_params)
-            if model and model != model_name:
-                raise ParameterError(
-                    urdf_params, "model", model_name, f"must be {model!r}, the model named with it"
-                )
-            return CertificationInput(
-                set_name(model_name, name, str(urdf_params)), ModelSource.of_builtin(model_name), params, text
-            )
-        if not model:
-            raise PendverifyError(f"with a URDF, name the model or give the parameter set ({PARAMS_HINT})")
-        params = PinocchioSystem.from_urdf(model, text, source=str(path)).geometry.params
-        if params is None:
-            raise PendverifyError(
-                f"{path}: give the parameter set ({PARAMS_HINT}): "
-                f"a {model} URDF alone does not fix the closed form"
-            )
-        name = set_name(model, name, str(path))
-        return CertificationInput(name, ModelSource.of_builtin(model), params, text)
-    if params_file:
-        model_name, name, params = load_parameter_file(params_file)
-        check_name(name, str(params_file), "name")
-        return CertificationInput(name, ModelSource.of_builtin(model_name), params, urdf_for(params, name))
-    raise PendverifyError("give a parameter file, a URDF, a model file (--analytic), or a sweep")
-
-
-def _plugin_input(model_file: str, urdf: str | None, params_file: str | None) -> CertificationInput:
-    """A model file, its URDF and its parameter file (None: the model file's ``PARAMS``), as
-    ``check --analytic``."""
-    source = ModelSource.of_file(model_file)
-    cls = source.load()
-    if urdf is None:
-        raise PendverifyError(f"{model_file}: give the URDF to certify {cls.name} against (--urdf, urdf=)")
-    if params_file is None and cls.default_params is None:
-        raise PendverifyError(
-            f"{model_file}: give the parameter set ({PARAMS_HINT}): the model file gives no PARAMS"
-        )
-    if params_file is None:
-        params = cls.default_params
+    if analytic is not None and model is not None:
+        raise PendverifyError(f"{analytic}: give a model file or a built-in model name, not both")
+    source = None if analytic is None else ModelSource.of_file(analytic)
+    if source is None and not urdf and not params_file:
+        raise PendverifyError("give a parameter file, a URDF, a model file (--analytic), or a sweep")
+    if source is not None:
+        model_cls, params, urdf = source.load(), urdf_params or params_file, urdf or None
+    elif urdf:
+        model_cls, params = (None if not model else ModelSource.of_builtin(model).load()), urdf_params
     else:
-        params = plugin_parameters(cls, model_file, params_file)
-    if not hasattr(params, "g"):
+        model_cls, params = None, params_file
+    where, name, description, text = None, None, None, None
+    if urdf is not None:
+        where, name, description, text = _urdf_input(urdf)
+    (target,) = select_targets(model_cls, description, params, erd_urdfs=False).targets
+    cls, values = type(target.model), target.model.params
+    if source is None:
+        source = ModelSource.of_builtin(cls.name)
+    elif not hasattr(values, "g"):
         raise ParameterError(
-            params_file or model_file,
+            params or analytic,
             "parameters.g",
             None,
             "certify needs a gravity parameter g: its runs set gravity by it",
         )
-    path, name, text = _urdf_input(urdf)
-    return CertificationInput(set_name(cls.name, name, path), source, params, text)
+    if urdf is None:
+        _, name, _ = load_parameter_file(params_file)
+        check_name(name, str(params_file), "name")
+        return CertificationInput(name, source, values, urdf_for(values, name))
+    text = text if text is not None else target.system.urdf.text  # a xacro file's: the URDF it expands to
+    return CertificationInput(set_name(cls.name, name, where), source, values, text)
 
 
-def _urdf_input(urdf: str | LoadedDescription) -> tuple[str, str, str]:
-    """(where it came from, bundle name, URDF text) of a URDF argument: a path, ``erd:NAME``, or a
-    model given as a Pinocchio object (its name names the bundle; ``certified_text``)."""
+def _urdf_input(urdf: str | LoadedDescription) -> tuple[str, str, str | LoadedDescription, str | None]:
+    """(where it came from, bundle name, the description to read, its URDF text if known) of a URDF
+    argument: a path, ``erd:NAME``, or a model given as a Pinocchio object (its name names the
+    bundle; its text is ``certified_text``).  The name must be a valid bundle name."""
     if isinstance(urdf, LoadedDescription):
         name = urdf.model.name
         check_name(name, urdf.source, "model name (it names the bundle)")
-        return urdf.source, name, certified_text(urdf)
-    path, name = _urdf_and_name(urdf)
-    return str(path), name, load_description(path).text  # a xacro file's: the URDF it expands to
-
-
-def _urdf_and_name(urdf: str):
-    """(path, bundle name) of a URDF argument; its stem must be a valid bundle name."""
+        return urdf.source, name, urdf, certified_text(urdf)
     path, name = resolve_urdf(urdf)
     check_name(name, str(urdf), "URDF file name (its stem names the bundle)")
-    return path, name
+    return str(path), name, str(path), None
 
 
 def check_sweep_names(sweep, source: str) -> None:

@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from pendverify.analytic.source_file import where
 from pendverify.checks.applicability import derived_notes
 from pendverify.checks.batch import CheckBatch
 from pendverify.checks.catalogue import applicable_checks, run_checks, skipped_notes
@@ -35,9 +34,10 @@ from pendverify.checks.trust import REFUSE_REL, Verdicts, check_conditioning
 from pendverify.checks.units import NAME as UNITS
 from pendverify.checks.units import units_check
 from pendverify.checks.verdict import FAIL, REFUSED, WARN, apply_strict, non_christoffel_c
-from pendverify.errors import IllConditionedError, PendverifyError
+from pendverify.errors import IllConditionedError
 from pendverify.progress import bar
 from pendverify.robot.geometry import MODEL_FORM_RTOL
+from pendverify.targets import urdf_needed
 
 
 def trusted(label: str, batch: CheckBatch) -> tuple[list[int], list[str], Verdicts]:
@@ -198,10 +198,7 @@ def model_report(model_cls, seed: int) -> Report:
     report = Report(seed=seed, states={label: 0}, results=[])
     units, notes = units_check(label, model_cls, seed)
     if units is None:  # nothing the model alone can show: as before, a robot description is needed
-        raise PendverifyError(
-            f"{where(model_cls)}: give --urdf (urdf= in the Python API): the URDF to verify "
-            f"{model_cls.name} against ({'; '.join(notes)})"
-        )
+        raise urdf_needed(model_cls, "; ".join(notes))
     report.results.append(units)
     if notes:
         report.notes[label] = notes

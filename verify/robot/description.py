@@ -142,9 +142,9 @@ def load_description(description: str | Path, source: str | None = None) -> Load
         notes.append("expanded by xacro, with the defaults of its xacro:arg arguments")
         notes += [f"xacro printed: {line}" for line in log]
         log = urdf_log
-    elif fmt == "urdf":
-        model, facts, log = build_pinocchio_model(text, source)
-        ignored = ignored_extensions(text, source)
+    elif fmt == "urdf":  # ``description_format`` has parsed this text: the readers parse it once more
+        model, facts, log = build_pinocchio_model(text, source, checked=True)
+        ignored = ignored_extensions(text, source, checked=True)
         if ignored:
             listed = ", ".join(f"<{name}>" + (f" ×{n}" if n > 1 else "") for name, n in ignored.items())
             notes.append(

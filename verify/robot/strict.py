@@ -160,14 +160,15 @@ class _Place:
         return f"{self.owner} {self.path}" if self.path else self.owner
 
 
-def read_urdf_strictly(text: str, source: str) -> DescriptionFacts:
+def read_urdf_strictly(text: str, source: str, checked: bool = False) -> DescriptionFacts:
     """Check every number of a URDF (see the module docstring) and return the facts Pinocchio hides.
 
     ``text`` is the URDF's XML, ``source`` names it in messages.  Any violation raises
     ``UrdfShapeError(source, problem)`` whose one-line problem names the link or joint,
-    the element path, the attribute, the offending value and the rule.
+    the element path, the attribute, the offending value and the rule.  ``checked``: the caller
+    has run ``parse_xml`` on this very text already (``parse_xml_as_urdfdom_reads``).
     """
-    root = parse_xml_as_urdfdom_reads(text, source)
+    root = parse_xml_as_urdfdom_reads(text, source, checked)
     if root.tag != "robot":
         tag = shortened(root.tag, TAG_WIDTH)
         raise UrdfShapeError(source, f"the root element is <{tag}>, a URDF's must be <robot>")

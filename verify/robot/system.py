@@ -66,8 +66,11 @@ class PinocchioSystem:
         urdf: LoadedDescription | None = None,
         model_form_rtol: float = MODEL_FORM_RTOL,
         gravity_vector=None,
+        model_cls=None,
     ):
         self.model = model
+        #: the closed form's gravity (m/s²) this system is evaluated with
+        self.g = g
         self.model.gravity.linear = np.array([0.0, 0.0, -g] if gravity_vector is None else gravity_vector)
         self.data = model.createData()
         self.cmap = geometry.cmap
@@ -77,6 +80,8 @@ class PinocchioSystem:
         self.tilt = None if gravity_vector is None else tilt_form(model, geometry.cmap, gravity_vector)
         self.source = source
         self.urdf = urdf
+        #: the closed-form model class whose coordinates these are (None: not given)
+        self.model_cls = model_cls
         #: the model-form threshold (``MODEL_FORM_RTOL``; ``check --model-form-rtol``)
         self.model_form_rtol = model_form_rtol
         #: a copy of the model with gravity off, and its data (Ṁ from RNEA's derivatives)
@@ -130,7 +135,8 @@ class PinocchioSystem:
         g = own if g is None else g
         geometry = geometry_for(model_cls, loaded.model, loaded.source, g)
         g = DEFAULT_G if g is None else g
-        return cls(loaded.model, geometry, g, loaded.source, loaded, gravity_vector=vector)
+        source = loaded.source
+        return cls(loaded.model, geometry, g, source, loaded, gravity_vector=vector, model_cls=model_cls)
 
     @classmethod
     def for_params(cls, params, source: str | None = None):
@@ -196,7 +202,17 @@ class PinocchioSystem:
             self.urdf,
             self.model_form_rtol,
             gravity_vector=None if self.tilt is None else gravity,
+            model_cls=self.model_cls,
         )
+
+    def with_gravity(self, g: float) -> PinocchioSystem:
+        """The same description at the closed form's gravity ``g`` along −z, as ``for_model`` would
+        make it from the description already read: the Pinocchio model copied, the coordinate map
+        read again at ``g`` (a reader's parameters and model-form terms carry g).  What a stress
+        case at another g evaluates (zero gravity) without reading the description again."""
+        geometry = geometry_for(self.model_cls, self.model, self.source, g)
+        cls, rtol = self.model_cls, self.model_form_rtol
+        return PinocchioSystem(self.model.copy(), geometry, g, self.source, self.urdf, rtol, model_cls=cls)
 
     def urdf_damping(self) -> np.ndarray | None:
         """The joints' <dynamics damping> (joint coordinates, Pinocchio's order), or None if no joint has one.

@@ -24,7 +24,9 @@ from pendverify.errors import UrdfShapeError
 from pendverify.robot.strict import DescriptionFacts, read_urdf_strictly
 
 
-def build_pinocchio_model(text: str, source: str) -> tuple[pin.Model, DescriptionFacts, list[str]]:
+def build_pinocchio_model(
+    text: str, source: str, checked: bool = False
+) -> tuple[pin.Model, DescriptionFacts, list[str]]:
     """Read ``text`` strictly, then build its Pinocchio model with urdfdom's log captured.
 
     Returns ``(model, facts, log)``: the model from ``pinocchio.buildModelFromXML``, the
@@ -32,9 +34,10 @@ def build_pinocchio_model(text: str, source: str) -> tuple[pin.Model, Descriptio
     line each (often empty; e.g. "Error: Could not parse collision element for Link [l]"
     when a collision shape is one urdfdom does not know).  If Pinocchio refuses the
     text, ``UrdfShapeError`` carries urdfdom's reason instead of Pinocchio's generic
-    "does not contain a valid URDF model".
+    "does not contain a valid URDF model".  ``checked``: the caller has run ``parse_xml`` on
+    this very text already (``read_urdf_strictly``).
     """
-    facts = read_urdf_strictly(text, source)
+    facts = read_urdf_strictly(text, source, checked)
     with _capture_fd2() as captured:
         try:
             model = pin.buildModelFromXML(text)

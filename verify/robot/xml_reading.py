@@ -100,10 +100,12 @@ def _expose_attribute_whitespace(text: str) -> str:
     return _ATTRIBUTE.sub(escape, text)
 
 
-def parse_xml_as_urdfdom_reads(text: str, source: str) -> ET.Element:
+def parse_xml_as_urdfdom_reads(text: str, source: str, checked: bool = False) -> ET.Element:
     """A URDF's tree as urdfdom reads it (see the module docstring); ``text`` is checked by
-    ``parse_xml`` first, so every refusal names the same rules."""
-    parse_xml(text, source)
+    ``parse_xml`` first, so every refusal names the same rules (``checked``: the caller has
+    run ``parse_xml`` on this very text already)."""
+    if not checked:
+        parse_xml(text, source)
     try:
         root = _names_as_written(_expose_attribute_whitespace(text), source)
     except expat.ExpatError:  # cannot happen for a well-formed file; keep the plain reading
@@ -129,12 +131,14 @@ def _names_as_written(text: str, source: str) -> ET.Element:
     return builder.close()
 
 
-def ignored_extensions(text: str, source: str) -> dict[str, int]:
+def ignored_extensions(text: str, source: str, checked: bool = False) -> dict[str, int]:
     """{name as written: count} of the prefixed elements a URDF holds (``drake:rotor_inertia``),
-    which urdfdom, and hence the model, leaves out; {} for a file without any."""
+    which urdfdom, and hence the model, leaves out; {} for a file without any (``checked``: as
+    ``parse_xml_as_urdfdom_reads``)."""
     if "xmlns:" not in text:
         return {}
-    parse_xml(text, source)
+    if not checked:
+        parse_xml(text, source)
     counts: dict[str, int] = {}
     stack = [_names_as_written(text, source)]
     while stack:

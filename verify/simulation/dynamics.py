@@ -31,7 +31,6 @@ import numpy as np
 from pendverify.analytic import MODELS, ClosedFormModel  # noqa: F401  (MODELS: the scenes' built-ins)
 from pendverify.errors import SceneError
 from pendverify.robot.system import PinocchioSystem
-from pendverify.robot.writer import urdf_for
 from pendverify.simulation.lqr import (
     closed_form_linearisation,
     linearisation_error,
@@ -39,6 +38,7 @@ from pendverify.simulation.lqr import (
     pinocchio_linearisation,
 )
 from pendverify.simulation.scene import Scene
+from pendverify.targets import target_system
 
 
 @dataclass
@@ -149,9 +149,7 @@ def build_dynamics(scene: Scene, engine: str | None = None, urdf: str | None = N
 
 def _system(scene: Scene, params, urdf: str | None, needed_by: str) -> PinocchioSystem:
     """Pinocchio's side: the given URDF, else the project's URDF of a built-in parameter set."""
-    if urdf is not None:
-        return PinocchioSystem.for_model(scene.model_cls, urdf, params.g)
-    if scene.model_file is not None:
+    if urdf is None and scene.model_file is not None:
         what = (
             "the lqr actuation linearises with Pinocchio"
             if needed_by == "lqr"
@@ -164,7 +162,7 @@ def _system(scene: Scene, params, urdf: str | None, needed_by: str) -> Pinocchio
             f"missing key: {what} on a URDF, and the model file {scene.model_file} has none "
             "the project can write (give urdf = FILE or --urdf)",
         )
-    return PinocchioSystem.for_model(scene.model_cls, urdf_for(params), params.g, f"<URDF of {scene.name}>")
+    return target_system(scene.model_cls, urdf, params, scene.name)
 
 
 def _prepare_lqr(law, model, system, scene) -> None:

@@ -1,11 +1,15 @@
-"""The stress framework: results, settings, the guarded comparison and the parameter sets.
+"""The stress framework: results, settings, the guarded comparison, and a case on a description.
 
 The comparison guards every state with the trust rule and then runs the core
 checks exactly as ``pendverify check`` does: one tolerance model
-(``pendverify.checks.catalogue``).
+(``pendverify.checks.catalogue``).  Every case that compares with Pinocchio runs on a
+model class, its robot description and a parameter set (``on_description``), whatever
+the model: a model file's (``pendverify.stress.generic``) or a reference system's
+(``pendverify.stress.catalogue``).
 
-The cases live in ``pendverify.stress.cases`` (states and parameters) and
-``pendverify.stress.sim_cases`` (simulations); ``pendverify.stress.catalogue`` lists them.
+The cases live in ``pendverify.stress.cases`` (states and parameters),
+``pendverify.stress.sim_cases`` (simulations), ``pendverify.stress.singular`` (near-singular
+M) and ``pendverify.stress.reference_cases`` (the reference systems' own studies).
 """
 
 from __future__ import annotations
@@ -18,16 +22,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from pendverify.analytic import MODELS
 from pendverify.checks.batch import CheckBatch
 from pendverify.checks.catalogue import applicable_checks, run_checks
 from pendverify.checks.sampling import DEFAULT_SEED, State, sample_states
 from pendverify.checks.trust import WARN_REL
 from pendverify.checks.verdict import REFUSED, WARN
 from pendverify.checks.verification import trusted
+from pendverify.errors import PendverifyError
 from pendverify.robot.description import LoadedDescription, load_description
 from pendverify.robot.system import PinocchioSystem
-from pendverify.stress.trust_study import StudyResult, cart_study
+from pendverify.stress.trust_study import StudyResult, trust_study
 from pendverify.validate import model_states
 
 SEED = DEFAULT_SEED
@@ -112,35 +116,40 @@ class Context:
     settings: Settings = FULL
     seed: int = SEED
     study: StudyResult | None = None
-    #: the URDF (text, path, or as read by ``load_description``) the cases compare with; None: the one
-    #: the project writes for each set
+    #: the robot description (URDF text, path, or as read by ``load_description``) the cases
+    #: compare with (``on_description`` sets it per case)
     urdf: str | LoadedDescription | None = None
-    #: the model class of the sets (a plug-in's); None: the built-in model each set names
+    #: the model class of the sets (``on_description`` sets it per case)
     model_cls: type | None = None
+    #: the system of ``urdf`` at one g, if the caller has it (the battery's): the cases' systems at
+    #: other g derive from it (``PinocchioSystem.with_gravity``) instead of reading ``urdf`` again
+    urdf_system: PinocchioSystem | None = field(default=None, repr=False, compare=False)
     #: the systems made so far, by parameter set (cases on the same set share one)
     systems: dict = field(default_factory=dict, repr=False, compare=False)
 
     def system(self, params):
-        """Pinocchio's side for a parameter set: ``urdf`` if given (the battery's), else the project's."""
+        """Pinocchio's side for a parameter set: ``urdf`` seen through ``model_cls``."""
         try:
             return self.systems[params]
         except (KeyError, TypeError):
             pass
-        if self.urdf is None:
-            system = system_for(params)
+        g = getattr(params, "g", None)
+        given = self.urdf_system
+        if given is not None:  # the URDF's system, built once: the cases' sets differ in g only
+            system = given if g is None or g == given.g else given.with_gravity(g)
         else:
             if not isinstance(self.urdf, LoadedDescription):  # read once: the cases' sets differ in g only
                 self.urdf = load_description(self.urdf, "<URDF being compared>")
-            cls = self.model_cls or MODELS[params.model]
-            system = PinocchioSystem.for_model(cls, self.urdf, getattr(params, "g", None))
+            system = PinocchioSystem.for_model(self.model_cls, self.urdf, g)
         with contextlib.suppress(TypeError):  # a set that cannot be a key is not kept
             self.systems[params] = system
         return system
 
-    def trust_study(self) -> StudyResult:
-        """The cart reference system's m1 → 0 study (``pendverify.stress.trust_study``), run once."""
+    def trust_study(self, base) -> StudyResult:
+        """The m1 → 0 study of the set ``base`` (``pendverify.stress.trust_study``), run once per context:
+        the catalogue's cases that read it ask for the same set."""
         if self.study is None:
-            self.study = cart_study(self.settings.study_masses)
+            self.study = trust_study(base, self.settings.study_masses)
         return self.study
 
 
@@ -151,11 +160,20 @@ class Case:
     run: Callable[[Context, str], StressResult]
 
 
+def on_description(case: Case, urdf, model_cls) -> Case:
+    """``case`` compared with the robot description ``urdf`` seen through ``model_cls``; a case
+    that cannot run there (a PendverifyError) fails, saying why."""
+
+    def run(ctx: Context, name: str) -> StressResult:
+        try:
+            return case.run(dataclasses.replace(ctx, urdf=urdf, model_cls=model_cls), name)
+        except PendverifyError as exc:
+            return StressResult(name, "not run", None, None, None, None, None, False, f"FAIL {exc}")
+
+    return Case(case.name, case.group, run)
+
+
 # --- comparing closed form and Pinocchio --------------------------------------------------------
-def system_for(params):
-    return PinocchioSystem.for_params(params)
-
-
 def error_ratio(r) -> float:
     return r.max_error / r.tolerance if r.tolerance > 0 else math.inf
 
@@ -168,7 +186,9 @@ def judged_ratio(r) -> float:
 
 
 @dataclass
-class Comparison:
+class GuardedComparison:
+    """The core checks' results on the states the trust rule accepted, and what it refused."""
+
     results: list
     kept: int
     refused: list[str]
@@ -178,7 +198,9 @@ class Comparison:
     level: str
 
 
-def compare(name: str, model, system, states: list[State], seed: int, pinocchio_angles=None) -> Comparison:
+def compare(
+    name: str, model, system, states: list[State], seed: int, pinocchio_angles=None
+) -> GuardedComparison:
     """Guard every state (validity, conditioning), then run the checks on the accepted ones.
 
     ``pinocchio_angles``: the map of the states' angles to those Pinocchio is evaluated at
@@ -198,12 +220,12 @@ def compare(name: str, model, system, states: list[State], seed: int, pinocchio_
     )
     level = "warn" if largest("bound") > WARN_REL else "ok"
     if not kept:
-        return Comparison([], 0, refused, kappa_raw, kappa_scaled, amplification, level)
+        return GuardedComparison([], 0, refused, kappa_raw, kappa_scaled, amplification, level)
     if refused:
         batch = batch.subset(kept)
     names = applicable_checks(model, system)
     results = run_checks(name, model, system, batch.states, seed, names, batch)
-    return Comparison(results, len(kept), refused, kappa_raw, kappa_scaled, amplification, level)
+    return GuardedComparison(results, len(kept), refused, kappa_raw, kappa_scaled, amplification, level)
 
 
 #: What a case expects of the trust rule: no refusal, some states refused (and some
@@ -212,7 +234,7 @@ def compare(name: str, model, system, states: list[State], seed: int, pinocchio_
 EXPECT = ("none", "some", "all", "any", "allowed")
 
 
-def refusals_as_expected(comp: Comparison, expect: str) -> bool:
+def refusals_as_expected(comp: GuardedComparison, expect: str) -> bool:
     refused, kept = len(comp.refused), comp.kept
     return {
         "none": refused == 0,
@@ -232,7 +254,9 @@ def verified(result, expect: str) -> bool:
     return result.passed or (result.status == REFUSED and expect in ("any", "allowed"))
 
 
-def stress_result(name, comp: Comparison, expect: str = "none", invariant=None, extra_ok=True, note=""):
+def stress_result(
+    name, comp: GuardedComparison, expect: str = "none", invariant=None, extra_ok=True, note=""
+):
     notes = [note] if note else []
     failed = [r for r in comp.results if not verified(r, expect)]
     refused = [r.check for r in comp.results if r.status == REFUSED]
@@ -286,9 +310,9 @@ def stress_result(name, comp: Comparison, expect: str = "none", invariant=None, 
     )
 
 
-def model_of(params, model_cls=None):
-    """The closed-form model of a parameter set (``model_cls`` plants a different one, for tests)."""
-    return (model_cls or MODELS[params.model])(params)
+def model_of(params, model_cls, ctx: Context):
+    """The closed-form model of a parameter set: ``model_cls``'s, or the context's model class."""
+    return (model_cls or ctx.model_cls)(params)
 
 
 def sampled_states(model, ctx: Context) -> list[State]:
@@ -303,7 +327,7 @@ def checks_case(
 
     def run(ctx: Context, name: str) -> StressResult:
         params = params_fn()
-        model = model_of(params, model_cls)
+        model = model_of(params, model_cls, ctx)
         states = sampled_states(model, ctx) + (extra_states(model) if extra_states else [])
         comp = compare(name, model, ctx.system(params), states, ctx.seed)
         return stress_result(name, comp, expect)

@@ -28,12 +28,12 @@ import time
 
 from pendverify.checks.applicability import derived_notes
 from pendverify.checks.catalogue import skipped_notes
-from pendverify.errors import PendverifyError, UnknownNameError
+from pendverify.errors import UnknownNameError
 from pendverify.robot.description import urdf_text
 from pendverify.robot.rebind import Binding
 from pendverify.stress.cases import high_speed_case, large_angle_case
 from pendverify.stress.catalogue import StressReport, run_case
-from pendverify.stress.framework import SEED, Case, Context, Settings, StressResult, checks_case
+from pendverify.stress.framework import SEED, Case, Context, Settings, checks_case, on_description
 from pendverify.stress.singular import near_singular_case
 from pendverify.targets import plugin_target
 
@@ -55,18 +55,6 @@ NOT_VARIED = {
 }
 
 
-def _on(case: Case, urdf: str, model_cls) -> Case:
-    """``case`` compared with ``urdf`` seen through ``model_cls``."""
-
-    def run(ctx: Context, name: str) -> StressResult:
-        try:
-            return case.run(dataclasses.replace(ctx, urdf=urdf, model_cls=model_cls), name)
-        except PendverifyError as exc:
-            return StressResult(name, "not run", None, None, None, None, None, False, f"FAIL {exc}")
-
-    return Case(case.name, case.group, run)
-
-
 def _label(x: float) -> str:
     return f"×{x:.0e}".replace("e+0", "e").replace("e-0", "e-")
 
@@ -75,7 +63,9 @@ def generic_cases(model_cls, params, urdf: str, source: str = "<URDF>") -> tuple
     """(cases, notes): the hard cases of a model file on its URDF, and what was not varied and why."""
     binding = Binding.of(urdf, params, source)
     cls, notes = model_cls, []
-    cases = [_on(checks_case("nominal", "nominal", lambda: params, "allowed", model_cls=cls), urdf, cls)]
+    cases = [
+        on_description(checks_case("nominal", "nominal", lambda: params, "allowed", model_cls=cls), urdf, cls)
+    ]
     for f in dataclasses.fields(params):
         kind = f.metadata.get("kind")
         group = KIND_CASES.get(kind)
@@ -91,21 +81,21 @@ def generic_cases(model_cls, params, urdf: str, source: str = "<URDF>") -> tuple
                 case = checks_case(
                     f"{f.name} {_label(factor)}", group, lambda p=changed: p, "allowed", model_cls=cls
                 )
-                cases.append(_on(case, binding.rewrite(changed), cls))
+                cases.append(on_description(case, binding.rewrite(changed), cls))
     if any(cls.angular):
         for shift in ANGLE_SHIFTS:
             case = large_angle_case(f"|θ| ≈ {shift:.0e} rad", lambda: params, cls, "allowed", shift)
-            cases.append(_on(case, urdf, cls))
+            cases.append(on_description(case, urdf, cls))
     else:
         notes.append("no angular coordinate: no large-angle case")
-    cases.append(_on(high_speed_case("|q̇| ≤ 1e3", lambda: params, cls), urdf, cls))
+    cases.append(on_description(high_speed_case("|q̇| ≤ 1e3", lambda: params, cls), urdf, cls))
     if hasattr(params, "g"):
         zero_g = checks_case("g = 0", "zero gravity", lambda: params.replace(g=0.0), model_cls=cls)
-        cases.append(_on(zero_g, urdf, cls))
+        cases.append(on_description(zero_g, urdf, cls))
     else:
         notes.append("the parameter set has no g: no zero-gravity case")
     if cls.has_mass_matrix:
-        cases.append(_on(near_singular_case(cls, params, binding), urdf, cls))
+        cases.append(on_description(near_singular_case(cls, params, binding), urdf, cls))
     else:
         notes.append(f"no near-singular case: {cls.__name__} gives q̈ alone, no M to drive towards singular")
     return cases, notes

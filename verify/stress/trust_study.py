@@ -3,8 +3,11 @@
 What ``trust_study`` measures
 -----------------------------
 For m1 = 1, 0.1, ..., 1e-16 kg and three aligned states it compares with a
-50-digit mpmath reference built from the *same* float parameters and state
-(M, f, det M, M⁻¹ and q̈ = M⁻¹f evaluated in ``REFERENCE_DIGITS`` digits):
+50-digit mpmath reference built from the *same* float parameters and state: the
+model's own closed forms as generated, generic over the number type
+(``pendverify.numerics.codegen.generic``: M from ``mass``, q̈ = M⁻¹ (τ − C q̇ − H) from
+``field``, solved by its LDLᵀ), evaluated on mpf numbers in ``REFERENCE_DIGITS`` digits,
+with det M and M⁻¹ of that M by mpmath:
 
 * det M: the cart's closed form (a sum of non-negative terms) and the LU
   determinant of Pinocchio's CRBA;
@@ -27,11 +30,12 @@ from dataclasses import dataclass, field
 import mpmath as mp
 import numpy as np
 
-from pendverify.analytic import MODELS, CartDoublePendulum, CartDoublePendulumParams, DoublePendulumParams
-from pendverify.analytic.params import default_parameter_file, load_parameter_file
+from pendverify.analytic import MODELS
 from pendverify.checks import trust
 from pendverify.checks.trust import REFUSE_REL
 from pendverify.errors import IllConditionedError
+from pendverify.numerics.generate import GeneratedSystem
+from pendverify.numerics.integrators import taylor
 from pendverify.robot.system import PinocchioSystem
 
 REFERENCE_DIGITS = 50
@@ -43,46 +47,25 @@ def _mpf(x) -> mp.mpf:
     return mp.mpf(float(x))  # exact: every double is an mpf
 
 
-def reference_mass_matrix(params, q) -> mp.matrix:
-    """M(q) of either reference system in ``REFERENCE_DIGITS`` digits (call inside ``mp.workdps``)."""
-    if isinstance(params, CartDoublePendulumParams):
-        m, m1, m2, l1, l2 = (_mpf(x) for x in (params.m, params.m1, params.m2, params.l1, params.l2))
-        t1, t2 = _mpf(q[1]), _mpf(q[2])
-        m12 = m1 + m2
-        c1, c2, c12 = mp.cos(t1), mp.cos(t2), mp.cos(t1 - t2)
-        return mp.matrix(
-            [
-                [m + m12, l1 * m12 * c1, m2 * l2 * c2],
-                [l1 * m12 * c1, l1**2 * m12, l1 * l2 * m2 * c12],
-                [m2 * l2 * c2, l1 * l2 * m2 * c12, l2**2 * m2],
-            ]
-        )
-    if isinstance(params, DoublePendulumParams):
-        m1, m2, l1, r1, r2, I1, I2 = (
-            _mpf(x) for x in (params.m1, params.m2, params.l1, params.r1, params.r2, params.I1, params.I2)
-        )
-        alpha = I1 + I2 + m1 * r1**2 + m2 * (l1**2 + r2**2)
-        beta, delta = m2 * l1 * r2, I2 + m2 * r2**2
-        c2 = mp.cos(_mpf(q[1]))
-        return mp.matrix([[alpha + 2 * beta * c2, delta + beta * c2], [delta + beta * c2, delta]])
-    raise TypeError(f"no reference for {type(params).__name__}")
+def reference_numbers(model, u=None, w=None) -> dict:
+    """The model's generated generic code with its numbers as mpf (exact), for ``reference_mass_matrix``
+    and ``reference_acceleration``: τ = B u + W w − D q̇, u and w (None: zero) as a constant input."""
+    B = np.hstack([model.input_matrix(), model.disturbance_matrix()])
+    u = np.zeros(len(model.inputs)) if u is None else np.asarray(u, dtype=float)
+    w = np.zeros(len(model.disturbances)) if w is None else np.asarray(w, dtype=float)
+    u0 = np.concatenate([u, w])
+    return taylor.exact_system(GeneratedSystem.from_model(model, model.damping_matrix(), B, None, u0))
 
 
-def reference_cart_rhs(p: CartDoublePendulumParams, y, yd, u, w) -> mp.matrix:
-    """The cart reference system's f(y, ẏ, u, w) in ``REFERENCE_DIGITS`` digits."""
-    m1, m2, l1, l2, g = (_mpf(x) for x in (p.m1, p.m2, p.l1, p.l2, p.g))
-    d = [_mpf(x) for x in (p.d1, p.d2, p.d3)]
-    t1, t2 = _mpf(y[1]), _mpf(y[2])
-    s1, s2, s12 = mp.sin(t1), mp.sin(t2), mp.sin(t1 - t2)
-    v = [_mpf(x) for x in yd]
-    ww = [_mpf(x) for x in w]
-    return mp.matrix(
-        [
-            l1 * (m1 + m2) * v[1] ** 2 * s1 + m2 * l2 * v[2] ** 2 * s2 - d[0] * v[0] + _mpf(u[0]) + ww[0],
-            -l1 * l2 * m2 * v[2] ** 2 * s12 + g * (m1 + m2) * l1 * s1 - d[1] * v[1] + ww[1],
-            l1 * l2 * m2 * v[1] ** 2 * s12 + g * l2 * m2 * s2 - d[2] * v[2] + ww[2],
-        ]
-    )
+def reference_mass_matrix(numbers: dict, q) -> mp.matrix:
+    """M(q) from the generated ``mass`` in mpf (call inside ``mp.workdps``)."""
+    rows = numbers["module"].mass(numbers, [_mpf(x) for x in q], mp.mpf, taylor.series_sincos)
+    return mp.matrix(rows)
+
+
+def reference_acceleration(numbers: dict, y, yd) -> list:
+    """q̈ = M⁻¹ (τ − C q̇ − H) from the generated ``field`` in mpf (call inside ``mp.workdps``)."""
+    return taylor.field(numbers, [_mpf(x) for x in (*y, *yd)])[len(y) :]
 
 
 def _rel(approx, exact) -> float:
@@ -158,14 +141,15 @@ class StudyResult:
 
 def _measure(params, label, y, v, u, w) -> StudyRow:
 
-    model = CartDoublePendulum(params)
+    model = MODELS[params.model](params)
     system = PinocchioSystem.for_params(params)
     verdict = trust.assess(model, y, system)
     root = np.sqrt(model.diagonal_scale(y))
+    numbers = reference_numbers(model, u, w)
     with mp.workdps(REFERENCE_DIGITS):
-        M = reference_mass_matrix(params, y)
+        M = reference_mass_matrix(numbers, y)
         det_ref = mp.det(M)
-        a_ref = mp.lu_solve(M, reference_cart_rhs(params, y, v, u, w))
+        a_ref = reference_acceleration(numbers, y, v)
         Minv_ref = M**-1
         a_scaled = [a_ref[i] * _mpf(root[i]) for i in range(3)]
         Minv_scaled = [Minv_ref[i, j] * _mpf(root[i] * root[j]) for i in range(3) for j in range(3)]
@@ -202,7 +186,7 @@ def _limit(rows: list[StudyRow], ok) -> float:
     return limit
 
 
-def zero_mass_demo(base: CartDoublePendulumParams):
+def zero_mass_demo(base):
     """Pinocchio with m1 = 0 (set in the loaded model; a parameter set refuses it).
 
     Returns (ABA's q̈ at θ2 = θ1 + 1e-12, whether ``check_conditioning`` refused).
@@ -214,7 +198,7 @@ def zero_mass_demo(base: CartDoublePendulumParams):
     system.model.inertias[2] = pin.Inertia(0.0, inertia.lever, inertia.inertia)
     system.data = system.model.createData()
     y, v, u, _ = study_states()["theta2=theta1+1e-12"]
-    model = CartDoublePendulum(base)
+    model = MODELS[base.model](base)
     tau = model.input_matrix() @ u - model.damping_matrix() @ v
     with np.errstate(all="ignore"):
         accel = system.acceleration(y, v, tau)
@@ -225,7 +209,7 @@ def zero_mass_demo(base: CartDoublePendulumParams):
     return accel, False
 
 
-def trust_study(base: CartDoublePendulumParams, masses=STUDY_MASSES) -> StudyResult:
+def trust_study(base, masses=STUDY_MASSES) -> StudyResult:
     """The m1 → 0 sweep of the cart reference system at the study states."""
     rows = [
         _measure(base.replace(m1=m1), label, *state)
@@ -259,11 +243,7 @@ def det_accuracy(params, q) -> tuple[float, float]:
     """(closed-form det, LU det of the CRBA): relative errors against the 50-digit det."""
     model = MODELS[params.model](params)
     system = PinocchioSystem.for_params(params)
+    numbers = reference_numbers(model)
     with mp.workdps(REFERENCE_DIGITS):
-        exact = mp.det(reference_mass_matrix(params, q))
+        exact = mp.det(reference_mass_matrix(numbers, q))
         return _rel(model.det_mass_matrix(q), [exact]), _rel(system.det_mass_matrix(q), [exact])
-
-
-def cart_study(masses=STUDY_MASSES) -> StudyResult:
-    """``trust_study`` on the cart reference system's default parameter set."""
-    return trust_study(load_parameter_file(default_parameter_file("cart_double_pendulum"))[2], masses)

@@ -7,6 +7,7 @@ high-precision references and the mpmath energies run the model's own closed for
     field(p, x, N, sincos)    ẋ = (q̇, M(q)⁻¹ (τ − bias(q, q̇))) as a list,
     energy(p, x, N, sincos)   E = ½ q̇ᵀ M(q) q̇ + V(q),  V from the model's ``potential_energy``,
     potential(p, q, N, sincos)  V(q),
+    mass(p, q, N, sincos)       M(q) as a list of rows,
 
 ``p`` the system's numbers in the caller's type (``{"params", "D", "B", "K",
 "u0"}``, ``pendverify.numerics.integrators.taylor.exact_system``), ``N`` that type's constructor
@@ -22,7 +23,9 @@ A model whose closed forms use another function (sqrt, exp, abs…) gets
 ``FIELD_ERROR`` (or ``ENERGY_ERROR``, also when V cannot be read) instead of the
 function: the compiled back ends do not need these, and the Taylor path raises it
 as a ``PendverifyError`` when asked.  ``FIELD_DIGEST`` is the SHA-256 of this part
-of the source: what a reference solution depends on (``reference.problem_key``).
+of the source: what a reference solution depends on (``reference.problem_key``); ``mass``,
+which no reference solution reads (the 50-digit M of ``pendverify.stress.trust_study`` does),
+follows it, outside the digest, and is left out with the field.
 """
 
 from __future__ import annotations
@@ -111,6 +114,15 @@ def _field(ex: Expressions) -> list[str]:
     )
 
 
+def _mass(ex: Expressions) -> list[str]:
+    n, pairs = ex.n, lower(ex.n)
+    body, reduced, pr = _body(ex, [ex.mass[i, j] for i, j in pairs], "q", False)
+    entry = {pair: pr.doprint(e) for pair, e in zip(pairs, reduced, strict=True)}
+    rows = ["[" + ", ".join(entry[max(i, j), min(i, j)] for j in range(n)) + "]" for i in range(n)]
+    body.append("return [" + ", ".join(rows) + "]")
+    return _function("mass", "p, q, N, sincos", "M(q) in the caller's number type, row by row.", body)
+
+
 def _energy(ex: Expressions) -> list[str]:
     import sympy as sp
 
@@ -128,9 +140,10 @@ def _energy(ex: Expressions) -> list[str]:
 
 def render_generic(ex: Expressions) -> str:
     """The generic part of the module (see the module docstring), FIELD_DIGEST first."""
-    chunks, field_error, energy_error = [], "", ""
+    chunks, field_error, energy_error, mass = [], "", "", ""
     try:
         chunks.append("\n".join(_field(ex)))
+        mass = "\n".join(_mass(ex))
     except Unsupported as exc:
         field_error = (
             f"its closed forms use {exc}: the Taylor path evaluates + − × ÷, integer powers, sin, cos"
@@ -156,4 +169,5 @@ def render_generic(ex: Expressions) -> str:
         ]
     )
     digest = hashlib.sha256(body.encode()).hexdigest()
-    return "# --- generic over the number type (plain Python) ---\n" + f"FIELD_DIGEST = {digest!r}\n" + body
+    head = "# --- generic over the number type (plain Python) ---\n" + f"FIELD_DIGEST = {digest!r}\n"
+    return head + body + ("\n\n" + mass if mass else "")

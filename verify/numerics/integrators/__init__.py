@@ -8,8 +8,10 @@ step is ``x_new = explicit_rk_step(f, t, x, h, tableau, k1=None)``.
 * ``tableaux``: the explicit Runge–Kutta methods as data (``EULER``, ``RK4``, by name in
   ``TABLEAUX``), with their stability functions.
 * ``runge_kutta``: the one explicit stepper, ``explicit_rk_step``, which runs any tableau on
-  numpy arrays (the scene driver ``pendverify.simulation.integrate`` and the stress suite's
-  ``pendverify.stress.integrators`` step with it).
+  numpy arrays (the scene driver ``pendverify.simulation.integrate`` and ``model_runs`` step
+  with it).
+* ``model_runs``: recorded runs of a closed-form model's own equations in Python (RK4 on the
+  one stepper, scipy's RK45, backward Euler, Störmer–Verlet), for the stress suite.
 * ``fixedstep``: the compiled fast path, numba templates copied into each model's generated
   module: the run of each tableau written from it (``render_explicit_runs``), and the two
   implicit symplectic methods; ``fixedstep_runner`` runs them.
@@ -18,7 +20,7 @@ step is ``x_new = explicit_rk_step(f, t, x, h, tableau, k1=None)``.
 * ``taylor``: the Taylor-series reference in high precision (``pendverify.numerics.reference``).
 
 scipy's ``solve_ivp`` (RK45, DOP853, Radau, BDF, LSODA, RK23) is called by the scene driver
-and by the stress suite's ``rk45``; none of its methods is written here.
+and by ``model_runs.rk45``; none of its methods is written here.
 
 Internal (``__all__`` is empty): docs/reference/api.md lists what is public; the names imported
 below are this package's interface to the rest of pendverify.

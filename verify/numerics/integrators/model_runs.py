@@ -1,20 +1,24 @@
-"""Small, self-contained integrators for the stress suite's simulated cases.
+"""Runs of a closed-form model's own equations in Python, recorded: RK4, RK45, backward Euler
+and Störmer–Verlet.
 
-Every method integrates a closed-form model's own equations,
+Every method integrates
 
     M(q) q̈ + C(q, q̇) q̇ + D q̇ + H(q) = 0        (no input, no disturbance),
 
 through ``model.acceleration`` (explicit and implicit methods) or through
 M, C and H (the symplectic method), and records the state every ``record``
-steps.  Energy is E = ½ q̇ᵀ M q̇ + V(q) from the same model; along exact
-solutions dE/dt = −q̇ᵀ D q̇ ≤ 0.
+steps in an ``IntegrationRecord``: the times and states, the steps and evaluations
+spent, and the step at which the run blew up (a non-finite state or one beyond
+``BLOW_UP``), which ends it, reported, not raised.
 
 Methods
 -------
-* ``rk4``: classical fixed-step Runge–Kutta, the tableau ``RK4`` of
-  ``pendverify.numerics.integrators`` run by its one stepper.  Stops at the first
-  non-finite state and reports the step (a blow-up, not an exception).
-* ``rk45``: SciPy's adaptive Dormand–Prince; reports its step count.
+* ``rk4``: classical fixed-step Runge–Kutta, the tableau ``RK4`` (``tableaux``) run by the
+  one stepper ``explicit_rk_step``.
+* ``rk45``: SciPy's adaptive Dormand–Prince; reports its step count.  It is scipy's
+  ``solve_ivp`` and not the Dormand–Prince tableau on ``explicit_rk_step``: what its
+  callers report is the step count of scipy's error control (step-size selection, first
+  step, error norm), which the one stepper, having no error estimate, does not carry.
 * ``implicit_euler``: backward Euler, x₊ = x + h F(x₊), by Newton with a
   central-difference Jacobian (L-stable: the stiff modes of heavy damping are
   damped at any step).
@@ -25,6 +29,10 @@ Methods
   check verifies): ∂T/∂q = Ṁ q̇ − C q̇ = Cᵀ q̇.  Its two implicit stages are
   solved by fixed-point iteration to rounding level.  Symplectic, so the energy
   error stays bounded over long horizons.  Conservative models only.
+
+The compiled counterparts on a model's generated code (``fixedstep``: Euler, symplectic
+Euler, implicit midpoint, RK4) are other methods, or the same tableaux, for the
+work–precision study; these run the model object itself, in Python, for the stress suite.
 """
 
 from __future__ import annotations
@@ -33,7 +41,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pendverify.numerics.integrators import RK4, explicit_rk_step
+from pendverify.numerics.integrators.runge_kutta import explicit_rk_step
+from pendverify.numerics.integrators.tableaux import RK4
 
 EPS = float(np.finfo(float).eps)
 FIXED_POINT_MAX = 60  # iterations per implicit stage before giving up
@@ -44,8 +53,8 @@ RK45_MAX_EVALUATIONS = 50_000  # RK45 gives up (and says so) beyond this
 
 
 @dataclass
-class Trajectory:
-    """Recorded times and states, with the work done and where it blew up (if it did)."""
+class IntegrationRecord:
+    """One run of a model: recorded times and states, the work done, and where it blew up (if it did)."""
 
     t: np.ndarray
     q: np.ndarray
@@ -54,14 +63,6 @@ class Trajectory:
     evaluations: int
     blew_up_at: int | None = None
     note: str = ""
-
-
-def energy(model, q, v) -> float:
-    return model.kinetic_energy(q, v) + model.potential_energy(q)
-
-
-def energies(model, traj: Trajectory) -> np.ndarray:
-    return np.array([energy(model, q, v) for q, v in zip(traj.q, traj.v, strict=True)])
 
 
 def state_derivative_of(model):
@@ -89,14 +90,14 @@ class _Recorder:
             self.t.append(t)
             self.x.append(x.copy())
 
-    def trajectory(self, steps, evaluations, blew_up_at=None, note="") -> Trajectory:
+    def finish(self, steps, evaluations, blew_up_at=None, note="") -> IntegrationRecord:
         X = np.array(self.x)
-        return Trajectory(
+        return IntegrationRecord(
             np.array(self.t), X[:, : self.n], X[:, self.n :], steps, evaluations, blew_up_at, note
         )
 
 
-def rk4(model, q0, v0, h: float, n: int, record: int = 1) -> Trajectory:
+def rk4(model, q0, v0, h: float, n: int, record: int = 1) -> IntegrationRecord:
     f = state_derivative_of(model)
 
     def rhs(t, x):
@@ -113,16 +114,16 @@ def rk4(model, q0, v0, h: float, n: int, record: int = 1) -> Trajectory:
                 x = np.full_like(x, np.nan)
             evaluations += RK4.stages
             if not _finite(x):
-                return rec.trajectory(i, evaluations, blew_up_at=i, note=f"non-finite after {i} steps")
+                return rec.finish(i, evaluations, blew_up_at=i, note=f"non-finite after {i} steps")
             rec.add(i, i * h, x, force=i == n)
-    return rec.trajectory(n, evaluations)
+    return rec.finish(n, evaluations)
 
 
 class _TooMuchWork(Exception):
     pass
 
 
-def rk45(model, q0, v0, t_end: float, rtol: float = 1e-6, atol: float = 1e-9) -> Trajectory:
+def rk45(model, q0, v0, t_end: float, rtol: float = 1e-6, atol: float = 1e-9) -> IntegrationRecord:
     """SciPy's RK45; stops at a blow-up (|x| > ``BLOW_UP``) or after ``RK45_MAX_EVALUATIONS``."""
     from scipy.integrate import solve_ivp
 
@@ -150,10 +151,10 @@ def rk45(model, q0, v0, t_end: float, rtol: float = 1e-6, atol: float = 1e-9) ->
     except _TooMuchWork:
         empty = np.empty((0, n))
         note = f"gave up after {RK45_MAX_EVALUATIONS} evaluations"
-        return Trajectory(np.empty(0), empty, empty, -1, count[0], blew_up_at=-1, note=note)
+        return IntegrationRecord(np.empty(0), empty, empty, -1, count[0], blew_up_at=-1, note=note)
     blew_up = sol.status != 0 or not np.all(np.isfinite(sol.y))
     steps = len(sol.t) - 1
-    return Trajectory(
+    return IntegrationRecord(
         sol.t,
         sol.y[:n].T,
         sol.y[n:].T,
@@ -175,12 +176,7 @@ def jacobian(f, x: np.ndarray) -> np.ndarray:
     return J
 
 
-def rk4_growth(J: np.ndarray, h: float) -> float:
-    """max |R(hλ)| over the eigenvalues λ of J, R the stability function of RK4's tableau."""
-    return float(np.max(np.abs(RK4.stability(h * np.linalg.eigvals(J)))))
-
-
-def implicit_euler(model, q0, v0, h: float, n: int, record: int = 1, tol: float = 1e-13) -> Trajectory:
+def implicit_euler(model, q0, v0, h: float, n: int, record: int = 1, tol: float = 1e-13) -> IntegrationRecord:
     """Backward Euler; Newton on G(x₊) = x₊ − x − h F(x₊) with a Jacobian per step."""
     f = state_derivative_of(model)
     x = np.concatenate([q0, v0]).astype(float)
@@ -199,12 +195,12 @@ def implicit_euler(model, q0, v0, h: float, n: int, record: int = 1, tol: float 
             if np.max(np.abs(dy)) <= tol * (1.0 + np.max(np.abs(y))):
                 break
         else:
-            return rec.trajectory(i, evaluations, blew_up_at=i, note=f"Newton did not converge at step {i}")
+            return rec.finish(i, evaluations, blew_up_at=i, note=f"Newton did not converge at step {i}")
         x = y
         if not _finite(x):
-            return rec.trajectory(i, evaluations, blew_up_at=i, note=f"non-finite after {i} steps")
+            return rec.finish(i, evaluations, blew_up_at=i, note=f"non-finite after {i} steps")
         rec.add(i, i * h, x, force=i == n)
-    return rec.trajectory(n, evaluations)
+    return rec.finish(n, evaluations)
 
 
 def _fixed_point(g, x0: np.ndarray) -> tuple[np.ndarray, int]:
@@ -220,7 +216,7 @@ def _fixed_point(g, x0: np.ndarray) -> tuple[np.ndarray, int]:
     return x, FIXED_POINT_MAX
 
 
-def stormer_verlet(model, q0, v0, h: float, n: int, record: int = 1) -> Trajectory:
+def stormer_verlet(model, q0, v0, h: float, n: int, record: int = 1) -> IntegrationRecord:
     """Generalized leapfrog in (q, p); needs a conservative model (D = 0)."""
     if np.any(model.damping_matrix() != 0):
         raise ValueError("stormer_verlet integrates conservative models only (D = 0)")
@@ -253,22 +249,7 @@ def stormer_verlet(model, q0, v0, h: float, n: int, record: int = 1) -> Trajecto
         evaluations += k1 + k2 + 2
         x = np.concatenate([q, p])
         if not _finite(x):
-            return rec.trajectory(i, evaluations, blew_up_at=i, note=f"non-finite after {i} steps")
+            return rec.finish(i, evaluations, blew_up_at=i, note=f"non-finite after {i} steps")
         if i % record == 0 or i == n:
             rec.add(i, i * h, np.concatenate([q, velocity(q, p)]), force=True)
-    return rec.trajectory(n, evaluations)
-
-
-def momenta(model, traj: Trajectory) -> np.ndarray:
-    """p = M(q) q̇ at every recorded state."""
-    return np.array([model.mass_matrix(q) @ v for q, v in zip(traj.q, traj.v, strict=True)])
-
-
-def fit_slope(t: np.ndarray, y: np.ndarray) -> tuple[float, float]:
-    """Least-squares slope of y(t) and the fit's R² (1 for a perfect line)."""
-    A = np.column_stack([t, np.ones_like(t)])
-    coef, *_ = np.linalg.lstsq(A, y, rcond=None)
-    resid = y - A @ coef
-    total = float(np.sum((y - y.mean()) ** 2))
-    r2 = 1.0 - float(np.sum(resid**2)) / total if total > 0 else 1.0
-    return float(coef[0]), r2
+    return rec.finish(n, evaluations)
