@@ -102,7 +102,7 @@ class CartDoublePendulum(ClosedFormModel):
         "f": ClosedForm("qvuw", "-C*v - H - D*v + B*u + W*w"),
     }
 
-    #: the map is read off the URDF (``pendverify.robot.seed_geometry``)
+    #: the map is read off the URDF (``pendverify.analytic.reference_geometry``)
     geometry_reader = "cart_double_pendulum"
 
     def mass_matrix(self, y):

@@ -105,8 +105,9 @@ class DoublePendulum(ClosedFormModel):
     }
 
     #: the map, the offsets and the parameters are read off the URDF
-    #: (``pendverify.robot.seed_geometry``)
+    #: (``pendverify.analytic.reference_geometry``)
     geometry_reader = "double_pendulum"
+    erd_urdf_folder = "double_pendulum_description/urdf"
 
     def derived_constants(self) -> dict[str, float]:
         """α, β, δ of the derivation."""

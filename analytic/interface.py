@@ -145,6 +145,9 @@ class ClosedFormModel(metaclass=ModelClass):
     #: The registered reader that reads the map (and parameters) off a URDF's geometry
     #: (``pendverify.robot.geometry``); "" for a model that declares its map instead.
     geometry_reader: ClassVar[str] = ""
+    #: The folder of example-robot-data (``pendverify.robot.erd``) whose URDFs belong to this
+    #: model's family, checked by default with ``--model`` naming it; "" for none.
+    erd_urdf_folder: ClassVar[str] = ""
     #: False for models that give only the force C·q̇ (``BiasOnlyModel``).
     has_coriolis_matrix: ClassVar[bool] = True
     #: False for models that give q̈ alone (``AccelerationOnlyModel``).

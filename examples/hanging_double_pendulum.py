@@ -186,9 +186,9 @@ class HangingDoublePendulum(ClosedFormModel):
 
 def hanging_double_pendulum_urdf(p: HangingDoublePendulumParams) -> str:
     """The project's double-pendulum URDF of the same physical parameters."""
-    from pendverify.robot.writer import double_pendulum_urdf
+    from pendverify.robot.writer import urdf_for
 
-    return double_pendulum_urdf(DoublePendulumParams(**p.as_dict()), name="hanging_double_pendulum")
+    return urdf_for(DoublePendulumParams(**p.as_dict()), "hanging_double_pendulum")
 
 
 if __name__ == "__main__":  # regenerate the URDF from the TOML next to this file

@@ -305,3 +305,16 @@ def test_every_command_goes_through_the_api():
         for door in doors_past_the_api(path)
     ]
     assert not doors, "commands import the library past pendverify.api:\n" + "\n".join(doors)
+
+
+def test_every_sub_package_is_installed():
+    """pyproject lists the packages explicitly (the folders are mapped onto ``pendverify``):
+    a sub-package missing there works in a checkout and is absent from a wheel."""
+    config = tomllib.loads((REPO / "pyproject.toml").read_text(encoding="utf-8"))["tool"]["setuptools"]
+    roots = {folder: name for name, folder in config["package-dir"].items()}
+    found = set()
+    for folder, name in roots.items():
+        for init in (REPO / folder).rglob("__init__.py"):
+            rel = init.parent.relative_to(REPO / folder).parts
+            found.add(".".join((name, *rel)))
+    assert found == set(config["packages"]), found ^ set(config["packages"])

@@ -27,7 +27,7 @@ import traceback
 
 from pendverify import __version__, commands
 from pendverify.atomic import STDOUT
-from pendverify.commands import HelpFormatter, add_global_options
+from pendverify.commands import EXAMPLE_PARAMS, EXAMPLE_SCENE, HelpFormatter, add_global_options
 from pendverify.signals import terminate_as_interrupt
 
 EXAMPLES = (
@@ -35,8 +35,8 @@ EXAMPLES = (
     "pendverify example double_pendulum double_pendulum",
     "pendverify check --model double_pendulum --samples 200 --quiet",
     "pendverify check --json - --quiet > report.json",
-    "pendverify --debug simulate double_pendulum/damped_double_pendulum.toml",
-    "pendverify certify double_pendulum/double_pendulum.toml -o certified",
+    f"pendverify --debug simulate {EXAMPLE_SCENE}",
+    f"pendverify certify {EXAMPLE_PARAMS} -o certified",
 )
 #: the command modules in the order of a newcomer's path (``pendverify --help`` lists them so):
 #: check a model, read it back, copy an example, simulate and look, then the deeper tools; a

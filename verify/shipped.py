@@ -18,6 +18,8 @@ from pathlib import Path, PurePosixPath
 FOLDERS = {
     "examples": ("pendverify.examples", ""),
     "scenes": ("pendverify.scenes", ""),
+    # the default problems of ``pendverify bench accuracy`` (``pendverify.bench.problems``)
+    "bench": ("pendverify.scenes", "bench"),
     "sweeps": ("pendverify.sweeps", ""),
     "urdf": ("pendverify.urdf", ""),
     "params": ("pendverify.analytic", "params"),

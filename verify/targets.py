@@ -35,7 +35,7 @@ from pendverify.analytic.source_file import where
 from pendverify.errors import ParameterError, PendverifyError, UnknownNameError
 from pendverify.robot import erd
 from pendverify.robot.description import LoadedDescription, description_stem, is_description_text
-from pendverify.robot.seed_geometry import DEFAULT_G
+from pendverify.robot.geometry import DEFAULT_G
 from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
 
@@ -106,7 +106,7 @@ def erd_target(stem: str, path: Path) -> Target:
 
 def erd_targets() -> list[Target]:
     """Every double-pendulum URDF example-robot-data ships (an error when it is not installed)."""
-    return [erd_target(stem, path) for stem, path in erd.double_pendulum_urdfs().items()]
+    return [erd_target(stem, path) for stem, path in erd.family_urdfs().items()]
 
 
 def erd_selection() -> Selection:

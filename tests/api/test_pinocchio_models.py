@@ -31,7 +31,7 @@ SCENE = Path(__file__).resolve().parents[2] / "scenes" / "minimal_double_pendulu
 
 @pytest.fixture
 def urdf_path():
-    return erd.double_pendulum_urdfs()[STEM]
+    return erd.family_urdfs()[STEM]
 
 
 @pytest.fixture

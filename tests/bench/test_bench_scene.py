@@ -1,19 +1,20 @@
 """``pendverify bench accuracy --scene``: the benchmark on a user's scene (a model file with its
-parameters and URDF), the refusals, and the seeds' default problems left as they were.
+parameters and URDF), the refusals, and the default problems (``scenes/bench``) left as they were.
 No test looks at a wall time."""
 
 from __future__ import annotations
 
 import csv
 import io
+import math
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from pendverify.bench import seed_problems, workprecision
-from pendverify.bench.problems import build_problem, engine_rhs, scene_problems
+from pendverify.bench import workprecision
+from pendverify.bench.problems import build_problem, engine_rhs, scene_problems, shipped_problems
 from pendverify.cli import main
 from tests.bench.test_bench import SMALL, run_quick
 
@@ -159,7 +160,7 @@ def test_the_aba_of_a_continuous_joint_matches_the_generated_field(tmp_path):
         assert err <= ENGINE_RTOL, (x, err)
 
 
-def test_the_seeds_default_problems_are_unchanged():
+def test_the_default_problems_are_unchanged():
     quick = workprecision.QUICK
     assert quick.horizons == {"mild": 5.0, "chaotic": 2.0, "cart_lqr": 3.0, "long": 200.0}
     assert workprecision.FULL.horizons == {"mild": 10.0, "chaotic": 2.0, "cart_lqr": 5.0, "long": 1000.0}
@@ -172,12 +173,22 @@ def test_the_seeds_default_problems_are_unchanged():
         ("cart_lqr", 3.0, "state"),
         ("long", 200.0, "energy"),
     ]
-    assert {k: s.metric for k, s in seed_problems.specs().items()} == {
+    assert {k: s.metric for k, s in shipped_problems(quick.energy_only).items()} == {
         "mild": "state",
         "chaotic": "state",
         "cart_lqr": "state",
         "long": "energy",
     }
-    chaotic = problems[1]
+    mild, chaotic, cart, long = problems
+    assert mild.x0.tolist() == long.x0.tolist() == [-math.pi / 2 + 0.5, 0.3, 0.0, 0.0]
+    assert mild.scene.model == long.scene.model and mild.scene.params == long.scene.params
+    assert mild.fast.packed().tolist() == long.fast.packed().tolist()  # the same field and force law
     assert chaotic.x0.tolist() == [2.0, 2.5, 0.0, 0.0] and chaotic.conservative
-    assert not problems[2].conservative  # friction and LQR on the cart
+    assert cart.x0.tolist() == [0.0, 0.1, -0.05, 0.2, 0.0, 0.3]
+    assert [p.title for p in problems] == [
+        "double pendulum, mild swing",
+        "double pendulum, chaotic",
+        "cart double pendulum, LQR",
+        "long conservative run (energy)",
+    ]
+    assert not cart.conservative  # friction and LQR on the cart

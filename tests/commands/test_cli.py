@@ -8,7 +8,7 @@ import pytest
 
 from pendverify.checks.catalogue import CHECK_NAMES
 from pendverify.cli import main
-from pendverify.robot.erd import double_pendulum_urdfs
+from pendverify.robot.erd import family_urdfs
 
 from ..conftest import default_params
 
@@ -38,7 +38,7 @@ def test_default_check_passes_and_writes_json(tmp_path, capsys):
 
 
 def test_model_urdf_extracts_parameters(capsys):
-    urdf = str(double_pendulum_urdfs()["double_pendulum_simple"])
+    urdf = str(family_urdfs()["double_pendulum_simple"])
     assert main(["check", "--model", "double_pendulum", "--urdf", urdf, "--samples", "20"]) == 0
     assert "parameters read off the URDF" in capsys.readouterr().out
 

@@ -48,7 +48,7 @@ def test_continuous_joints_get_cos_sin():
 
 
 def test_cart_mass_matrix_is_the_kinetic_energy_hessian():
-    """M's third row (lost in the seed) equals ∂²K/∂ẏ² of the seed's kinetic energy."""
+    """M's third row (lost in the source derivation) equals ∂²K/∂ẏ² of the cart's kinetic energy."""
     model = CartDoublePendulum(default_params("cart_double_pendulum"))
     p = model.params
     y = np.array([0.4, 0.9, -1.3])

@@ -13,7 +13,7 @@ import pendverify
 from pendverify.cli import main
 from pendverify.errors import PendverifyError
 from pendverify.robot import erd
-from pendverify.robot.erd import double_pendulum_urdfs
+from pendverify.robot.erd import family_urdfs
 from pendverify.robot.system import PinocchioSystem
 from pendverify.simulation.scene import load_scene
 from pendverify.viz.review_folder import scene_targets
@@ -22,13 +22,13 @@ REPO = Path(__file__).resolve().parents[2]
 
 
 def test_urdfs_are_found_in_the_installed_distribution():
-    found = double_pendulum_urdfs()
+    found = family_urdfs()
     assert {"double_pendulum", "double_pendulum_simple", "double_pendulum_continuous"} <= set(found)
     assert all(path.is_file() for path in found.values())
 
 
 def test_simple_urdf_parameters_are_read_off_exactly():
-    system = PinocchioSystem.from_urdf("double_pendulum", double_pendulum_urdfs()["double_pendulum_simple"])
+    system = PinocchioSystem.from_urdf("double_pendulum", family_urdfs()["double_pendulum_simple"])
     p = system.geometry.params
     expected = dict(m1=0.2, m2=0.3, l1=0.1, r1=0.05, r2=0.1, I1=0.000177083, I2=0.001015625, b1=0.05, b2=0.05)
     for key, value in expected.items():
@@ -40,7 +40,7 @@ def test_simple_urdf_parameters_are_read_off_exactly():
 
 
 def test_mesh_urdf_off_line_centre_of_mass_is_reported():
-    system = PinocchioSystem.from_urdf("double_pendulum", double_pendulum_urdfs()["double_pendulum"])
+    system = PinocchioSystem.from_urdf("double_pendulum", family_urdfs()["double_pendulum"])
     form = system.geometry.model_form
     assert "off the joint-1→joint-2 line" in form.what
     assert any(
@@ -54,7 +54,7 @@ def test_mesh_urdf_off_line_centre_of_mass_is_reported():
 
 
 def test_continuous_joints_are_read_like_revolute_ones():
-    found = double_pendulum_urdfs()
+    found = family_urdfs()
     a = PinocchioSystem.from_urdf("double_pendulum", found["double_pendulum"]).geometry.params
     b = PinocchioSystem.from_urdf("double_pendulum", found["double_pendulum_continuous"]).geometry.params
     assert a == b
@@ -150,9 +150,7 @@ def test_the_api_skips_and_says_so_and_erd_false_says_nothing(monkeypatch):
 
 def test_the_review_folder_skips_them_too(monkeypatch):
     scene = load_scene(REPO / "scenes" / "damped_double_pendulum.toml")
-    assert [t.label for t in scene_targets([scene]).targets][1:] == [
-        f"erd:{stem}" for stem in double_pendulum_urdfs()
-    ]
+    assert [t.label for t in scene_targets([scene]).targets][1:] == [f"erd:{stem}" for stem in family_urdfs()]
     _without_erd(monkeypatch)
     selection = scene_targets([scene])
     assert [t.label for t in selection.targets] == ["double_pendulum"]

@@ -1,6 +1,6 @@
 """Robot descriptions beyond plain URDF (issue 14, item 4): xacro, MJCF, SDFormat.
 
-The shipped xacro and MJCF descriptions of the seed-000 double pendulum build the very
+The shipped xacro and MJCF descriptions of the reference double pendulum build the very
 model the URDF builds; ``check`` gives the same table on each; a planted error in each
 format fails ``crba`` and ``gravity``; malformed numbers in each format are one line and
 exit status 2; an SDF is read by Drake, and refused without it naming the extra.
@@ -30,7 +30,7 @@ XACRO = REPO / "examples" / "double_pendulum.xacro"
 MJCF = REPO / "examples" / "double_pendulum.mjcf.xml"
 PARAMS = REPO / "analytic" / "params" / "double_pendulum.toml"
 FORMATS = {"xacro": XACRO, "mjcf": MJCF}
-SEED_MODEL = MODELS["double_pendulum"]
+REFERENCE_MODEL = MODELS["double_pendulum"]
 
 
 def one_error(err: str) -> str:
@@ -76,10 +76,10 @@ def test_each_format_builds_the_urdfs_model(fmt):
 
 
 @pytest.mark.parametrize("fmt", FORMATS)
-def test_the_seed_reader_reads_each_format_off_pinocchios_model(fmt):
+def test_the_reference_reader_reads_each_format_off_pinocchios_model(fmt):
     """``geometry_reader`` works on the Pinocchio model, so the format does not matter."""
-    expected = PinocchioSystem.for_model(SEED_MODEL, URDF).geometry.params
-    read = PinocchioSystem.for_model(SEED_MODEL, FORMATS[fmt]).geometry.params
+    expected = PinocchioSystem.for_model(REFERENCE_MODEL, URDF).geometry.params
+    read = PinocchioSystem.for_model(REFERENCE_MODEL, FORMATS[fmt]).geometry.params
     assert read == expected
 
 
@@ -307,8 +307,8 @@ def test_an_sdf_builds_the_urdfs_model(tmp_path):
     path.write_text(SDF)
     sdf, urdf = load_description(path), load_description(URDF)
     assert sdf.format == "sdf"
-    from_sdf = PinocchioSystem.for_model(SEED_MODEL, path).geometry.params.as_dict()
-    from_urdf = PinocchioSystem.for_model(SEED_MODEL, URDF).geometry.params.as_dict()
+    from_sdf = PinocchioSystem.for_model(REFERENCE_MODEL, path).geometry.params.as_dict()
+    from_urdf = PinocchioSystem.for_model(REFERENCE_MODEL, URDF).geometry.params.as_dict()
     # Drake keeps a body's inertia about the body origin: shifting it back to the centre of mass
     # rounds each term of size m r² (and I) once, so the two agree to a few ulps of I + m r²
     lever = max(from_urdf["m1"] * from_urdf["r1"] ** 2, from_urdf["m2"] * from_urdf["r2"] ** 2)
@@ -397,7 +397,7 @@ def test_the_animation_draws_each_formats_visuals_where_the_urdfs_are(fmt):
     from pendverify.viz.geometry import VisualSystem
 
     def shapes(path):
-        objects = VisualSystem.for_model(SEED_MODEL, path).objects
+        objects = VisualSystem.for_model(REFERENCE_MODEL, path).objects
         return [(o.parentJoint, type(o.geometry).__name__, o.placement.translation.tolist()) for o in objects]
 
     assert shapes(FORMATS[fmt]) == shapes(URDF)
@@ -408,12 +408,12 @@ def test_systems_on_one_read_description_leave_it_as_it_was():
     system its own model copy at its own g; the description neither re-read nor changed."""
     loaded = load_description(MJCF)
     before = (loaded.model.gravity.linear.copy(), list(loaded.reading_notes))
-    at_g = PinocchioSystem.for_model(SEED_MODEL, loaded, 9.81)
-    at_zero = PinocchioSystem.for_model(SEED_MODEL, loaded, 0.0)
+    at_g = PinocchioSystem.for_model(REFERENCE_MODEL, loaded, 9.81)
+    at_zero = PinocchioSystem.for_model(REFERENCE_MODEL, loaded, 0.0)
     assert at_g.model is not loaded.model and at_zero.model is not at_g.model
     assert np.array_equal(loaded.model.gravity.linear, before[0]) and loaded.reading_notes == before[1]
     q = np.array([0.3, -0.7])
-    fresh = PinocchioSystem.for_model(SEED_MODEL, MJCF, 9.81)
+    fresh = PinocchioSystem.for_model(REFERENCE_MODEL, MJCF, 9.81)
     assert np.array_equal(at_g.gravity(q), fresh.gravity(q))
     assert np.array_equal(at_zero.gravity(q), np.zeros(2)) and at_g.notes == fresh.notes
 

@@ -133,8 +133,9 @@ def test_non_finite_states_are_refused_not_propagated(call, key):
 
 def test_a_model_without_a_urdf_writer_is_a_clear_error():
     from pendverify.analytic.plugin import load_model_class, plugin_parameters
+    from pendverify.analytic.reference_urdfs import WRITERS
     from pendverify.errors import PendverifyError
-    from pendverify.robot.writer import WRITERS, urdf_for
+    from pendverify.robot.writer import urdf_for
 
     examples = Path(__file__).resolve().parents[2] / "examples"
     cls = load_model_class(examples / "cart_pole.py")
@@ -142,3 +143,22 @@ def test_a_model_without_a_urdf_writer_is_a_clear_error():
     assert set(WRITERS) == {"double_pendulum", "cart_double_pendulum"}
     with pytest.raises(PendverifyError, match="no URDF writer for model 'cart_pole': give the URDF"):
         urdf_for(params)
+
+
+def test_a_model_naming_an_unknown_geometry_reader_is_a_clear_error(tmp_path):
+    from pendverify.analytic.reference_geometry import READERS
+    from pendverify.errors import UnknownNameError
+    from pendverify.robot.system import geometry_for
+
+    class Renamed(DoublePendulum):
+        geometry_reader = "no_such_reader"
+
+    urdf = tmp_path / "double.urdf"
+    urdf.write_text(urdf_for(default_params("double_pendulum")))
+    assert set(READERS) == {"double_pendulum", "cart_double_pendulum"}
+    assert PinocchioSystem.for_model(DoublePendulum, urdf).geometry.params is not None
+    with pytest.raises(UnknownNameError, match="no_such_reader"):
+        PinocchioSystem.for_model(Renamed, urdf)
+    pinocchio_model = load_description(urdf).model
+    with pytest.raises(UnknownNameError, match="double_pendulum, cart_double_pendulum"):
+        geometry_for(Renamed, pinocchio_model, str(urdf), None)

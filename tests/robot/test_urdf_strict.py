@@ -10,7 +10,7 @@ import pinocchio as pin
 import pytest
 
 from pendverify.errors import UrdfShapeError
-from pendverify.robot.erd import double_pendulum_urdfs
+from pendverify.robot.erd import family_urdfs
 from pendverify.robot.inertia_rounding import FLOAT_SLACK, check_inertia_tensor, inertia_tolerance, resolution
 from pendverify.robot.strict import DescriptionFacts, JointDynamics, read_urdf_strictly
 from pendverify.robot.urdfdom import build_pinocchio_model
@@ -354,7 +354,7 @@ SHIPPED = {
         f"urdf/{name}": REPO / "urdf" / name for name in ("double_pendulum.urdf", "cart_double_pendulum.urdf")
     },
     **{f"examples/{p.name}": p for p in sorted((REPO / "examples").glob("*.urdf"))},
-    **{f"example-robot-data/{stem}": path for stem, path in double_pendulum_urdfs().items()},
+    **{f"example-robot-data/{stem}": path for stem, path in family_urdfs().items()},
 }
 
 

@@ -24,11 +24,12 @@ import umsgpack
 from PIL import Image
 
 from pendverify.analytic import MODELS
+from pendverify.analytic.reference_urdfs import COLOURS
 from pendverify.checks.evidence import Evidence
 from pendverify.checks.report import Report
 from pendverify.cli import main
 from pendverify.errors import TrajectoryError
-from pendverify.robot.writer import COLOURS, urdf_for
+from pendverify.robot.writer import urdf_for
 from pendverify.simulation.scene import load_scene, parse_scene
 from pendverify.simulation.simulate import run_scene
 from pendverify.viz.animation import DEFAULT_FPS, Trajectory, build_scene, render_html

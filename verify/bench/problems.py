@@ -8,15 +8,17 @@ URDF (or the URDF the project writes for a built-in parameter set) for scipy's `
 Every problem carries its ``metric``: "state" (states against a Taylor reference) or
 "energy" (relative energy error only; conservative scenes).
 
-Where problems come from: the reference systems' table (``seed_problems``, the default run), or a
-user's scene (``scene_problems``, ``pendverify bench accuracy --scene``):
+Where problems come from: the shipped scenes ``scenes/bench/*.toml`` (``shipped_problems``, the
+default run: the problem's key is the file's name, its title the scene's name, and the run's
+configuration says which are compared by energy alone), or a user's scene (``scene_problems``,
+``pendverify bench accuracy --scene``):
 
 * a state problem over min(the scene's duration, ``Config.scene_horizon``: 10 s full,
   3 s quick) — the references are Taylor series in decimal arithmetic, whose cost grows
   with the horizon, and a chaotic scene's double-precision solutions stop agreeing with
-  any reference a few seconds in (the reference systems' chaotic problem is compared over 2 s);
+  any reference a few seconds in (the default run's ``chaotic`` is compared over 2 s);
 * when the scene is conservative (no damping, actuation or disturbance), an energy-only
-  long run of ``Config.scene_long`` seconds (1000 s full, 200 s quick), as the reference systems' ``long``.
+  long run of ``Config.scene_long`` seconds (1000 s full, 200 s quick), as the default run's ``long``.
 
 The state problem is the scene's anchor: the single-trajectory ratio, the engine study
 and the ensemble run on it.  Each problem's scene keeps its model, parameters, URDF and
@@ -44,9 +46,10 @@ import numpy as np
 from pendverify.errors import InputError, PendverifyError
 from pendverify.numerics.generate import GeneratedSystem
 from pendverify.numerics.integrators.taylor import energy_above_minimum, float_system
+from pendverify.shipped import shipped_folder
 from pendverify.simulation import engines
 from pendverify.simulation.dynamics import build_dynamics
-from pendverify.simulation.scene import Integrator, Scene, load_scene, parse_scene
+from pendverify.simulation.scene import Integrator, Scene, load_scene
 
 METRICS = ("state", "energy")
 INVARIANT_INTEGRATOR = Integrator("DOP853", 1e-10, 1e-10)
@@ -56,7 +59,7 @@ INVARIANT_INTEGRATOR = Integrator("DOP853", 1e-10, 1e-10)
 class ProblemSpec:
     key: str
     title: str
-    scene: dict | Scene  # a scene document (the reference systems') or a parsed scene (a user's)
+    scene: Scene
     metric: str = "state"  # "state" or "energy"
 
 
@@ -83,13 +86,7 @@ class Problem:
 
 def _scene(spec: ProblemSpec, duration: float, grid_intervals: int) -> Scene:
     rate = grid_intervals / duration
-    if isinstance(spec.scene, Scene):
-        return replace(spec.scene, duration=duration, sample_rate=rate, integrator=INVARIANT_INTEGRATOR)
-    doc = dict(spec.scene)
-    doc["time"] = {"duration": duration, "sample_rate": rate}
-    i = INVARIANT_INTEGRATOR
-    doc["integrator"] = {"method": i.method, "rtol": i.rtol, "atol": i.atol}
-    return parse_scene(doc, f"<benchmark {spec.key}>")
+    return replace(spec.scene, duration=duration, sample_rate=rate, integrator=INVARIANT_INTEGRATOR)
 
 
 def _refuse(scene: Scene, exc: Exception, what: str) -> InputError:
@@ -118,6 +115,18 @@ def build_problem(spec: ProblemSpec, duration: float, grid_intervals: int = 64) 
     return Problem(spec.key, spec.title, scene, dyn, fast, x0, duration, grid, spec.metric)
 
 
+def shipped_problems(energy_only: tuple = ()) -> dict[str, ProblemSpec]:
+    """The default run's problems by key: each shipped scene ``scenes/bench/KEY.toml``, titled by
+    its name, compared by its energy when KEY is in ``energy_only``, else by its states."""
+    specs = {}
+    for path in sorted(shipped_folder("bench").glob("*.toml")):
+        scene = load_scene(path)
+        specs[path.stem] = ProblemSpec(
+            path.stem, scene.name, scene, "energy" if path.stem in energy_only else "state"
+        )
+    return specs
+
+
 def scene_problems(path, config) -> tuple[object, dict[str, ProblemSpec]]:
     """(the configuration for a user's scene, its problems): see the module docstring."""
     scene = load_scene(path)
@@ -129,7 +138,11 @@ def scene_problems(path, config) -> tuple[object, dict[str, ProblemSpec]]:
         specs[long] = ProblemSpec(long, f"{scene.name}, long run (energy)", scene, "energy")
         horizons[long] = config.scene_long
     name = f"{config.name}, scene {Path(path).name}"
-    return replace(config, name=name, horizons=horizons, anchor=key, engine_problems=(key,)), specs
+    energy_only = tuple(k for k, s in specs.items() if s.metric == "energy")
+    config = replace(
+        config, name=name, horizons=horizons, anchor=key, engine_problems=(key,), energy_only=energy_only
+    )
+    return config, specs
 
 
 def continuous_aba(problem: Problem) -> engines.EngineRhs:

@@ -1,7 +1,7 @@
 """Work–precision benchmark: how much wall time each digit of accuracy costs.
 
 Problems (``pendverify.bench.problems``): scenes, so the fast path's invariant checks run
-on the very same dynamics; by default the reference systems' table (``pendverify.bench.seed_problems``:
+on the very same dynamics; by default the shipped scenes ``scenes/bench`` (``problems.shipped_problems``:
 mild, chaotic, cart_lqr, long), or a user's scene, any model (``--scene``).  Each carries
 its metric: "state" problems are compared against references, "energy" ones by the
 relative energy error alone.
@@ -43,8 +43,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from pendverify.bench import seed_problems
-from pendverify.bench.problems import Problem, ProblemSpec, build_problem
+from pendverify.bench.problems import Problem, ProblemSpec, build_problem, shipped_problems
 from pendverify.bench.timing import measure
 from pendverify.numerics.fastpath import integrate as fast_integrate
 from pendverify.numerics.integrators import fixedstep, fixedstep_runner
@@ -74,6 +73,7 @@ class Config:
     scipy_methods: tuple = SCIPY_METHODS
     anchor: str = "chaotic"  # the state problem of the single-trajectory ratio, engines and ensemble
     engine_problems: tuple = ("chaotic", "cart_lqr")
+    energy_only: tuple = ("long",)  # the problems compared by their energy alone, never their states
     ensemble_variants: tuple = ("threads", "serial", "vectorised")
     seed: int = 20260301
     scene_horizon: float = 10.0  # s: a user's scene is compared over min(its duration, this)
@@ -129,14 +129,14 @@ QUICK = replace(
 
 # --- problems --------------------------------------------------------------------------------
 def make_problem(spec: ProblemSpec | str, duration: float, grid_intervals: int = 64) -> Problem:
-    """A problem over ``duration``: a ``ProblemSpec``, or the key of a reference system's problem."""
-    spec = seed_problems.specs()[spec] if isinstance(spec, str) else spec
+    """A problem over ``duration``: a ``ProblemSpec``, or the key of a default problem (``scenes/bench``)."""
+    spec = shipped_problems(FULL.energy_only)[spec] if isinstance(spec, str) else spec
     return build_problem(spec, duration, grid_intervals)
 
 
 def make_problems(config: Config, specs: dict | None = None) -> list[Problem]:
-    """The problems of ``config.horizons`` from ``specs`` (default: the reference systems' table)."""
-    specs = seed_problems.specs() if specs is None else specs
+    """The problems of ``config.horizons`` from ``specs`` (default: the shipped ``scenes/bench``)."""
+    specs = shipped_problems(config.energy_only) if specs is None else specs
     return [make_problem(specs[k], T, config.grid_intervals) for k, T in config.horizons.items()]
 
 

@@ -25,6 +25,11 @@ from __future__ import annotations
 
 import argparse
 
+#: the files the help's examples name, where ``pendverify example double_pendulum double_pendulum``
+#: copies them (one place for the paths several commands cite)
+EXAMPLE_SCENE = "double_pendulum/damped_double_pendulum.toml"
+EXAMPLE_PARAMS = "double_pendulum/double_pendulum.toml"
+
 #: what each global option does, as its help says it
 GLOBAL_HELP = {
     "debug": "on an internal error, print the traceback as well (default: off)",
@@ -189,6 +194,12 @@ def add_sampling_options(parser: argparse.ArgumentParser, samples_default: int |
     parser.add_argument(
         "--seed", type=non_negative_int, default=None, help="seed of the state sampler (default: 20260301)"
     )
+
+
+def add_model_option(parser, default: str = "both reference systems") -> None:
+    """``--model NAME``: one of the built-in models (``pendverify.analytic.MODELS``, whose names this
+    help lists for the reader); ``default`` says what runs without it."""
+    parser.add_argument("--model", help=f"double_pendulum or cart_double_pendulum (default: {default})")
 
 
 def add_analytic_option(parser, what: str) -> None:

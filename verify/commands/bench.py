@@ -4,9 +4,10 @@
 ``pendverify bench explain [--quick]``: how well the diagnosis names and repairs planted errors,
 and its cost (``pendverify.bench.explain``).
 
-Without ``--scene``, the two reference systems' problems (``pendverify.bench.seed_problems``); with it, a
-user's scene, any model (``pendverify.bench.problems.scene_problems`` says which problems
-and refuses what the benchmark cannot run, exit status 2).
+Without ``--scene``, the two reference systems' problems (the shipped scenes ``scenes/bench``,
+``pendverify.bench.problems.shipped_problems``); with it, a user's scene, any model
+(``pendverify.bench.problems.scene_problems`` says which problems and refuses what the benchmark
+cannot run, exit status 2).
 
 Writes DIR/work_precision.png (the plot), DIR/work_precision.csv (every point)
 and DIR/work_precision.md (the tables), and prints the tables.  BLAS is limited
@@ -20,7 +21,7 @@ from __future__ import annotations
 import argparse
 
 from pendverify.atomic import check_output, check_report_output
-from pendverify.commands import add_command, positive_int, write_json_report
+from pendverify.commands import EXAMPLE_PARAMS, EXAMPLE_SCENE, add_command, positive_int, write_json_report
 
 BLAS_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
@@ -40,7 +41,7 @@ def register(sub) -> None:
         "work–precision: error against wall time for each integrator and engine",
         [
             "pendverify bench accuracy --quick",
-            "pendverify bench accuracy --scene double_pendulum/damped_double_pendulum.toml -o out --svg",
+            f"pendverify bench accuracy --scene {EXAMPLE_SCENE} -o out --svg",
         ],
     )
     a.add_argument(
@@ -61,7 +62,7 @@ def register(sub) -> None:
         "the certification battery's cost per parameter set on one core: its parts and their floor",
         [
             "pendverify bench certify --quick",
-            "pendverify bench certify --params double_pendulum/double_pendulum.toml --json bench.json",
+            f"pendverify bench certify --params {EXAMPLE_PARAMS} --json bench.json",
         ],
         json="every figure",
     )

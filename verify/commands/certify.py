@@ -8,6 +8,7 @@ from pendverify.atomic import check_output, check_report_output
 from pendverify.certify.settings_rules import samples_option, seed_option
 from pendverify.certify.sweep_limits import DEFAULT_MAX_SETS, WORKER_TIMEOUT_S
 from pendverify.commands import (
+    EXAMPLE_PARAMS,
     add_analytic_option,
     add_command,
     add_package_path_option,
@@ -24,7 +25,7 @@ def register(sub) -> None:
         "certify",
         "run the full battery on a parameter set and certify it",
         [
-            "pendverify certify double_pendulum/double_pendulum.toml -o certified",
+            f"pendverify certify {EXAMPLE_PARAMS} -o certified",
             "pendverify certify --sweep double_pendulum/double_pendulum_200.toml --workers 2 -o certified",
             "pendverify certify --urdf robot.urdf --model double_pendulum --params mine.toml -o certified "
             "--key keys/pendverify-signing.key.pem",

@@ -8,6 +8,7 @@ import time
 
 from pendverify.commands import (
     add_command,
+    add_model_option,
     add_package_path_option,
     add_sampling_options,
     builtin_models,
@@ -30,11 +31,7 @@ def register(sub) -> None:
         ],
         json="the report",
     )
-    p.add_argument(
-        "--model",
-        help="double_pendulum or cart_double_pendulum (default: both reference systems, and "
-        "example-robot-data's URDFs)",
-    )
+    add_model_option(p, "both reference systems, and example-robot-data's URDFs")
     p.add_argument(
         "--analytic",
         metavar="FILE",

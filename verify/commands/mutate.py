@@ -6,6 +6,7 @@ import argparse
 
 from pendverify.commands import (
     add_command,
+    add_model_option,
     add_package_path_option,
     add_sampling_options,
     builtin_models,
@@ -25,9 +26,7 @@ def register(sub) -> None:
         ],
         json="the mutants and their verdicts",
     )
-    p.add_argument(
-        "--model", help="double_pendulum or cart_double_pendulum (default: both reference systems)"
-    )
+    add_model_option(p)
     p.add_argument("--analytic", metavar="FILE", help="your own model file instead (with --urdf, --params)")
     p.add_argument("--urdf", help="the URDF (or xacro, MJCF) of --analytic")
     p.add_argument("--params", help="the parameter file of --analytic")

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import argparse
 
-from pendverify.commands import add_analytic_option, add_command, add_package_path_option
+from pendverify.commands import EXAMPLE_SCENE, add_analytic_option, add_command, add_package_path_option
 
 
 def register(sub) -> None:
@@ -21,7 +21,7 @@ def register(sub) -> None:
         "render",
         "write a self-contained HTML animation of a scene (meshcat, plays from file://)",
         [
-            "pendverify render double_pendulum/damped_double_pendulum.toml -o chaos.html --trace",
+            f"pendverify render {EXAMPLE_SCENE} -o chaos.html --trace",
             "pendverify render --trajectory run.npz -o run.html",
             "pendverify render --trajectory cart_pole.npz --analytic cart_pole/cart_pole.py -o run.html",
         ],

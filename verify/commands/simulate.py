@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 
-from pendverify.commands import add_command, add_package_path_option, write_json_report
+from pendverify.commands import EXAMPLE_SCENE, add_command, add_package_path_option, write_json_report
 
 
 def register(sub) -> None:
@@ -14,9 +14,9 @@ def register(sub) -> None:
         "simulate",
         "simulate a scene and check the physics invariants its effects imply",
         [
-            "pendverify simulate double_pendulum/damped_double_pendulum.toml",
+            f"pendverify simulate {EXAMPLE_SCENE}",
             "pendverify simulate cart_double_pendulum/cart_lqr_push.toml -o run.npz --csv --html run.html",
-            "pendverify simulate double_pendulum/damped_double_pendulum.toml --engine both --json - --quiet",
+            f"pendverify simulate {EXAMPLE_SCENE} --engine both --json - --quiet",
         ],
         json="the run's metadata and invariant results",
     )

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from pendverify.commands import add_command, builtin_models, write_json_report
+from pendverify.commands import add_command, add_model_option, builtin_models, write_json_report
 
 
 def register(sub) -> None:
@@ -18,9 +18,7 @@ def register(sub) -> None:
         ],
         json="the comparison",
     )
-    p.add_argument(
-        "--model", help="double_pendulum or cart_double_pendulum (default: both reference systems)"
-    )
+    add_model_option(p)
     p.add_argument(
         "--analytic", metavar="FILE", help="your own model file instead (it must define energies())"
     )

@@ -1,4 +1,7 @@
-"""Locate example-robot-data's double-pendulum URDFs through the installed distribution.
+"""Locate example-robot-data's URDFs of a built-in model's family through the installed distribution.
+
+The model is the one whose class names example-robot-data's folder (``erd_urdf_folder``: the
+double pendulum's ``double_pendulum_description/urdf``); nothing here names it.
 
 No machine path is written down: the files are found in the distribution's own
 record of installed files (``importlib.metadata``), which works for the cmeel
@@ -14,15 +17,16 @@ from __future__ import annotations
 import importlib.metadata
 from pathlib import Path
 
+from pendverify.analytic import MODELS
 from pendverify.errors import PendverifyError, PlaceError, UrdfShapeError, folder_given, missing_file
 from pendverify.robot.description import description_stem
 
 DISTRIBUTION = "example-robot-data"
 #: how to install it along with pendverify
 INSTALL_HINT = "pip install 'pendverify[erd]'"
-#: the built-in model whose family example-robot-data's double-pendulum URDFs belong to
-MODEL = "double_pendulum"
-DOUBLE_PENDULUM_DIR = "double_pendulum_description/urdf"
+#: the built-in model whose family example-robot-data's URDFs in ``URDF_FOLDER`` belong to
+MODEL = next(name for name, cls in MODELS.items() if cls.erd_urdf_folder)
+URDF_FOLDER = MODELS[MODEL].erd_urdf_folder
 #: a URDF argument ``erd:NAME`` names example-robot-data's URDF NAME
 PREFIX = "erd:"
 #: the sentence a default check reports when example-robot-data is not installed
@@ -37,18 +41,18 @@ def installed() -> importlib.metadata.Distribution | None:
         return None
 
 
-def double_pendulum_urdfs() -> dict[str, Path]:
-    """{stem: path} of every double-pendulum URDF example-robot-data ships."""
+def family_urdfs() -> dict[str, Path]:
+    """{stem: path} of every URDF example-robot-data ships in ``URDF_FOLDER`` (``MODEL``'s family)."""
     dist = installed()
     if dist is None:
         raise PendverifyError(f"{DISTRIBUTION} is not installed ({INSTALL_HINT})")
     found = {}
     for record in dist.files or ():
         text = str(record).replace("\\", "/")
-        if DOUBLE_PENDULUM_DIR in text and text.endswith(".urdf"):
+        if URDF_FOLDER in text and text.endswith(".urdf"):
             found[Path(text).stem] = Path(str(dist.locate_file(record))).resolve()
     if not found:
-        raise PendverifyError(f"{DISTRIBUTION} {dist.version} ships no {DOUBLE_PENDULUM_DIR}/*.urdf")
+        raise PendverifyError(f"{DISTRIBUTION} {dist.version} ships no {URDF_FOLDER}/*.urdf")
     return dict(sorted(found.items()))
 
 
@@ -62,7 +66,7 @@ def erd_urdf(spec: str) -> tuple[str, Path]:
     installed or has no URDF of that name (the message lists the ones it has)."""
     if installed() is None:
         raise PlaceError(spec, f"{DISTRIBUTION} is not installed ({INSTALL_HINT})")
-    found = double_pendulum_urdfs()
+    found = family_urdfs()
     stem = spec[len(PREFIX) :]
     if stem not in found:
         raise UrdfShapeError(spec, f"example-robot-data has no {stem!r}; it has {', '.join(found)}")

@@ -5,9 +5,9 @@ loaded in Pinocchio: the coordinate map q = T (θ − θ0) (``pendverify.robot.c
 parameters read off the URDF where the model's family fixes them, notes, and a
 ``ModelForm`` for a term of the URDF the closed form cannot express.
 
-Readers are looked up in a registry, never chosen by a model's name: a model
-class names its reader in ``geometry_reader`` (the reference systems' readers live in
-``pendverify.robot.seed_geometry``); a model without one declares its map
+Readers are looked up by the name a model class gives in ``geometry_reader``, never chosen by
+a model's name: the reference systems' readers live beside them
+(``pendverify.analytic.reference_geometry.READERS``); a model without one declares its map
 (``urdf_joints``, ``joint_transform``, ``joint_offset``; ``pendverify.robot.joint_map``).
 """
 
@@ -20,7 +20,6 @@ import numpy as np
 import pinocchio as pin
 
 from pendverify.analytic import ParameterSet
-from pendverify.errors import UnknownNameError
 from pendverify.robot.coordinates import CoordinateMap
 
 #: Largest relative size (|ΔH_i| / Σ|terms of H_i|) of a term the closed form cannot express
@@ -28,6 +27,7 @@ from pendverify.robot.coordinates import CoordinateMap
 #: centres of mass rounded at the micrometre (example-robot-data: 7.6e-6) and fails
 #: a 0.1 mm offset on a 0.5 m pendulum; ``pendverify check --model-form-rtol`` sets it.
 MODEL_FORM_RTOL = 1e-4
+DEFAULT_G = 9.81  # m/s², Pinocchio's default, used when a URDF alone is given
 
 
 @dataclass
@@ -95,22 +95,5 @@ def combined(forms: list[ModelForm | None]) -> ModelForm | None:
     )
 
 
+#: a function reading a model's map (and parameters) off a URDF in Pinocchio: (model, source, g)
 GeometryReader = Callable[[pin.Model, str, "float | None"], UrdfGeometry]
-#: {reader name: function reading a model's map (and parameters) off a URDF in Pinocchio}
-READERS: dict[str, GeometryReader] = {}
-
-
-def register_reader(name: str) -> Callable[[GeometryReader], GeometryReader]:
-    """Decorator: make a geometry reader available to models whose ``geometry_reader`` is ``name``."""
-
-    def register(reader: GeometryReader) -> GeometryReader:
-        READERS[name] = reader
-        return reader
-
-    return register
-
-
-def reader(name: str) -> GeometryReader:
-    if name not in READERS:
-        raise UnknownNameError("geometry reader", name, tuple(READERS))
-    return READERS[name]

@@ -25,16 +25,16 @@ import numpy as np
 import pinocchio as pin
 
 from pendverify.analytic import MODELS
+from pendverify.analytic.reference_geometry import READERS
 from pendverify.display import listed, shortened
-from pendverify.robot import seed_geometry  # noqa: F401  (registers the reference systems' readers)
+from pendverify.errors import UnknownNameError
 from pendverify.robot.batch import PinocchioBatch, finite_rows
 from pendverify.robot.coordinates import CoordinateMap
 from pendverify.robot.description import LoadedDescription, load_description
 from pendverify.robot.finite_terms import check_finite_terms
-from pendverify.robot.geometry import MODEL_FORM_RTOL, ModelForm, UrdfGeometry, combined, reader
+from pendverify.robot.geometry import DEFAULT_G, MODEL_FORM_RTOL, ModelForm, UrdfGeometry, combined
 from pendverify.robot.gravity_tilt import tilt_form
 from pendverify.robot.joint_map import declared_geometry
-from pendverify.robot.seed_geometry import DEFAULT_G
 from pendverify.robot.writer import urdf_for
 from pendverify.validate import finite_state
 
@@ -42,7 +42,9 @@ from pendverify.validate import finite_state
 def geometry_for(cls, pin_model: pin.Model, source: str, g: float | None) -> UrdfGeometry:
     """The coordinate map of model class ``cls`` to a URDF: its reader's, or the one it declares."""
     if cls.geometry_reader:
-        return reader(cls.geometry_reader)(pin_model, source, g)
+        if cls.geometry_reader not in READERS:
+            raise UnknownNameError("geometry reader", cls.geometry_reader, tuple(READERS))
+        return READERS[cls.geometry_reader](pin_model, source, g)
     return declared_geometry(cls, pin_model, source)
 
 

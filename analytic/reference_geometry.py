@@ -17,8 +17,8 @@ centre of mass seen from joint 2.  For the cart, θi is the direction of rod i
 (joint 1 → joint 2, joint 2 → centre of mass of rod 2) measured from upright
 towards the rail's axis.
 
-Both register themselves (``pendverify.robot.geometry``) under the name of their
-model, which names them in its ``geometry_reader``.
+``READERS`` holds both under the names their models give in ``geometry_reader``
+(``pendverify.robot.system.geometry_for`` looks them up).
 """
 
 from __future__ import annotations
@@ -28,13 +28,13 @@ import math
 import numpy as np
 import pinocchio as pin
 
-from pendverify.analytic import DoublePendulumParams
+from pendverify.analytic.cart_double_pendulum import CartDoublePendulum
+from pendverify.analytic.double_pendulum import DoublePendulum, DoublePendulumParams
 from pendverify.errors import ParameterError, UrdfShapeError
 from pendverify.robot.coordinates import CoordinateMap
-from pendverify.robot.geometry import ModelForm, UrdfGeometry, register_reader
+from pendverify.robot.geometry import DEFAULT_G, GeometryReader, ModelForm, UrdfGeometry
 
 PARALLEL_TOL = 1e-9  # |sin| of the angle between axes that count as parallel
-DEFAULT_G = 9.81  # m/s², Pinocchio's default, used when a URDF alone is given
 
 _REVOLUTE = {"JointModelRX", "JointModelRY", "JointModelRZ", "JointModelRevoluteUnaligned"}
 _CONTINUOUS = {
@@ -92,7 +92,6 @@ def _up(model: pin.Model) -> np.ndarray:
     return np.array([0.0, 0.0, 1.0])
 
 
-@register_reader("double_pendulum")
 def double_pendulum_geometry(model: pin.Model, source: str, g: float | None = None) -> UrdfGeometry:
     """Read the double pendulum's parameters and coordinate map off a two-revolute-joint URDF."""
     _check_chain(model, source, ["revolute", "revolute"])
@@ -179,7 +178,6 @@ def double_pendulum_geometry(model: pin.Model, source: str, g: float | None = No
     return UrdfGeometry(cmap, params, model_form, notes)
 
 
-@register_reader("cart_double_pendulum")
 def cart_double_pendulum_geometry(model: pin.Model, source: str, g: float | None = None) -> UrdfGeometry:
     """The coordinate map of a cart with two rods: absolute angles from upright."""
     _check_chain(model, source, ["prismatic", "revolute", "revolute"])
@@ -214,3 +212,10 @@ def cart_double_pendulum_geometry(model: pin.Model, source: str, g: float | None
     theta0 = np.array([float(p1 @ rail), phi1, phi1 + phi2])
     nq = tuple(model.joints[i].nq for i in (1, 2, 3))
     return UrdfGeometry(CoordinateMap(np.linalg.inv(A), theta0, nq))
+
+
+#: reader name (a model class's ``geometry_reader``) → the reader
+READERS: dict[str, GeometryReader] = {
+    DoublePendulum.geometry_reader: double_pendulum_geometry,
+    CartDoublePendulum.geometry_reader: cart_double_pendulum_geometry,
+}
