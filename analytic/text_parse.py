@@ -38,11 +38,11 @@ import sympy as sp
 from pendverify.analytic.matrix_equation import matrix_text, read_matrix_equation
 from pendverify.analytic.matrix_equation_parse import names_vectors
 from pendverify.analytic.parameter_set import KIND_RULES
-from pendverify.analytic.params import read_toml
 from pendverify.analytic.text_equations import latex_side, read_equations, split_equations
 from pendverify.analytic.text_expression import FUNCTIONS, ExpressionError, fragment, read_expression
 from pendverify.analytic.text_model_latex import parse_latex_equation, read_symbol_table, refuse_toml_escapes
 from pendverify.display import shortened
+from pendverify.documents import read_toml
 from pendverify.errors import ExcerptError, ParameterError, PendverifyError, excerpt
 from pendverify.file_kinds import expect_kind
 

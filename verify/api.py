@@ -507,7 +507,8 @@ def review_scenes(folder: str | Path | None = None) -> list[Path]:
 
 def _scene_files(folder: str | Path | None) -> tuple[list[Path], list[str]]:
     """(the scene files of ``folder``, one note per TOML file left out as another kind)."""
-    from pendverify.file_kinds import KINDS, file_kind
+    from pendverify.documents import file_kind
+    from pendverify.file_kinds import KINDS
     from pendverify.shipped import shipped_folder
 
     path = Path(folder) if folder else shipped_folder("scenes")

@@ -39,12 +39,13 @@ from pathlib import Path
 import numpy as np
 
 from pendverify.analytic import MODELS
-from pendverify.analytic.params import default_parameter_file, load_parameter_file, read_toml
+from pendverify.analytic.params import default_parameter_file, load_parameter_file
 from pendverify.analytic.plugin import plugin_parameters
 from pendverify.certify.battery import BatterySettings
 from pendverify.certify.model_source import ModelSource
 from pendverify.certify.settings_rules import settings_problem
 from pendverify.certify.sweep_limits import DEFAULT_MAX_SETS
+from pendverify.documents import read_toml
 from pendverify.errors import PendverifyError, SweepError
 from pendverify.file_kinds import expect_kind
 from pendverify.robot.description import urdf_text

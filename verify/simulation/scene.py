@@ -49,8 +49,9 @@ from pathlib import Path
 import numpy as np
 
 from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
-from pendverify.analytic.params import default_parameter_file, load_parameter_file, read_toml
+from pendverify.analytic.params import default_parameter_file, load_parameter_file
 from pendverify.analytic.plugin import check_model_outputs, load_model_class, plugin_parameters
+from pendverify.documents import read_toml
 from pendverify.errors import InputError, PendverifyError, SceneError
 from pendverify.file_kinds import expect_kind
 from pendverify.simulation.effects import parse_actuation, parse_disturbance
