@@ -92,23 +92,34 @@ def check_value(key: str, value: Any, spec: Key, fail: Fail) -> Any:
 
 
 def check_table(table: Mapping, schema: Table, fail: Fail, prefix: str = "") -> dict[str, Any]:
-    """The values of ``table`` checked against ``schema`` (unknown keys first, then each key in the
-    schema's order), with each absent optional key that has a default set to it.
+    """``check_keys`` then ``check_values``: the values of ``table`` checked against ``schema``.
 
     ``fail(prefix + key, value, rule)`` raises the document's error; ``prefix`` names a nested
     table (``"ranges.m1."``)."""
-    listed = ", ".join(schema.listed or schema.keys)
+    check_keys(table, schema, fail, prefix)
+    return check_values(table, schema, fail, prefix)
+
+
+def check_keys(table: Mapping, schema: Table, fail: Fail, prefix: str = "") -> None:
+    """Fail on the first key of ``table`` that ``schema`` does not have."""
     for key, value in table.items():
         if key not in schema.keys:
-            fail(prefix + key, value, schema.unknown.format(keys=listed))
+            fail(prefix + key, value, schema.unknown.format(keys=", ".join(schema.listed or schema.keys)))
+
+
+def check_values(table: Mapping, schema: Table, fail: Fail, prefix: str = "") -> dict[str, Any]:
+    """The values of ``schema``'s keys in ``table``, each checked by its rules in the schema's order
+    (a missing required key fails), with each absent optional key that has a default set to it.
+
+    A reader whose keys need more than rules (a file they name, one key's rule depending on
+    another's value) checks those after, from the values returned."""
     values = {}
     for key, spec in schema.keys.items():
         if key in table:
             values[key] = check_value(prefix + key, table[key], spec, fail)
         elif spec.required:
             last = spec.rules[-1][1] if spec.rules else ""
-            last = "" if callable(last) else last
-            fail(prefix + key, MISSING, schema.missing.format(rule=last))
+            fail(prefix + key, MISSING, schema.missing.format(rule="" if callable(last) else last))
         elif spec.default is not MISSING:
             values[key] = spec.default
     return values
