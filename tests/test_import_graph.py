@@ -238,6 +238,7 @@ COMMAND_MAY_IMPORT = {
     # the rules options are parsed with (argparse types, defaults, names), light enough for --help
     "pendverify.analytic": {"MODELS"},
     "pendverify.simulation.limits": {"MAX_SAMPLES_VARIABLE", "max_samples"},
+    "pendverify.simulation.engine_names": {"SCENE_ENGINE_CHOICES"},
     "pendverify.certify.settings_rules": {"samples_option", "seed_option"},
     "pendverify.certify.sweep_limits": {"DEFAULT_MAX_SETS", "WORKER_TIMEOUT_S"},
 }

@@ -447,7 +447,7 @@ def simulate(
     ``energy``; ``invariants`` (name, error, tolerance, passed, detail); ``engine_comparison``
     (engine ``both``); ``passed``; ``notes``; ``metadata()``, ``to_npz_bytes()``, ``to_csv()``.
     """
-    from pendverify.simulation.scene import SCENE_ENGINE_CHOICES
+    from pendverify.simulation.engine_names import SCENE_ENGINE_CHOICES
     from pendverify.simulation.simulate import run_scene
 
     loaded = load_scene(scene)

@@ -55,6 +55,7 @@ from pendverify.documents import read_toml
 from pendverify.errors import InputError, PendverifyError, SceneError
 from pendverify.file_kinds import expect_kind
 from pendverify.simulation.effects import parse_actuation, parse_disturbance
+from pendverify.simulation.engine_names import SCENE_ENGINE_CHOICES
 from pendverify.simulation.laws import Law
 from pendverify.simulation.limits import DEFAULT_MAX_STEPS, check_scene_work
 from pendverify.simulation.scene_reader import TableReader
@@ -64,9 +65,6 @@ MIN_RTOL = 100 * 2.220446049250313e-16
 
 ADAPTIVE_METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 FIXED_STEP_METHODS = ("rk4",)
-#: what a scene's ``engine`` may be: ABA integrated, the closed form integrated, or ABA integrated
-#: with the closed form compared along the trajectory
-SCENE_ENGINE_CHOICES = ("aba", "closed_form", "both")
 TOP_KEYS = (
     "name",
     "model",
