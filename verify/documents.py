@@ -14,8 +14,11 @@ A schema:
   with neither stays absent: no silent default).
 * ``Table(keys, unknown, missing)``: ``keys`` maps each allowed key to its ``Key`` (in the order
   errors list them); ``unknown`` is the rule for a key not among them, with ``{keys}`` replaced by
-  the allowed keys joined by ", "; ``missing`` the rule for a missing required key, with ``{rule}``
-  replaced by the key's last rule.
+  the allowed keys joined by ", " (or a function of the key: a "did you mean"); ``missing`` the
+  rule for a missing required key, with ``{rule}`` replaced by the key's last rule.
+
+A reader whose keys depend on each other (a vector's length on the model, one key's rule on
+another's value) checks them one at a time with ``check_value``, in the order it reads them.
 
 Errors are raised by the document kind's ``fail(key, value, rule)`` (its ``InputError`` subclass,
 whose sentence is ``FILE: key 'KEY' = VALUE: RULE``), so every kind keeps its sentence; a missing
@@ -76,7 +79,8 @@ class Table:
     """One table of a document: its keys, and the rules for an unknown and a missing key."""
 
     keys: Mapping[str, Key]
-    unknown: str = "unknown key; expected one of {keys}"
+    #: the rule for an unknown key: a template, or a function of the key (a "did you mean")
+    unknown: str | Callable[[str], str] = "unknown key; expected one of {keys}"
     missing: str = "missing key"
     #: the order of the keys in the ``unknown`` rule (default: ``keys``'s order)
     listed: Sequence[str] = field(default=())
@@ -104,6 +108,8 @@ def check_keys(table: Mapping, schema: Table, fail: Fail, prefix: str = "") -> N
     """Fail on the first key of ``table`` that ``schema`` does not have."""
     for key, value in table.items():
         if key not in schema.keys:
+            if callable(schema.unknown):
+                fail(prefix + key, value, schema.unknown(key))
             fail(prefix + key, value, schema.unknown.format(keys=", ".join(schema.listed or schema.keys)))
 
 
