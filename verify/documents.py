@@ -8,10 +8,11 @@ Reading never executes code: TOML is data, and a schema's tests are predicates o
 
 A schema:
 
-* ``Key(rules, required, default)``: ``rules`` is a sequence of ``(test, rule)`` pairs, checked in
-  order; the first ``test(value)`` that is false makes the error, with ``rule`` as its rule
-  sentence.  A missing key is an error when ``required``; else the key takes ``default`` (a key
-  with neither stays absent: no silent default).
+* ``Key(rules, required, default, missing)``: ``rules`` is a sequence of ``(test, rule)`` pairs,
+  checked in order; the first ``test(value)`` that is false makes the error, with ``rule`` (or
+  ``rule(value)``) as its rule sentence.  A missing key is an error when ``required`` (its rule
+  ``missing``, else the table's); else the key takes ``default`` (a key with neither stays
+  absent: no silent default).
 * ``Table(keys, unknown, missing)``: ``keys`` maps each allowed key to its ``Key`` (in the order
   errors list them); ``unknown`` is the rule for a key not among them, with ``{keys}`` replaced by
   the allowed keys joined by ", " (or a function of the key: a "did you mean"); ``missing`` the
@@ -72,6 +73,8 @@ class Key:
     rules: Sequence[Rule] = ()
     required: bool = True
     default: Any = MISSING
+    #: the rule when this key is missing (else the table's ``missing``)
+    missing: str = ""
 
 
 @dataclass(frozen=True)
@@ -125,7 +128,11 @@ def check_values(table: Mapping, schema: Table, fail: Fail, prefix: str = "") ->
             values[key] = check_value(prefix + key, table[key], spec, fail)
         elif spec.required:
             last = spec.rules[-1][1] if spec.rules else ""
-            fail(prefix + key, MISSING, schema.missing.format(rule="" if callable(last) else last))
+            fail(
+                prefix + key,
+                MISSING,
+                spec.missing or schema.missing.format(rule="" if callable(last) else last),
+            )
         elif spec.default is not MISSING:
             values[key] = spec.default
     return values
