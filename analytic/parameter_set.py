@@ -78,11 +78,9 @@ def kind_rules(kind: str) -> tuple:
 
 def check_value(source: str, key: str, value: object, kind: str) -> float:
     """Return ``value`` as a float, or raise a ParameterError naming the rule."""
-
-    def fail(key, value, rule):
-        raise ParameterError(source, key, value, rule)
-
-    return as_float(documents.check_value(key, value, _kind_key(kind), fail))
+    return as_float(
+        documents.check_value(key, value, _kind_key(kind), documents.raising(ParameterError, source))
+    )
 
 
 @functools.cache
@@ -127,10 +125,7 @@ class ParameterSet:
     @classmethod
     def from_mapping(cls: type[P], data: dict[str, Any], source: str = "<inline>", prefix: str = "") -> P:
         """Build a set from a mapping, rejecting unknown and missing keys (``schema``)."""
-
-        def fail(key, value, rule):
-            raise ParameterError(source, key, None if value is documents.MISSING else value, rule)
-
+        fail = documents.raising(ParameterError, source)
         values = {k: as_float(v) for k, v in documents.check_table(data, cls.schema(), fail, prefix).items()}
         try:
             return cls(**values)

@@ -23,7 +23,7 @@ import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from pendverify.documents import MISSING, Key, Table, check_table, is_string, is_table, read_toml
+from pendverify.documents import Key, Table, check_table, is_string, is_table, raising, read_toml
 from pendverify.errors import ParameterError
 from pendverify.file_kinds import expect_kind
 
@@ -53,17 +53,12 @@ def document_schema(registry: dict[str, type[ParameterSet]]) -> Table:
         },
         unknown="unknown key; a parameter file has {keys}",
         missing="{rule}",
-        listed=("model", "name", "parameters"),
     )
 
 
 def parse_parameter_document(data: dict[str, Any], source: str, registry: dict[str, type[ParameterSet]]):
     """Split a parameter document into (model name, set name, parameter set)."""
-
-    def fail(key, value, rule):
-        raise ParameterError(source, key, None if value is MISSING else value, rule)
-
-    values = check_table(data, document_schema(registry), fail)
+    values = check_table(data, document_schema(registry), raising(ParameterError, source))
     model = values["model"]
     name = values.get("name", Path(source).stem if source != "<inline>" else model)
     return model, name, registry[model].from_mapping(values["parameters"], source, prefix="parameters.")

@@ -21,10 +21,10 @@ A schema:
 A reader whose keys depend on each other (a vector's length on the model, one key's rule on
 another's value) checks them one at a time with ``check_value``, in the order it reads them.
 
-Errors are raised by the document kind's ``fail(key, value, rule)`` (its ``InputError`` subclass,
-whose sentence is ``FILE: key 'KEY' = VALUE: RULE``), so every kind keeps its sentence; a missing
-key's value is ``MISSING``.  The rule builders below (``number_rules``, ``vector_rules``,
-``choice_rules``) hold the sentences the readers share.
+Errors are raised by the document kind's ``fail(key, value, rule)`` (``raising``: its
+``InputError`` subclass, ``FILE: key 'KEY' = VALUE: RULE``), so every kind keeps its sentence; a
+missing key's value is ``MISSING``.  ``number_rules``, ``vector_rules`` and ``choice_rules`` hold
+the sentences the readers share.
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ from __future__ import annotations
 import math
 import sys
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -85,8 +85,15 @@ class Table:
     #: the rule for an unknown key: a template, or a function of the key (a "did you mean")
     unknown: str | Callable[[str], str] = "unknown key; expected one of {keys}"
     missing: str = "missing key"
-    #: the order of the keys in the ``unknown`` rule (default: ``keys``'s order)
-    listed: Sequence[str] = field(default=())
+
+
+def raising(error: type[PendverifyError], source: str) -> Fail:
+    """The ``fail`` that raises ``error(source, key, value, rule)`` (a missing key's value: None)."""
+
+    def fail(key: str, value: Any, rule: str):
+        raise error(source, key, None if value is MISSING else value, rule)
+
+    return fail
 
 
 def check_value(key: str, value: Any, spec: Key, fail: Fail) -> Any:
@@ -113,7 +120,7 @@ def check_keys(table: Mapping, schema: Table, fail: Fail, prefix: str = "") -> N
         if key not in schema.keys:
             if callable(schema.unknown):
                 fail(prefix + key, value, schema.unknown(key))
-            fail(prefix + key, value, schema.unknown.format(keys=", ".join(schema.listed or schema.keys)))
+            fail(prefix + key, value, schema.unknown.format(keys=", ".join(schema.keys)))
 
 
 def check_values(table: Mapping, schema: Table, fail: Fail, prefix: str = "") -> dict[str, Any]:

@@ -46,7 +46,6 @@ from pendverify.certify.model_source import ModelSource
 from pendverify.certify.settings_rules import settings_problem
 from pendverify.certify.sweep_limits import DEFAULT_MAX_SETS
 from pendverify.documents import (
-    MISSING,
     Key,
     Table,
     check_keys,
@@ -57,6 +56,7 @@ from pendverify.documents import (
     is_integer,
     is_string,
     is_table,
+    raising,
     read_toml,
 )
 from pendverify.errors import PendverifyError, SweepError
@@ -121,15 +121,6 @@ RANGE = Table(
 )
 
 
-def _failing(source: str):
-    """The ``fail`` of a sweep file's checks: a ``SweepError`` (a missing key's value shown as None)."""
-
-    def fail(key, value, rule):
-        raise SweepError(source, key, None if value is MISSING else value, rule)
-
-    return fail
-
-
 def _range(source, key, value):
     """(min, max, scale, points) of ``ranges.KEY``."""
     if isinstance(value, list) and len(value) == 2:
@@ -138,7 +129,7 @@ def _range(source, key, value):
         table = value
     else:
         raise SweepError(source, f"ranges.{key}", value, "expected [min, max] or a table {min, max, ...}")
-    spec = check_table(table, RANGE, _failing(source), f"ranges.{key}.")
+    spec = check_table(table, RANGE, raising(SweepError, source), f"ranges.{key}.")
     if spec["max"] < spec["min"]:
         raise SweepError(source, f"ranges.{key}", value, "expected min <= max")
     if spec["scale"] == "log" and spec["min"] <= 0:
@@ -166,9 +157,9 @@ def load_sweep(path: str | Path, max_sets: int = DEFAULT_MAX_SETS) -> Sweep:
     source = str(path)
     data = read_toml(path, "sweep file")
     expect_kind(data, path, "sweep")
-    check_keys(data, SWEEP, _failing(source))
+    check_keys(data, SWEEP, raising(SweepError, source))
     model, base, urdf = _model_and_base(path, data)
-    values = check_values(data, SWEEP, _failing(source))
+    values = check_values(data, SWEEP, raising(SweepError, source))
     mode, count, ranges = values["mode"], values["count"], values["ranges"]
     known = base.keys()
     binding = Binding.of(urdf, base, data["urdf"]) if urdf is not None else None
@@ -244,7 +235,9 @@ def _model_and_base(path: Path, data: dict):
     """(model source, base parameter set, base URDF text or None) of a sweep file."""
     source = str(path)
     ref = data.get("model")
-    base_ref = check_value("base", data.get("base", "default"), SWEEP.keys["base"], _failing(source))
+    base_ref = check_value(
+        "base", data.get("base", "default"), SWEEP.keys["base"], raising(SweepError, source)
+    )
     if isinstance(ref, str) and ref.endswith((".py", ".toml")):
         model_file = path.parent / ref
         try:
