@@ -151,6 +151,15 @@ CASES = [
 ]
 
 
+BEYOND_A_DOUBLE = "9" * 310  # a TOML integer float() overflows on (NumPy's isfinite raised TypeError on it)
+CASES.append(
+    (
+        f'model = "double_pendulum"\n[ranges]\nm1 = [0.5, {BEYOND_A_DOUBLE}]\n',
+        f"key 'ranges.m1.max' = {BEYOND_A_DOUBLE}: expected a finite number",
+    )
+)
+
+
 @pytest.mark.parametrize(("text", "sentence"), CASES)
 def test_each_rule_has_its_sentence(tmp_path, monkeypatch, text, sentence):
     monkeypatch.delenv("PENDVERIFY_MAX_SAMPLES", raising=False)  # the limit the samples sentence names
