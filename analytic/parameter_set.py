@@ -21,9 +21,11 @@ that hold parameter sets are read by ``pendverify.analytic.params``.
 from __future__ import annotations
 
 import dataclasses
-import math
+import functools
 from typing import Any, ClassVar, TypeVar
 
+from pendverify import documents
+from pendverify.documents import as_float, is_finite, is_number
 from pendverify.errors import ParameterError
 
 #: kind → (the comparison with 0 a value must satisfy, the unit)
@@ -62,21 +64,28 @@ def _rule_text(kind: str) -> str:
     return f"{article} {kind} must be a finite number {comparison} (in {unit})"
 
 
+@functools.cache
+def kind_rules(kind: str) -> tuple:
+    """The rules of a quantity of ``kind`` (``pendverify.documents``): a finite number (not a
+    boolean) > 0 or >= 0 as ``KIND_RULES`` says; each broken one's sentence is the kind's rule."""
+    rule = _rule_text(kind)
+    if KIND_RULES[kind][0] == "> 0":
+        bound = lambda v: as_float(v) > 0  # noqa: E731
+    else:
+        bound = lambda v: as_float(v) >= 0  # noqa: E731
+    return (is_number, lambda v: f"{rule}; got a {type(v).__name__}"), (is_finite, rule), (bound, rule)
+
+
 def check_value(source: str, key: str, value: object, kind: str) -> float:
     """Return ``value`` as a float, or raise a ParameterError naming the rule."""
-    rule = _rule_text(kind)
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ParameterError(source, key, value, rule + f"; got a {type(value).__name__}")
-    try:
-        x = float(value)
-    except OverflowError:  # a TOML integer beyond a double
-        x = math.inf
-    if not math.isfinite(x):
-        raise ParameterError(source, key, value, rule)
-    strict = KIND_RULES[kind][0] == "> 0"
-    if (strict and not x > 0) or (not strict and not x >= 0):
-        raise ParameterError(source, key, value, rule)
-    return x
+    return as_float(
+        documents.check_value(key, value, _kind_key(kind), documents.raising(ParameterError, source))
+    )
+
+
+@functools.cache
+def _kind_key(kind: str) -> documents.Key:
+    return documents.Key(kind_rules(kind))
 
 
 P = TypeVar("P", bound="ParameterSet")
@@ -101,22 +110,23 @@ class ParameterSet:
         return tuple(f.name for f in dataclasses.fields(cls))
 
     @classmethod
-    def from_mapping(cls: type[P], data: dict[str, Any], source: str = "<inline>", prefix: str = "") -> P:
-        """Build a set from a mapping, rejecting unknown and missing keys."""
-        known = cls.keys()
-        for key, value in data.items():
-            if key not in known:
-                raise ParameterError(
-                    source,
-                    prefix + key,
-                    value,
-                    f"unknown key; the {cls.model} parameters are {', '.join(known)}",
+    def schema(cls) -> documents.Table:
+        """The set as a table of a document: one key per parameter, its kind's rules."""
+        return documents.Table(
+            {
+                f.name: documents.Key(
+                    kind_rules(f.metadata["kind"]), missing=f"missing key ({f.metadata['doc']})"
                 )
-        values = {}
-        for f in dataclasses.fields(cls):
-            if f.name not in data:
-                raise ParameterError(source, prefix + f.name, None, f"missing key ({f.metadata['doc']})")
-            values[f.name] = check_value(source, prefix + f.name, data[f.name], f.metadata["kind"])
+                for f in dataclasses.fields(cls)
+            },
+            unknown=f"unknown key; the {cls.model} parameters are {{keys}}",
+        )
+
+    @classmethod
+    def from_mapping(cls: type[P], data: dict[str, Any], source: str = "<inline>", prefix: str = "") -> P:
+        """Build a set from a mapping, rejecting unknown and missing keys (``schema``)."""
+        fail = documents.raising(ParameterError, source)
+        values = {k: as_float(v) for k, v in documents.check_table(data, cls.schema(), fail, prefix).items()}
         try:
             return cls(**values)
         except ParameterError as exc:  # a rule across fields: name the file

@@ -9,7 +9,8 @@ A parameter file looks like::
     ...
 
 Unknown and missing keys are errors, as are booleans, strings and non-finite
-numbers.  Every error names the file, the key, the value and the rule.
+numbers.  Every error names the file, the key, the value and the rule.  The file is read, and
+its top level checked, by ``pendverify.documents`` (``document_schema``).
 
 ``ParameterSet``, ``quantity`` and ``check_value`` live in ``pendverify.analytic.parameter_set``
 (a model file imports the first two as ``from pendverify import ParameterSet, quantity``); reached
@@ -18,13 +19,13 @@ through this module they still work, with a ``DeprecationWarning`` naming their 
 
 from __future__ import annotations
 
-import sys
 import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from pendverify.errors import ParameterError, folder_given, missing_file, unreadable_file, wrong_kind
-from pendverify.file_kinds import KINDS, expect_kind, suffix_kind
+from pendverify.documents import Key, Table, check_table, is_string, is_table, raising, read_toml
+from pendverify.errors import ParameterError
+from pendverify.file_kinds import expect_kind
 
 if TYPE_CHECKING:
     from pendverify.analytic.parameter_set import ParameterSet
@@ -36,72 +37,31 @@ MOVED = {
     "check_value": "from pendverify.analytic.parameter_set import check_value",
 }
 
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - exercised on Python 3.10 only
-    import tomli as tomllib
 
-
-def read_toml(path: Path, what: str = "TOML file") -> dict[str, Any]:
-    """Parse a TOML file (a ``what``: "parameter file", "scene file", ... in messages).
-
-    A missing, unreadable or folder path is a ``UserFileError`` naming the file and the next
-    step, as is a file whose name says it is another kind (``model.py``, ``robot.urdf``); a
-    syntax error, a ParameterError that names the file."""
-    if not path.name.lower().endswith(".toml"):
-        kind = suffix_kind(path)
-        if kind is not None:
-            raise wrong_kind(path, what, KINDS[kind].noun, KINDS[kind].given_as)
-    try:
-        with open(path, "rb") as fh:
-            raw = fh.read()
-    except FileNotFoundError:
-        raise missing_file(path, what) from None
-    except IsADirectoryError:
-        raise folder_given(path, what) from None
-    except OSError as exc:
-        raise unreadable_file(path, what, exc.strerror or str(exc)) from None
-    try:
-        text = raw.decode("utf-8-sig")  # a byte-order mark is allowed, as in URDFs
-    except UnicodeDecodeError as exc:
-        raise ParameterError(
-            str(path), "<file>", str(path), f"not UTF-8 text (byte {exc.start}: {exc.reason}); TOML is UTF-8"
-        ) from None
-    try:
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ParameterError(str(path), "<file>", str(path), f"not valid TOML: {exc}") from None
-    except RecursionError:
-        raise ParameterError(str(path), "<file>", str(path), "not valid TOML: nested too deeply") from None
+def document_schema(registry: dict[str, type[ParameterSet]]) -> Table:
+    """A parameter file's top level: ``model`` one of ``registry``, ``name`` a string, ``parameters``
+    a table (whose values ``ParameterSet.from_mapping`` checks)."""
+    model_rule = (
+        f"must be one of {', '.join(registry)}; the parameters of a model file of your own go with "
+        "that file (--analytic FILE)"
+    )
+    return Table(
+        {
+            "model": Key(((lambda v: isinstance(v, str) and v in registry, model_rule),)),
+            "name": Key(((is_string, "must be a string"),), required=False),
+            "parameters": Key(((is_table, "must be a table of parameter values"),)),
+        },
+        unknown="unknown key; a parameter file has {keys}",
+        missing="{rule}",
+    )
 
 
 def parse_parameter_document(data: dict[str, Any], source: str, registry: dict[str, type[ParameterSet]]):
     """Split a parameter document into (model name, set name, parameter set)."""
-    allowed = {"model", "name", "parameters"}
-    for key, value in data.items():
-        if key not in allowed:
-            raise ParameterError(
-                source,
-                key,
-                value,
-                f"unknown key; a parameter file has {', '.join(sorted(allowed))}",
-            )
-    model = data.get("model")
-    if model not in registry:
-        raise ParameterError(
-            source,
-            "model",
-            model,
-            f"must be one of {', '.join(registry)}; the parameters of a model file of your own go with "
-            "that file (--analytic FILE)",
-        )
-    name = data.get("name", Path(source).stem if source != "<inline>" else model)
-    if not isinstance(name, str):
-        raise ParameterError(source, "name", name, "must be a string")
-    table = data.get("parameters")
-    if not isinstance(table, dict):
-        raise ParameterError(source, "parameters", table, "must be a table of parameter values")
-    return model, name, registry[model].from_mapping(table, source, prefix="parameters.")
+    values = check_table(data, document_schema(registry), raising(ParameterError, source))
+    model = values["model"]
+    name = values.get("name", Path(source).stem if source != "<inline>" else model)
+    return model, name, registry[model].from_mapping(values["parameters"], source, prefix="parameters.")
 
 
 def load_parameter_file(path: str | Path, registry: dict[str, type[ParameterSet]] | None = None):

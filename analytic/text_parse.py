@@ -38,11 +38,11 @@ import sympy as sp
 from pendverify.analytic.matrix_equation import matrix_text, read_matrix_equation
 from pendverify.analytic.matrix_equation_parse import names_vectors
 from pendverify.analytic.parameter_set import KIND_RULES
-from pendverify.analytic.params import read_toml
 from pendverify.analytic.text_equations import latex_side, read_equations, split_equations
 from pendverify.analytic.text_expression import FUNCTIONS, ExpressionError, fragment, read_expression
 from pendverify.analytic.text_model_latex import parse_latex_equation, read_symbol_table, refuse_toml_escapes
 from pendverify.display import shortened
+from pendverify.documents import MISSING, Key, Table, check_keys, check_value, is_string, is_table, read_toml
 from pendverify.errors import ExcerptError, ParameterError, PendverifyError, excerpt
 from pendverify.file_kinds import expect_kind
 
@@ -56,6 +56,54 @@ TOP_KEYS = (
 #: ``declaration``): the equations come from elsewhere (``pendverify.analytic.mechanics_model``)
 DECLARATION_KEYS = ("name", "coordinates", "inputs", "disturbances", "parameters", "urdf")
 NOTATIONS = ("sympy", "latex")
+
+# The rules of a text model's keys (``pendverify.documents``), read in the order
+# notation, name, coordinates (each one's kind), inputs, disturbances, parameters (each one's
+# declaration and unit); a rule's sentence is the problem after "FILE: key 'KEY': ".
+NOTATION = Key(
+    ((lambda v: v in NOTATIONS, lambda v: f"{v!r}: must be one of {', '.join(map(repr, NOTATIONS))}"),),
+    required=False,
+    default="sympy",
+)
+NAME = Key(((lambda v: is_string(v) and v.isidentifier(), "missing, or not a name (letters, digits, _)"),))
+COORDINATES = Key(
+    ((lambda v: is_table(v) and bool(v), 'missing: a table such as theta1 = "angle", x = "position"'),)
+)
+COORDINATE_KIND = Key(
+    ((lambda v: v in ("angle", "position"), lambda v: f'{v!r}: must be "angle" or "position"'),)
+)
+NAMES = Key(
+    ((lambda v: isinstance(v, list) and all(map(is_string, v)), "must be a list of names"),),
+    required=False,
+    default=[],
+)
+PARAMETERS = Key(((is_table, 'missing: a table such as m1 = { kind = "mass", unit = "kg" }'),))
+DECLARATION = Key(
+    (
+        (
+            lambda d: (
+                is_table(d)
+                and is_string(d.get("kind"))
+                and d["kind"] in KIND_RULES
+                and not set(d) - {"kind", "unit", "doc"}
+            ),
+            f"must be {{ kind = ..., unit = ... }} with kind one of {', '.join(KIND_RULES)}",
+        ),
+    )
+)
+UNIT = Key(((is_string, "must be a string"),))
+
+
+def _unknown(top_keys: tuple[str, ...]):
+    """The rule for an unknown top-level key: the known keys it is close to, if any."""
+
+    def rule(key: str) -> str:
+        close = difflib.get_close_matches(key, top_keys, n=3)
+        return f"unknown key{'; did you mean ' + ', '.join(close) + '?' if close else ''}"
+
+    return rule
+
+
 #: each equation: (shape as a string of dimension names, the argument groups it may use)
 EQUATIONS = {
     "M": ("nn", "q"), "C": ("nn", "qv"), "C_plus_D": ("nn", "qv"), "Cqdot": ("n", "qv"), "H": ("n", "q"),
@@ -102,10 +150,17 @@ class Reader:
         """The problem at position ``at`` of the key's ``text``: one error with a caret under it."""
         raise ExcerptError(f"{self.path}: key '{shortened(key, 80)}': {problem}", *excerpt(text, at))
 
+    def rule(self, key: str, value, rule: str):
+        """``fail`` as a ``pendverify.documents`` rule's ``fail`` (a text model's sentence shows no value)."""
+        self.fail(key, rule)
+
+    def value(self, data: dict, key: str, spec: Key, prefix: str = ""):
+        """``data[key]`` (else the key's default, else None) checked by ``spec``'s rules."""
+        value = data.get(key, None if spec.default is MISSING else spec.default)
+        return check_value(prefix + key, value, spec, self.rule)
+
     def names(self, data: dict, key: str) -> tuple[str, ...]:
-        value = data.get(key, [])
-        if not isinstance(value, list) or not all(isinstance(x, str) for x in value):
-            self.fail(key, "must be a list of names")
+        value = self.value(data, key, NAMES)
         for name in value:
             self.identifier(key, name)
         return tuple(value)
@@ -197,44 +252,25 @@ def read_text_document(path: Path, data: dict, top_keys: tuple[str, ...] = TOP_K
     ``top_keys``: the keys it may hold (a declaration without equations allows fewer).
     """
     reader = Reader(path)
-    for key in data:
-        if key not in top_keys:
-            close = difflib.get_close_matches(key, top_keys, n=3)
-            reader.fail(key, f"unknown key{'; did you mean ' + ', '.join(close) + '?' if close else ''}")
-    notation = data.get("notation", "sympy")
-    if notation not in NOTATIONS:
-        reader.fail("notation", f"{notation!r}: must be one of {', '.join(map(repr, NOTATIONS))}")
+    check_keys(
+        data, Table(dict.fromkeys(top_keys, Key(required=False)), unknown=_unknown(top_keys)), reader.rule
+    )
+    notation = reader.value(data, "notation", NOTATION)
     if "symbols" in data and notation != "latex":
         reader.fail("symbols", 'a symbol table is for notation = "latex"')
-    name = data.get("name")
-    if not isinstance(name, str) or not name.isidentifier():
-        reader.fail("name", "missing, or not a name (letters, digits, _)")
-    coords = data.get("coordinates")
-    if not isinstance(coords, dict) or not coords:
-        reader.fail("coordinates", 'missing: a table such as theta1 = "angle", x = "position"')
-    for c, kind in coords.items():
+    name = reader.value(data, "name", NAME)
+    coords = reader.value(data, "coordinates", COORDINATES)
+    for c in coords:
         reader.identifier(f"coordinates.{c}", c)
-        if kind not in ("angle", "position"):
-            reader.fail(f"coordinates.{c}", f'{kind!r}: must be "angle" or "position"')
+        reader.value(coords, c, COORDINATE_KIND, "coordinates.")
     inputs, disturbances = reader.names(data, "inputs"), reader.names(data, "disturbances")
-    params = data.get("parameters")
-    if not isinstance(params, dict):
-        reader.fail("parameters", 'missing: a table such as m1 = { kind = "mass", unit = "kg" }')
+    params = reader.value(data, "parameters", PARAMETERS)
     parameters = {}
     for p, decl in params.items():
         reader.identifier(f"parameters.{p}", p)
-        if (
-            not isinstance(decl, dict)
-            or decl.get("kind") not in KIND_RULES
-            or set(decl) - {"kind", "unit", "doc"}
-        ):
-            reader.fail(
-                f"parameters.{p}",
-                f"must be {{ kind = ..., unit = ... }} with kind one of {', '.join(KIND_RULES)}",
-            )
+        reader.value(params, p, DECLARATION, "parameters.")
         unit = decl.get("unit", KIND_RULES[decl["kind"]][1])
-        if not isinstance(unit, str):
-            reader.fail(f"parameters.{p}.unit", "must be a string")
+        reader.value({"unit": unit}, "unit", UNIT, f"parameters.{p}.")
         parameters[p] = (decl["kind"], unit)
     rates = tuple(f"d{c}" for c in coords)
     accelerations = tuple(f"dd{c}" for c in coords)

@@ -241,10 +241,12 @@ COMMAND_MAY_IMPORT = {
     "pendverify.symbolic.mutation_report": {"format_report"},
     "pendverify.symbolic.compare": {"format_report"},
     "pendverify.worked_examples": {"NAMES", "next_commands"},  # the names --help lists; what to type next
-    "pendverify.file_kinds": {"KINDS", "file_kind"},  # the option a stray file belongs behind
+    "pendverify.file_kinds": {"KINDS"},  # the option a stray file belongs behind
+    "pendverify.documents": {"file_kind"},  # the kind of a stray file
     # the rules options are parsed with (argparse types, defaults, names), light enough for --help
     "pendverify.analytic": {"MODELS"},
     "pendverify.simulation.limits": {"MAX_SAMPLES_VARIABLE", "max_samples"},
+    "pendverify.simulation.engine_names": {"SCENE_ENGINE_CHOICES"},
     "pendverify.certify.settings_rules": {"samples_option", "seed_option"},
     "pendverify.certify.sweep_limits": {"DEFAULT_MAX_SETS", "WORKER_TIMEOUT_S"},
 }

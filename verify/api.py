@@ -447,7 +447,7 @@ def simulate(
     ``energy``; ``invariants`` (name, error, tolerance, passed, detail); ``engine_comparison``
     (engine ``both``); ``passed``; ``notes``; ``metadata()``, ``to_npz_bytes()``, ``to_csv()``.
     """
-    from pendverify.simulation.scene import SCENE_ENGINE_CHOICES
+    from pendverify.simulation.engine_names import SCENE_ENGINE_CHOICES
     from pendverify.simulation.simulate import run_scene
 
     loaded = load_scene(scene)
@@ -507,7 +507,8 @@ def review_scenes(folder: str | Path | None = None) -> list[Path]:
 
 def _scene_files(folder: str | Path | None) -> tuple[list[Path], list[str]]:
     """(the scene files of ``folder``, one note per TOML file left out as another kind)."""
-    from pendverify.file_kinds import KINDS, file_kind
+    from pendverify.documents import file_kind
+    from pendverify.file_kinds import KINDS
     from pendverify.shipped import shipped_folder
 
     path = Path(folder) if folder else shipped_folder("scenes")

@@ -19,21 +19,16 @@ certificate   ``.cert.json``                                         ``pendverif
 
 The readers of each kind call ``expect_kind`` on the document they parsed, so a parameter file
 given as a scene (or a text model given as ``--params``) is told what it is and where it goes,
-not which of its keys the other reader does not know.  Reading a file here never runs it.
+not which of its keys the other reader does not know.  ``pendverify.documents.file_kind`` tells
+the kind of a file on disk.
 """
 
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 
 from pendverify.errors import wrong_kind
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - exercised on Python 3.10 only
-    import tomli as tomllib
 
 
 @dataclass(frozen=True)
@@ -92,19 +87,6 @@ def suffix_kind(path: str | Path) -> str | None:
     if name.endswith(SUFFIXES):
         return "description"
     return None
-
-
-def file_kind(path: str | Path) -> str | None:
-    """The kind of the file at ``path`` (its suffix; a TOML file's keys), or None when unknown or
-    unreadable: a guess for a hint, never an error of its own."""
-    kind = suffix_kind(path)
-    if kind is not None or not str(path).lower().endswith(".toml"):
-        return kind
-    try:
-        with open(path, "rb") as handle:
-            return toml_kind(tomllib.loads(handle.read().decode("utf-8-sig")))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError, RecursionError):
-        return None
 
 
 def expect_kind(data: dict, path: str | Path, kind: str) -> None:

@@ -15,17 +15,12 @@ that folder, and a scene's relative paths (``../examples/cart_pole.py``) hold as
 from __future__ import annotations
 
 import shlex
-import sys
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 
 from pendverify.display import REPR_LIMIT, html_table, shortened
+from pendverify.documents import parse_toml
 from pendverify.errors import FileAccessError, UnknownNameError
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - exercised on Python 3.10 only
-    import tomli as tomllib
 from pendverify.shipped import shipped_file, shipped_path
 
 
@@ -122,8 +117,10 @@ def _entry(table: dict) -> WorkedExample:
 
 def load_catalogue() -> tuple[WorkedExample, ...]:
     """The worked examples of the shipped catalogue (``examples/catalogue.toml``), in its order."""
-    text = shipped_file("examples", CATALOGUE).read_text(encoding="utf-8")
-    return tuple(_entry(table) for table in tomllib.loads(text)["example"])
+    path = shipped_file("examples", CATALOGUE)
+    return tuple(
+        _entry(table) for table in parse_toml(path.read_text(encoding="utf-8"), str(path))["example"]
+    )
 
 
 #: the shipped file that lists the worked examples

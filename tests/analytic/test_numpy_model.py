@@ -267,7 +267,7 @@ def test_certify_takes_the_files_params(tmp_path, capsys):
 
 
 def _values() -> dict[str, float]:
-    from pendverify.analytic.params import read_toml
+    from pendverify.documents import read_toml
 
     return dict(read_toml(DP_PARAMS)["parameters"])
 

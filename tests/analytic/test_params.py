@@ -88,6 +88,15 @@ def test_unknown_model_and_top_level_key(tmp_path):
         load_parameter_file(path)
 
 
+def test_a_model_that_is_not_a_name_is_refused_not_a_crash(tmp_path):
+    path = tmp_path / "m.toml"
+    path.write_text('model = ["double_pendulum"]\n[parameters]\n')  # unhashable: a registry lookup raised
+    with pytest.raises(
+        ParameterError, match=r"key 'model' = \['double_pendulum'\]: must be one of double_pendulum"
+    ):
+        load_parameter_file(path)
+
+
 def test_bad_toml_and_missing_file(tmp_path):
     path = tmp_path / "broken.toml"
     path.write_text("model = \n")

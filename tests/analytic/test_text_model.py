@@ -72,6 +72,12 @@ BAD = [
     ("python code", ('"0"]', "\"__import__('os')\"]"), ["key 'C[1,1]'", "only sin, cos"]),
     ("attribute", ('"0"]', '"g.__class__"]'), ["key 'C[1,1]'", "Attribute"]),
     ("bad kind", ('kind = "gravity"', 'kind = "acceleration"'), ["key 'parameters.g'", "kind one of"]),
+    ("kind not a name", ('kind = "gravity"', "kind = [1]"), ["key 'parameters.g'", "kind one of"]),
+    (
+        "unit not a string",
+        ('kind = "gravity", unit = "m/s²"', 'kind = "gravity", unit = 3'),
+        ["key 'parameters.g.unit'", "string"],
+    ),
     ("rate in M", ('"I2 + m2*r2**2"]', '"I2 + m2*r2**2*dtheta1"]'), ["key 'M[1,1]'", "'dtheta1'"]),
     ("xor", ('"g*m2*r2*cos(theta1 + theta2)"', '"g*m2^r2"'), ["key 'H[1]'", "**"]),
 ]

@@ -19,11 +19,12 @@ import pytest
 
 import pendverify
 from pendverify.analytic import DoublePendulum, DoublePendulumParams
-from pendverify.analytic.params import default_parameter_file, load_parameter_file, read_toml
+from pendverify.analytic.params import default_parameter_file, load_parameter_file
 from pendverify.analytic.plugin import validate_model_class
 from pendverify.checks.evidence import check_record
 from pendverify.checks.report import Report
 from pendverify.cli import main
+from pendverify.documents import read_toml
 from pendverify.errors import PendverifyError
 from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for

@@ -15,8 +15,9 @@ from pathlib import Path
 import pytest
 
 from pendverify.cli import COMMAND_ORDER, build_parser, command_modules, main
+from pendverify.documents import file_kind
 from pendverify.errors import COPY_EXAMPLES
-from pendverify.file_kinds import file_kind, toml_kind
+from pendverify.file_kinds import toml_kind
 from pendverify.shipped import shipped_file
 from tests.cli_parsers import subcommands
 

@@ -18,7 +18,6 @@ catalogue entry with ``pairs = N`` is planted N pairs of errors in two different
 
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass
 
 from pendverify.diagnosis.code_corpus import (
@@ -104,12 +103,10 @@ def _shipped(spec: str):
 def _catalogue() -> list[dict]:
     """The entries of ``CORPUS_CATALOGUE``, each with its ``label``: ``"acrobot_tedrake
     (non-Christoffel C)"``."""
-    if sys.version_info >= (3, 11):
-        import tomllib
-    else:  # pragma: no cover - exercised on Python 3.10 only
-        import tomli as tomllib
+    from pendverify.documents import parse_toml
 
-    catalogue = tomllib.loads(_shipped("examples/" + CORPUS_CATALOGUE).read_text(encoding="utf-8"))
+    path = _shipped("examples/" + CORPUS_CATALOGUE)
+    catalogue = parse_toml(path.read_text(encoding="utf-8"), str(path))
     return [entry | {"label": f"{entry['name']} ({entry['class']})"} for entry in catalogue.get("model", ())]
 
 

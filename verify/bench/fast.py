@@ -38,7 +38,7 @@ from pendverify.bench.timing import measure
 from pendverify.bench.workprecision import Config, Point
 from pendverify.numerics.fast_scene import simulate_compiled
 from pendverify.numerics.fastpath import integrate, integrate_ensemble
-from pendverify.simulation import engines
+from pendverify.simulation.engine_names import RHS_ENGINES
 
 
 @dataclass(frozen=True)
@@ -62,7 +62,7 @@ def engine_study(problem: Problem, tol: float, config: Config, ref) -> list[Engi
     from scipy.integrate import solve_ivp
 
     rows = []
-    for name in engines.RHS_ENGINES:
+    for name in RHS_ENGINES:
         rhs = engine_rhs(problem, name)
         if rhs is None:  # crba_cholesky, minverse on a URDF with continuous joints
             continue

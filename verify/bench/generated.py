@@ -39,6 +39,7 @@ from numba import njit
 
 from pendverify.analytic import MODELS
 from pendverify.analytic.params import default_parameter_file, load_parameter_file
+from pendverify.cache_location import CACHE_VARIABLE
 from pendverify.numerics import fastpath
 from pendverify.numerics.generate import GeneratedSystem
 from pendverify.simulation import engines
@@ -172,7 +173,7 @@ print(json.dumps(result))
 def cache_timings(stepper: bool = True, cache: str | None = None) -> list[dict]:
     """[first process, second process] on one empty cache directory (seconds; see the docstring)."""
     with tempfile.TemporaryDirectory() as tmp:
-        env = dict(os.environ, PENDVERIFY_CACHE=cache or tmp)
+        env = {**os.environ, CACHE_VARIABLE: cache or tmp}
         runs = []
         for _ in range(2):
             start = time.perf_counter()

@@ -49,6 +49,7 @@ from pendverify.numerics.integrators.taylor import energy_above_minimum, float_s
 from pendverify.shipped import shipped_folder
 from pendverify.simulation import engines
 from pendverify.simulation.dynamics import build_dynamics
+from pendverify.simulation.engine_names import PINOCCHIO_ENGINES
 from pendverify.simulation.scene import Integrator, Scene, load_scene
 
 METRICS = ("state", "energy")
@@ -179,6 +180,6 @@ def continuous_aba(problem: Problem) -> engines.EngineRhs:
 
 def engine_rhs(problem: Problem, engine: str) -> engines.EngineRhs | None:
     """The right-hand side of ``engine`` on the problem's URDF; None if that engine cannot take it."""
-    if engine in engines.PINOCCHIO_ENGINES and problem.continuous_joints:
+    if engine in PINOCCHIO_ENGINES and problem.continuous_joints:
         return continuous_aba(problem) if engine == "aba" else None
     return engines.build(engine, problem.dynamics.model, problem.fast, problem.dynamics.system)

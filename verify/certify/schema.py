@@ -1,7 +1,8 @@
 """What ``recheck`` verifies before it re-runs anything: the schema and the derived fields.
 
 ``check_schema`` rejects a certificate that lacks a required key, has an unknown one,
-or holds a value of the wrong type, naming the field (``checks[3].error``).
+or holds a value of the wrong type, naming the field (``checks[3].error``); the schema is written
+as ``pendverify.documents`` tables (``TOP``, ``NESTED``, ``ITEM``), the style of every document.
 ``check_derived`` computes again every field that is derived from others — the
 ``summary`` from the items, ``derived`` from the parameters through the model's
 ``derived_constants`` — and rejects a certificate whose recorded values differ.
@@ -9,7 +10,6 @@ or holds a value of the wrong type, naming the field (``checks[3].error``).
 
 from __future__ import annotations
 
-import math
 import re
 from datetime import datetime
 
@@ -18,6 +18,7 @@ from pendverify.certify.model_source import MODEL_FILE_RULE, model_file_problem
 from pendverify.certify.names import check_name
 from pendverify.certify.settings_rules import settings_problem
 from pendverify.certify.simulations import BATTERY_ENGINES
+from pendverify.documents import MISSING, Key, Table, check_table, is_finite, is_integer, is_string, is_table
 from pendverify.errors import CertificateError, PendverifyError
 
 NONFINITE = ("inf", "-inf", "nan")  # how pendverify.jsonio writes non-finite numbers
@@ -39,22 +40,8 @@ def _number(v) -> bool:
     return _as_float(v) is not None
 
 
-def _finite(v) -> bool:
-    """A number that is not infinite or NaN (written as itself, never as a string)."""
-    number = _as_float(v)
-    return number is not None and math.isfinite(number)
-
-
 def _model_file(v) -> bool:
     return isinstance(v, str) and not model_file_problem(v)
-
-
-def _integer(v) -> bool:
-    return isinstance(v, int) and not isinstance(v, bool)
-
-
-def _string(v) -> bool:
-    return isinstance(v, str)
 
 
 def _table_of(test):
@@ -72,63 +59,83 @@ def _date(v) -> bool:
         return False
 
 
-# key: (required, test, what it must be)
-TOP = {
-    "schema": (True, _string, "a string"),
-    "name": (True, _string, "a string"),
-    "model": (True, _string, "a string"),
-    "model_source": (False, lambda v: isinstance(v, dict), "a table"),
-    "parameters": (True, _table_of(_finite), "a table of finite numbers"),
-    "derived": (True, _table_of(_number), "a table of numbers"),
-    "urdf": (True, lambda v: isinstance(v, dict), "a table"),
-    "settings": (True, lambda v: isinstance(v, dict), "a table"),
-    "versions": (True, _table_of(_string), "a table of strings"),
-    "checks": (True, lambda v: isinstance(v, list) and bool(v), "a non-empty list of items"),
-    "summary": (True, lambda v: isinstance(v, dict), "a table"),
-    "notes": (True, lambda v: isinstance(v, list) and all(map(_string, v)), "a list of strings"),
-    "date": (True, _date, "an ISO 8601 time with its UTC offset"),
-    "signature": (False, lambda v: isinstance(v, dict), "a table"),
-    "digest": (True, lambda v: isinstance(v, dict), "a table"),
-}
+def _engine(v) -> bool:
+    return isinstance(v, str) and v in BATTERY_ENGINES
+
+
+def _key(test, what: str, required: bool = True) -> Key:
+    """A certificate key: ``test`` passes, else "expected ``what``"."""
+    return Key(((test, f"expected {what}"),), required)
+
+
+def _table(keys: dict[str, Key]) -> Table:
+    return Table(keys, unknown="unknown key; expected {keys}", missing="is missing: {rule}")
+
+
+STRING, TABLE = _key(is_string, "a string"), _key(is_table, "a table")
+HEX64 = _key(_hex64, "64 hex digits")
+TOP = _table(
+    {
+        "schema": STRING,
+        "name": STRING,
+        "model": STRING,
+        "model_source": _key(is_table, "a table", required=False),
+        "parameters": _key(_table_of(is_finite), "a table of finite numbers"),
+        "derived": _key(_table_of(_number), "a table of numbers"),
+        "urdf": TABLE,
+        "settings": TABLE,
+        "versions": _key(_table_of(is_string), "a table of strings"),
+        "checks": _key(lambda v: isinstance(v, list) and bool(v), "a non-empty list of items"),
+        "summary": TABLE,
+        "notes": _key(lambda v: isinstance(v, list) and all(map(is_string, v)), "a list of strings"),
+        "date": _key(_date, "an ISO 8601 time with its UTC offset"),
+        "signature": _key(is_table, "a table", required=False),
+        "digest": TABLE,
+    }
+)
 NESTED = {
-    "urdf": {"text": (True, _string, "a string"), "sha256": (True, _hex64, "64 hex digits")},
-    "model_source": {
-        "file": (True, _model_file, f"a model file's name ({MODEL_FILE_RULE})"),
-        "text": (True, _string, "a string"),
-        "sha256": (True, _hex64, "64 hex digits"),
-    },
-    "settings": {
-        "samples": (True, _integer, "an integer"),
-        "seed": (True, _integer, "an integer"),
-        "sim_duration": (True, _number, "a number"),
-        "sim_rtol": (True, _number, "a number"),
-    },
-    "digest": {"algorithm": (True, _string, "a string"), "value": (True, _string, "a string")},
-    "signature": {
-        "envelope": (True, _string, "a file name"),
-        "keyid": (True, _hex64, "64 hex digits (a key fingerprint)"),
-        "format": (True, _string, "a string"),
-    },
-}
-FIGURES = ("error", "tolerance", "max_error")  # an item's figures
-ITEM = {
-    "name": (True, _string, "a string"),
-    "kind": (True, lambda v: v in ("check", "stress", "invariant"), "check, stress or invariant"),
-    "error": (True, _number, "a number"),
-    "tolerance": (True, _number, "a number"),
-    "at": (True, _string, "a string"),
-    "max_error": (True, lambda v: v is None or _number(v), "a number or null"),
-    "max_error_at": (True, _string, "a string"),
-    "samples": (True, _integer, "an integer"),
-    "seed": (True, _integer, "an integer"),
-    "passed": (True, lambda v: isinstance(v, bool), "true or false"),
-    "detail": (True, _string, "a string"),
-    "engine": (
-        False,
-        lambda v: v in BATTERY_ENGINES,
-        f"one of {', '.join(BATTERY_ENGINES)} (invariant items)",
+    "urdf": _table({"text": STRING, "sha256": HEX64}),
+    "model_source": _table(
+        {
+            "file": _key(_model_file, f"a model file's name ({MODEL_FILE_RULE})"),
+            "text": STRING,
+            "sha256": HEX64,
+        }
+    ),
+    "settings": _table(
+        {
+            "samples": _key(is_integer, "an integer"),
+            "seed": _key(is_integer, "an integer"),
+            "sim_duration": _key(_number, "a number"),
+            "sim_rtol": _key(_number, "a number"),
+        }
+    ),
+    "digest": _table({"algorithm": STRING, "value": STRING}),
+    "signature": _table(
+        {
+            "envelope": _key(is_string, "a file name"),
+            "keyid": _key(_hex64, "64 hex digits (a key fingerprint)"),
+            "format": STRING,
+        }
     ),
 }
+FIGURES = ("error", "tolerance", "max_error")  # an item's figures
+ITEM = _table(
+    {
+        "name": STRING,
+        "kind": _key(lambda v: v in ("check", "stress", "invariant"), "check, stress or invariant"),
+        "error": _key(_number, "a number"),
+        "tolerance": _key(_number, "a number"),
+        "at": STRING,
+        "max_error": _key(lambda v: v is None or _number(v), "a number or null"),
+        "max_error_at": STRING,
+        "samples": _key(is_integer, "an integer"),
+        "seed": _key(is_integer, "an integer"),
+        "passed": _key(lambda v: isinstance(v, bool), "true or false"),
+        "detail": STRING,
+        "engine": _key(_engine, f"one of {', '.join(BATTERY_ENGINES)} (invariant items)", False),
+    }
+)
 
 
 def _bad(source: str, key: str, value, rule: str) -> CertificateError:
@@ -136,17 +143,13 @@ def _bad(source: str, key: str, value, rule: str) -> CertificateError:
     return CertificateError(f"{source}: key '{key}' = {shown}: {rule}")
 
 
-def _check_table(table: dict, spec: dict, source: str, prefix: str) -> None:
-    for key, value in table.items():
-        if key not in spec:
-            raise _bad(source, prefix + key, value, f"unknown key; expected {', '.join(spec)}")
-    for key, (required, test, what) in spec.items():
-        if key not in table:
-            if required:
-                raise CertificateError(f"{source}: key '{prefix}{key}' is missing: expected {what}")
-            continue
-        if not test(table[key]):
-            raise _bad(source, prefix + key, table[key], f"expected {what}")
+def _check_table(table: dict, schema: Table, source: str, prefix: str) -> None:
+    def fail(key, value, rule):
+        if value is MISSING:
+            raise CertificateError(f"{source}: key '{key}' {rule}")
+        raise _bad(source, key, value, rule)
+
+    check_table(table, schema, fail, prefix)
 
 
 def check_schema(cert, source: str) -> None:
@@ -172,7 +175,7 @@ def check_schema(cert, source: str) -> None:
         _check_table(item, ITEM, source, f"checks[{i}].")
         if item["passed"]:
             for key in FIGURES:
-                if item[key] is not None and not _finite(item[key]):
+                if item[key] is not None and not is_finite(item[key]):
                     rule = "a passed item's figures are finite numbers"
                     raise _bad(source, f"checks[{i}].{key}", item[key], rule)
     try:

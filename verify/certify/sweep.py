@@ -39,16 +39,33 @@ from pathlib import Path
 import numpy as np
 
 from pendverify.analytic import MODELS
-from pendverify.analytic.params import default_parameter_file, load_parameter_file, read_toml
+from pendverify.analytic.params import default_parameter_file, load_parameter_file
 from pendverify.analytic.plugin import plugin_parameters
 from pendverify.certify.battery import BatterySettings
 from pendverify.certify.model_source import ModelSource
 from pendverify.certify.settings_rules import settings_problem
 from pendverify.certify.sweep_limits import DEFAULT_MAX_SETS
+from pendverify.documents import (
+    Key,
+    Table,
+    check_keys,
+    check_table,
+    check_value,
+    check_values,
+    is_finite,
+    is_integer,
+    is_string,
+    is_table,
+    raising,
+    read_toml,
+)
 from pendverify.errors import PendverifyError, SweepError
 from pendverify.file_kinds import expect_kind
 from pendverify.robot.description import urdf_text
 from pendverify.robot.rebind import Binding
+
+MODES = ("random", "grid")
+SCALES = ("linear", "log")
 
 
 @dataclass(frozen=True)
@@ -60,35 +77,64 @@ class Sweep:
     base: dict | None = None  # a model file's: the base set's values
 
 
+def _setting(key: str, unit: str = ""):
+    """The rule of a battery setting: certify's options' and recheck's (``settings_rules``)."""
+    name = "sim_duration" if key == "duration" else key
+    return ((lambda v: not settings_problem(name, v), lambda v: settings_problem(name, v) + unit),)
+
+
+def _at_least_one(v) -> bool:
+    return is_integer(v) and v >= 1
+
+
+#: a sweep file's top level; ``model``, ``base`` and ``urdf`` name files (``_model_and_base``)
+SWEEP = Table(
+    {
+        "model": Key(required=False),
+        "base": Key(
+            ((lambda v: is_string(v) and bool(v), 'expected "default" or a parameter file (a string)'),),
+            required=False,
+            default="default",
+        ),
+        "urdf": Key(required=False),
+        "mode": Key(((lambda v: v in MODES, "expected random or grid"),), required=False, default="random"),
+        "count": Key(((_at_least_one, "expected an integer >= 1"),), required=False, default=100),
+        "seed": Key(_setting("seed"), required=False, default=0),
+        "samples": Key(_setting("samples"), required=False, default=200),
+        "duration": Key(_setting("duration", " (s, per simulated effect)"), required=False, default=1.0),
+        "ranges": Key(
+            ((lambda v: is_table(v) and bool(v), "expected a table of at least one parameter range"),)
+        ),
+    },
+    missing="{rule}",
+)
+#: one range given as a table (``[min, max]`` is the table of those two)
+RANGE = Table(
+    {
+        "min": Key(((is_finite, "expected a finite number"),)),
+        "max": Key(((is_finite, "expected a finite number"),)),
+        "scale": Key(((lambda v: v in SCALES, "expected linear or log"),), required=False, default="linear"),
+        "points": Key(((_at_least_one, "expected an integer >= 1"),), required=False, default=3),
+    },
+    unknown="unknown key; expected {keys}",
+    missing="{rule}",
+)
+
+
 def _range(source, key, value):
-    if isinstance(value, list):
-        spec = {"min": value[0] if value else None, "max": value[1] if len(value) > 1 else None}
-        if len(value) != 2:
-            raise SweepError(source, f"ranges.{key}", value, "expected [min, max] or a table {min, max, ...}")
+    """(min, max, scale, points) of ``ranges.KEY``."""
+    if isinstance(value, list) and len(value) == 2:
+        table = {"min": value[0], "max": value[1]}
     elif isinstance(value, dict):
-        spec = dict(value)
-        for k in spec:
-            if k not in ("min", "max", "scale", "points"):
-                raise SweepError(
-                    source, f"ranges.{key}.{k}", spec[k], "unknown key; expected min, max, scale, points"
-                )
+        table = value
     else:
         raise SweepError(source, f"ranges.{key}", value, "expected [min, max] or a table {min, max, ...}")
-    for bound in ("min", "max"):
-        x = spec.get(bound)
-        if isinstance(x, bool) or not isinstance(x, (int, float)) or not np.isfinite(x):
-            raise SweepError(source, f"ranges.{key}.{bound}", x, "expected a finite number")
+    spec = check_table(table, RANGE, raising(SweepError, source), f"ranges.{key}.")
     if spec["max"] < spec["min"]:
         raise SweepError(source, f"ranges.{key}", value, "expected min <= max")
-    scale = spec.get("scale", "linear")
-    if scale not in ("linear", "log"):
-        raise SweepError(source, f"ranges.{key}.scale", scale, "expected linear or log")
-    if scale == "log" and spec["min"] <= 0:
+    if spec["scale"] == "log" and spec["min"] <= 0:
         raise SweepError(source, f"ranges.{key}.min", spec["min"], "a log range needs min > 0")
-    points = spec.get("points", 3)
-    if isinstance(points, bool) or not isinstance(points, int) or points < 1:
-        raise SweepError(source, f"ranges.{key}.points", points, "expected an integer >= 1")
-    return float(spec["min"]), float(spec["max"]), scale, points
+    return float(spec["min"]), float(spec["max"]), spec["scale"], spec["points"]
 
 
 def _count(source, mode: str, count: int, specs: dict, max_sets: int) -> int:
@@ -111,31 +157,10 @@ def load_sweep(path: str | Path, max_sets: int = DEFAULT_MAX_SETS) -> Sweep:
     source = str(path)
     data = read_toml(path, "sweep file")
     expect_kind(data, path, "sweep")
-    allowed = ("model", "base", "urdf", "mode", "count", "seed", "samples", "duration", "ranges")
-    for key, value in data.items():
-        if key not in allowed:
-            raise SweepError(source, key, value, f"unknown key; expected one of {', '.join(allowed)}")
+    check_keys(data, SWEEP, raising(SweepError, source))
     model, base, urdf = _model_and_base(path, data)
-    mode = data.get("mode", "random")
-    if mode not in ("random", "grid"):
-        raise SweepError(source, "mode", mode, "expected random or grid")
-    count = data.get("count", 100)
-    if isinstance(count, bool) or not isinstance(count, int) or count < 1:
-        raise SweepError(source, "count", count, "expected an integer >= 1")
-    values = {
-        "seed": data.get("seed", 0),
-        "samples": data.get("samples", 200),
-        "duration": data.get("duration", 1.0),
-    }
-    for key, value in values.items():  # the battery's settings: the rule certify's options and recheck apply
-        problem = settings_problem("sim_duration" if key == "duration" else key, value)
-        if problem:
-            raise SweepError(
-                source, key, value, problem + (" (s, per simulated effect)" if key == "duration" else "")
-            )
-    ranges = data.get("ranges")
-    if not isinstance(ranges, dict) or not ranges:
-        raise SweepError(source, "ranges", ranges, "expected a table of at least one parameter range")
+    values = check_values(data, SWEEP, raising(SweepError, source))
+    mode, count, ranges = values["mode"], values["count"], values["ranges"]
     known = base.keys()
     binding = Binding.of(urdf, base, data["urdf"]) if urdf is not None else None
     specs = {}
@@ -210,9 +235,9 @@ def _model_and_base(path: Path, data: dict):
     """(model source, base parameter set, base URDF text or None) of a sweep file."""
     source = str(path)
     ref = data.get("model")
-    base_ref = data.get("base", "default")
-    if not isinstance(base_ref, str) or not base_ref:
-        raise SweepError(source, "base", base_ref, 'expected "default" or a parameter file (a string)')
+    base_ref = check_value(
+        "base", data.get("base", "default"), SWEEP.keys["base"], raising(SweepError, source)
+    )
     if isinstance(ref, str) and ref.endswith((".py", ".toml")):
         model_file = path.parent / ref
         try:

@@ -85,7 +85,8 @@ def register(sub) -> None:
 def stray_files(files: list[str]) -> str:
     """What to type instead of ``pendverify check FILE ...``: each file behind the option its kind
     takes (``pendverify.file_kinds``), as a message for the usage error."""
-    from pendverify.file_kinds import KINDS, file_kind
+    from pendverify.documents import file_kind
+    from pendverify.file_kinds import KINDS
 
     options, unknown = [], []
     for name in files:

@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 
 from pendverify.commands import EXAMPLE_SCENE, add_analytic_option, add_command, add_package_path_option
+from pendverify.simulation.engine_names import SCENE_ENGINE_CHOICES
 
 
 def register(sub) -> None:
@@ -37,7 +38,7 @@ def register(sub) -> None:
     p.add_argument("--trace", action="store_true", help="draw the path of the tip as it moves")
     p.add_argument(
         "--engine",
-        choices=("aba", "closed_form", "both"),
+        choices=SCENE_ENGINE_CHOICES,
         help="override the scene's engine (default: the scene's)",
     )
     p.add_argument(

@@ -6,6 +6,7 @@ import argparse
 import math
 
 from pendverify.commands import EXAMPLE_SCENE, add_command, add_package_path_option, write_json_report
+from pendverify.simulation.engine_names import SCENE_ENGINE_CHOICES
 
 
 def register(sub) -> None:
@@ -25,7 +26,7 @@ def register(sub) -> None:
     p.add_argument("--csv", action="store_true", help="also write a CSV beside the npz")
     p.add_argument(
         "--engine",
-        choices=("aba", "closed_form", "both"),
+        choices=SCENE_ENGINE_CHOICES,
         help="override the scene's engine (default: the scene's)",
     )
     p.add_argument(

@@ -32,10 +32,10 @@ import sympy as sp
 from pendverify.analytic.latex_names import conventions
 from pendverify.analytic.latex_normalise import canonical_symbol, normalise
 from pendverify.analytic.latex_parse import LatexReader, SymbolTable
-from pendverify.analytic.params import read_toml
 from pendverify.analytic.text_expression import read_expression
 from pendverify.analytic.text_parse import CONSTANTS, FUNCTIONS
 from pendverify.diagnosis.clock import now
+from pendverify.documents import read_toml
 from pendverify.errors import PendverifyError
 from pendverify.symbolic.zero_test import is_zero, probe
 

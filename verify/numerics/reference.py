@@ -16,7 +16,7 @@ reference's own error, chaos included (both runs amplify their errors alike).
 The reference is stored as a double-double (hi + lo, ≈ 32 digits), and errors
 of a double-precision run are formed as (x − hi) − lo, exact to ≈ 1e-32.
 
-Cache.  Results go to ``$PENDVERIFY_CACHE`` or ``~/.cache/pendverify``, one
+Cache.  Results go to the cache folder (``pendverify.cache_location``), one
 ``.npz`` per problem, named by the SHA-256 of a canonical description (the
 digest of the model's generated generic code ``FIELD_DIGEST`` — the equations the
 reference integrates —, the packed parameters and force law and the initial
@@ -32,7 +32,6 @@ from __future__ import annotations
 import hashlib
 import io
 import json
-import os
 import sys
 import time
 import zipfile
@@ -44,6 +43,7 @@ import mpmath
 import numpy as np
 
 from pendverify.atomic import write_atomic
+from pendverify.cache_location import cache_root
 from pendverify.errors import FileAccessError
 from pendverify.numerics.codegen.folder import create_private
 from pendverify.numerics.integrators.taylor import (
@@ -91,14 +91,6 @@ class Reference:
         )
 
 
-def cache_dir() -> Path:
-    env = os.environ.get("PENDVERIFY_CACHE")
-    if env:
-        return Path(env)
-    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
-    return Path(base) / "pendverify"
-
-
 def problem_key(fast, x0, duration, grid, digits=DIGITS, check_digits=CHECK_DIGITS) -> str:
     def hexes(a):
         return [float(v).hex() for v in np.ravel(a)]
@@ -117,7 +109,7 @@ def problem_key(fast, x0, duration, grid, digits=DIGITS, check_digits=CHECK_DIGI
 
 
 def _cache_path(key: str) -> Path:
-    return cache_dir() / f"reference-{key[:24]}.npz"
+    return cache_root() / f"reference-{key[:24]}.npz"
 
 
 #: what reading a cached reference that is not one ``_assemble`` wrote raises (truncated, garbage)

@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pendverify.simulation.laws import LQR, PD, Constant, Law, Noise, Pulse, Sine, Step, Table
+from pendverify.simulation.laws import LQR, PD, Constant, Law, Noise, Pulse, Sine, Step, TabulatedLaw
 
 #: Rounding allowance of the equilibrium test |H_i(q*)| ≤ K·ε·(1 + max|q*|)·Σ|coefficients of H_i|.
 EQUILIBRIUM_K = 16.0
@@ -96,7 +96,7 @@ def parse_actuation(r, model_cls, params=None) -> Law | None:
         if not isinstance(rows, list) or len(rows) != len(times):
             r.fail("values", rows, f"expected {len(times)} rows, one per time")
         values = np.array([_row(r, "values", row, n, i) for i, row in enumerate(rows)])
-        return Table(kind, n, times=times, values=values)
+        return TabulatedLaw(kind, n, times=times, values=values)
     if kind == "lqr":
         r.only(("type", "Q", "R", "saturation", "equilibrium"))
         name, q_star = _equilibrium(r, model_cls(params))

@@ -30,10 +30,7 @@ import numpy as np
 
 from pendverify.robot.system import PinocchioSystem
 from pendverify.robot.writer import urdf_for
-
-#: the engines ``build`` makes a right-hand side of (the table above)
-RHS_ENGINES = ("closed_form", "compiled", "aba", "crba_cholesky", "minverse")
-PINOCCHIO_ENGINES = ("aba", "crba_cholesky", "minverse")
+from pendverify.simulation.engine_names import PINOCCHIO_ENGINES
 
 
 @dataclass

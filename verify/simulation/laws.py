@@ -2,7 +2,7 @@
 
 * ``Constant``: u = value.  ``Step``: ``before`` until ``time``, ``after`` from it.
 * ``Sine``: u = offset + amplitude·sin(2π·frequency·t + phase).
-* ``Table``: piecewise linear through (times, values), held at the ends.
+* ``TabulatedLaw``: piecewise linear through (times, values), held at the ends.
 * ``Pulse``: a rectangular pulse of height impulse/width on [time, time + width), so
   its integral is the impulse.
 * ``Noise``: band-limited noise Σ_k a·sin(2π f_k t + φ_k) over ``components`` N
@@ -78,7 +78,7 @@ class Sine(Law):
 
 
 @dataclass
-class Table(Law):
+class TabulatedLaw(Law):
     times: np.ndarray = None
     values: np.ndarray = None
 

@@ -49,11 +49,13 @@ from pathlib import Path
 import numpy as np
 
 from pendverify.analytic import MODELS, ClosedFormModel, ParameterSet
-from pendverify.analytic.params import default_parameter_file, load_parameter_file, read_toml
+from pendverify.analytic.params import default_parameter_file, load_parameter_file
 from pendverify.analytic.plugin import check_model_outputs, load_model_class, plugin_parameters
+from pendverify.documents import read_toml
 from pendverify.errors import InputError, PendverifyError, SceneError
 from pendverify.file_kinds import expect_kind
 from pendverify.simulation.effects import parse_actuation, parse_disturbance
+from pendverify.simulation.engine_names import SCENE_ENGINE_CHOICES
 from pendverify.simulation.laws import Law
 from pendverify.simulation.limits import DEFAULT_MAX_STEPS, check_scene_work
 from pendverify.simulation.scene_reader import TableReader
@@ -63,9 +65,6 @@ MIN_RTOL = 100 * 2.220446049250313e-16
 
 ADAPTIVE_METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 FIXED_STEP_METHODS = ("rk4",)
-#: what a scene's ``engine`` may be: ABA integrated, the closed form integrated, or ABA integrated
-#: with the closed form compared along the trajectory
-SCENE_ENGINE_CHOICES = ("aba", "closed_form", "both")
 TOP_KEYS = (
     "name",
     "model",

@@ -41,6 +41,7 @@ from pathlib import Path
 
 from pendverify.analytic.source_file import defining_file
 from pendverify.atomic import write_atomic
+from pendverify.cache_location import cache_root
 from pendverify.errors import FileAccessError, PendverifyError
 from pendverify.numerics.codegen import expressions as _expressions
 from pendverify.numerics.codegen import folder, numba_files, signed
@@ -63,9 +64,7 @@ SOURCES = (
 def cache_dir() -> Path:
     """Where generated modules (and numba's cache of them) live: ``generated`` in the cache folder
     if that is private and writable, else a temporary folder (``codegen.folder``)."""
-    from pendverify.numerics.reference import cache_dir as base
-
-    return folder.used(base() / "generated")
+    return folder.used(cache_root() / "generated")
 
 
 @functools.cache
