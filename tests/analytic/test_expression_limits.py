@@ -1,20 +1,18 @@
 """Expressions in text and LaTeX models are bounded: huge exact numbers and deep nesting are refused
 with one line naming the key and the limit; long pasted sums are read; messages quote a fragment.
 
-Each planted file runs ``pendverify show`` (or ``check``) in a subprocess with a hard timeout, so a
-regression that hangs fails instead of stalling the suite.
+Each planted file runs ``pendverify show`` (or ``check``) in-process under a hard bound on its CPU
+time (``tests.cli_run``), so a regression that hangs fails instead of stalling the suite.
 """
 
 from __future__ import annotations
 
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
 from pendverify.analytic.expression_limits import MAX_BITS, MAX_EXPONENT, MAX_NESTING
+from tests.cli_run import Done, run_main
 from tests.error_message import one_error
 
 REPO = Path(__file__).resolve().parents[2]
@@ -23,14 +21,10 @@ LATEX = REPO / "examples" / "double_pendulum_latex.toml"
 URDF = REPO / "urdf" / "double_pendulum.urdf"
 TEXT_PARAMS = REPO / "examples" / "minimal_double_pendulum.toml"
 LATEX_PARAMS = REPO / "analytic" / "params" / "double_pendulum.toml"
-TIMEOUT = 120
 
 
-def run(*args: str) -> subprocess.CompletedProcess:
-    env = dict(os.environ, PYTHONWARNINGS="ignore")
-    return subprocess.run(
-        [sys.executable, "-m", "pendverify", *args], capture_output=True, text=True, timeout=TIMEOUT, env=env
-    )
+def run(*args: str) -> Done:
+    return run_main(list(args))
 
 
 def text_model(tmp_path: Path, v_prefix: str) -> Path:
@@ -54,7 +48,7 @@ def latex_model(tmp_path: Path, h_first: str, h_second: str | None = None) -> Pa
     return path
 
 
-def assert_refused(result: subprocess.CompletedProcess, *words: str) -> None:
+def assert_refused(result: Done, *words: str) -> None:
     err = result.stderr.strip()
     assert result.returncode == 2, err[-2000:]
     headline, _, _ = one_error(err)

@@ -8,15 +8,14 @@ The valid values are tiny (at most 4 sets with ``--max-sets 4``, up to 3 battery
 0.02 s per simulated effect), and the tasks run on a thread of the test's process
 (``InProcessWorkers``: the sweep file is what is fuzzed, not the worker processes, which
 ``test_sweep_signals`` and ``test_sweep_lost_workers`` plant), so a sweep that runs is
-quick. Each example has a hard timeout (``HARD_TIMEOUT_S``, SIGALRM): a hang fails the
-test instead of stalling it.
+quick. Each example has a hard bound (``HARD_LIMIT_S`` of CPU time, ``tests.hard_limit``): a
+hang fails the test instead of stalling it, and load on the machine does not.
 Seeded, without an example database.
 """
 
 from __future__ import annotations
 
 import contextlib
-import signal
 from concurrent.futures import ThreadPoolExecutor
 
 import pytest
@@ -25,10 +24,11 @@ from hypothesis import strategies as st
 
 from pendverify.certify import sweep_run
 from tests.commands.test_cli_fuzz import FUZZ_SEED, PARAMS, assert_contract, workdir
+from tests.hard_limit import hard_limit
 
 pytestmark = pytest.mark.sweep  # every example certifies a fuzzed sweep file
 
-HARD_TIMEOUT_S = 120
+HARD_LIMIT_S = 120
 
 VALUES = [  # TOML values of every type, for any key
     "0",
@@ -133,24 +133,6 @@ class InProcessWorkers:
         self.executor.shutdown(wait=True, cancel_futures=cancel)
 
 
-class HardTimeout(Exception):
-    """An example ran past ``HARD_TIMEOUT_S``."""
-
-
-@contextlib.contextmanager
-def hard_timeout(seconds: int):
-    def expired(signum, frame):
-        raise HardTimeout(f"past {seconds} s")
-
-    previous = signal.signal(signal.SIGALRM, expired)
-    signal.alarm(seconds)
-    try:
-        yield
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, previous)
-
-
 @contextlib.contextmanager
 def in_process_workers():
     real = sweep_run.Workers
@@ -165,7 +147,7 @@ def in_process_workers():
 @settings(max_examples=40, deadline=None, database=None, suppress_health_check=[HealthCheck.too_slow])
 @given(sweep=sweep_files(), resume=st.booleans())
 def test_fuzz_sweep_files(sweep, resume):
-    with workdir() as folder, hard_timeout(HARD_TIMEOUT_S), in_process_workers():
+    with workdir() as folder, hard_limit(HARD_LIMIT_S), in_process_workers():
         (folder / "params.toml").write_text(PARAMS)
         path = folder / "sweep.toml"
         path.write_bytes(sweep)

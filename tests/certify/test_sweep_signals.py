@@ -17,12 +17,18 @@ import pytest
 
 from pendverify.certify import issue
 from pendverify.cli import main
-from tests.certify.test_sweep_interrupt import SWEEP, pendverify_process, session_processes, short_scene
+from tests.certify.test_sweep_interrupt import (
+    HANG_S,
+    SWEEP,
+    pendverify_process,
+    session_processes,
+    short_scene,
+)
 
 pytestmark = pytest.mark.sweep  # every test runs a sweep in a process and signals it
 
 SETS = 24  # enough that a sweep is still running when its first certificate lands
-TIMEOUT_S = 60  # a hard bound on every wait: a hang fails the test, it does not stall the suite
+TIMEOUT_S = HANG_S  # a hard bound on every wait: a hang fails the test, it does not stall the suite
 
 
 def _sweep(folder: Path, count: int = SETS) -> Path:

@@ -10,13 +10,13 @@ and returns (exit status, stdout + stderr), an exception escaping ``main`` being
 
 from __future__ import annotations
 
-import signal
 import traceback
 from pathlib import Path
 
 from pendverify.cli import main
 from tests.conformance.formats import Model, write_model, write_parameters
 from tests.conformance.systems import SYSTEMS, System, write_description
+from tests.hard_limit import Hang, hard_limit
 
 #: the initial coordinates of every scene: small angles and offsets, the i-th alternating in sign
 INITIAL = (0.2, -0.15, 0.1, -0.05, 0.05)
@@ -100,46 +100,29 @@ def command_lines(command: str, files: Files, keys: Path) -> list[list[str]]:
     return table[command]()
 
 
-#: the longest a command line may run [s] before its cell counts as hung: the slowest passing
-#: cell measured was about a minute on a loaded 2-core machine (a first compilation of a model's
-#: generated code, ~20 s, plus the command), so 5 minutes is a hang or unbounded work, not load
+#: the most CPU time a command line may take [s] before its cell counts as hung (``tests.hard_limit``):
+#: the slowest passing cell measured took about 36 s alone on a 2-core machine (a first compilation of
+#: a model's generated code plus the command), so 5 minutes is a hang or unbounded work, whatever the
+#: load on the machine
 CELL_LIMIT = 300
-
-
-class CellTimeout(BaseException):
-    """Raised by the alarm in ``run``; a command may still catch it (a model's exception is bad
-    input to pendverify), so ``_fired`` records that the limit was reached whatever it returns."""
-
-
-_fired: list[bool] = []
-
-
-def _alarm(signum, frame):
-    _fired.append(True)
-    raise CellTimeout
 
 
 def run(argv: list[str], capsys) -> tuple[int | str, str]:
     """``main(argv)`` in-process, its output captured by pytest's ``capsys`` (the way
     tests/commands do it): (exit status, "raised" or "timeout", what it printed)."""
     capsys.readouterr()
-    _fired.clear()
-    previous = signal.signal(signal.SIGALRM, _alarm)
-    signal.alarm(CELL_LIMIT)
     trace = ""
     try:
-        status: int | str = main(argv)
+        with hard_limit(CELL_LIMIT) as limit:
+            status: int | str = main(argv)
     except SystemExit as exit_:  # argparse's usage errors
         status = exit_.code if isinstance(exit_.code, int) else 2
-    except CellTimeout:
-        status, trace = "timeout", f"no exit within {CELL_LIMIT} s"
+    except Hang:
+        status = "timeout"
     except Exception:  # a traceback out of main: a failed cell, kept with its text
         status, trace = "raised", traceback.format_exc()
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, previous)
-    if _fired:
-        status, trace = "timeout", f"no exit within {CELL_LIMIT} s"
+    if limit.fired:  # also where a command caught the Hang (a model's exception is bad input to it)
+        status, trace = "timeout", limit.describe()
     captured = capsys.readouterr()
     return status, captured.out + captured.err + trace
 

@@ -132,34 +132,8 @@ def test_the_items_of_a_derivation():
     assert source_items(pair.derivation, SymbolicModel.of(pair)) == []
 
 
-@pytest.mark.slow
-def test_the_mechanics_class_of_the_corpus():
-    """The corpus's mechanics model (``examples/corpus_mechanics_double_pendulum.py``, Kane), its
-    errors planted in the derivation's items, a seeded sample of two per operator as ``bench explain
-    --quick`` draws them.  Measured (full corpus: 50 planted, 44 detected): every detected error
-    named; a sign, factor, parameter or θ̇ swap is undone by an edit of its item, so each of those
-    is restored; a dropped item is not (an item edited to 0 has no term to edit back: the entries
-    are searched then, and a dropped weight is restored there), nor confirmed wrongly."""
-    from pendverify.bench.explain import class_targets
-    from pendverify.diagnosis.corpus import SOURCE, sample_plants, score_model
-
-    label, model, system, _ = next(t for t in class_targets() if "(mechanics)" in t[0])
-    sm = SymbolicModel.of(type(model))
-    chosen = sample_plants(sm, 2)
-    assert chosen and all(p.method == SOURCE for p in chosen)  # planted in the derivation
-    scores = score_model(label, model, system, chosen)
-    assert scores.clean
-    detected = [s for s in scores.scores if s.detected]
-    assert len(detected) >= 12
-    assert all(s.named for s in detected)
-    assert not any(s.wrong_confirmed for s in detected)
-    undoable = [s for s in detected if s.plant.operator != "drop"]
-    assert all(s.restored for s in undoable), [(s.plant.what, s.message) for s in undoable if not s.restored]
-    assert sum(s.confirmed for s in detected) >= 0.75 * len(detected)
-    unrepaired = [s for s in detected if not s.repaired]
-    assert unrepaired  # the seeded sample holds link 2's mass dropped, which no single edit restores
-    for s in unrepaired:  # what was tried is said, the source edits first
-        assert "edit(s) of the KanesMethod's bodies, particles and loads (8 items) were screened" in s.message
+# the mechanics class of the corpus (its errors planted in the derivation's items, scored as ``bench
+# explain --quick`` scores them) is asserted in tests/diagnosis/test_corpus.py, on the same run
 
 
 #: a diagnosis bound short enough that the derivation's items are not all screened within its share

@@ -5,8 +5,6 @@ from __future__ import annotations
 import copy
 import json
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +17,7 @@ from pendverify.errors import IntegrationError, SceneError
 from pendverify.simulation.dynamics import build_dynamics
 from pendverify.simulation.scene import load_scene, parse_scene
 from pendverify.simulation.simulate import run_scene
+from tests.cli_run import Done, run_main
 
 REPO = Path(__file__).resolve().parents[2]
 EXAMPLES = REPO / "examples"
@@ -382,10 +381,9 @@ def test_bad_scene_is_exit_2_with_one_line(tmp_path, capsys):
 FAST_GRAVITY = GOOD + "[effects]\ngravity = 1_000_000_000\n"
 
 
-def _run_cli(*args: str, timeout: float = 120) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "pendverify", *args], capture_output=True, text=True, timeout=timeout
-    )
+def _run_cli(*args: str) -> Done:
+    """The command in-process under a hard bound on its CPU time (a run that does not stop fails)."""
+    return run_main(list(args))
 
 
 def test_an_adaptive_run_that_needs_too_many_steps_stops_naming_the_key_and_limit(tmp_path):

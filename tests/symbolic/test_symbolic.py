@@ -8,9 +8,6 @@ energies written from the stated conventions does.
 from __future__ import annotations
 
 import math
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -32,6 +29,7 @@ from pendverify.symbolic.compare import DIFFERS, EQUAL, SKIPPED, WARNING, compar
 from pendverify.symbolic.lagrange import derive
 from pendverify.symbolic.work import DEFAULT_MAX_SYMBOLIC, MAX_SYMBOLIC_VARIABLE, symbolic_work
 from pendverify.symbolic.zero_test import is_zero
+from tests.cli_run import Done, run_main
 
 from ..conftest import SEED, default_params
 
@@ -216,14 +214,12 @@ def _dense_text_model(path: Path, n: int) -> Path:
     return path
 
 
-def _sympy_cli(*args: str, env: dict | None = None) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "pendverify", "sympy", *args],
-        capture_output=True,
-        text=True,
-        timeout=120,
-        env={**os.environ, **(env or {})},
-    )
+def _sympy_cli(*args: str, env: dict | None = None) -> Done:
+    """``pendverify sympy ARGS`` in-process with ``env`` set (the limit is read at each call)."""
+    with pytest.MonkeyPatch.context() as mp:
+        for name, value in (env or {}).items():
+            mp.setenv(name, value)
+        return run_main(["sympy", *args])
 
 
 @pytest.mark.slow
