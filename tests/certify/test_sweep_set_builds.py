@@ -1,22 +1,27 @@
-"""A sweep set builds its ``PinocchioSystem`` once and reads its URDF once.
+"""A sweep set builds its ``PinocchioSystem`` once and parses its URDF once.
 
 One set of a sweep goes through the whole battery (checks, stress cases, simulations) in
 ``sweep_task.certify_chunk``, the function a worker runs.  Counted while it runs: systems built
 from a description (``PinocchioSystem.for_model``), descriptions read
-(``robot.description.load_description``, counted at ``description_format``, which it calls
-once per read), XML documents parsed with the strict readers' rules (``defusedxml``'s
-``fromstring`` in ``robot.xml_reading.parse_xml``) and URDF texts parsed by urdfdom
-(``pinocchio.buildModelFromXML``).  The stress
-cases at another g (zero gravity) derive their system from the set's
-(``PinocchioSystem.with_gravity``) instead of building one.
+(``robot.description.load_description``, counted at ``format_of``, which it calls once per
+read), XML documents parsed by pendverify (its one parse, ``robot.xml_reading._parse``), every
+other XML parser Python offers (expat parsers created, ElementTree's and defusedxml's parsers and
+``fromstring``/``parse``/``iterparse``, lxml's if it is installed: none may run but the expat
+parser of pendverify's own parse) and URDF texts parsed by urdfdom
+(``pinocchio.buildModelFromXML``, the build of the system's model).  The stress cases at another
+g (zero gravity) derive their system from the set's (``PinocchioSystem.with_gravity``) instead of
+building one.
 """
 
 from __future__ import annotations
 
 import shutil
+import xml.etree.ElementTree as ET
 from collections import Counter
 from pathlib import Path
+from xml.parsers import expat
 
+import defusedxml.ElementTree as DET
 import pinocchio as pin
 import pytest
 
@@ -44,9 +49,9 @@ def _counting(monkeypatch) -> Counter:
     counts: Counter = Counter()
     for_model = PinocchioSystem.for_model.__func__
     with_gravity = getattr(PinocchioSystem, "with_gravity", None)
-    reads = description.description_format
+    reads = description.format_of
     urdfdom = pin.buildModelFromXML
-    xml = xml_reading.DET.fromstring
+    xml = xml_reading._parse
 
     def counted(key, fn):
         def call(*args, **kwargs):
@@ -58,10 +63,22 @@ def _counting(monkeypatch) -> Counter:
     monkeypatch.setattr(PinocchioSystem, "for_model", classmethod(counted("built", for_model)))
     if with_gravity is not None:
         monkeypatch.setattr(PinocchioSystem, "with_gravity", counted("derived", with_gravity))
-    monkeypatch.setattr(description, "description_format", counted("read", reads))
+    monkeypatch.setattr(description, "format_of", counted("read", reads))
     monkeypatch.setattr(pin, "buildModelFromXML", counted("parsed", urdfdom))
-    monkeypatch.setattr(xml_reading.DET, "fromstring", counted("xml", xml))
+    monkeypatch.setattr(xml_reading, "_parse", counted("xml", xml))
+    monkeypatch.setattr(expat, "ParserCreate", counted("expat", expat.ParserCreate))
+    for module, name in _OTHER_PARSERS:
+        monkeypatch.setattr(module, name, counted("other xml", getattr(module, name)))
     return counts
+
+
+_OTHER_PARSERS = [(m, n) for m in (ET, DET) for n in ("XMLParser", "fromstring", "parse", "iterparse", "XML")]
+try:
+    from lxml import etree as LXML
+except ImportError:  # lxml is optional: without it nothing can call it
+    pass
+else:
+    _OTHER_PARSERS += [(LXML, n) for n in ("XMLParser", "fromstring", "parse", "iterparse", "XML")]
 
 
 @pytest.mark.parametrize("plugin", [False, True], ids=["built-in", "model file"])
@@ -73,4 +90,6 @@ def test_a_sweep_set_builds_its_system_once_and_reads_its_urdf_once(tmp_path, mo
     (result,) = certify_chunk(sweep.model, sweep.sets[1:2], settings, sweep.urdf, sweep.base)
     assert result.passed, result
     assert {i.name.split(":")[0] for i in result.items} == {"check", "stress", "invariant"}, result.items
-    assert counts == Counter(built=1, read=1, xml=1, parsed=1, derived=1), f"{plugin=} {counts=}"
+    # one expat parser: the one ``_parse`` runs; "other xml" absent
+    expected = Counter(built=1, read=1, xml=1, expat=1, parsed=1, derived=1)
+    assert counts == expected, f"{plugin=} {counts=}"

@@ -27,6 +27,7 @@ xacro: the URDF it expanded to), notes, and for an MJCF where each number came f
 
 from __future__ import annotations
 
+import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -38,7 +39,7 @@ from pendverify.errors import UrdfShapeError, folder_given, missing_file, unread
 from pendverify.robot.strict import DescriptionFacts
 from pendverify.robot.urdfdom import build_pinocchio_model
 from pendverify.robot.xacro_expand import XACRO_SUFFIXES, expand_xacro, uses_xacro
-from pendverify.robot.xml_reading import MAX_XML_CHARACTERS, ignored_extensions, parse_xml
+from pendverify.robot.xml_reading import MAX_XML_CHARACTERS, XmlDocument, ignored_extensions, read_xml
 
 #: format → the root element it has (xacro: the URDF's, after expansion)
 FORMATS = {"urdf": "robot", "xacro": "robot", "mjcf": "mujoco", "sdf": "sdf"}
@@ -75,6 +76,8 @@ class LoadedDescription:
     origins: dict[str, str] = field(default_factory=dict)
     #: the visual geometry given with a Pinocchio model (None: built from ``text`` when drawn)
     visual_model: pin.GeometryModel | None = None
+    #: the file's XML from its one parse (``xml_reading.read_xml``; None for a Pinocchio model)
+    xml: XmlDocument | None = None
 
     def notes(self) -> list[str]:
         out = [f"Pinocchio's {READERS[self.format]} parser logged: {line}" for line in self.log]
@@ -103,7 +106,11 @@ def description_stem(path: str | Path) -> str:
 
 def description_format(text: str, path: Path | None, source: str) -> str:
     """The format of a description (see the module docstring); anything else is refused."""
-    root = parse_xml(text, source)
+    return format_of(read_xml(text, source).root, path, source)
+
+
+def format_of(root: ET.Element, path: Path | None, source: str) -> str:
+    """The format of a description whose XML is ``root`` (see ``description_format``)."""
     if (path is not None and path.name.lower().endswith(XACRO_SUFFIXES)) or uses_xacro(root):
         return "xacro"
     local = root.tag.rsplit("}", 1)[-1]  # a default namespace (Drake's URDFs) names no format
@@ -130,11 +137,12 @@ def load_description(description: str | Path, source: str | None = None) -> Load
         text = read_text_file(path, source)
     else:
         text, source = str(description), source or TEXT_SOURCE
-    fmt = description_format(text, path, source)
+    document = read_xml(text, source)
+    fmt = format_of(document.root, path, source)
     notes: list[str] = []
     origins: dict[str, str] = {}
     if fmt == "xacro":
-        text, log = expand_xacro(text, path, source)
+        text, log = expand_xacro(text, path, source, document)
         try:
             model, facts, urdf_log = build_pinocchio_model(text, source)
         except UrdfShapeError as exc:
@@ -142,9 +150,9 @@ def load_description(description: str | Path, source: str | None = None) -> Load
         notes.append("expanded by xacro, with the defaults of its xacro:arg arguments")
         notes += [f"xacro printed: {line}" for line in log]
         log = urdf_log
-    elif fmt == "urdf":  # ``description_format`` has parsed this text: the readers parse it once more
-        model, facts, log = build_pinocchio_model(text, source, checked=True)
-        ignored = ignored_extensions(text, source, checked=True)
+    elif fmt == "urdf":
+        model, facts, log = build_pinocchio_model(text, source, document)
+        ignored = ignored_extensions(document)
         if ignored:
             listed = ", ".join(f"<{name}>" + (f" ×{n}" if n > 1 else "") for name, n in ignored.items())
             notes.append(
@@ -160,7 +168,7 @@ def load_description(description: str | Path, source: str | None = None) -> Load
 
         model, facts, log = build_sdf_model(text, source)
     offset = anchor_base(model)
-    return LoadedDescription(model, source, text, facts, offset, log, fmt, notes, origins)
+    return LoadedDescription(model, source, text, facts, offset, log, fmt, notes, origins, xml=document)
 
 
 def urdf_text(description: str | Path, purpose: str, source: str | None = None) -> str:

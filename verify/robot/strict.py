@@ -57,7 +57,7 @@ from pendverify.display import shortened
 from pendverify.errors import UrdfShapeError
 from pendverify.robot.inertia_rounding import check_inertia_tensor
 from pendverify.robot.urdf_numbers import NOT_A_NUMBER, parse_number, parse_vector, quoted, why_not
-from pendverify.robot.xml_reading import parse_xml_as_urdfdom_reads
+from pendverify.robot.xml_reading import XmlDocument, as_urdfdom_reads, read_xml
 
 __all__ = ["DescriptionFacts", "JointDynamics", "read_urdf_strictly"]
 
@@ -160,15 +160,15 @@ class _Place:
         return f"{self.owner} {self.path}" if self.path else self.owner
 
 
-def read_urdf_strictly(text: str, source: str, checked: bool = False) -> DescriptionFacts:
+def read_urdf_strictly(text: str, source: str, document: XmlDocument | None = None) -> DescriptionFacts:
     """Check every number of a URDF (see the module docstring) and return the facts Pinocchio hides.
 
     ``text`` is the URDF's XML, ``source`` names it in messages.  Any violation raises
     ``UrdfShapeError(source, problem)`` whose one-line problem names the link or joint,
-    the element path, the attribute, the offending value and the rule.  ``checked``: the caller
-    has run ``parse_xml`` on this very text already (``parse_xml_as_urdfdom_reads``).
+    the element path, the attribute, the offending value and the rule.  ``document``: ``text``
+    as the caller has parsed it already (``read_xml``); None: parsed here.
     """
-    root = parse_xml_as_urdfdom_reads(text, source, checked)
+    root = as_urdfdom_reads(document or read_xml(text, source))
     if root.tag != "robot":
         tag = shortened(root.tag, TAG_WIDTH)
         raise UrdfShapeError(source, f"the root element is <{tag}>, a URDF's must be <robot>")

@@ -6,6 +6,11 @@ reason and whatever urdfdom logs during a successful parse is handed back to the
 caller instead of reaching the terminal.  The capture swaps the process-wide
 descriptor 2; calls are serialised by a lock, but another thread writing to fd 2 at
 the same moment is captured as well.
+
+urdfdom parses the text itself (Pinocchio's bindings build a model from a URDF's text or
+file only, not from a tree already parsed): that parse is the building of the model, the one
+step that makes a ``PinocchioSystem``'s model, and the strict reader's tree
+(``xml_reading.read_xml``) is the only parse pendverify does of the text.
 """
 
 from __future__ import annotations
@@ -22,10 +27,11 @@ import pinocchio as pin
 
 from pendverify.errors import UrdfShapeError
 from pendverify.robot.strict import DescriptionFacts, read_urdf_strictly
+from pendverify.robot.xml_reading import XmlDocument
 
 
 def build_pinocchio_model(
-    text: str, source: str, checked: bool = False
+    text: str, source: str, document: XmlDocument | None = None
 ) -> tuple[pin.Model, DescriptionFacts, list[str]]:
     """Read ``text`` strictly, then build its Pinocchio model with urdfdom's log captured.
 
@@ -34,10 +40,10 @@ def build_pinocchio_model(
     line each (often empty; e.g. "Error: Could not parse collision element for Link [l]"
     when a collision shape is one urdfdom does not know).  If Pinocchio refuses the
     text, ``UrdfShapeError`` carries urdfdom's reason instead of Pinocchio's generic
-    "does not contain a valid URDF model".  ``checked``: the caller has run ``parse_xml`` on
-    this very text already (``read_urdf_strictly``).
+    "does not contain a valid URDF model".  ``document``: ``text`` as the caller has parsed it
+    already (``xml_reading.read_xml``); None: parsed here.
     """
-    facts = read_urdf_strictly(text, source, checked)
+    facts = read_urdf_strictly(text, source, document)
     with _capture_fd2() as captured:
         try:
             model = pin.buildModelFromXML(text)

@@ -2,7 +2,7 @@
 
 Conventions:
 
-* The file is first read as XML with the strict reader's rules (``pendverify.robot.xml_reading.parse_xml``:
+* The file is first read as XML with the strict reader's rules (``pendverify.robot.xml_reading.read_xml``:
   no DOCTYPE, no entities); xacro then processes that document as ``xacro FILE`` would, with
   no ``name:=value`` mappings: every ``xacro:arg`` takes the default the file gives it (an
   argument without a default is xacro's own error).  Includes are resolved relative to the
@@ -33,7 +33,7 @@ from pathlib import Path
 from pendverify.display import shortened
 from pendverify.errors import UrdfShapeError
 from pendverify.robot.packages import PACKAGE_SCHEME, resolve_uri
-from pendverify.robot.xml_reading import parse_xml
+from pendverify.robot.xml_reading import XmlDocument, read_xml
 
 #: namespace URIs that mark an element or attribute as xacro's (ElementTree spells them {uri}tag)
 XACRO_NAMESPACES = ("http://www.ros.org/wiki/xacro", "http://ros.org/wiki/xacro", "http://wiki.ros.org/xacro")
@@ -56,13 +56,16 @@ def uses_xacro(root) -> bool:
     return False
 
 
-def expand_xacro(text: str, path: Path | None, source: str) -> tuple[str, list[str]]:
+def expand_xacro(
+    text: str, path: Path | None, source: str, document: XmlDocument | None = None
+) -> tuple[str, list[str]]:
     """(URDF text, xacro's log lines) of the xacro document ``text`` read from ``path`` (None: text given).
 
     Raises ``UrdfShapeError(source, ...)`` for XML the strict reader refuses and for every
-    error xacro reports.
+    error xacro reports.  ``document``: ``text`` as the caller has parsed it already (None: parsed here).
     """
-    parse_xml(text, source)  # DOCTYPE/entities and malformed XML are refused with the strict reader's words
+    if document is None:  # DOCTYPE/entities and malformed XML are refused with the strict reader's words
+        read_xml(text, source)
     try:
         import xacro
     except ImportError:  # pragma: no cover - a dependency of pendverify
