@@ -345,6 +345,7 @@ def select_targets(
     return selection
 
 
-def plugin_target(model_file: str, urdf: str | None, params_file: str | None) -> Target:
-    """The target of a model file, its URDF and (optionally) its parameter file, as ``check --analytic``."""
-    return select_targets(load_model_class(model_file), urdf, params_file, erd_urdfs=False).targets[0]
+def plugin_target(model_file: str, urdf: str | None, params=None) -> Target:
+    """The target of a model file, its URDF and (optionally) its parameters, as ``check --analytic``
+    (a parameter file, a mapping of values or a parameter set: ``parameter_values``)."""
+    return select_targets(load_model_class(model_file), urdf, params, erd_urdfs=False).targets[0]

@@ -75,11 +75,12 @@ class ExplainBench:
 CORPUS_CATALOGUE = "diagnosis_corpus.toml"
 
 
-def _target(model_file, urdf, params_file):
-    """(model, system) of a model file checked against ``urdf`` with the parameters of ``params_file``."""
+def _target(model_file, urdf, params):
+    """(model, system) of a model file checked against ``urdf`` with ``params`` (a parameter file,
+    a mapping of values or a parameter set, as ``targets.parameter_values`` takes them)."""
     from pendverify.targets import plugin_target
 
-    target = plugin_target(str(model_file), str(urdf), str(params_file))
+    target = plugin_target(str(model_file), str(urdf), params)
     return target.model, target.system
 
 
