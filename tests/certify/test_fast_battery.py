@@ -15,10 +15,9 @@ from pendverify.certify.issue import recheck
 from pendverify.certify.model_source import ModelSource
 from pendverify.certify.simulations import ABA, COMPILED, CROSS_CHECK_STATES, invariant_items
 from pendverify.checks.evidence import item_record
-from pendverify.numerics import fast_scene
 from pendverify.numerics.energies import GeneratedEnergies
 from pendverify.robot.writer import urdf_for
-from pendverify.simulation import invariants
+from pendverify.simulation import compiled_scene, invariants
 from pendverify.simulation.scene import load_scene
 
 from ..checks.test_planted_errors import CoriolisSignFlip, WrongCosineInH
@@ -30,7 +29,7 @@ ENERGY_RTOL = 1e-12  # the same closed forms, read by SymPy and summed in anothe
 
 @pytest.mark.parametrize("name", ["damped_double_pendulum", "cart_rods_falling", "furuta_arm_turning"])
 def test_generated_energies_are_the_closed_forms(name):
-    run = fast_scene.simulate_compiled(load_scene(REPO / "scenes" / f"{name}.toml"))
+    run = compiled_scene.simulate_compiled(load_scene(REPO / "scenes" / f"{name}.toml"))
     xs = run.result.steps_x
     fast = GeneratedEnergies.of(run.dynamics, run.system)
     slow = invariants.TrajectoryEnergies(run.dynamics)

@@ -271,12 +271,12 @@ def test_certify_with_an_unusable_cache_issues_the_same_items(tmp_path):
 def test_the_battery_stops_rather_than_change_engine_when_no_folder_can_be_written(monkeypatch):
     """A cache error reaches the command as its one line: the battery does not fall back to ABA."""
     from pendverify.certify import simulations
-    from pendverify.numerics import fast_scene
+    from pendverify.simulation import compiled_scene
 
     def unwritable(scene):
         raise FileAccessError("/nowhere/generated/rhs.py", "write", "Read-only file system")
 
-    monkeypatch.setattr(fast_scene, "compile_scene", unwritable)
+    monkeypatch.setattr(compiled_scene, "compile_scene", unwritable)
     scene = types.SimpleNamespace()  # compile_scene fails before it reads the scene
     with pytest.raises(FileAccessError):
         simulations.run_battery_scene(scene, "robot.urdf", None)

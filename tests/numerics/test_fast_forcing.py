@@ -15,16 +15,16 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from pendverify.errors import FastPathError, PendverifyError
-from pendverify.numerics import fast_scene, fastpath
 from pendverify.numerics.generate import GeneratedSystem
-from pendverify.numerics.integrators import fixedstep_runner, taylor
+from pendverify.numerics.integrators import dop853_runner, fixedstep_runner, taylor
+from pendverify.simulation import compiled_scene
 from pendverify.simulation.dynamics import build_dynamics
 from pendverify.simulation.scene import load_scene, parse_scene
 
 from ..conftest import SEED, assert_close
 
 REPO = Path(__file__).resolve().parents[2]
-RHS_RTOL = 1e-12  # the same closed form, summed in another order (as tests/numerics/test_fastpath.py)
+RHS_RTOL = 1e-12  # the same closed form, summed in another order (as tests/numerics/test_dop853_runner.py)
 ACCURACY_FACTOR = 100.0  # the fast path's stated accuracy: ≤ 100 · rtol · (1 + ‖x‖∞), T ≤ 2 s
 
 NOISY_CART = {
@@ -69,7 +69,7 @@ def test_each_stage_is_evaluated_at_its_own_time(which):
     system = GeneratedSystem.from_dynamics(build_dynamics(scene, "closed_form"))
     x0 = np.concatenate([scene.q0, scene.v0, [0.0, 0.0]])
     rtol = 1e-10
-    ours = fastpath.integrate(system, x0, 1.0, rtol, rtol)
+    ours = dop853_runner.integrate(system, x0, 1.0, rtol, rtol)
     theirs = solve_ivp(system.scipy_rhs(), (0.0, 1.0), x0, method="DOP853", rtol=rtol, atol=rtol)
     assert ours.steps == len(theirs.t) - 1 and ours.nfev == theirs.nfev
     bound = ACCURACY_FACTOR * rtol * (1 + np.max(np.abs(theirs.y[:, -1])))
@@ -81,7 +81,7 @@ def test_each_stage_is_evaluated_at_its_own_time(which):
 
 @pytest.mark.parametrize("which", ["sine", "sine+noise"])
 def test_the_work_energy_balance_holds_on_the_fast_path(which):
-    run = fast_scene.simulate_compiled(_scenes()[which])
+    run = compiled_scene.simulate_compiled(_scenes()[which])
     assert [i.name.split(" ")[0] for i in run.invariants] == ["work–energy"]
     assert run.passed, [(i.name, i.error, i.tolerance) for i in run.invariants]
 
@@ -99,7 +99,7 @@ def test_laws_that_jump_are_refused_by_name(effect, law):
     if effect == "actuation":
         doc["model"], doc["initial"] = "double_pendulum", {"q": [0.3, 0.2]}
     with pytest.raises(FastPathError, match=f"effects.{effect}"):
-        fast_scene.simulate_compiled(parse_scene(doc, "<jumps>"))
+        compiled_scene.simulate_compiled(parse_scene(doc, "<jumps>"))
 
 
 def test_the_time_invariant_back_ends_refuse_forcing():

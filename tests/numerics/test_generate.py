@@ -27,7 +27,7 @@ by at most 2β; that is the tolerance of the pairwise comparison.
 and the cancellation between τ, Coriolis and gravity terms): over the sampled
 states it runs from ≈ 50 u at benign states up to ≈ 2e5 u (seeds) and 6e5 u
 (triple pendulum) relative to max(1, |a|) — tighter than the fixed 1e-12 ≈ 9e3 u
-of ``tests/numerics/test_fastpath.py`` where the state is benign, looser where it is
+of ``tests/numerics/test_dop853_runner.py`` where the state is benign, looser where it is
 ill-conditioned.  The errors observed are ≤ 4 % of β (≤ 40 u ≈ 4e-15 relative to
 max(1, |a|)); the last test prints them.
 """
@@ -57,10 +57,10 @@ from pendverify.analytic.params import default_parameter_file, load_parameter_fi
 from pendverify.analytic.plugin import load_model_class
 from pendverify.checks.sampling import sample_states
 from pendverify.errors import PendverifyError
-from pendverify.numerics import fastpath
 from pendverify.numerics.codegen import cache as code_cache
 from pendverify.numerics.codegen import expressions as codegen_expressions
 from pendverify.numerics.generate import GeneratedSystem
+from pendverify.numerics.integrators import dop853_runner
 
 REPO = Path(__file__).resolve().parents[2]
 #: the model files of examples/ but those SymPy cannot read (NumPy functions: no code is generated)
@@ -367,13 +367,13 @@ seed = MODELS["double_pendulum"](load_parameter_file(default_parameter_file("dou
 cls = load_model_class(sys.argv[1])  # a plug-in: imported under a name salted per process
 plugin = cls(load_parameter_file(sys.argv[1][:-3] + ".toml", {cls.name: cls.params_type})[2])
 result = {}
-from pendverify.numerics import fastpath
+from pendverify.numerics.integrators import dop853_runner
 from pendverify.numerics.integrators import fixedstep_runner, taylor
 for model in (seed, plugin):
     system = generate.GeneratedSystem.from_model(model)
     x = np.array([0.3, -0.2, 0.5, 0.1])
     out = system.rhs(x).tolist()
-    out += fastpath.integrate(system, x, 0.05, 1e-8, 1e-8).x.tolist()
+    out += dop853_runner.integrate(system, x, 0.05, 1e-8, 1e-8).x.tolist()
     out += fixedstep_runner.integrate_fixed("implicit_midpoint", system, x, 0.05, 4)[0][-1].tolist()
     out += [float(v) for v in taylor.field(taylor.float_system(system), list(x))]
     entry = dict(origin=system.kernel.origin, out=out)
@@ -447,7 +447,7 @@ def test_generated_stepper_is_scipys_dop853(name):
 
     Both runs are DOP853 at rtol = atol = 1e-10 over 1 s (T ≤ 2 s): each is within the fast
     path's stated accuracy 100 · rtol · (1 + ‖x‖∞) of the exact flow, so they differ by at
-    most twice that (``tests/numerics/test_fastpath.py`` compares the steps themselves to rounding).
+    most twice that (``tests/numerics/test_dop853_runner.py`` compares the steps themselves to rounding).
     """
     model = _seed(name)
     rng = np.random.default_rng(SEED)
@@ -456,8 +456,8 @@ def test_generated_stepper_is_scipys_dop853(name):
     x0 = np.append(np.full(2 * model.nv, 0.4), [0.0, 0.0])
     rtol = 1e-10
     t_out = np.linspace(0.0, 1.0, 5)
-    ours = fastpath.integrate(gen, x0, 1.0, rtol, rtol, t_out=t_out, record=True)
-    plain = fastpath.integrate(gen, x0, 1.0, rtol, rtol)
+    ours = dop853_runner.integrate(gen, x0, 1.0, rtol, rtol, t_out=t_out, record=True)
+    plain = dop853_runner.integrate(gen, x0, 1.0, rtol, rtol)
     steps = solve_ivp(gen.scipy_rhs(), (0.0, 1.0), x0, method="DOP853", rtol=rtol, atol=rtol)
     assert steps.success and (plain.nfev, plain.steps) == (steps.nfev, len(steps.t) - 1)
     sol = solve_ivp(gen.scipy_rhs(), (0.0, 1.0), x0, method="DOP853", rtol=rtol, atol=rtol, t_eval=t_out)

@@ -23,10 +23,11 @@ from pendverify.analytic import MODELS
 from pendverify.bench.workprecision import make_problem
 from pendverify.checks.sampling import sample_states
 from pendverify.errors import PendverifyError
-from pendverify.numerics import fast_scene, fastpath, reference
+from pendverify.numerics import reference
 from pendverify.numerics.codegen.expressions import expressions, momentum_rate
 from pendverify.numerics.generate import GeneratedSystem
-from pendverify.numerics.integrators import fixedstep, fixedstep_runner, taylor
+from pendverify.numerics.integrators import dop853_runner, fixedstep, fixedstep_runner, taylor
+from pendverify.simulation import compiled_scene
 from pendverify.simulation.scene import load_scene
 
 from .test_generate import (
@@ -154,7 +155,7 @@ def _fixed_errors(system, reference_system, method: str, x0, T: float) -> tuple[
     coarse, _, ok1 = fixedstep_runner.integrate_fixed(method, system, x0, T, steps, steps)
     fine, _, ok2 = fixedstep_runner.integrate_fixed(method, system, x0, T, 2 * steps, 2 * steps)
     assert ok1 and ok2
-    exact = fastpath.integrate(reference_system, x0, T, 1e-13, 1e-13).x
+    exact = dop853_runner.integrate(reference_system, x0, T, 1e-13, 1e-13).x
     estimate = np.max(np.abs(coarse[-1] - fine[-1])) / (1 - 2.0**-p)
     slack = 100 * 1e-13 * (1 + np.max(np.abs(exact)))
     return float(np.max(np.abs(coarse[-1] - exact))), float(2 * estimate + slack)
@@ -282,7 +283,7 @@ def test_a_function_other_than_sin_and_cos_is_refused_by_the_taylor_path_only():
     x = np.array([0.1, 0.4, -0.2, 0.3, 0.5, -0.1])
     expected = np.linalg.solve(model.mass_matrix(x[:3]), -model.bias(x[:3], x[3:]))
     assert np.allclose(system.rhs(x)[3:], expected, rtol=1e-12, atol=1e-12)  # the compiled path works
-    assert fastpath.integrate(system, x, 0.1, 1e-8, 1e-8).x.shape == (6,)
+    assert dop853_runner.integrate(system, x, 0.1, 1e-8, 1e-8).x.shape == (6,)
     with pytest.raises(PendverifyError, match="Taylor path"):
         taylor.exact_system(system)
     assert np.isfinite(system.potential_minimum)  # V has no sqrt: the energy still works
@@ -347,6 +348,6 @@ def test_short_reference_agrees_with_scipys_dop853():
 
 
 def test_fast_path_runs_a_plugin_scene():
-    run = fast_scene.simulate_compiled(load_scene(REPO / "scenes" / "damped_triple_pendulum.toml"))
+    run = compiled_scene.simulate_compiled(load_scene(REPO / "scenes" / "damped_triple_pendulum.toml"))
     assert run.system.model == "triple_pendulum" and run.invariants
     assert run.passed, [(i.name, i.error, i.tolerance) for i in run.invariants]

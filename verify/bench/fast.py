@@ -36,8 +36,8 @@ import numpy as np
 from pendverify.bench.problems import Problem, engine_rhs
 from pendverify.bench.timing import measure
 from pendverify.bench.workprecision import Config, Point
-from pendverify.numerics.fast_scene import simulate_compiled
-from pendverify.numerics.fastpath import integrate, integrate_ensemble
+from pendverify.numerics.integrators.dop853_runner import integrate, integrate_ensemble
+from pendverify.simulation.compiled_scene import simulate_compiled
 from pendverify.simulation.engine_names import RHS_ENGINES
 
 
@@ -220,7 +220,7 @@ def ensemble_study(problem: Problem, tol: float, config: Config, member_refs: li
 
 
 def fast_invariants(problems: list[Problem]) -> list[tuple[str, list]]:
-    """The scene invariants of each state problem, on the fast path (``fast_scene.simulate_compiled``)."""
+    """The scene invariants of each state problem, on the fast path (``compiled_scene.simulate_compiled``)."""
 
     out = []
     for problem in problems:

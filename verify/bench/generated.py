@@ -12,7 +12,7 @@ kernel) is timed against Pinocchio's ``aba`` right-hand side
 (``pendverify.simulation.engines``), both called from Python, alternating, so the
 ratio wrapper / aba comes from the same run.
 
-One integration.  The fast path's compiled DOP853 (``fastpath.integrate``) against
+One integration.  The fast path's compiled DOP853 (``dop853_runner.integrate``) against
 scipy's DOP853 on the same generated right-hand side (``solve_ivp`` on
 ``scipy_rhs``: the same steps, scipy's bookkeeping in Python), alternating.
 
@@ -40,8 +40,8 @@ from numba import njit
 from pendverify.analytic import MODELS
 from pendverify.analytic.params import default_parameter_file, load_parameter_file
 from pendverify.cache_location import CACHE_VARIABLE
-from pendverify.numerics import fastpath
 from pendverify.numerics.generate import GeneratedSystem
+from pendverify.numerics.integrators import dop853_runner
 from pendverify.simulation import engines
 
 
@@ -133,7 +133,7 @@ def integration(t_end: float = 1.0, tol: float = 1e-10, repeats: int = 15) -> li
         fun = gen.scipy_rhs()
 
         def ours(gen=gen, x0=x0):
-            return fastpath.integrate(gen, x0, t_end, tol, tol)
+            return dop853_runner.integrate(gen, x0, t_end, tol, tol)
 
         def scipy(fun=fun, x0=x0):
             return solve_ivp(fun, (0.0, t_end), x0, method="DOP853", rtol=tol, atol=tol)
@@ -150,7 +150,8 @@ start = time.perf_counter()
 import numpy as np
 from pendverify.analytic import MODELS
 from pendverify.analytic.params import default_parameter_file, load_parameter_file
-from pendverify.numerics import fastpath, generate
+from pendverify.numerics import generate
+from pendverify.numerics.integrators import dop853_runner
 result = {}
 for name in MODELS:
     model = MODELS[name](load_parameter_file(default_parameter_file(name))[2])
@@ -162,7 +163,7 @@ for name in MODELS:
     t2 = time.perf_counter()
     entry = dict(origin=system.kernel.origin, kernel_s=t1 - t0, rhs_first_call_s=t2 - t1)
     if STEPPER:
-        fastpath.integrate(system, x, 0.01, 1e-6, 1e-6)
+        dop853_runner.integrate(system, x, 0.01, 1e-6, 1e-6)
         entry["stepper_first_call_s"] = time.perf_counter() - t2
     result[name] = entry
 result["process_s"] = time.perf_counter() - start

@@ -34,8 +34,7 @@ from pendverify.bench.workprecision import (
     scipy_sweep,
 )
 from pendverify.display import html_fields
-from pendverify.numerics import fastpath
-from pendverify.numerics.integrators import fixedstep_runner
+from pendverify.numerics.integrators import dop853_runner, fixedstep_runner
 from pendverify.numerics.reference import references
 
 
@@ -144,7 +143,7 @@ def run_benchmark(
     results.references = {p.key: r for p, r in zip(state, refs[: len(state)], strict=True)}
     results.reference_seconds = time.perf_counter() - t0
     systems = [p.fast for p in problems]
-    results.compile_seconds = fastpath.warm_up(systems) + fixedstep_runner.warm_up(systems)
+    results.compile_seconds = dop853_runner.warm_up(systems) + fixedstep_runner.warm_up(systems)
     log(f"generated back ends compiled or loaded in {results.compile_seconds:.1f} s; sweeping")
     results.points = run_sweeps(problems, results.references, config, log)
     results.orders = order_fits(results.points)

@@ -23,7 +23,7 @@ bound is reported next to the smallest error plotted.
 
 Methods.  Adaptive: scipy's RK45, DOP853, Radau and LSODA with ``rtol = atol``,
 on Pinocchio's ``aba`` (the usual choice), and the fast path (compiled DOP853 on
-the right-hand side generated from the model, ``pendverify.numerics.fastpath``).
+the right-hand side generated from the model, ``pendverify.numerics.integrators.dop853_runner``).
 Fixed step, compiled from the model too (``pendverify.numerics.integrators.fixedstep``):
 explicit Euler, symplectic Euler, implicit midpoint and RK4 with halving steps;
 their observed order is the least-squares slope of log error against log h over
@@ -45,8 +45,8 @@ import numpy as np
 
 from pendverify.bench.problems import Problem, ProblemSpec, build_problem, shipped_problems
 from pendverify.bench.timing import measure
-from pendverify.numerics.fastpath import integrate as fast_integrate
 from pendverify.numerics.integrators import fixedstep, fixedstep_runner
+from pendverify.numerics.integrators.dop853_runner import integrate as fast_integrate
 from pendverify.numerics.reference import energy_errors
 
 ORDER_WINDOW = (1e-11, 1e-2)

@@ -3,7 +3,7 @@
 Engines, recorded in each invariant item's ``engine`` (``BATTERY_ENGINES``):
 
 * ``compiled`` — the compiled DOP853 on the model's generated closed form
-  (``pendverify.numerics.fast_scene``), the invariants evaluated on its own accepted steps
+  (``pendverify.simulation.compiled_scene``), the invariants evaluated on its own accepted steps
   with the model's generated energy (``pendverify.numerics.energies``).  Every battery
   scene compiles: gravity, damping, the sine input and the seeded noise
   (``pendverify.numerics.forcing``).  It is the engine of every item the battery issues,
@@ -111,7 +111,7 @@ def invariant_items(model_cls, params, urdf: str, settings, engines=None, system
 def run_battery_scene(scene, urdf: str, engine: str | None):
     """(engine, run or None, accepted steps, why it failed): on the fast path unless ``engine`` says aba
     or (``engine`` None) the scene does not compile."""
-    from pendverify.numerics import fast_scene
+    from pendverify.simulation import compiled_scene
     from pendverify.simulation.simulate import run_scene
 
     if engine not in (None, *BATTERY_ENGINES):
@@ -120,7 +120,7 @@ def run_battery_scene(scene, urdf: str, engine: str | None):
     compiled = None
     if engine in (None, COMPILED):
         try:
-            compiled = fast_scene.compile_scene(scene)
+            compiled = compiled_scene.compile_scene(scene)
         except FileAccessError:
             # the code cache cannot be written, not even a temporary folder (``codegen.folder``):
             # the item's engine must not change because of where code is cached; stop with the line
@@ -131,7 +131,7 @@ def run_battery_scene(scene, urdf: str, engine: str | None):
     try:
         with np.errstate(over="ignore", invalid="ignore"):  # a diverging run is judged by its items
             if compiled is not None:
-                run = fast_scene.simulate_compiled(scene, compiled)
+                run = compiled_scene.simulate_compiled(scene, compiled)
                 return COMPILED, run, len(run.result.steps_t) - 1, ""
             run = run_scene(scene, "aba", urdf)
             return ABA, run, len(run.integration.steps_t) - 1, ""

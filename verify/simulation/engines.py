@@ -7,8 +7,9 @@ engine              q̈
 ==================  =========================================================================
 ``closed_form``     the project's closed form as ``pendverify.simulation.dynamics`` evaluates it:
                     M(q)⁻¹ (τ − C(q, q̇) q̇ − H(q)) with numpy, model coordinates
-``compiled``        the fast path's compiled closed form (``pendverify.numerics.fastpath``), called
-                    from Python: what is left is scipy's own overhead
+``compiled``        the fast path's compiled closed form
+                    (``pendverify.numerics.integrators.dop853_runner``), called from Python:
+                    what is left is scipy's own overhead
 ``aba``             ``pinocchio.aba(q, v, τ)``
 ``crba_cholesky``   ``crba`` → ``cholesky.decompose`` → ``cholesky.solve(τ − rnea(q, v, 0))``
 ``minverse``        ``computeMinverse(q) @ (τ − rnea(q, v, 0))``

@@ -15,8 +15,9 @@ step is ``x_new = explicit_rk_step(f, t, x, h, tableau, k1=None)``.
 * ``fixedstep``: the compiled fast path, numba templates copied into each model's generated
   module: the run of each tableau written from it (``render_explicit_runs``), and the two
   implicit symplectic methods; ``fixedstep_runner`` runs them.
-* ``dop853``: scipy's adaptive DOP853 step for step, compiled the same way
-  (``pendverify.numerics.fastpath`` runs it).
+* ``dop853``: scipy's adaptive DOP853 step for step, compiled the same way; ``dop853_runner``
+  runs it on one state or an ensemble (the fast path; ``pendverify.simulation.compiled_scene``
+  runs a scene on it).
 * ``taylor``: the Taylor-series reference in high precision (``pendverify.numerics.reference``).
 
 scipy's ``solve_ivp`` (RK45, DOP853, Radau, BDF, LSODA, RK23) is called by the scene driver

@@ -28,7 +28,7 @@ rtol and atol: the same nfev and step count, each step equal to scipy's step fro
 the same state within the rounding of its stage sums (computed in another order),
 step sizes within the jitter that rounding of the error estimate explains (up to
 ≈ 1e-7 relative; on a chaotic trajectory the final states of the two then differ
-by a change of truncation error, ≈ 1e-10 at rtol 1e-5); ``tests/numerics/test_fastpath.py``
+by a change of truncation error, ≈ 1e-10 at rtol 1e-5); ``tests/numerics/test_dop853_runner.py``
 derives each bound.  So the fast path is as accurate as scipy's DOP853.
 Against the high-precision references (``pendverify.numerics.reference``), the tests
 check a final-state error ≤ 100 · rtol · (1 + ‖x‖∞) for rtol ≤ 1e-8 over
@@ -37,7 +37,7 @@ chaotic pendulum over 2 s.
 
 The fast path is the model's closed form; that the closed form agrees with
 Pinocchio is what ``pendverify check`` establishes (ε-level, every check).
-``pendverify.numerics.fast_scene.simulate_compiled`` runs a scene — a reference system's or a plug-in
+``pendverify.simulation.compiled_scene.simulate_compiled`` runs a scene — a reference system's or a plug-in
 model's — on the fast path and evaluates the *same* invariants as ``pendverify.simulation.simulate``
 (``pendverify.simulation.invariants``), on the fast path's own steps, with the same
 adaptive bound.

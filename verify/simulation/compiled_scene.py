@@ -17,8 +17,8 @@ import numpy as np
 
 from pendverify.errors import FastPathError
 from pendverify.numerics.energies import GeneratedEnergies
-from pendverify.numerics.fastpath import FastResult, integrate
 from pendverify.numerics.generate import GeneratedSystem
+from pendverify.numerics.integrators.dop853_runner import FastResult, integrate
 from pendverify.simulation.dynamics import build_dynamics
 from pendverify.simulation.invariants import adaptive_bound, energy_scale, evaluate
 

@@ -16,9 +16,10 @@ from scipy.integrate._ivp import dop853_coefficients
 from pendverify.analytic import MODELS
 from pendverify.bench.workprecision import make_problem
 from pendverify.errors import FastPathError
-from pendverify.numerics import fast_scene, fastpath, reference
+from pendverify.numerics import reference
 from pendverify.numerics.generate import GeneratedSystem
-from pendverify.numerics.integrators import taylor
+from pendverify.numerics.integrators import dop853_runner, taylor
+from pendverify.simulation import compiled_scene
 from pendverify.simulation.dynamics import build_dynamics
 from pendverify.simulation.scene import load_scene, parse_scene
 
@@ -226,8 +227,8 @@ def _compare_with_scipy(key, tol, ours_system=None, scipy_tol=None) -> _Comparis
     problem = make_problem(key, T_STEPS)
     f, x0, grid, T = problem.fast.scipy_rhs(), problem.x0, problem.grid, T_STEPS
     ours_system, scipy_tol = ours_system or problem.fast, scipy_tol or tol
-    ours = fastpath.integrate(ours_system, x0, T, tol, tol, record=True)
-    dense = fastpath.integrate(ours_system, x0, T, tol, tol, t_out=grid, record=True)
+    ours = dop853_runner.integrate(ours_system, x0, T, tol, tol, record=True)
+    dense = dop853_runner.integrate(ours_system, x0, T, tol, tol, t_out=grid, record=True)
     assert np.array_equal(dense.steps_t, ours.steps_t) and np.array_equal(dense.dense[0], x0)
     theirs = solve_ivp(f, (0, T), x0, "DOP853", rtol=scipy_tol, atol=scipy_tol)
     t, X, N = ours.steps_t, ours.steps_x, ours.steps
@@ -325,7 +326,7 @@ def test_fast_path_agrees_with_the_reference_to_its_stated_accuracy(key, duratio
     ref = reference.reference(problem.fast, problem.x0, duration, problem.grid, *REF_DIGITS)
     assert ref.error_bound < 1e-18, ref.describe()
     for tol in (1e-8, 1e-10, 1e-12):
-        res = fastpath.integrate(problem.fast, problem.x0, duration, tol, tol, t_out=problem.grid)
+        res = dop853_runner.integrate(problem.fast, problem.x0, duration, tol, tol, t_out=problem.grid)
         stated = ACCURACY_FACTOR * tol * (1 + np.max(np.abs(ref.hi)))
         err = ref.final_error(res.x)
         assert err <= stated, f"{key=} {tol=}: final error {err:.2e} > {stated:.2e}"
@@ -336,7 +337,7 @@ def test_headline_accuracy_on_the_chaotic_pendulum():
     """The README's claim: rtol = atol = 1e-11 reaches a final error ≤ 1e-10 over T = 2 s."""
     problem = make_problem("chaotic", 2.0, 4)
     ref = reference.reference(problem.fast, problem.x0, 2.0, problem.grid, *REF_DIGITS)
-    res = fastpath.integrate(problem.fast, problem.x0, 2.0, 1e-11, 1e-11)
+    res = dop853_runner.integrate(problem.fast, problem.x0, 2.0, 1e-11, 1e-11)
     assert ref.final_error(res.x) <= 1e-10, ref.final_error(res.x)
 
 
@@ -373,15 +374,15 @@ def test_energy_of_the_reference_is_the_models(name):
 def test_ensemble_is_the_single_runs():
     problem = make_problem("chaotic", 0.5)
     X0 = problem.x0 + np.random.default_rng(SEED).uniform(-0.05, 0.05, (6, 4)) * [1, 1, 0, 0]
-    X, nfev = fastpath.integrate_ensemble(problem.fast, X0, 0.5, 1e-9, 1e-9, threads=2)
+    X, nfev = dop853_runner.integrate_ensemble(problem.fast, X0, 0.5, 1e-9, 1e-9, threads=2)
     for i, x0 in enumerate(X0):
-        single = fastpath.integrate(problem.fast, x0, 0.5, 1e-9, 1e-9)
+        single = dop853_runner.integrate(problem.fast, x0, 0.5, 1e-9, 1e-9)
         assert np.array_equal(X[i], single.x) and nfev[i] == single.nfev, f"member {i}"
 
 
 @pytest.mark.parametrize("name", ["chaotic_double_pendulum", "damped_double_pendulum", "cart_rods_falling"])
 def test_fast_path_passes_the_simulators_invariants(name):
-    run = fast_scene.simulate_compiled(load_scene(REPO / "scenes" / f"{name}.toml"))
+    run = compiled_scene.simulate_compiled(load_scene(REPO / "scenes" / f"{name}.toml"))
     assert run.invariants, name
     assert run.passed, [(i.name, i.error, i.tolerance) for i in run.invariants]
     assert np.all(np.isfinite(run.x))
@@ -390,4 +391,4 @@ def test_fast_path_passes_the_simulators_invariants(name):
 def test_laws_with_jumps_are_refused_by_name():
     """A sine compiles (tests/numerics/test_fast_forcing.py); an impulse does not."""
     with pytest.raises(FastPathError, match=r"effects\.disturbance"):
-        fast_scene.simulate_compiled(load_scene(REPO / "scenes" / "cart_lqr_push.toml"))
+        compiled_scene.simulate_compiled(load_scene(REPO / "scenes" / "cart_lqr_push.toml"))
