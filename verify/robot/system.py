@@ -55,6 +55,10 @@ class PinocchioSystem:
     and the rest take and return the model's coordinates (``cmap`` maps them to the URDF's
     joints); ``geometry`` is what the model's reader saw in the URDF (its parameters, where it
     reads them), ``notes`` what loading noticed, ``source`` where the URDF came from.
+
+    Made by ``for_model`` (a model class and a description); ``for_params`` and ``from_urdf`` are
+    ``for_model`` for a built-in model; ``with_map`` and ``with_gravity`` derive a system from one
+    already read.  The constructor takes the parts these have read.
     """
 
     def __init__(
