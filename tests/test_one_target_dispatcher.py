@@ -20,6 +20,8 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
+from tests.source_scan import docstring_ids
+
 REPO = Path(__file__).resolve().parents[1]
 HOME = "verify/targets.py"
 SCANNED = ("verify", "viz")
@@ -27,16 +29,6 @@ SENTENCES = ("give the parameter set", "the URDF to verify", "the URDF to certif
 READERS = {"parameter_values", "plugin_parameters", "load_parameter_file"}
 BUILDERS = {"for_model", "for_params", "from_urdf"}
 TARGET_BUILDERS = {"default_target", "model_target", "params_target", "erd_target", "plugin_target"}
-
-
-def _docstrings(tree: ast.AST) -> set[int]:
-    ids = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Module | ast.ClassDef | ast.FunctionDef | ast.AsyncFunctionDef):
-            body = node.body
-            if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant):
-                ids.add(id(body[0].value))
-    return ids
 
 
 def _called(node: ast.AST) -> set[str]:
@@ -51,7 +43,7 @@ def _called(node: ast.AST) -> set[str]:
 def second_dispatchers(source: str) -> list[str]:
     """What in one module's source chooses targets beside ``pendverify.targets`` (module docstring)."""
     tree = ast.parse(source)
-    docstrings = _docstrings(tree)
+    docstrings = docstring_ids(tree)
     found = []
     for node in ast.walk(tree):
         if isinstance(node, ast.Constant) and isinstance(node.value, str) and id(node) not in docstrings:

@@ -26,6 +26,8 @@ from pathlib import Path
 
 import pytest
 
+from tests.source_scan import docstring_ids
+
 REPO = Path(__file__).resolve().parents[1]
 SCANNED = ("verify", "viz")
 #: the reference systems' model names, which are also their modules' names in ``analytic/``
@@ -40,16 +42,6 @@ ALLOWED = {
     # sets, which hard states), keyed by the models' names; every case takes its model and set from it
     "verify/stress/catalogue.py",
 }
-
-
-def _docstrings(tree: ast.AST) -> set[int]:
-    ids = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Module | ast.ClassDef | ast.FunctionDef | ast.AsyncFunctionDef):
-            body = node.body
-            if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant):
-                ids.add(id(body[0].value))
-    return ids
 
 
 def _identifiers(node: ast.AST) -> list[str]:
@@ -72,7 +64,7 @@ def references(source: str) -> list[tuple[int, str]]:
     """(line, what) for each place ``source`` names a reference system in code (see the module
     docstring); docstrings and prose strings aside."""
     tree = ast.parse(source)
-    skip = _docstrings(tree)
+    skip = docstring_ids(tree)
     found = []
     for node in ast.walk(tree):
         line = getattr(node, "lineno", 0)
