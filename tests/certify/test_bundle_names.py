@@ -69,7 +69,7 @@ def test_sweep_set_names_are_checked_before_any_set_runs():
 def _bundle(tmp_path, name: str, force: bool = True):
     params = default_params("double_pendulum")
     cert = {"schema": "x", "checks": [], "settings": {}, "model": "double_pendulum"}
-    return write_bundle(tmp_path / "out", name, params, "<robot/>", cert, force)
+    return write_bundle(tmp_path / "out", name, params, "<robot/>", cert, force, description_format="urdf")
 
 
 def test_a_bundle_write_outside_the_folder_is_refused_even_past_the_name_check(tmp_path):

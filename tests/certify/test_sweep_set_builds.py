@@ -10,7 +10,8 @@ other XML parser Python offers (expat parsers created, ElementTree's and defused
 parser of pendverify's own parse) and URDF texts parsed by urdfdom
 (``pinocchio.buildModelFromXML``, the build of the system's model).  The stress cases at another
 g (zero gravity) derive their system from the set's (``PinocchioSystem.with_gravity``) instead of
-building one.
+building one.  Writing the set's certificate (``issue.write_sweep_certificates``, in the main
+process) parses nothing: the bundle names the description's file by the format the battery read.
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ import defusedxml.ElementTree as DET
 import pinocchio as pin
 import pytest
 
+from pendverify.certify.issue import write_sweep_certificates
 from pendverify.certify.sweep import load_sweep
 from pendverify.certify.sweep_task import certify_chunk
 from pendverify.robot import description, xml_reading
@@ -90,6 +92,8 @@ def test_a_sweep_set_builds_its_system_once_and_reads_its_urdf_once(tmp_path, mo
     (result,) = certify_chunk(sweep.model, sweep.sets[1:2], settings, sweep.urdf, sweep.base)
     assert result.passed, result
     assert {i.name.split(":")[0] for i in result.items} == {"check", "stress", "invariant"}, result.items
+    assert write_sweep_certificates(sweep, [result], tmp_path / "out") == 1
+    assert (tmp_path / "out" / f"{result.name}.urdf").read_text() == result.urdf
     # one expat parser: the one ``_parse`` runs; "other xml" absent
     expected = Counter(built=1, read=1, xml=1, expat=1, parsed=1, derived=1)
     assert counts == expected, f"{plugin=} {counts=}"

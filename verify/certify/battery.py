@@ -52,11 +52,13 @@ class BatteryRun:
     """The battery's evidence on one set: every item, and what reading the URDF being
     certified noticed (``PinocchioSystem.notes``), which its certificate records as ``notes``;
     ``not_run``: one sentence per part of the battery that does not apply to the model, why
-    (``invariants_not_run``), also among ``notes``."""
+    (``invariants_not_run``), also among ``notes``; ``description_format``: the format of the
+    description certified (``robot.description.FORMATS``), which names its file in the bundle."""
 
     items: list[Evidence]
     notes: list[str]
     not_run: tuple[str, ...] = ()
+    description_format: str = "urdf"
 
     @property
     def passed(self) -> bool:
@@ -176,4 +178,4 @@ def run_battery(
             items += part()
             progress.update(1)
     skipped = (not_run,) if not_run else ()
-    return BatteryRun(items, [*system.notes, *skipped], skipped)
+    return BatteryRun(items, [*system.notes, *skipped], skipped, loaded.format)

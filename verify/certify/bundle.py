@@ -77,12 +77,17 @@ def write_bundle(
     force: bool = False,
     model=None,
     key=None,
+    *,
+    description_format: str,
 ) -> Path:
     """Write the bundle (``key``, an Ed25519 private key, signs it: NAME.intoto.jsonl), the
-    certificate last.  An existing bundle is never replaced unless ``force``."""
+    certificate last.  An existing bundle is never replaced unless ``force``.
+    ``description_format``: the format of ``urdf`` as its reading found it
+    (``BatteryRun.description_format``), which gives its file's suffix."""
     refuse_existing(directory, name, force)
     Path(directory).mkdir(parents=True, exist_ok=True)
-    urdf_path, params_path, cert_path = bundle_paths(directory, name, text_suffix(urdf))
+    suffix = FILE_SUFFIXES[description_format]
+    urdf_path, params_path, cert_path = bundle_paths(directory, name, suffix)
     files = {urdf_path: urdf, params_path: params.to_toml(name)}
     if model is not None and not model.builtin:
         files[model_path(directory, name, model.file)] = model.text

@@ -187,7 +187,9 @@ def write_certificate(
     check_name(name, "<certify>", "name")
     keyid = fingerprint(key.public_key()) if key is not None else None
     cert = build_certificate(name, model, params, urdf, settings, battery, keyid=keyid)
-    path = write_bundle(output, name, params, urdf, cert, force, model, key)
+    path = write_bundle(
+        output, name, params, urdf, cert, force, model, key, description_format=battery.description_format
+    )
     return cert, path
 
 
