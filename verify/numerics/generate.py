@@ -17,7 +17,8 @@ writes one Python module per model:
   eliminated (``sympy.cse``), floats as exact literals;
 * the DOP853 stepper of ``pendverify.numerics.integrators.dop853`` and the fixed-step methods of
   ``pendverify.numerics.integrators.fixedstep``, copied from their templates so that they call this
-  model's functions inlined (``codegen.templates``, which says why copied);
+  model's functions directly (``codegen.templates``, which says why copied; inlined where short,
+  ``codegen.compiled``);
 * plain-Python ``field``, ``energy`` and ``potential`` generic over the number type
   (float, numpy, mpmath, Decimal, Taylor series) for the high-precision references
   (``codegen.generic``).

@@ -7,7 +7,8 @@ generated and the packed layout).  The pieces:
 * ``printers``: SymPy printers for numba (floats) and for generic numbers (``N``);
 * ``ldlt``: the unrolled root-free Cholesky solve both renderers share;
 * ``templates``: functions written once in dop853 / fixedstep and copied into
-  each generated module, so that they inline that model's right-hand side;
+  each generated module, so that they call that model's right-hand side directly (inlined
+  where short);
 * ``compiled``: the numba functions ``_rhs``, ``_hamilton``, ``_to_momentum``;
 * ``generic``: the plain-Python ``field``, ``energy`` and ``potential`` (Taylor, mpmath);
 * ``cache``: the on-disk cache of generated modules, keyed by the model's source;

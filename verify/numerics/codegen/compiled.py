@@ -24,6 +24,24 @@ fixed-step methods of ``fixedstep``, and ``fixedstep_runner.integrate_fixed`` re
 system with forcing).
 
 All three read the packed array P (layout in ``pendverify.numerics.generate``).
+
+Inlining.  The integrators copied into the module (``codegen.templates``) call ``_rhs_t`` and
+``_rhs`` at several sites (DOP853 four, the fixed-step methods five); numba's ``inline="always"``
+types and lowers the whole body again at each, so the compile time grows with body × sites, while
+what inlining saves per evaluation (a call, and the stage arrays known apart) is fixed.  Measured
+on one core (a 2-core VM, numba 0.68; first compilation of DOP853 and the fixed-step ``_run``,
+then their runs, the same functions called instead of inlined):
+
+===============  ==========  ========================  =======================
+model            body lines  compile, inlined / called  run when called
+===============  ==========  ========================  =======================
+single pendulum  45          11.9 s / 9.2 s            +21–27 % (euler, rk4)
+triple pendulum  109         16.6 s / 9.1 s            +11–13 % (dop853, rk4)
+5-link chain     303         32.7 s / 11.9 s           +3–5 % (rk4, euler)
+===============  ==========  ========================  =======================
+
+Inlining pays for itself while the body is short: up to ``INLINE_LINES`` lines it is inlined, a
+longer body is called (compiling in about a third of the time for a few per cent of run time).
 """
 
 from __future__ import annotations
@@ -34,6 +52,8 @@ from pendverify.numerics.codegen.ldlt import ldlt_lines
 from pendverify.numerics.codegen.printers import numba_printer
 
 HEADER = 2  # P[0] = n, P[1] = nu
+#: the longest ``_rhs_t`` body (lines) that is inlined at its call sites (module docstring)
+INLINE_LINES = 200
 
 
 def _reads(ex: Expressions, state: str, rates: bool) -> list[str]:
@@ -140,8 +160,9 @@ def render_rhs(ex: Expressions) -> list[str]:
         f"    out[{2 * n}] = " + " + ".join(f"v{i}*ti{i}" for i in range(n)),
         f"    out[{2 * n + 1}] = -(" + " + ".join(f"v{i}*td{i}" for i in range(n)) + ")",
     ]
-    autonomous = _function("_rhs", "P, x, out", ["_rhs_t(P, 0.0, x, out)"], inline=True)
-    return [*_function("_rhs_t", "P, t, x, out", body, inline=True), "", *autonomous]
+    inline = len(body) <= INLINE_LINES
+    autonomous = _function("_rhs", "P, x, out", ["_rhs_t(P, 0.0, x, out)"], inline=inline)
+    return [*_function("_rhs_t", "P, t, x, out", body, inline=inline), "", *autonomous]
 
 
 def render_hamilton(ex: Expressions) -> list[str]:

@@ -6,7 +6,8 @@ marked ``@template(...)``, calling placeholders (``_rhs = placeholder("_rhs")``)
 the model-specific functions.  ``copy`` reads their source with ``inspect`` and
 writes it into a generated module, decorated ``@njit(cache=True, error_model="numpy",
 ...)`` there, with the module-level constants they read as exact literals, so that
-each calls that model's ``_rhs`` (or ``_hamilton``) inlined — and numba caches them
+each calls that model's ``_rhs`` (or ``_hamilton``) directly — inlined where its body is short
+(``codegen.compiled``) — and numba caches them
 with the module.  Why copied and not passed as an argument: numba specialises a
 function on a dispatcher argument, but its on-disk cache keys that specialisation on
 the dispatcher object, so a new process never hits it and compiles again (≈ 10 s per

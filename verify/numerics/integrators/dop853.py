@@ -6,9 +6,9 @@ step factors in [0.2, 10], with scipy's 7th-order dense output when output
 times are asked for (3 extra evaluations per step that contains one, as scipy
 counts them).  The functions are *templates* (``pendverify.numerics.codegen.
 templates``): copied verbatim into each model's generated module, where they call
-that model's ``_rhs_t`` inlined and are compiled and cached with it
-(``pendverify.numerics.integrators.dop853_runner.integrate`` runs the copy).  They take one packed
-float array P (``GeneratedSystem.packed``).  Every evaluation is at its stage's
+that model's ``_rhs_t`` (inlined where short: ``codegen.compiled``) and are compiled and
+cached with it (``pendverify.numerics.integrators.dop853_runner.integrate`` runs the copy).
+They take one packed float array P (``GeneratedSystem.packed``).  Every evaluation is at its stage's
 time, t + c_s·h as scipy has it, so a system with time-varying forcing (a sine
 input, band-limited noise: ``pendverify.numerics.generate``) takes the steps scipy
 takes on the same right-hand side; without forcing, t is read by nothing.

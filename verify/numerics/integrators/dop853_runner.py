@@ -16,7 +16,7 @@ What is compiled.
   alike), under any time-invariant force law τ = B (u0 − K x) − D q̇;
 * ``_dop853``: scipy's DOP853 reproduced step for step
   (``pendverify.numerics.integrators.dop853``, a template copied into each model's generated
-  module, where it calls that model's ``_rhs`` inlined and is compiled and cached
+  module, where it calls that model's ``_rhs`` (inlined where short) and is compiled and cached
   with it); ``integrate`` runs the generated module's copy.
 * ``integrate_ensemble``: many initial states at once, one compiled DOP853 per
   state with its own step control; the kernel releases the GIL, so a pool of

@@ -5,8 +5,9 @@ same parameters, same force law τ = B (u0 − K x) − D q̇), compiled with nu
 that a million Euler steps cost milliseconds and the methods are compared on
 equal terms.  The functions below are templates (``numerics.codegen.templates``),
 copied into each model's generated module, where ``_run`` calls that model's
-``_rhs`` and ``_hamilton`` inlined; ``fixedstep_runner.integrate_fixed`` runs the
-module's copy.  This module holds the templates and their constants only.
+``_rhs`` (inlined where short: ``codegen.compiled``) and ``_hamilton``;
+``fixedstep_runner.integrate_fixed`` runs the module's copy.  This module holds the templates
+and their constants only.
 
 =====================  =====  ===========================================================
 method                 order  one step, h
