@@ -86,9 +86,14 @@ COMMANDS = {
 }
 
 #: the bench's accuracy study on a model's scene (≈ 10 to 35 s: its fixed-step methods compiled) and
-#: certify+recheck (≈ 5 to 25 s: the battery) are slow
+#: certify+recheck (≈ 5 to 25 s: the battery) are slow, and most of that is compiling the model's
+#: code: they run here on the model written in this test; on the shipped examples and the text
+#: models the conformance matrix (tests/conformance: every system and format, the text and LaTeX
+#: formats included, through these two commands) and the certificate tests (certify/test_certify:
+#: every shipped example; analytic/test_text_model: the SymPy-syntax example) cover them
 SLOW_COMMANDS = ("bench", "certify+recheck")
 COMMAND_PARAMS = [pytest.param(c, marks=pytest.mark.slow) if c in SLOW_COMMANDS else c for c in COMMANDS]
+FAST_COMMANDS = [c for c in COMMANDS if c not in SLOW_COMMANDS]
 
 WRITTEN_HERE = '''"""The cart-pole, written again in a file of this test: a user's own model."""
 
@@ -108,7 +113,7 @@ def _written_here(tmp_path: Path) -> Path:
     return path
 
 
-@pytest.mark.parametrize("command", COMMAND_PARAMS)
+@pytest.mark.parametrize("command", FAST_COMMANDS)
 @pytest.mark.parametrize("stem", [s for s in STEMS if s not in TEXT_ONLY])
 def test_each_command_on_each_example(command, stem, tmp_path, capsys):
     model = Model(EXAMPLES / f"{stem}.py", stem, tmp_path)
@@ -140,7 +145,7 @@ TEXT_MODELS = {
 }
 
 
-@pytest.mark.parametrize("command", COMMAND_PARAMS)
+@pytest.mark.parametrize("command", FAST_COMMANDS)
 @pytest.mark.parametrize("kind", list(TEXT_MODELS))
 def test_each_command_on_a_text_model(kind, command, tmp_path, capsys):
     """A model written as text (TOML, SymPy syntax or LaTeX): every command takes it too."""
