@@ -1,5 +1,6 @@
 """The checks: one Pinocchio quantity against its closed form, on many states.
 
+``Check`` is what a check is; what it reports is an ``Evidence`` (``pendverify.checks.evidence``).
 ``CHECKS`` names each check, what it compares and its constant K; what it measures at
 one state (error and scale) is in ``pendverify.checks.quantities``, which checks apply
 to a model in ``pendverify.checks.applicability``, and the scaled coordinates the
@@ -37,6 +38,10 @@ share, ``pendverify.checks.judge.collect`` forms the tolerance above as arrays a
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
 from pendverify.checks import quantities
 from pendverify.checks.applicability import (
     hand_written,
@@ -49,17 +54,38 @@ from pendverify.checks.applicability import (
 from pendverify.checks.batch import CheckBatch
 from pendverify.checks.evidence import Evidence
 from pendverify.checks.judge import collect, conclude
-from pendverify.checks.result import Check
+
+if TYPE_CHECKING:
+    from pendverify.analytic import ClosedFormModel
+    from pendverify.checks.quantities import Measure, Terms
+    from pendverify.robot.system import PinocchioSystem
 
 __all__ = [
     "CHECKS",
     "CHECK_NAMES",
+    "Check",
     "applicable_checks",
     "not_applicable",
     "run_check",
     "run_checks",
     "skipped_notes",
 ]
+
+
+@dataclass(frozen=True)
+class Check:
+    """One comparison: a Pinocchio quantity against its closed form, judged with the constant K."""
+
+    name: str
+    pinocchio: str
+    closed_form: str
+    K: float
+    #: the check's measure at every state of a batch (``pendverify.checks.quantities``)
+    measure: Callable[[Terms], Measure]
+    #: "" when the check applies to this model and system, else why it is not run
+    requires: Callable[[ClosedFormModel, PinocchioSystem | None], str] = lambda model, system: ""
+    #: whether the Pinocchio side is computed by its world-frame recursions (then A counts)
+    world_frame: bool = True
 
 
 CHECKS: tuple[Check, ...] = (

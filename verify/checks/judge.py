@@ -15,15 +15,18 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from pendverify.checks.batch import CheckBatch
 from pendverify.checks.evidence import Evidence
-from pendverify.checks.result import Check
 from pendverify.checks.sampling import State
 from pendverify.checks.trust import EPS, REFUSE_REL
 from pendverify.checks.verdict import FAIL, PASS, REFUSED, WARN
+
+if TYPE_CHECKING:
+    from pendverify.checks.catalogue import Check
 
 
 @dataclass(frozen=True)
