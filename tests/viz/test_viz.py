@@ -58,7 +58,7 @@ SHOT_GAP_S = 1.0
 #: animation by its clock's time since the last frame (meshcat's ``Animator.update``) and
 #: ``RECORD_FRAMES`` reads the page's clock in the same frame, so over the ≥ 0.5 s compared the two
 #: differ by the order of one frame's script time (milliseconds): 1 within 10 % (``RATE_SLACK``) —
-#: plus, where the two run in separate frame callbacks, one frame's advance (``rate_band``)
+#: plus, where the two run in separate frame callbacks, one frame's advance (``RecordedRate.band``)
 RATE_SLACK = 0.1
 #: records, at every animation frame, the page's clock and the animation's [s]: the rate is measured
 #: between frames, so how late the test reads them (on a loaded machine, seconds) does not enter it
