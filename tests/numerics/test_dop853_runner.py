@@ -290,6 +290,16 @@ def _compare_with_scipy(key, tol, ours_system=None, scipy_tol=None) -> _Comparis
     )
 
 
+def test_the_stages_are_compiled_once():
+    """A step's stages and the dense output's extra stages call ``_stages`` with other bounds:
+    one compilation serves both (``dop853._stages``: constants passed as ``np.int64``, which
+    numba would otherwise type by their value and compile again)."""
+    system = GeneratedSystem.from_model(MODELS["double_pendulum"](default_params("double_pendulum")))
+    res = dop853_runner.integrate(system, np.array([0.4, -0.3, 0.0, 0.2]), 0.5, 1e-8, 1e-8, t_out=[0.25])
+    assert res.steps > 1
+    assert len(system.kernel.module._stages.signatures) == 1, system.kernel.module._stages.signatures
+
+
 @pytest.mark.parametrize("key", ["chaotic", "cart_lqr"])
 @pytest.mark.parametrize("tol", [1e-5, 1e-9])
 def test_dop853_takes_scipys_steps(key, tol):
