@@ -180,6 +180,12 @@ def load_model_class(path: str | Path) -> type[ClosedFormModel]:
         cls = load_text_model(path)
         validate_model_class(cls, path)
         return cls
+    if path.suffix.lower() == ".m":
+        raise PendverifyError(
+            f"{path}: a MATLAB file is read through a declaration: write a text model (.toml) with its "
+            f'coordinates, parameters and [matlab] files = ["{path.name}"], and give that '
+            "(docs/matlab.md)"
+        )
     if path.suffix != ".py":
         kind = suffix_kind(path)
         if kind is not None and kind != "model":

@@ -16,6 +16,8 @@ import sys
 
 #: the attribute of a text model's stand-in module that holds the text file's path
 TEXT_FILE = "text_model_file"
+#: the attribute that holds the paths of the other files the text model reads (its ``.m`` files)
+COMPANION_FILES = "text_model_companions"
 
 
 def defining_file(cls: type) -> str:

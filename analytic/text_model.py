@@ -31,7 +31,7 @@ from pendverify.analytic.forms import Energies
 from pendverify.analytic.interface import AccelerationOnlyModel, BiasOnlyModel, ClosedFormModel
 from pendverify.analytic.module_names import module_name
 from pendverify.analytic.parameter_set import ParameterSet
-from pendverify.analytic.source_file import TEXT_FILE
+from pendverify.analytic.source_file import COMPANION_FILES, TEXT_FILE
 from pendverify.analytic.text_parse import EQUATIONS, Reader, TextModelSpec, read_text_model
 from pendverify.display import shortened
 
@@ -332,6 +332,8 @@ def build_model_class(
     if module is None:
         module = types.ModuleType(module_name(spec.path))
         setattr(module, TEXT_FILE, str(spec.path))
+        if spec.matlab is not None:
+            setattr(module, COMPANION_FILES, tuple(str(p) for p in spec.matlab.files))
         sys.modules[module.__name__] = module
     params_type = parameter_type(spec, class_name)
     namespace = {

@@ -35,6 +35,7 @@ from pathlib import Path
 
 import sympy as sp
 
+from pendverify.analytic.matlab_model import read_matlab, whole_output
 from pendverify.analytic.matrix_equation import matrix_text, read_matrix_equation
 from pendverify.analytic.matrix_equation_parse import names_vectors
 from pendverify.analytic.parameter_set import KIND_RULES
@@ -50,7 +51,7 @@ CONSTANTS = {"pi": sp.pi}
 TOP_KEYS = (
     "name", "notation", "coordinates", "inputs", "disturbances", "parameters", "symbols", "urdf",
     "M", "C", "C_plus_D", "Cqdot", "H", "V", "D", "B", "W", "f", "det_M", "M_inv", "qddot",
-    "G", "h", "equations",
+    "G", "h", "equations", "matlab",
 )  # fmt: skip
 #: the keys of a declaration without equations (a Python model file's ``DECLARATION``, the API's
 #: ``declaration``): the equations come from elsewhere (``pendverify.analytic.mechanics_model``)
@@ -137,6 +138,8 @@ class TextModelSpec:
     urdf_joints: tuple[str, ...] = ()
     joint_transform: tuple | None = None
     joint_offset: tuple | None = None
+    #: with a [matlab] table: the .m files read and where their outputs were written
+    matlab: object = None
 
 
 class Reader:
@@ -313,10 +316,35 @@ def _read_equations(reader: Reader, spec: TextModelSpec, data: dict) -> None:
         refuse_toml_escapes(reader, data, EQUATIONS)
         everything = {s.name: s for g in "qvuwap" for s in spec.symbols[g]} | FUNCTIONS | CONSTANTS
         latex = read_symbol_table(reader, data.get("symbols"), everything, parse_entry, spec)
+    outputs: dict = {}
+    if "matlab" in data:
+        if latex is not None:
+            reader.fail(
+                "matlab", 'the equations of a [matlab] table are read as SymPy, not notation = "latex"'
+            )
+        spec.matlab, outputs = read_matlab(reader, spec, data["matlab"])
+        if not any(key in data for key in EQUATIONS):
+            reader.fail(
+                "matlab", "says which files, but no key says which output is which: give M, f, qddot, …"
+            )
+    scalars = {k: v for k, v in outputs.items() if not isinstance(v, sp.MatrixBase)}
     for key, (shape, groups) in EQUATIONS.items():
         if key not in data:
             continue
         allowed = {s.name: s for g in groups + "p" for s in spec.symbols[g]} | FUNCTIONS | CONSTANTS
+        if outputs:
+            spec.matlab.written[key] = data[key]
+            rows = n if shape else 0
+            cols = dims[shape[1]] if len(shape) == 2 else None
+            whole = (
+                whole_output(reader, spec.matlab, outputs, key, data[key], (rows, cols))
+                if rows and shape != "e"
+                else None
+            )
+            if whole is not None:
+                spec.equations[key] = whole
+                continue
+            allowed = allowed | scalars
         if shape == "e":
             _read_whole_equations(reader, spec, data, key, allowed, latex)
             continue

@@ -54,7 +54,7 @@ KINDS = {
 
 #: top-level TOML keys that only one kind of document holds
 TOML_MARKERS = {
-    "model": frozenset({"coordinates", "notation", "M", "f", "qddot", "equations"}),
+    "model": frozenset({"coordinates", "notation", "M", "f", "qddot", "equations", "matlab"}),
     "scene": frozenset({"initial", "time", "integrator", "effects", "engine"}),
     "sweep": frozenset({"ranges", "base", "mode", "count"}),
 }

@@ -39,7 +39,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from pendverify.analytic.source_file import defining_file
+from pendverify.analytic.source_file import COMPANION_FILES, defining_file
 from pendverify.atomic import write_atomic
 from pendverify.cache_location import cache_root
 from pendverify.errors import FileAccessError, PendverifyError
@@ -150,6 +150,7 @@ def _model_key(model_cls) -> str | None:
         for c in classes:
             files.add(defining_file(c))
             module = sys.modules.get(c.__module__)
+            files.update(getattr(module, COMPANION_FILES, ()))  # a text model's .m files
             for obj in vars(module).values() if module else ():
                 target = (
                     obj
