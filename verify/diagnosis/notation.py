@@ -6,6 +6,8 @@
   put back where its expression stands (SymPy's ``subs``, which also finds 2·I2 + 2·m2·r2²
   as 2·δ); the location is the file and the equation's key;
 * a text model file in SymPy syntax: SymPy's own printing over the file's names;
+* a declaration of ``.m`` files (``[matlab]``): MATLAB syntax (``sympy.octave_code``), and the
+  location of an entry the ``.m`` file's line where it is written (``MatlabSource.line_of``);
 * a repaired entry of either kind of file is the user's own text of the entry with the fewest
   terms changed, each changed term printed as above (``pendverify.diagnosis.source_edit``);
 * a Python class: the same printing, which is a Python expression over the class's names;
@@ -45,7 +47,8 @@ class Notation:
         spec = getattr(model_cls, "text_spec", None)
         if spec is None:
             return cls("python", where(model_cls), model_cls.__name__)
-        notation = cls(spec.notation, str(spec.path), model_cls.__name__, dict(spec.derived), spec=spec)
+        kind = "matlab" if spec.matlab is not None else spec.notation
+        notation = cls(kind, str(spec.path), model_cls.__name__, dict(spec.derived), spec=spec)
         for key, value in spec.latex_symbols.items():
             value = sp.sympify(value)
             if isinstance(value, sp.Symbol):
@@ -59,6 +62,8 @@ class Notation:
 
     def render(self, expr) -> str:
         """The expression as the model's source would write it."""
+        if self.kind == "matlab":
+            return sp.octave_code(expr)
         if self.kind != "latex":
             return str(expr)
         forms = []
@@ -74,7 +79,12 @@ class Notation:
         class, a key derived from others, or when the text is not found, both printed whole."""
         whole = self.render(old), self.render(new)
         key = TEXT_KEYS.get(method, method)
-        if self.spec is None or key in self.derived or key not in self.spec.equations:
+        if (
+            self.spec is None
+            or key in self.derived
+            or key not in self.spec.equations
+            or self.kind == "matlab"
+        ):
             return whole
         if not self._source:
             try:
@@ -92,10 +102,23 @@ class Notation:
         edited = minimal_edit(source, written, old, new, self.render)
         return written, edited if edited is not None else whole[1]
 
-    def location(self, method: str, label: str) -> str:
-        """Where the entry sits: the file, the key (or Class.method) and the entry."""
+    def location(self, method: str, label: str, index: int | None = None) -> str:
+        """Where the entry sits: the file, the key (or Class.method) and the entry; for an entry an
+        ``.m`` file writes (flat ``index``), that file and its line."""
         if self.kind == "python":
             return f"{self.source}, {self.class_name}.{method}, entry {label}"
         key = TEXT_KEYS.get(method, method)
+        if (
+            self.kind == "matlab"
+            and index is not None
+            and key in self.spec.equations
+            and key not in self.derived
+        ):
+            value = self.spec.equations[key]
+            position = entry_position(method, value.shape, index) if isinstance(value, sp.MatrixBase) else ()
+            found = self.spec.matlab.line_of(key, position, self.spec.matlab.entry_text(key, position))
+            if found is not None:
+                path, line = found
+                return f"{path}, line {line}, entry {label} (key {key} of {self.source})"
         how = f" (derived: {self.derived[key]})" if key in self.derived else ""
         return f"{self.source}, key {key}{how}, entry {label}"

@@ -514,7 +514,7 @@ def _findings(
     for (method, index), (old, new) in changes.items():
         label = entry_label(method, forms[method], index)
         written, suggested = notation.entry_edit(method, index, old, new)
-        location = notation.location(method, label)
+        location = notation.location(method, label, index)
         shown = (
             f"{written} → {suggested}"
             if len(written) + len(suggested) <= 160
