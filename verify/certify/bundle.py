@@ -91,9 +91,14 @@ def write_bundle(
     files = {urdf_path: urdf, params_path: params.to_toml(name)}
     if model is not None and not model.builtin:
         files[model_path(directory, name, model.file)] = model.text
+        for relative, text in model.companions:  # the files it reads, where it reads them
+            files[Path(directory) / relative] = text
     text = certificate_text(cert)
     if key is not None:
-        contents = {p.name: t.encode() for p, t in {**files, cert_path: text}.items()}
+        contents = {
+            Path(p).relative_to(directory).as_posix(): t.encode()
+            for p, t in {**files, cert_path: text}.items()
+        }
         configuration = {"schema": cert["schema"], "model": cert["model"], **cert["settings"]}
         files[envelope_path(directory, name)] = envelope_line(
             statement(contents, cert["checks"], configuration), key
@@ -103,12 +108,15 @@ def write_bundle(
     return cert_path
 
 
-def bundle_file_names(name: str) -> set[str]:
+def bundle_file_names(name: str, cert: dict | None = None) -> set[str]:
     """Every file name set ``name``'s bundle may hold besides its envelope (what a signed statement
-    may name as subjects)."""
+    may name as subjects): with the certificate ``cert``, the files its model reads too (a
+    declaration's .m files, by their paths relative to the bundle)."""
+    record = (cert or {}).get("model_source") or {}
+    companions = {c["file"] for c in record.get("companions", ())}
     descriptions = {f"{name}{suffix}" for suffix in FILE_SUFFIXES.values()}
     models = {model_path(".", name, f"model{suffix}").name for suffix in MODEL_SUFFIXES}
-    return {*descriptions, *models, *(p.name for p in bundle_paths(".", name))}
+    return {*descriptions, *models, *companions, *(p.name for p in bundle_paths(".", name))}
 
 
 def check_files_beside(cert_path: str | Path, cert: dict) -> None:
@@ -127,6 +135,7 @@ def check_files_beside(cert_path: str | Path, cert: dict) -> None:
     record = cert.get("model_source")
     if record is not None:
         embedded[model_path(".", name, record["file"]).name] = record["text"]
+        embedded.update({c["file"]: c["text"] for c in record.get("companions", ())})
     for file_name, text in embedded.items():
         path = cert_path.parent / file_name
         if not path.is_file():
@@ -184,7 +193,7 @@ def verify_signed_by(cert_path: str | Path, cert: dict, trusted, data: bytes, ke
     subjects = statement_subjects(stmt, str(envelope))
     if own not in subjects:
         raise SigningError(f"{envelope}: the signed statement does not name {own}; rejected")
-    foreign = sorted(set(subjects) - bundle_file_names(name))
+    foreign = sorted(set(subjects) - bundle_file_names(name, cert))
     if foreign:
         raise SigningError(
             f"{envelope}: the signed statement names {shortened(foreign[0], 80)!r}, not a file of set "

@@ -29,7 +29,13 @@ MODEL_FILE_RULE = (
     f"at most {MAX_FILE_NAME_BYTES} bytes"
 )
 
-_LOADED: dict[tuple[str, str], type[ClosedFormModel]] = {}  # (file name, sha256) -> class, per process
+#: the files a text model reads beside itself (its ``[matlab]`` files): a relative path of plain
+#: names ending in .m, inside the model file's folder
+COMPANION_RULE = (
+    "a path relative to the model file's folder, of plain names, ending in .m, not leaving the folder"
+)
+
+_LOADED: dict[tuple, type[ClosedFormModel]] = {}  # (file name, sha256s) -> class, per process
 
 
 def sha256_text(text: str) -> str:
@@ -43,6 +49,8 @@ class ModelSource:
     name: str  # the model's name (the class's ``name``)
     file: str = ""  # the model file's name, for messages and the bundle
     text: str = ""  # the model file's source; "" for a built-in model
+    #: the files the model file reads (a declaration's .m files): (path relative to it, text)
+    companions: tuple[tuple[str, str], ...] = ()
 
     @property
     def builtin(self) -> bool:
@@ -65,9 +73,13 @@ class ModelSource:
         path = Path(path)
         model_cls = load_model_class(path)
         text = path.read_text(encoding="utf-8")
-        source = cls(model_cls.name, path.name, text)
-        _LOADED[(source.file, source.sha256)] = model_cls
+        source = cls(model_cls.name, path.name, text, _companions(model_cls, path))
+        _LOADED[source.key] = model_cls
         return source
+
+    @property
+    def key(self) -> tuple:
+        return (self.file, self.sha256, *(sha256_text(t) for _, t in self.companions))
 
     @property
     def sha256(self) -> str:
@@ -77,9 +89,9 @@ class ModelSource:
         """The model class: built in, or imported from the embedded text (once per process)."""
         if self.builtin:
             return MODELS[self.name]
-        key = (self.file, self.sha256)
+        key = self.key
         if key not in _LOADED:
-            _LOADED[key] = load_from_text(self.text, self.file)
+            _LOADED[key] = load_from_text(self.text, self.file, self.companions)
         model_cls = _LOADED[key]
         if model_cls.name != self.name:
             raise PendverifyError(
@@ -89,7 +101,12 @@ class ModelSource:
 
     def as_record(self) -> dict:
         """The certificate's ``model_source`` field (plug-ins only)."""
-        return {"file": self.file, "text": self.text, "sha256": self.sha256}
+        record = {"file": self.file, "text": self.text, "sha256": self.sha256}
+        if self.companions:
+            record["companions"] = [
+                {"file": f, "text": t, "sha256": sha256_text(t)} for f, t in self.companions
+            ]
+        return record
 
     @classmethod
     def from_certificate(cls, cert: dict, source: str) -> ModelSource:
@@ -105,7 +122,42 @@ class ModelSource:
         problem = source_problem(record)
         if problem:
             raise PendverifyError(f"{source}: {problem}")
-        return cls(name, record["file"], record["text"])
+        companions = tuple((c["file"], c["text"]) for c in record.get("companions", ()))
+        return cls(name, record["file"], record["text"], companions)
+
+
+def _companions(model_cls, path: Path) -> tuple[tuple[str, str], ...]:
+    """The files a text model reads beside itself, as (relative path, text), each checked by
+    ``COMPANION_RULE`` (a certificate embeds them, and its bundle writes them beside the model)."""
+    matlab = getattr(getattr(model_cls, "text_spec", None), "matlab", None)
+    if matlab is None:
+        return ()
+    folder = path.resolve().parent
+    out = []
+    for file in matlab.files:
+        resolved = Path(file).resolve()
+        if not resolved.is_relative_to(folder):
+            raise PendverifyError(
+                f"{path}: key 'matlab.files': {file} is outside the model file's folder; a certificate "
+                "embeds the model's files by their place beside it: move it there"
+            )
+        relative = resolved.relative_to(folder).as_posix()
+        out.append((relative, resolved.read_text(encoding="utf-8", errors="replace")))
+    return tuple(out)
+
+
+def companion_problem(name: str) -> str:
+    """Why ``name`` cannot be an embedded companion's path (``COMPANION_RULE``), or ""."""
+    parts = name.split("/")
+    if (
+        not name.endswith(".m")
+        or any(p in ("", ".", "..") for p in parts)
+        or any(c == "\\" or ord(c) < 32 or ord(c) == 127 for c in name)
+        or any(len(p.encode("utf-8", "surrogatepass")) > MAX_FILE_NAME_BYTES for p in parts)
+        or len(parts) > 8
+    ):
+        return COMPANION_RULE
+    return ""
 
 
 def model_file_problem(name: str) -> str:
@@ -130,6 +182,24 @@ def source_problem(record) -> str:
     if model_file_problem(record["file"]):
         shown = shortened(record["file"], 60)
         return f"key 'model_source.file' = {shown!r}: expected {MODEL_FILE_RULE}"
+    companions = record.get("companions", [])
+    if not isinstance(companions, list) or not all(
+        isinstance(c, dict)
+        and set(c) == {"file", "text", "sha256"}
+        and all(isinstance(v, str) for v in c.values())
+        for c in companions
+    ):
+        return "key 'model_source.companions': expected a list of tables of strings file, text and sha256"
+    for c in companions:
+        if companion_problem(c["file"]):
+            return (
+                f"key 'model_source.companions' file {shortened(c['file'], 60)!r}: expected {COMPANION_RULE}"
+            )
+        if sha256_text(c["text"]) != c["sha256"]:
+            return (
+                f"key 'model_source.companions': the embedded {shortened(c['file'], 60)} does not match its "
+                "sha256: the model was edited after it was certified"
+            )
     computed = sha256_text(record["text"])
     if computed != record["sha256"]:
         return (
@@ -139,13 +209,21 @@ def source_problem(record) -> str:
     return ""
 
 
-def load_from_text(text: str, file_name: str) -> type[ClosedFormModel]:
-    """Import a model file's source through the plug-in loader, from a private temporary copy."""
+def load_from_text(text: str, file_name: str, companions=()) -> type[ClosedFormModel]:
+    """Import a model file's source through the plug-in loader, from a private temporary copy (and
+    of the files it reads, ``companions``: (relative path, text), checked by ``companion_problem``)."""
     name = Path(file_name).name or "model.py"
     with tempfile.TemporaryDirectory(prefix="pendverify-model-") as tmp:
         path = Path(tmp) / name
         path.write_text(text, encoding="utf-8")
         remember_text(path, text)  # the generated code's key outlives the temporary copy
+        for relative, companion in companions:
+            if companion_problem(relative):
+                raise PendverifyError(f"{name} (the embedded model source): {relative!r}: {COMPANION_RULE}")
+            target = Path(tmp) / relative
+            target.parent.mkdir(parents=True, exist_ok=True)
+            target.write_text(companion, encoding="utf-8")
+            remember_text(target, companion)
         try:
             return load_model_class(path)
         except PendverifyError as exc:

@@ -100,6 +100,7 @@ NESTED = {
             "file": _key(_model_file, f"a model file's name ({MODEL_FILE_RULE})"),
             "text": STRING,
             "sha256": HEX64,
+            "companions": _key(lambda v: isinstance(v, list), "a list of the files it reads", required=False),
         }
     ),
     "settings": _table(
