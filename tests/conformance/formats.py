@@ -425,6 +425,74 @@ def write_numpy_functions(model: Model) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _octave(expr) -> str:
+    return sp.octave_code(expr)
+
+
+def matlab_function(name: str, outputs: dict[str, sp.Matrix], arguments: dict[str, list | None]) -> str:
+    """A function file as ``matlabFunction`` writes one: the vector arguments unpacked (``q1 =
+    in1(1,:);``), common subexpressions as ``t2 = …;`` temporaries, each matrix output refilled
+    column by column (``reshape([…],[r,c])``) or a column literal, outputs after the first inside
+    ``if nargout > K`` blocks."""
+    entries = [e for m in outputs.values() for e in m.T]  # column-major, as reshape reads them
+    temporaries = sp.numbered_symbols("t", start=2)
+    shared, reduced = sp.cse(entries, symbols=temporaries, optimizations="basic")
+    lines = [
+        f"function [{','.join(outputs)}] = {name}({','.join(arguments)})",
+        f"%{name.upper()}",
+        f"%    [{','.join(outputs).upper()}] = {name.upper()}({','.join(arguments).upper()})",
+        "",
+        "%    Written by tests/conformance/formats.py in the style of matlabFunction.",
+        "",
+    ]
+    for argument, names in arguments.items():  # a vector argument unpacked; a scalar (None) as it is
+        lines += [f"{n} = {argument}({k + 1},:);" for k, n in enumerate(names or ())]
+    lines += [f"{t} = {_octave(e)};" for t, e in shared]
+    at = 0
+    for k, (output, matrix) in enumerate(outputs.items()):
+        values = [_octave(e) for e in reduced[at : at + len(matrix)]]
+        at += len(matrix)
+        if matrix.shape == (1, 1):
+            body = f"{output} = {values[0]};"
+        elif matrix.cols == 1:
+            body = f"{output} = [{';'.join(values)}];"
+        else:
+            body = f"{output} = reshape([{','.join(values)}],[{matrix.rows},{matrix.cols}]);"
+        lines += [body] if k == 0 else [f"if nargout > {k}", f"    {body}", "end"]
+    return "\n".join(lines) + "\n"
+
+
+def matlab_files(model: Model, stem: str) -> dict[str, str]:
+    """The ``.m`` files of the MATLAB format: M(in1, in2) and [C, G, B, V](in1, in2), in1 the
+    coordinates (and rates), in2 the parameters; D stays in the declaration, in SymPy syntax."""
+    f = model.forms
+    params = list(model.kinds)
+    q, dq = [str(s) for s in f.q], [str(s) for s in f.dq]
+    return {
+        f"{stem}_M.m": matlab_function(f"{stem}_M", {"M": f.M}, {"in1": q, "in2": params}),
+        f"{stem}_terms.m": matlab_function(
+            f"{stem}_terms",
+            {"C": f.C, "G": f.H, "B": f.B, "V": sp.Matrix([f.V])},
+            {"in1": q + dq, "in2": params},
+        ),
+    }
+
+
+def write_matlab(model: Model, stem: str) -> str:
+    """The declaration: which output is which key, and what in1 and in2 are in each file."""
+    f = model.forms
+    names = list(matlab_files(model, stem))
+    lines = [*_toml_head(model), 'M = "M"', 'C = "C"', 'H = "G"', 'B = "B"', 'V = "V"']
+    if _has_damping(model):
+        lines.append(f"D = {_toml_value(_rows(f.D))}")
+    lines += ["", "[matlab]", f"files = {_toml_value(names)}", ""]
+    lines += [f'[matlab.arguments."{names[0]}"]', f"in1 = {_toml_value([str(s) for s in f.q])}"]
+    lines += [f"in2 = {_toml_value(list(model.kinds))}", ""]
+    lines += [f'[matlab.arguments."{names[1]}"]', f"in1 = {_toml_value([str(s) for s in f.q + f.dq])}"]
+    lines += [f"in2 = {_toml_value(list(model.kinds))}"]
+    return "\n".join(lines) + "\n" + _toml_tables(model)
+
+
 def _numpy_functions_missing() -> str | None:
     if importlib.util.find_spec("pendverify.analytic.numpy_model") is None:
         return "this pendverify has no NumPy-functions model format (pendverify.analytic.numpy_model)"
@@ -435,11 +503,14 @@ def _numpy_functions_missing() -> str | None:
 class Format:
     """A model format: its writer, file suffix, whether SymPy sees its closed forms, a skip reason."""
 
-    write: Callable[[Model], str]
+    #: (model) → the model file's text; with companions, (model, the file's stem) → its text
+    write: Callable[..., str]
     suffix: str
     symbolic: bool
     #: the reason to skip the format's cells (None: pendverify takes it)
     missing: Callable[[], str | None] = lambda: None
+    #: the other files the model file reads, {name: text}, from the model and the file's stem
+    companions: Callable[[Model, str], dict[str, str]] | None = None
 
 
 FORMATS: dict[str, Format] = {
@@ -453,6 +524,7 @@ FORMATS: dict[str, Format] = {
     "dynamics_f": Format(lambda m: _write_dynamics(m, "f(x, u)"), ".py", symbolic=False),
     "dynamics_qddot": Format(lambda m: _write_dynamics(m, "qddot(q, v, u)"), ".py", symbolic=False),
     "numpy_functions": Format(write_numpy_functions, ".py", symbolic=False, missing=_numpy_functions_missing),
+    "matlab": Format(write_matlab, ".toml", symbolic=True, companions=matlab_files),
 }
 
 
@@ -461,8 +533,14 @@ def write_model(model: Model, format_name: str, folder: Path) -> Path:
     (the code cache keys on file names and contents: the same model is compiled once)."""
     fmt = FORMATS[format_name]
     tag = "planted" if model.plant else "true"
-    path = folder / f"{model.system.name}_{format_name}_{model.description}_{tag}{fmt.suffix}"
-    path.write_text(fmt.write(model))
+    stem = f"{model.system.name}_{format_name}_{model.description}_{tag}"
+    path = folder / f"{stem}{fmt.suffix}"
+    if fmt.companions is None:
+        path.write_text(fmt.write(model))
+        return path
+    for name, text in fmt.companions(model, stem).items():
+        (folder / name).write_text(text)
+    path.write_text(fmt.write(model, stem))
     return path
 
 

@@ -39,16 +39,6 @@ pytestmark = pytest.mark.conformance
 CELLS = selected()
 
 
-@pytest.fixture(scope="session")
-def signing_keys(tmp_path_factory):
-    """A key pair from ``pendverify keygen`` for ``certify --key`` and ``recheck --trust``."""
-    from pendverify.cli import main
-
-    folder = tmp_path_factory.mktemp("conformance-keys")
-    assert main(["keygen", "-o", str(folder / "keys")]) == 0
-    return folder / "keys"
-
-
 def _log(cell: Cell, argv: list[str], got, expected: int, printed: str) -> None:
     """One JSON line per command line to ``PENDVERIFY_CONFORMANCE_LOG`` when it is set (for a
     report of every failing cell grouped by its message)."""
