@@ -59,6 +59,8 @@ def _is_zero(expr) -> bool:
 def complete_equations(reader: Reader, spec: TextModelSpec) -> None:
     """Check the set of equations and derive what is given in another form (module docstring)."""
     eq = spec.equations
+    if spec.balance:
+        _acceleration_from_balance(reader, spec)
     if "M" not in eq and "qddot" in eq:
         if not _mass_from_acceleration(reader, spec):
             return  # q̈ alone, inputs that do not span the coordinates: an AccelerationOnlyModel
@@ -82,7 +84,9 @@ def complete_equations(reader: Reader, spec: TextModelSpec) -> None:
                 reader.fail(
                     "M",
                     f"not symmetric: M[{i},{j}] = {shortened(str(M[i, j]), 60)} "
-                    f"but M[{j},{i}] = {shortened(str(M[j, i]), 60)}",
+                    f"but M[{j},{i}] = {shortened(str(M[j, i]), 60)}; if M q̈ = f are balance "
+                    "equations (Newton–Euler, MATLAB's equationsToMatrix), whose M is not the mass "
+                    "matrix, declare balance = true",
                 )
     q = spec.symbols["q"]
     if "H" not in eq and "V" not in eq:
@@ -110,6 +114,26 @@ _F_PARTS = {
 
 def _cancelled(matrix):
     return matrix.applyfunc(lambda x: sp.cancel(sp.together(x)))
+
+
+def _acceleration_from_balance(reader: Reader, spec: TextModelSpec) -> None:
+    """``balance = true``: M q̈ = f are balance equations, q̈ = M⁻¹ f, read as a q̈ alone is.
+
+    Newton–Euler balances (a torque about each joint, MATLAB's ``equationsToMatrix`` of them) give
+    T·M q̈ = T·f for some invertible T: the same motion, but T·M is not the mass matrix and need
+    not be symmetric.  Only q̈ is then the model's own: it is solved for exactly (SymPy's LU
+    solve, each entry cancelled) and the model goes on as one that writes q̈ and B."""
+    eq = spec.equations
+    if "M" not in eq or "f" not in eq:
+        reader.fail("balance", "balance equations are M q̈ = f: give M and f")
+    others = [k for k in ("C", "C_plus_D", "Cqdot", "H", "V", "qddot", "det_M", "M_inv") if k in eq]
+    if others:
+        reader.fail("balance", f"balance equations are M q̈ = f alone (with B, D, W): not {others[0]}")
+    M, f = eq.pop("M"), eq.pop("f")
+    if _is_zero(M.det()):
+        reader.fail("M", "is singular (det M = 0): the balance equations do not determine q̈")
+    eq["qddot"] = _cancelled(M.LUsolve(f))
+    spec.derived["qddot"] = "M⁻¹ f of the balance equations"
 
 
 def _mass_from_acceleration(reader: Reader, spec: TextModelSpec) -> bool:

@@ -51,7 +51,7 @@ CONSTANTS = {"pi": sp.pi}
 TOP_KEYS = (
     "name", "notation", "coordinates", "inputs", "disturbances", "parameters", "symbols", "urdf",
     "M", "C", "C_plus_D", "Cqdot", "H", "V", "D", "B", "W", "f", "det_M", "M_inv", "qddot",
-    "G", "h", "equations", "matlab",
+    "G", "h", "equations", "matlab", "balance",
 )  # fmt: skip
 #: the keys of a declaration without equations (a Python model file's ``DECLARATION``, the API's
 #: ``declaration``): the equations come from elsewhere (``pendverify.analytic.mechanics_model``)
@@ -67,6 +67,7 @@ NOTATION = Key(
     default="sympy",
 )
 NAME = Key(((lambda v: is_string(v) and v.isidentifier(), "missing, or not a name (letters, digits, _)"),))
+BALANCE = Key(((lambda v: isinstance(v, bool), "must be true or false"),), required=False, default=False)
 COORDINATES = Key(
     ((lambda v: is_table(v) and bool(v), 'missing: a table such as theta1 = "angle", x = "position"'),)
 )
@@ -140,6 +141,8 @@ class TextModelSpec:
     joint_offset: tuple | None = None
     #: with a [matlab] table: the .m files read and where their outputs were written
     matlab: object = None
+    #: balance = true: M q̈ = f are balance equations (M need not be the symmetric mass matrix)
+    balance: bool = False
 
 
 class Reader:
@@ -303,6 +306,7 @@ def read_text_document(path: Path, data: dict, top_keys: tuple[str, ...] = TOP_K
         inputs, disturbances, parameters, symbols,
     )  # fmt: skip
     spec.notation = notation
+    spec.balance = reader.value(data, "balance", BALANCE)
     _read_equations(reader, spec, data)
     _read_urdf(reader, spec, data.get("urdf", {}))
     return spec

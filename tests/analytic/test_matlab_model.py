@@ -221,3 +221,20 @@ def test_editing_a_m_file_changes_the_generated_code_key(tmp_path):
     forget()
     after = model_key(load_text_model(path))
     assert before is not None and after is not None and before != after
+
+
+def test_an_unsymmetric_matrix_names_balance_equations(tmp_path):
+    """A mass matrix that is not symmetric is refused (a typo's first sign), naming the way to
+    declare balance equations, whose matrix need not be."""
+    body = "M = [m, l; 2*l, m];\nf = [0; -m*g*l*sin(theta)];\n"
+    (tmp_path / "eq.m").write_text(body)
+    declaration = DECLARATION.format(arguments="").replace('files = ["pend.m"]', 'files = ["eq.m"]')
+    declaration = declaration.replace('M = "M"\nH = "G"\nC = [["0"]]\n', 'M = "M"\nf = "f"\n')
+    declaration = declaration.replace("[coordinates]\ntheta", "[coordinates]\ntheta")
+    path = tmp_path / "eq.toml"
+    path.write_text(declaration.replace('theta = "angle"', 'theta = "angle"\nphi = "angle"'))
+    with pytest.raises(PendverifyError, match=r"key 'M': not symmetric.*declare balance = true"):
+        load_text_model(path)
+    path.write_text(path.read_text().replace('name = "pendulum_m"', 'name = "pendulum_m"\nbalance = true'))
+    cls = load_text_model(path)
+    assert cls.text_spec.derived["qddot"] == "M⁻¹ f of the balance equations"

@@ -6,16 +6,17 @@ derived closed forms (``tests/conformance/closed_forms.py``), in ``matlabFunctio
 (``formats.matlab_function``), and checked with ``pendverify check`` against the system's URDF:
 
 * OptimTraj's acrobot (github.com/MatthewPeterKelly/OptimTraj, ``autoGen_acrobotDynamics.m``):
-  ``[M11,M12,M21,M22,f1,f2] = f(q1,q2,dq1,dq2,u,m1,…)``, scalar arguments and outputs, the
-  matrix written negated (MM·q̈ = ff with MM = −M), later outputs in ``if nargout > K`` blocks;
+  ``[M11,M12,M21,M22,f1,f2] = f(q1,q2,dq1,dq2,u,m1,…)``, scalar arguments and outputs, later
+  outputs in ``if nargout > K`` blocks, and balance equations (torques about the base and about
+  the elbow, negated): the matrix is not the symmetric mass matrix (``balance = true``);
 * OptimTraj's cart-pole (``autoGen_cartPoleDynamics.m``): ``[ddx,ddq] = f(q,dq,u,…)``, the
   accelerations themselves, the cart's coordinate not an argument;
 * the cart double pendulum of a course (NTNU TTK4130, ``PendulumODEMatrices.m``):
   ``[W,RHS] = f(in1,F,in3)``, W·q̈ = RHS, W refilled by ``reshape`` column by column, in1 the
   state and in3 the parameters.
 
-A planted error (10 % on M12 and M21 of the acrobot's file) is named at the ``.m`` file's line
-and its repair printed in MATLAB syntax; a certificate of a declaration embeds its ``.m`` files,
+A planted error (10 % on W(1,2) and W(2,1) of the course's file) is named at the ``.m`` file's
+line and its repair printed in MATLAB syntax; a certificate of a declaration embeds its ``.m`` files,
 and ``recheck`` reads those, not the files at their paths now.
 """
 
@@ -62,20 +63,26 @@ def _scalar_arguments(expressions, system) -> dict[str, None]:
 
 
 def acrobot_optimtraj(system, plant: bool = False):
+    """Balance equations: the first row the torque about the base of both links, the second about
+    the elbow (row 1 + row 2, row 2 of M q̈ = forcing), as Newton–Euler gives them: T·M is not
+    symmetric, and the file writes it negated (MM·q̈ = ff with MM = −T·M)."""
     forms = model_forms(system.name, "urdf")
-    M = forms.M.copy()
-    if plant:
-        M[0, 1] = M[1, 0] = FACTOR * M[0, 1]
-    outputs = {f"M{i + 1}{j + 1}": sp.Matrix([[-M[i, j]]]) for i in range(2) for j in range(2)}
-    outputs |= {f"f{i + 1}": sp.Matrix([[-forms.forcing[i]]]) for i in range(2)}
-    text = matlab_function(
-        "autoGen_acrobotDynamics", outputs, _scalar_arguments([*M, *forms.forcing], system)
-    )
-    keys = {"M": '[["-M11", "-M12"], ["-M21", "-M22"]]', "f": '["-f1", "-f2"]'}
+    T = sp.Matrix([[1, 1], [0, 1]])
+    MM, ff = -(T * forms.M), -(T * forms.forcing)
+    if plant:  # 10 % on one entry: balance equations need not be symmetric, so only q̈ shows it
+        MM[0, 1] = FACTOR * MM[0, 1]
+    outputs = {f"M{i + 1}{j + 1}": sp.Matrix([[MM[i, j]]]) for i in range(2) for j in range(2)}
+    outputs |= {f"f{i + 1}": sp.Matrix([[ff[i]]]) for i in range(2)}
+    arguments = _scalar_arguments([*MM, *ff], system)
+    text = matlab_function("autoGen_acrobotDynamics", outputs, arguments)
+    B = _toml_value([[str(e) for e in forms.B.row(i)] for i in range(2)])
+    keys = {"M": '[["-M11", "-M12"], ["-M21", "-M22"]]', "f": '["-f1", "-f2"]', "balance": "true", "B": B}
+    if system.damping:  # q̈ alone does not determine D (balance equations: M is not the mass matrix)
+        keys["D"] = _toml_value([[str(e) for e in forms.D.row(i)] for i in range(2)])
     return {"autoGen_acrobotDynamics.m": text}, keys, {}
 
 
-def cart_pole_optimtraj(system, plant: bool = False):
+def cart_pole_optimtraj(system):
     forms = model_forms(system.name, "urdf")
     qddot = forms.M.LUsolve(forms.forcing).applyfunc(sp.cancel)
     outputs = {f"ddq{i + 1}": sp.Matrix([[qddot[i]]]) for i in range(2)}
@@ -88,7 +95,10 @@ def cart_double_pendulum_course(system, plant: bool = False):
     forms = model_forms(system.name, "urdf")
     state = [str(s) for s in (*forms.q, *forms.dq)]
     params = list(system.parameter_kinds("urdf"))
-    outputs = {"W": forms.M, "RHS": forms.forcing}
+    W = forms.M.copy()
+    if plant:  # 10 % on W(1,2) and W(2,1): an error of the derivation, W stays symmetric
+        W[0, 1] = W[1, 0] = FACTOR * W[0, 1]
+    outputs = {"W": W, "RHS": forms.forcing}
     arguments = {"in1": state, **dict.fromkeys(system.inputs), "in3": params}
     text = matlab_function("PendulumODEMatrices", outputs, arguments)
     return {"PendulumODEMatrices.m": text}, {"M": '"W"', "f": '"RHS"'}, {"in1": state, "in3": params}
@@ -103,7 +113,7 @@ SHAPES = {
 
 def _write(tmp_path, name: str, plant: bool = False):
     system = SYSTEMS[name]
-    files, keys, arguments = SHAPES[name](system, plant)
+    files, keys, arguments = SHAPES[name](system, plant) if plant else SHAPES[name](system)
     for file, text in files.items():
         (tmp_path / file).write_text(text)
     model = tmp_path / f"{name}.toml"
@@ -113,28 +123,36 @@ def _write(tmp_path, name: str, plant: bool = False):
     return model, write_description(system, "urdf", tmp_path), params
 
 
+def _files(model, urdf, params) -> list[str]:
+    return ["--analytic", str(model), "--urdf", str(urdf), "--params", str(params)]
+
+
 @pytest.mark.parametrize("name", SHAPES)
 def test_the_published_shapes_verify(tmp_path, name):
     model, urdf, params = _write(tmp_path, name)
-    done = run_main(
-        ["check", "--analytic", str(model), "--urdf", str(urdf), "--params", str(params), "--samples", "20"]
-    )
+    done = run_main(["check", *_files(model, urdf, params), "--samples", "20"])
     assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-2000:]
 
 
 def test_a_planted_error_is_named_at_the_m_files_line_in_matlab_syntax(tmp_path):
-    model, urdf, params = _write(tmp_path, "acrobot", plant=True)
-    done = run_main(
-        ["check", "--analytic", str(model), "--urdf", str(urdf), "--params", str(params), "--samples", "20"]
-    )
+    model, urdf, params = _write(tmp_path, "cart_double_pendulum", plant=True)
+    done = run_main(["check", *_files(model, urdf, params), "--samples", "20"])
     assert done.returncode == 1, done.stdout[-3000:] + done.stderr[-2000:]
-    source = (tmp_path / "autoGen_acrobotDynamics.m").read_text().splitlines()
-    line = next(k for k, text in enumerate(source, start=1) if text.strip().startswith("M12 ="))
+    source = (tmp_path / "PendulumODEMatrices.m").read_text().splitlines()
+    line = next(k for k, text in enumerate(source, start=1) if text.strip().startswith("W = reshape"))
     repairs = [r for r in done.stdout.splitlines() if "M[1,2]: " in r and "makes every check pass" in r]
     assert repairs, done.stdout[-3000:]
-    assert f"autoGen_acrobotDynamics.m, line {line}, entry M[1,2]" in repairs[0], repairs[0]
+    assert f"PendulumODEMatrices.m, line {line}, entry M[1,2]" in repairs[0], repairs[0]
     written = repairs[0].split("M[1,2]: ", 1)[1]
     assert re.search(r"\.\*|\.\^", written) and "**" not in written, repairs[0]  # MATLAB's operators
+
+
+def test_an_error_in_balance_equations_fails(tmp_path):
+    """balance = true reads q̈ = M⁻¹ f: an error in one entry of the balance matrix fails aba."""
+    model, urdf, params = _write(tmp_path, "acrobot", plant=True)
+    done = run_main(["check", *_files(model, urdf, params), "--samples", "20"])
+    assert done.returncode == 1, done.stdout[-3000:] + done.stderr[-2000:]
+    assert re.search(r"aba .* FAIL", done.stdout) and "qddot[" in done.stdout, done.stdout[-3000:]
 
 
 def test_a_certificate_embeds_the_m_files(tmp_path, signing_keys):
