@@ -132,6 +132,9 @@ def _companions(model_cls, path: Path) -> tuple[tuple[str, str], ...]:
     matlab = getattr(getattr(model_cls, "text_spec", None), "matlab", None)
     if matlab is None:
         return ()
+    # deferred on purpose: the MATLAB reader (SymPy, lark) loads only for a model that used it
+    from pendverify.analytic.matlab_parse import read_source
+
     folder = path.resolve().parent
     out = []
     for file in matlab.files:
@@ -142,7 +145,7 @@ def _companions(model_cls, path: Path) -> tuple[tuple[str, str], ...]:
                 "embeds the model's files by their place beside it: move it there"
             )
         relative = resolved.relative_to(folder).as_posix()
-        out.append((relative, resolved.read_text(encoding="utf-8", errors="replace")))
+        out.append((relative, read_source(resolved)))  # decoded as the reader decoded it
     return tuple(out)
 
 
