@@ -896,6 +896,35 @@ def generate_keys(folder: str | Path, force: bool = False) -> tuple[Path, Path, 
 
 
 # --- worked examples -------------------------------------------------------------------------------
+def export(
+    model: ModelLike,
+    lang: str,
+    output: str | Path,
+    urdf: UrdfLike | None = None,
+    params: ParamsLike | None = None,
+    *,
+    force: bool = False,
+):
+    """Write a model's closed forms as code, verified: ``pendverify export`` (docs/export.md).
+
+    ``lang`` is ``"c"`` (``NAME.h``, ``NAME.c``), ``"matlab"`` (one ``.m`` function per quantity
+    and their declaration) or ``"numpy"`` (a NumPy-functions model file); the files go into the
+    folder ``output`` (existing ones are replaced only with ``force``).  Before they are written
+    the code is read back as a model and checked against ``urdf`` with ``params``
+    (``pendverify.export.verification``); the result's ``verification`` says how, and its line
+    is in every file's banner.  Returns an ``ExportResult``.
+    """
+    # deferred on purpose: SymPy's code printers load only when code is exported
+    from pendverify.export.files import export_model
+
+    model_cls = load_model(model)
+    if urdf is not None:
+        urdf = _urdf_arg(urdf)
+    return export_model(
+        model_cls, lang, Path(output), check, urdf=urdf, params=params, force=_flag("force", force)
+    )
+
+
 def worked_examples() -> tuple[WorkedExample, ...]:
     """The worked examples installed with pendverify (``pendverify example``)."""
     from pendverify.worked_examples import EXAMPLES

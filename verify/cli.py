@@ -52,6 +52,7 @@ COMMAND_ORDER = (
     "mutate",
     "certify",  # certify, recheck
     "keygen",
+    "export",
     "stress",
     "bench",
 )

@@ -1,0 +1,153 @@
+"""The quantities a model writes, as SymPy matrices over its own names: what ``export`` writes.
+
+A model's M(q), C(q, q̇)·q̇, G(q), and its D, B and W (where it has inputs and disturbances), read
+by ``SymbolicModel`` as ``show`` reads them.  Each is a matrix (a vector is one column) over the
+coordinates, their rates ``d<coordinate>`` and the parameters, named as the model names them.
+A model that writes q̈ alone (no M) is refused: its code would be its q̈, which ``export`` does
+not write yet.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from pathlib import Path
+
+import sympy as sp
+
+from pendverify.analytic.source_file import where
+from pendverify.errors import PendverifyError
+
+#: key → (the model's method, its arguments, what it is), in the order files list them
+QUANTITIES = {
+    "M": ("mass_matrix", "q", "the mass matrix M(q), n × n"),
+    "Cqdot": ("coriolis_force", "qv", "the Coriolis and centrifugal force C(q, q̇)·q̇, n entries"),
+    "G": ("gravity", "q", "the gravity vector G(q) = ∂V/∂q, n entries"),
+    "D": ("damping_matrix", "", "the viscous friction matrix D, n × n"),
+    "B": ("input_matrix", "", "the input matrix B, n × inputs"),
+    "W": ("disturbance_matrix", "", "the disturbance matrix W, n × disturbances"),
+}
+
+
+@dataclass(frozen=True)
+class ExportForms:
+    """A model's quantities (``QUANTITIES``) and what a declaration of them says."""
+
+    name: str
+    source: Path | None
+    coordinates: tuple[str, ...]
+    angular: tuple[bool, ...]
+    inputs: tuple[str, ...]
+    disturbances: tuple[str, ...]
+    parameters: tuple[tuple[str, str, str], ...]  # (name, kind, unit)
+    urdf: dict
+    quantities: dict  # key → sp.Matrix
+    q: tuple
+    v: tuple
+    p: tuple
+
+    @property
+    def rates(self) -> tuple[str, ...]:
+        return tuple(f"d{c}" for c in self.coordinates)
+
+    def declaration(self) -> dict:
+        """The model's declaration (``pendverify.analytic.text_parse.DECLARATION_KEYS``)."""
+        out = {
+            "name": self.name,
+            "coordinates": {
+                c: "angle" if a else "position" for c, a in zip(self.coordinates, self.angular, strict=True)
+            },
+            "inputs": list(self.inputs),
+            "disturbances": list(self.disturbances),
+            "parameters": {n: {"kind": k, "unit": u} for n, k, u in self.parameters},
+        }
+        if self.urdf:
+            out["urdf"] = self.urdf
+        return out
+
+
+def export_forms(model_cls) -> ExportForms:
+    """The quantities of ``model_cls`` (module docstring); a ``PendverifyError`` naming the model
+    when SymPy cannot read them."""
+    from pendverify.analytic.parameter_set import KIND_RULES
+    from pendverify.analytic.symbolic_reading import SymbolicModel
+
+    if "mass_matrix" not in model_cls.hand_written():
+        raise PendverifyError(
+            f"{where(model_cls)}: the model writes no mass matrix (q̈ alone): export writes M, C·q̇, G, "
+            "D, B and W, and a model of q̈ alone is not exported yet"
+        )
+    sm = SymbolicModel.of(model_cls)
+    n = len(model_cls.coordinates)
+    names = {
+        **{s: sp.Symbol(c, real=True) for s, c in zip(sm.symbols["q"], model_cls.coordinates, strict=True)},
+        **{
+            s: sp.Symbol(f"d{c}", real=True)
+            for s, c in zip(sm.symbols["v"], model_cls.coordinates, strict=True)
+        },
+    }
+    fields = dataclasses.fields(model_cls.params_type)
+    names |= {sm.parameters[f.name]: sp.Symbol(f.name, real=True) for f in fields}
+    quantities = {}
+    widths = {"B": len(model_cls.inputs), "W": len(getattr(model_cls, "disturbances", ()))}
+    for key, (method, args, _) in QUANTITIES.items():
+        if key in widths and widths[key] == 0:
+            continue
+        value = _evaluate(sm, model_cls, key, method, args)
+        matrix = sp.Matrix(value) if isinstance(value, sp.MatrixBase) else sp.Matrix([value])
+        if key in ("Cqdot", "G") and len(matrix) == n:
+            matrix = matrix.reshape(n, 1)  # a vector, however the model shaped it
+        want = (n, widths.get(key, 1 if key in ("Cqdot", "G") else n))
+        if matrix.shape != want:
+            raise PendverifyError(
+                f"{where(model_cls)}: {method} must be {want[0]} × {want[1]}, got {matrix.shape}"
+            )
+        quantities[key] = matrix.xreplace(names)
+    allowed = set(names.values())
+    for key, matrix in quantities.items():
+        stray = sorted(s.name for s in matrix.free_symbols - allowed)
+        if stray:
+            raise PendverifyError(f"{where(model_cls)}: {QUANTITIES[key][0]} depends on {', '.join(stray)}")
+    urdf = {}
+    if model_cls.urdf_joints:
+        urdf["joints"] = list(model_cls.urdf_joints)
+    if model_cls.joint_transform is not None:
+        urdf["transform"] = [[float(x) for x in row] for row in model_cls.joint_transform]
+    if model_cls.joint_offset is not None:
+        urdf["offset"] = [float(x) for x in model_cls.joint_offset]
+    try:
+        source = Path(where(model_cls))
+    except (TypeError, ValueError):  # pragma: no cover - where() always gives a string
+        source = None
+    return ExportForms(
+        name=model_cls.name,
+        source=source if source is not None and source.is_file() else None,
+        coordinates=tuple(model_cls.coordinates),
+        angular=tuple(bool(a) for a in model_cls.angular),
+        inputs=tuple(model_cls.inputs),
+        disturbances=tuple(getattr(model_cls, "disturbances", ())),
+        parameters=tuple(
+            (f.name, f.metadata["kind"], f.metadata.get("unit") or KIND_RULES[f.metadata["kind"]][1])
+            for f in fields
+        ),
+        urdf=urdf,
+        quantities=quantities,
+        q=tuple(sp.Symbol(c, real=True) for c in model_cls.coordinates),
+        v=tuple(sp.Symbol(f"d{c}", real=True) for c in model_cls.coordinates),
+        p=tuple(sp.Symbol(f.name, real=True) for f in fields),
+    )
+
+
+def _evaluate(sm, model_cls, key: str, method: str, args: str):
+    """One quantity: C·q̇ from the model's C(q, q̇) where it writes the matrix, G as ∂V/∂q where
+    it writes V alone; every other one as the model's method gives it."""
+    written = model_cls.hand_written()
+    if key == "Cqdot" and "coriolis_force" not in written:
+        if "coriolis_matrix" in written:
+            return sp.Matrix(sm.evaluate("coriolis_matrix", "qv")) * sp.Matrix(sm.symbols["v"])
+        return sp.Matrix(sm.evaluate("bias", "qv")) - sp.Matrix(_evaluate(sm, model_cls, "G", "gravity", "q"))
+    if key == "G" and "gravity" not in written and "potential_energy" in written:
+        V = sm.evaluate("potential_energy", "q")
+        V = V[0] if isinstance(V, sp.MatrixBase) else V
+        return sp.Matrix([sp.diff(V, q) for q in sm.symbols["q"]])
+    return sm.evaluate(method, args)
