@@ -102,6 +102,7 @@ __all__ = [
     "check_animation_length",
     "compare_symbolic",
     "copy_example",
+    "export",
     "generate_keys",
     "implied_parameters",
     "load_model",
@@ -769,6 +770,7 @@ def certify_set(
     samples: int | None = None,
     seed: int | None = None,
     force: bool = False,
+    export: str | None = None,
 ) -> Issued:
     """Run the full battery and, if every item passes, write a certificate bundle into ``output``.
 
@@ -780,6 +782,9 @@ def certify_set(
     (``PinocchioRobot(model, urdf_text=...)``), which must build that very model; without
     one it is refused (a certificate embeds its URDF).
     ``key``: an Ed25519 private key file (``pendverify keygen``) that signs it.
+    ``export``: a language of ``export`` (``"c"``, ``"matlab"``, ``"numpy"``): the model's code,
+    verified against the set's URDF, is added to the bundle, its banner naming the certificate's
+    digest; it needs ``key``, whose signature covers those files (``recheck`` refuses an edited one).
     Returns the issued result (``items``, ``certified``, ``certificate``, ``path``).
     (Not ``certify``: that name is the ``pendverify.certify`` sub-package.)
     """
@@ -800,7 +805,40 @@ def certify_set(
         None if analytic is None else str(analytic),
     )
     signer = None if key is None else load_private_key(key)  # a bad key fails before any work
-    return issue(target, settings, str(output), force, key=signer)
+    exporter = None if export is None else _certificate_exporter(target, export, signer)
+    return issue(target, settings, str(output), force, key=signer, exporter=exporter)
+
+
+def _certificate_exporter(target, lang: str, signer):
+    """``certify --export LANG``: the certificate → the model's code, verified (else refused)."""
+    # deferred on purpose: SymPy's code printers load only when code is exported
+    from pendverify.export.files import LANGUAGES, exported_files
+    from pendverify.export.verification import VERIFIED
+
+    if lang not in LANGUAGES:
+        raise InputError(OPTIONS_SOURCE, "export", lang, f"one of {', '.join(LANGUAGES)}")
+    if signer is None:
+        raise PendverifyError(
+            "certify --export: give --key as well: the exported code is covered by the bundle's "
+            "signature, which is how recheck tells an edited file"
+        )
+
+    def exporter(cert: dict) -> dict[str, str]:
+        files, verification = exported_files(
+            target.model.load(),
+            lang,
+            check,
+            urdf=target.urdf,
+            params=target.params.as_dict(),
+            certificate=cert["digest"]["value"],
+        )
+        if verification.status != VERIFIED:
+            raise PendverifyError(
+                f"certify --export {lang}: the exported code is not verified: {verification.line}"
+            )
+        return files
+
+    return exporter
 
 
 class SweepCertificates(NamedTuple):

@@ -77,3 +77,34 @@ def test_exported_files_are_not_replaced_without_force(tmp_path):
     api.export(example.model.source, "numpy", tmp_path)
     done = run_main(["export", str(example.model.source), "--lang", "numpy", "-o", str(tmp_path)])
     assert done.returncode == 2 and "give --force" in done.stderr
+
+
+def test_certify_export_signs_the_code_and_recheck_catches_an_edited_file(tmp_path):
+    """``certify --export c``: the verified C code in the bundle, its banner naming the certificate's
+    digest, covered by the signature; a hand-edited .c is refused by ``recheck``, naming it."""
+    keys = tmp_path / "keys"
+    assert run_main(["keygen", "-o", str(keys)]).returncode == 0
+    example = _example("minimal_double_pendulum")
+    out = tmp_path / "bundle"
+    argv = ["certify", "--analytic", str(example.written_model.source), "--urdf", str(example.urdf.source)]
+    argv += ["--params", str(example.params.source), "-o", str(out), "--samples", "30"]
+    done = run_main([*argv, "--key", str(keys / "pendverify-signing.key.pem"), "--export", "c"])
+    assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
+    cert = next(out.glob("*.cert.json"))
+    source = out / "minimal_double_pendulum.c"
+    digest = __import__("json").loads(cert.read_text())["digest"]["value"]
+    assert f"Certificate: sha256 {digest}" in source.read_text()
+    assert "Verification: pendverify check of the written code: all checks pass" in source.read_text()
+    trust = ["--trust", str(keys / "pendverify-signing.pub.pem")]
+    assert run_main(["recheck", str(cert), *trust]).returncode == 0
+    source.write_text(source.read_text().replace("out[0] = ", "out[0] = 1.1*", 1))
+    done = run_main(["recheck", str(cert), *trust])
+    assert done.returncode == 2 and "minimal_double_pendulum.c" in done.stderr, done.stderr
+
+
+def test_certify_export_needs_a_key(tmp_path):
+    example = _example("minimal_double_pendulum")
+    argv = ["certify", "--analytic", str(example.written_model.source), "--urdf", str(example.urdf.source)]
+    argv += ["--params", str(example.params.source), "-o", str(tmp_path), "--export", "c"]
+    done = run_main(argv)
+    assert done.returncode == 2 and "give --key as well" in done.stderr, done.stderr

@@ -31,6 +31,7 @@ from pendverify.certify.signing import (
 )
 from pendverify.display import shortened
 from pendverify.errors import CertificateError, PendverifyError, SigningError
+from pendverify.export.names import export_file_names
 from pendverify.robot.description import FILE_SUFFIXES, text_suffix
 
 
@@ -79,6 +80,7 @@ def write_bundle(
     key=None,
     *,
     description_format: str,
+    extra_files: dict[str, str] | None = None,
 ) -> Path:
     """Write the bundle (``key``, an Ed25519 private key, signs it: NAME.intoto.jsonl), the
     certificate last.  An existing bundle is never replaced unless ``force``.
@@ -93,6 +95,11 @@ def write_bundle(
         files[model_path(directory, name, model.file)] = model.text
         for relative, text in model.companions:  # the files it reads, where it reads them
             files[Path(directory) / relative] = text
+    for file_name, text in (extra_files or {}).items():  # the model's code (certify --export)
+        path = Path(directory) / file_name
+        if path.exists() and not force:
+            raise CertificateError(f"{path} exists; pass --force to replace it")
+        files[path] = text
     text = certificate_text(cert)
     if key is not None:
         contents = {
@@ -114,6 +121,8 @@ def bundle_file_names(name: str, cert: dict | None = None) -> set[str]:
     declaration's .m files, by their paths relative to the bundle)."""
     record = (cert or {}).get("model_source") or {}
     companions = {c["file"] for c in record.get("companions", ())}
+    if cert is not None and isinstance(cert.get("model"), str):
+        companions |= export_file_names(cert["model"])  # certify --export's files
     descriptions = {f"{name}{suffix}" for suffix in FILE_SUFFIXES.values()}
     models = {model_path(".", name, f"model{suffix}").name for suffix in MODEL_SUFFIXES}
     return {*descriptions, *models, *companions, *(p.name for p in bundle_paths(".", name))}

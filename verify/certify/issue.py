@@ -147,18 +147,25 @@ class Issued:
 
 
 def issue(
-    target: CertificationInput, settings: BatterySettings, output, force: bool = False, key=None
+    target: CertificationInput,
+    settings: BatterySettings,
+    output,
+    force: bool = False,
+    key=None,
+    exporter=None,
 ) -> Issued:
     """Run the battery on the target's URDF; write the bundle only if every item passes.
 
-    ``key`` (an Ed25519 private key, ``signing.load_private_key``) signs the certificate."""
+    ``key`` (an Ed25519 private key, ``signing.load_private_key``) signs the certificate;
+    ``exporter`` (the certificate → the files of the model's code, verified: ``certify --export``)
+    adds files to the bundle, which the signature covers."""
     check_name(target.name, "<certify>", "name")
     refuse_existing(output, target.name, force)
     battery = run_battery(target.model.load(), target.params, target.urdf, settings)
     if not battery.passed:
         return Issued(battery.items, not_run=battery.not_run)
     cert, path = write_certificate(
-        target.name, target.model, target.params, target.urdf, settings, battery, output, force, key
+        target.name, target.model, target.params, target.urdf, settings, battery, output, force, key, exporter
     )
     return Issued(battery.items, cert, path, battery.not_run)
 
@@ -173,6 +180,7 @@ def write_certificate(
     output,
     force: bool = False,
     key=None,
+    exporter=None,
 ) -> tuple[dict, Path]:
     """Build the certificate of a set whose battery passed and write its bundle (signed by
     ``key`` if given): (the certificate, its path).
@@ -187,8 +195,18 @@ def write_certificate(
     check_name(name, "<certify>", "name")
     keyid = fingerprint(key.public_key()) if key is not None else None
     cert = build_certificate(name, model, params, urdf, settings, battery, keyid=keyid)
+    extra = exporter(cert) if exporter is not None else {}
     path = write_bundle(
-        output, name, params, urdf, cert, force, model, key, description_format=battery.description_format
+        output,
+        name,
+        params,
+        urdf,
+        cert,
+        force,
+        model,
+        key,
+        description_format=battery.description_format,
+        extra_files=extra,
     )
     return cert, path
 

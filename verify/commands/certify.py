@@ -80,6 +80,12 @@ def register(sub) -> None:
         "--key",
         help="sign the certificate(s) with this Ed25519 private key (pendverify keygen) (default: unsigned)",
     )
+    p.add_argument(
+        "--export",
+        choices=("c", "matlab", "numpy"),
+        help="add the model's code in this language to the bundle, verified against the URDF and signed "
+        "(needs --key; one set, not --sweep) (default: none)",
+    )
     add_package_path_option(p)
     p.set_defaults(func=run_certify)
 
@@ -127,6 +133,8 @@ def run_certify(args: argparse.Namespace) -> int:
     check_output(args.output, folder=True)  # before any work
     check_report_output(args.json)
     if args.sweep:
+        if args.export:
+            refuse_together("--sweep", "--export", "export one set's code: certify that set with --export")
         return _run_sweep(args)
     issued = api.certify_set(
         args.output,
@@ -139,6 +147,7 @@ def run_certify(args: argparse.Namespace) -> int:
         samples=args.samples,
         seed=args.seed,
         force=args.force,
+        export=args.export,
     )
     if not args.quiet:
         _print_items(issued.items)

@@ -57,6 +57,8 @@ def banner(
         lines.append(
             f"Parameter set: {params} (sha256 {_sha256(params)}); the code takes the parameters as p."
         )
+    elif certificate:
+        lines.append("Parameter set: the certificate's; the code takes the parameters as p.")
     else:
         lines.append("Parameter set: none; the code takes the parameters as p.")
     if certificate:
@@ -65,34 +67,37 @@ def banner(
     return lines
 
 
-def export_model(
-    model_cls,
-    lang: str,
-    output: Path,
-    check,
-    *,
-    urdf=None,
-    params=None,
-    certificate: str | None = None,
-    force: bool = False,
-) -> ExportResult:
-    """Write ``model_cls``'s quantities as ``lang`` code into ``output``, verified first by ``check``
-    (``pendverify.api.check``, given by the caller: the library does not import the API)."""
+def exported_files(
+    model_cls, lang: str, check, *, urdf=None, params=None, certificate: str | None = None
+) -> tuple[dict[str, str], Verification]:
+    """The files of ``model_cls``'s quantities in ``lang`` (name → text), verified by ``check``
+    (``pendverify.api.check``, given by the caller: the library does not import the API), the
+    verification's line in their banner."""
     if lang not in WRITERS:
         raise PendverifyError(f"export: --lang {lang!r}: one of {', '.join(LANGUAGES)}")
-    check_output(output, folder=True)
     forms = export_forms(model_cls)
     if urdf is not None and model_cls.geometry_reader:
         forms = dataclasses.replace(forms, urdf=_read_map(model_cls, urdf))
     params_path = Path(params) if isinstance(params, str | Path) else None
     draft = WRITERS[lang](forms, banner(forms, lang, params_path, certificate, "(being verified)"))
-    existing = sorted(name for name in draft if (output / name).exists())
+    verification = verify(lang, draft, forms, urdf, params, check)
+    return WRITERS[lang](
+        forms, banner(forms, lang, params_path, certificate, verification.line)
+    ), verification
+
+
+def export_model(
+    model_cls, lang: str, output: Path, check, *, urdf=None, params=None, force: bool = False
+) -> ExportResult:
+    """Write ``model_cls``'s quantities as ``lang`` code into ``output``, verified first
+    (``exported_files``)."""
+    check_output(output, folder=True)
+    files, verification = exported_files(model_cls, lang, check, urdf=urdf, params=params)
+    existing = sorted(name for name in files if (output / name).exists())
     if existing and not force:
         raise PendverifyError(f"{output / existing[0]}: exists; give --force to replace the exported files")
-    verification = verify(lang, draft, forms, urdf, params, check)
-    final = WRITERS[lang](forms, banner(forms, lang, params_path, certificate, verification.line))
     output.mkdir(parents=True, exist_ok=True)
-    written = tuple(write_atomic(output / name, text) for name, text in final.items())
+    written = tuple(write_atomic(output / name, text) for name, text in files.items())
     return ExportResult(lang, written, verification)
 
 

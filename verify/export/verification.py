@@ -28,7 +28,7 @@ from pathlib import Path
 
 from pendverify.errors import PendverifyError
 from pendverify.export.closed_forms import QUANTITIES, ExportForms
-from pendverify.export.writers import c_name
+from pendverify.export.names import c_name
 
 #: the longest a C compilation may take [s]: a 7-link arm's source compiles in a few seconds
 COMPILE_SECONDS = 120

@@ -28,6 +28,7 @@ from sympy.printing.numpy import NumPyPrinter
 
 from pendverify.errors import PendverifyError
 from pendverify.export.closed_forms import QUANTITIES, ExportForms
+from pendverify.export.names import c_name
 
 #: C's keywords, the names its math library declares and the functions' arguments: a coordinate
 #: or parameter so named is renamed ``name_`` in a function's body
@@ -71,12 +72,6 @@ def renamed(forms: ExportForms, reserved: frozenset) -> ExportForms:
         v=tuple(swap[s] for s in forms.v),
         p=tuple(swap[s] for s in forms.p),
     )
-
-
-def c_name(name: str) -> str:
-    """A C identifier of the model's name (its functions' prefix)."""
-    ident = re.sub(r"\W", "_", name.lower()).strip("_") or "model"
-    return ident if not ident[0].isdigit() else f"m_{ident}"
 
 
 def _temporaries(forms: ExportForms):

@@ -1,0 +1,21 @@
+"""The names of exported files: from the model's name, so a bundle knows them before they exist."""
+
+from __future__ import annotations
+
+import re
+
+#: the model methods exported, one file each in MATLAB (``NAME_<method>.m``)
+METHODS = ("mass_matrix", "coriolis_force", "gravity", "damping_matrix", "input_matrix", "disturbance_matrix")
+
+
+def c_name(name: str) -> str:
+    """A C identifier of the model's name (its functions' and files' prefix)."""
+    ident = re.sub(r"\W", "_", name.lower()).strip("_") or "model"
+    return ident if not ident[0].isdigit() else f"m_{ident}"
+
+
+def export_file_names(model_name: str) -> frozenset[str]:
+    """Every file ``export`` may write for model ``model_name``, in any language."""
+    prefix = c_name(model_name)
+    matlab = {f"{prefix}_{method}.m" for method in METHODS}
+    return frozenset({f"{prefix}.h", f"{prefix}.c", f"{prefix}_numpy.py", f"{prefix}_matlab.toml", *matlab})
