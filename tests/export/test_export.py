@@ -108,3 +108,10 @@ def test_certify_export_needs_a_key(tmp_path):
     argv += ["--params", str(example.params.source), "-o", str(tmp_path), "--export", "c"]
     done = run_main(argv)
     assert done.returncode == 2 and "give --key as well" in done.stderr, done.stderr
+
+
+def test_the_file_names_a_bundle_allows_are_those_export_writes():
+    from pendverify.export.closed_forms import QUANTITIES
+    from pendverify.export.names import METHODS
+
+    assert METHODS == tuple(method for method, _, _ in QUANTITIES.values())

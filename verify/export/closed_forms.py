@@ -15,18 +15,22 @@ from pathlib import Path
 
 import sympy as sp
 
+from pendverify.analytic.numpy_model import FUNCTIONS
 from pendverify.analytic.source_file import where
 from pendverify.errors import PendverifyError
 
-#: key → (the model's method, its arguments, what it is), in the order files list them
-QUANTITIES = {
-    "M": ("mass_matrix", "q", "the mass matrix M(q), n × n"),
-    "Cqdot": ("coriolis_force", "qv", "the Coriolis and centrifugal force C(q, q̇)·q̇, n entries"),
-    "G": ("gravity", "q", "the gravity vector G(q) = ∂V/∂q, n entries"),
-    "D": ("damping_matrix", "", "the viscous friction matrix D, n × n"),
-    "B": ("input_matrix", "", "the input matrix B, n × inputs"),
-    "W": ("disturbance_matrix", "", "the disturbance matrix W, n × disturbances"),
+#: what each exported quantity is, by its function's name in the NumPy-functions model format
+#: (``pendverify.analytic.numpy_model.FUNCTIONS``), in the order files list them
+DESCRIPTIONS = {
+    "M": "the mass matrix M(q), n × n",
+    "Cqdot": "the Coriolis and centrifugal force C(q, q̇)·q̇, n entries",
+    "G": "the gravity vector G(q) = ∂V/∂q, n entries",
+    "D": "the viscous friction matrix D, n × n",
+    "B": "the input matrix B, n × inputs",
+    "W": "the disturbance matrix W, n × disturbances",
 }
+#: key → (the model's method, its arguments, what it is)
+QUANTITIES = {key: (FUNCTIONS[key][2], FUNCTIONS[key][0], what) for key, what in DESCRIPTIONS.items()}
 
 
 @dataclass(frozen=True)

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import re
 
-#: the model methods exported, one file each in MATLAB (``NAME_<method>.m``)
+#: the model methods exported, one file each in MATLAB (``NAME_<method>.m``): those of
+#: ``closed_forms.QUANTITIES`` (a test compares them; this module imports neither SymPy nor NumPy)
 METHODS = ("mass_matrix", "coriolis_force", "gravity", "damping_matrix", "input_matrix", "disturbance_matrix")
 
 
