@@ -51,6 +51,7 @@ COMMANDS = (
     "certify+recheck",
     "stress",
     "bench accuracy",
+    "export",
 )
 #: commands that take no model file (a format is meaningless for them)
 MODEL_FREE = ("show --robot",)
@@ -78,6 +79,11 @@ _NO_CODE_FROM_FUNCTIONS = (
     "read by SymPy: refused in one line (docs/models.md, 'NumPy functions')"
 )
 
+_EXPORT_READS_SYMPY = (
+    "export writes the closed forms SymPy reads from the model; code (NumPy functions, dynamics) is not "
+    "read: refused in one line (docs/commands/export.md)"
+)
+
 _STRESS_URDF = (
     "stress --analytic rewrites the robot file's numbers for its cases: an MJCF is refused in one line "
     "('an MJCF description, but stress --analytic rewrites a URDF's numbers: give a URDF or xacro file')"
@@ -89,6 +95,7 @@ EXPECTED: dict[tuple[str, str, str], tuple[int, str]] = {
     **{(f, c, "*"): (2, _NOT_SYMBOLIC) for f in NUMERIC_ONLY for c in ("show", "sympy", "mutate")},
     **{(f, c, "*"): (2, _NO_CLOSED_M) for f in DYNAMICS_CODE for c in SCENE_COMMANDS},
     ("numpy_functions", "bench accuracy", "*"): (2, _NO_CODE_FROM_FUNCTIONS),
+    **{(f, "export", "*"): (2, _EXPORT_READS_SYMPY) for f in NUMERIC_ONLY},
     ("*", "stress", "mjcf"): (2, _STRESS_URDF),
 }
 #: formats that give no V: pendverify integrates V from H when it reads the file

@@ -31,6 +31,11 @@ class Files:
         self.params = write_parameters(model, folder)
         self.model = write_model(model, format_name, folder) if format_name != "-" else None
 
+    def export_language(self) -> str:
+        """The language ``export`` writes this cell's model in: c, matlab and numpy in turn over the
+        model files' names (stable: the same cell always exports the same language)."""
+        return ("c", "matlab", "numpy")[sum(map(ord, self.model.name)) % 3]
+
     def analytic(self) -> list[str]:
         return ["--analytic", str(self.model), "--urdf", str(self.robot), "--params", str(self.params)]
 
@@ -66,6 +71,13 @@ def _certify(files: Files, keys: Path) -> list[list[str]]:
     return [certify, recheck]
 
 
+def _export(files: Files, out: Path) -> list[list[str]]:
+    """``export`` of the cell's model: without a robot (the code written, unverified), then checked
+    against the cell's description (replacing the files), in the cell's language."""
+    head = ["export", str(files.model), "--lang", files.export_language(), "-o", str(out)]
+    return [head, [*head, "--force", "--urdf", str(files.robot), "--params", str(files.params)]]
+
+
 def command_lines(command: str, files: Files, keys: Path) -> list[list[str]]:
     """The ``main`` argument lists ``command`` runs on ``files`` (all must give the cell's status)."""
     tmp = files.folder
@@ -96,6 +108,7 @@ def command_lines(command: str, files: Files, keys: Path) -> list[list[str]]:
         "bench accuracy": lambda: [
             ["bench", "accuracy", "--scene", str(files.scene()), "--quick", "-o", str(tmp / "bench")]
         ],
+        "export": lambda: _export(files, tmp / "code"),
     }
     return table[command]()
 
