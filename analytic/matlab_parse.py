@@ -155,8 +155,6 @@ class MatlabFunction:
     outputs: tuple[str, ...]
     arguments: tuple[str, ...]
     statements: list[tuple[Statement, Tree]]
-    #: name → the line of its last assignment
-    assigned: dict[str, int] = field(default_factory=dict)
 
 
 @dataclass

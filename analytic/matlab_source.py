@@ -178,7 +178,7 @@ def tokens_of(text: str) -> list[Statement]:
             current.append(token)
             at += len(token.text)
             glued = True
-        if in_matrix_now(brackets) and not continued:
+        if _in_matrix(brackets) and not continued:
             current.append(Tok("ROWSEP", "\n", number, len(line)))
         elif not brackets and not continued:
             end_statement()
@@ -189,7 +189,8 @@ def tokens_of(text: str) -> list[Statement]:
     return statements
 
 
-def in_matrix_now(brackets: list[str]) -> bool:
+def _in_matrix(brackets: list[str]) -> bool:
+    """Whether the innermost open bracket is a matrix literal's."""
     return bool(brackets) and brackets[-1] == "["
 
 
