@@ -238,3 +238,19 @@ def test_an_unsymmetric_matrix_names_balance_equations(tmp_path):
     path.write_text(path.read_text().replace('name = "pendulum_m"', 'name = "pendulum_m"\nbalance = true'))
     cls = load_text_model(path)
     assert cls.text_spec.derived["qddot"] == "M⁻¹ f of the balance equations"
+
+
+def test_a_certificate_takes_m_files_beside_the_declaration_only(tmp_path):
+    """A certificate's bundle holds the .m files beside the model file: one elsewhere is refused
+    before any work, naming it; one beside it is embedded by its name."""
+    from pendverify.certify.model_source import ModelSource
+
+    path = _declaration(tmp_path)
+    assert ModelSource.of_file(path).companions == (("pend.m", PENDULUM),)
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "sub" / "pend.m").write_text(PENDULUM)
+    path.write_text(path.read_text().replace('files = ["pend.m"]', 'files = ["sub/pend.m"]'))
+    with pytest.raises(
+        PendverifyError, match=r"key 'matlab.files': .*sub/pend.m is not beside the model file"
+    ):
+        ModelSource.of_file(path)

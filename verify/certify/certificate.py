@@ -11,8 +11,8 @@ model              the model's name: double_pendulum | cart_double_pendulum, or 
                    plug-in's (its class's ``name``)
 model_source       plug-ins only: {"file": the model file's name, "text": its source
                    verbatim, "sha256": of that text (UTF-8), and for a declaration of
-                   .m files "companions": a list of {"file": its path relative to
-                   the model file, "text", "sha256"}}; ``recheck`` runs
+                   .m files "companions": a list of {"file": its name (beside the
+                   model file), "text", "sha256"}}; ``recheck`` runs
                    the battery on this text, never on the file at that path now
                    (Python text only when a trusted key signed it, or when told
                    to run embedded code: ``pendverify.certify.issue.recheck``)

@@ -31,9 +31,7 @@ MODEL_FILE_RULE = (
 
 #: the files a text model reads beside itself (its ``[matlab]`` files): a relative path of plain
 #: names ending in .m, inside the model file's folder
-COMPANION_RULE = (
-    "a path relative to the model file's folder, of plain names, ending in .m, not leaving the folder"
-)
+COMPANION_RULE = "a plain file name ending in .m, of a file beside the model file (no folder)"
 
 _LOADED: dict[tuple, type[ClosedFormModel]] = {}  # (file name, sha256s) -> class, per process
 
@@ -49,7 +47,7 @@ class ModelSource:
     name: str  # the model's name (the class's ``name``)
     file: str = ""  # the model file's name, for messages and the bundle
     text: str = ""  # the model file's source; "" for a built-in model
-    #: the files the model file reads (a declaration's .m files): (path relative to it, text)
+    #: the files the model file reads (a declaration's .m files, beside it): (file name, text)
     companions: tuple[tuple[str, str], ...] = ()
 
     @property
@@ -139,25 +137,22 @@ def _companions(model_cls, path: Path) -> tuple[tuple[str, str], ...]:
     out = []
     for file in matlab.files:
         resolved = Path(file).resolve()
-        if not resolved.is_relative_to(folder):
+        if resolved.parent != folder:
             raise PendverifyError(
-                f"{path}: key 'matlab.files': {file} is outside the model file's folder; a certificate "
-                "embeds the model's files by their place beside it: move it there"
+                f"{path}: key 'matlab.files': {file} is not beside the model file; a certificate embeds "
+                "the model's .m files, and its bundle holds them, beside the model file: move it there"
             )
-        relative = resolved.relative_to(folder).as_posix()
-        out.append((relative, read_source(resolved)))  # decoded as the reader decoded it
+        out.append((resolved.name, read_source(resolved)))  # decoded as the reader decoded it
     return tuple(out)
 
 
 def companion_problem(name: str) -> str:
     """Why ``name`` cannot be an embedded companion's path (``COMPANION_RULE``), or ""."""
-    parts = name.split("/")
     if (
         not name.endswith(".m")
-        or any(p in ("", ".", "..") for p in parts)
-        or any(c == "\\" or ord(c) < 32 or ord(c) == 127 for c in name)
-        or any(len(p.encode("utf-8", "surrogatepass")) > MAX_FILE_NAME_BYTES for p in parts)
-        or len(parts) > 8
+        or name in (".m", "..m")
+        or any(c in "/\\" or ord(c) < 32 or ord(c) == 127 for c in name)
+        or len(name.encode("utf-8", "surrogatepass")) > MAX_FILE_NAME_BYTES
     ):
         return COMPANION_RULE
     return ""
@@ -214,17 +209,18 @@ def source_problem(record) -> str:
 
 def load_from_text(text: str, file_name: str, companions=()) -> type[ClosedFormModel]:
     """Import a model file's source through the plug-in loader, from a private temporary copy (and
-    of the files it reads, ``companions``: (relative path, text), checked by ``companion_problem``)."""
+    of the files it reads, ``companions``: (file name, text), checked by ``companion_problem``)."""
     name = Path(file_name).name or "model.py"
     with tempfile.TemporaryDirectory(prefix="pendverify-model-") as tmp:
         path = Path(tmp) / name
         path.write_text(text, encoding="utf-8")
         remember_text(path, text)  # the generated code's key outlives the temporary copy
-        for relative, companion in companions:
-            if companion_problem(relative):
-                raise PendverifyError(f"{name} (the embedded model source): {relative!r}: {COMPANION_RULE}")
-            target = Path(tmp) / relative
-            target.parent.mkdir(parents=True, exist_ok=True)
+        for companion_name, companion in companions:
+            if companion_problem(companion_name):
+                raise PendverifyError(
+                    f"{name} (the embedded model source): {companion_name!r}: {COMPANION_RULE}"
+                )
+            target = Path(tmp) / companion_name
             target.write_text(companion, encoding="utf-8")
             remember_text(target, companion)
         try:

@@ -49,6 +49,8 @@ class ExportForms:
     q: tuple
     v: tuple
     p: tuple
+    #: the files the model file reads (a declaration's .m files)
+    companions: tuple[Path, ...] = ()
 
     @property
     def rates(self) -> tuple[str, ...]:
@@ -139,6 +141,9 @@ def export_forms(model_cls) -> ExportForms:
         q=tuple(sp.Symbol(c, real=True) for c in model_cls.coordinates),
         v=tuple(sp.Symbol(f"d{c}", real=True) for c in model_cls.coordinates),
         p=tuple(sp.Symbol(f.name, real=True) for f in fields),
+        companions=tuple(
+            getattr(getattr(getattr(model_cls, "text_spec", None), "matlab", None), "files", ())
+        ),
     )
 
 

@@ -53,6 +53,9 @@ def banner(
     )
     lines = [f"The closed forms of model {forms.name}, written by pendverify {version} export --lang {lang}."]
     lines.append(f"Model: {source}.")
+    if forms.companions:
+        read = ", ".join(f"{path.name} (sha256 {_sha256(path)})" for path in forms.companions)
+        lines.append(f"Its .m files: {read}.")
     if params is not None:
         lines.append(
             f"Parameter set: {params} (sha256 {_sha256(params)}); the code takes the parameters as p."
