@@ -146,29 +146,26 @@ def _companions(model_cls, path: Path) -> tuple[tuple[str, str], ...]:
     return tuple(out)
 
 
-def companion_problem(name: str) -> str:
-    """Why ``name`` cannot be an embedded companion's path (``COMPANION_RULE``), or ""."""
-    if (
-        not name.endswith(".m")
-        or name in (".m", "..m")
+def _plain_file_name(name: str, suffixes: tuple[str, ...]) -> bool:
+    """Whether ``name`` is one plain file name (no folder, separator or control character, at most
+    ``MAX_FILE_NAME_BYTES``) ending in one of ``suffixes`` and not only that suffix."""
+    return not (
+        name in (".", "..")
         or any(c in "/\\" or ord(c) < 32 or ord(c) == 127 for c in name)
         or len(name.encode("utf-8", "surrogatepass")) > MAX_FILE_NAME_BYTES
-    ):
-        return COMPANION_RULE
-    return ""
+        or not name.endswith(suffixes)
+        or name in suffixes
+    )
+
+
+def companion_problem(name: str) -> str:
+    """Why ``name`` cannot be an embedded companion's name (``COMPANION_RULE``), or ""."""
+    return "" if _plain_file_name(name, (".m",)) and name != "..m" else COMPANION_RULE
 
 
 def model_file_problem(name: str) -> str:
     """Why ``name`` cannot be an embedded model's file name (``MODEL_FILE_RULE``), or ""."""
-    if (
-        name in (".", "..")
-        or any(c in "/\\" or ord(c) < 32 or ord(c) == 127 for c in name)
-        or len(name.encode("utf-8", "surrogatepass")) > MAX_FILE_NAME_BYTES
-        or not name.endswith(MODEL_SUFFIXES)
-        or name in MODEL_SUFFIXES
-    ):
-        return MODEL_FILE_RULE
-    return ""
+    return "" if _plain_file_name(name, MODEL_SUFFIXES) else MODEL_FILE_RULE
 
 
 def source_problem(record) -> str:
