@@ -60,8 +60,8 @@ class MatlabSource:
     files: tuple[Path, ...] = ()
     #: output name → (file, its Output)
     outputs: dict[str, tuple[Path, Output]] = field(default_factory=dict)
-    #: equation key → output name, for a key given as one matrix output (``M = "W"``), and its sign
-    whole: dict[str, tuple[str, int]] = field(default_factory=dict)
+    #: equation key → output name, for a key given as one matrix output (``M = "W"``, ``"-W"``)
+    whole: dict[str, str] = field(default_factory=dict)
     #: equation key → its value in the declaration (a string, or lists of them)
     written: dict[str, object] = field(default_factory=dict)
 
@@ -72,17 +72,17 @@ class MatlabSource:
             item = item[i] if isinstance(item, list) and i < len(item) else None
         return item if isinstance(item, str) else None
 
-    def line_of(self, key: str, position: tuple[int, ...], entry_text: str | None) -> tuple[Path, int] | None:
+    def line_of(self, key: str, position: tuple[int, ...]) -> tuple[Path, int] | None:
         """(file, line) where the entry at ``position`` of equation ``key`` was written, if known:
-        the entry of a whole matrix output, or an entry that names one scalar output."""
+        the entry of a whole matrix output, or an entry the declaration writes as one scalar output."""
         if key in self.whole:
-            name, _ = self.whole[key]
-            path, output = self.outputs[name]
+            path, output = self.outputs[self.whole[key]]
             cell = position if len(position) == 2 else (*position, 0)
             value = output.value
             if isinstance(value, sp.MatrixBase) and value.shape[0] == 1 and len(position) == 1:
                 cell = (0, position[0])
             return path, output.line_of(cell)
+        entry_text = self.entry_text(key, position)
         if entry_text is not None:
             name = entry_text.strip().lstrip("+-").strip()
             if name in self.outputs:
@@ -112,12 +112,12 @@ def read_matlab(reader, spec, table) -> tuple[MatlabSource, dict[str, object]]:
         path = (spec.path.parent / given) if not Path(given).is_absolute() else Path(given)
         if path.suffix.lower() != ".m":
             reader.fail("matlab.files", f"{shortened(repr(given), 60)} is not a .m file")
-        function = _read_file(reader, path)
+        text, function = _read_file(reader, path)
         bindings = _bindings(reader, function, arguments, declared)
         try:
             outputs = evaluate(function, bindings)
         except SourceError as exc:
-            _fail_in_file(path, function, exc)
+            _fail_at(path, text, exc)
         source.files += (path,)
         for name, output in outputs.items():
             if name in values:
@@ -139,7 +139,8 @@ def _declared(spec) -> dict[str, sp.Symbol]:
     return {s.name: s for group in "qvuwp" for s in spec.symbols[group]}
 
 
-def _read_file(reader, path: Path) -> MatlabFunction:
+def _read_file(reader, path: Path) -> tuple[str, MatlabFunction]:
+    """The file's text and its statements parsed."""
     try:
         text = read_source(path)
     except FileNotFoundError:
@@ -148,16 +149,12 @@ def _read_file(reader, path: Path) -> MatlabFunction:
         reader.fail("matlab.files", f"{path}: a folder, not a .m file")
     except OSError as exc:
         reader.fail("matlab.files", f"{path}: cannot be read ({exc.strerror or exc})")
-    except SourceError as exc:
-        raise ExcerptError(f"{path}: {exc.why}", "", 0) from None
+    except SourceError as exc:  # larger than a model file is read
+        reader.fail("matlab.files", f"{path}: {exc.why}")
     try:
-        return parse_function(path, text)
+        return text, parse_function(path, text)
     except SourceError as exc:
         _fail_at(path, text, exc)
-
-
-def _fail_in_file(path: Path, function: MatlabFunction, exc: SourceError):
-    _fail_at(path, read_source(path), exc)
 
 
 def _fail_at(path: Path, text: str, exc: SourceError):
@@ -252,5 +249,5 @@ def whole_output(reader, source: MatlabSource, values: dict, key: str, value, sh
     if matrix.shape != (rows, cols):
         path, _ = source.outputs[name]
         reader.fail(key, f"{name} of {path.name} is {output.rows}×{output.cols}; {key} is {rows}×{cols}")
-    source.whole[key] = (name, sign)
+    source.whole[key] = name
     return sp.Matrix(matrix) * sign

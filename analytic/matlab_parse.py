@@ -261,7 +261,7 @@ def evaluate(function: MatlabFunction, bindings: dict[str, object]) -> dict[str,
     """The function's outputs (a script's: every name it assigns), its arguments bound to
     ``bindings`` (SymPy symbols, ``VectorArgument``\\ s, ``StructArgument``\\ s); ``SourceError``
     at the first problem."""
-    run = _Evaluation(function, dict(bindings))
+    run = _Evaluation(dict(bindings))
     for statement, tree in function.statements:
         run.statement(statement, tree)
     if function.name is None:
@@ -276,8 +276,7 @@ def evaluate(function: MatlabFunction, bindings: dict[str, object]) -> dict[str,
 
 
 class _Evaluation:
-    def __init__(self, function: MatlabFunction, bindings: dict[str, object]):
-        self.function = function
+    def __init__(self, bindings: dict[str, object]):
         self.values = bindings
         self.arguments = set(bindings)
         self.assigned: dict[str, Output] = {}
@@ -286,7 +285,7 @@ class _Evaluation:
     # statements
     def statement(self, statement: Statement, tree: Tree) -> None:
         kind = tree.data
-        if kind in ("end_block",):
+        if kind == "end_block":
             return
         if kind == "condition":
             name, cmp, number = (str(c) for c in tree.children[1:])

@@ -254,3 +254,14 @@ def test_a_certificate_takes_m_files_beside_the_declaration_only(tmp_path):
         PendverifyError, match=r"key 'matlab.files': .*sub/pend.m is not beside the model file"
     ):
         ModelSource.of_file(path)
+
+
+def test_a_file_past_the_size_bound_is_one_line(tmp_path, monkeypatch):
+    import pendverify.analytic.matlab_parse as matlab_parse
+
+    monkeypatch.setattr(matlab_parse, "MAX_FILE_BYTES", 64)
+    path = _declaration(tmp_path)
+    done = run_main(["show", str(path)])
+    headline, fragment, column = one_error(done.stderr.removeprefix("pendverify: error: "))
+    assert done.returncode == 2 and fragment == "" and column is None
+    assert "key 'matlab.files'" in headline and "a model file is read up to 64 bytes" in headline

@@ -116,7 +116,7 @@ class Notation:
         ):
             value = self.spec.equations[key]
             position = entry_position(method, value.shape, index) if isinstance(value, sp.MatrixBase) else ()
-            found = self.spec.matlab.line_of(key, position, self.spec.matlab.entry_text(key, position))
+            found = self.spec.matlab.line_of(key, position)
             if found is not None:
                 path, line = found
                 return f"{path}, line {line}, entry {label} (key {key} of {self.source})"
