@@ -121,13 +121,10 @@ def export_forms(model_cls) -> ExportForms:
         urdf["transform"] = [[float(x) for x in row] for row in model_cls.joint_transform]
     if model_cls.joint_offset is not None:
         urdf["offset"] = [float(x) for x in model_cls.joint_offset]
-    try:
-        source = Path(where(model_cls))
-    except (TypeError, ValueError):  # pragma: no cover - where() always gives a string
-        source = None
+    source = Path(where(model_cls))  # the file, or the module's name for a class made at run time
     return ExportForms(
         name=model_cls.name,
-        source=source if source is not None and source.is_file() else None,
+        source=source if source.is_file() else None,
         coordinates=tuple(model_cls.coordinates),
         angular=tuple(bool(a) for a in model_cls.angular),
         inputs=tuple(model_cls.inputs),

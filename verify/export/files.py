@@ -22,6 +22,8 @@ from pendverify.export.verification import FAILED, Verification, verify
 from pendverify.export.writers import WRITERS
 
 LANGUAGES = tuple(WRITERS)
+#: the verification line of the draft that is verified, replaced by the outcome's line
+PENDING = "(being verified)"
 
 
 @dataclass(frozen=True)
@@ -82,11 +84,13 @@ def exported_files(
     if urdf is not None and model_cls.geometry_reader:
         forms = dataclasses.replace(forms, urdf=_read_map(model_cls, urdf))
     params_path = Path(params) if isinstance(params, str | Path) else None
-    draft = WRITERS[lang](forms, banner(forms, lang, params_path, certificate, "(being verified)"))
+    draft = WRITERS[lang](forms, banner(forms, lang, params_path, certificate, PENDING))
     verification = verify(lang, draft, forms, urdf, params, check)
-    return WRITERS[lang](
-        forms, banner(forms, lang, params_path, certificate, verification.line)
-    ), verification
+    # the code verified is the code written: only its banner's last line changes
+    done = f"Verification: {verification.line}."
+    return {
+        name: text.replace(f"Verification: {PENDING}.", done, 1) for name, text in draft.items()
+    }, verification
 
 
 def export_model(
