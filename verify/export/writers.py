@@ -24,11 +24,11 @@ import json
 import re
 
 import sympy as sp
-from sympy.printing.numpy import NumPyPrinter
 
 from pendverify.errors import PendverifyError
 from pendverify.export.closed_forms import QUANTITIES, ExportForms
 from pendverify.export.names import c_name
+from pendverify.numerics.codegen.printers import numpy_printer
 
 #: C's keywords, the names its math library declares and the functions' arguments: a coordinate
 #: or parameter so named is renamed ``name_`` in a function's body
@@ -218,7 +218,7 @@ def write_numpy(forms: ExportForms, banner: list[str]) -> dict[str, str]:
     prefix = c_name(forms.name)
     fields = [p.name for p in forms.p]
     forms = renamed(forms, NUMPY_RESERVED)
-    printer = NumPyPrinter({"fully_qualified_modules": True})
+    printer = numpy_printer()
     lines = ['"""' + "\n".join(banner) + '\n"""', "", "import numpy", "", ""]
     for key, matrix in forms.quantities.items():
         args = _arguments(key)
