@@ -17,6 +17,11 @@ as functions, written with NumPy as it is (``np.cos``, ``np.array``, ``@``)::
     V(q, p)          the potential energy, a number (optional: the ``energy`` check needs it)
     D(p), B(p), W(p) the friction, input and disturbance matrices, n × n, n × inputs,
                      n × disturbances (D and W optional, zero; B required with inputs)
+    det_M(q, p)      det M(q), a number (optional: the ``det`` check compares it with M's)
+    qddot(q, v, u, w, p)  q̈, n entries, u the inputs and w the disturbances as arrays
+                     (optional: the ``aba`` check compares it with Pinocchio's; a model of q̈
+                     alone is ``DYNAMICS`` with ``"dynamics": "qddot(q, v, u)"``,
+                     ``pendverify.analytic.python_dynamics``)
 
 exactly one of C, Cqdot and h; with ``DECLARATION``, the mapping a ``sympy.physics.mechanics``
 model file declares (``pendverify.analytic.text_parse.DECLARATION_KEYS``: ``name``,
@@ -37,7 +42,8 @@ and the state.  Each function's signature is checked when the model is made
 The functions are evaluated numerically only (``numeric_only``): SymPy does not read them
 (``show``, ``sympy``, ``mutate`` refuse in one line), the checks call them state by state, and a
 failing state is not judged again in high precision.  det M and M⁻¹ are derived from M (not
-checked); q̈ is derived from the parts (``aba`` checks their composition).
+checked) unless ``det_M`` gives it; q̈ is derived from the parts (``aba`` checks their composition)
+unless ``qddot`` gives it (``aba`` then checks the given q̈).
 
 The tolerance scales a closed form gets as Σ|terms| (``pendverify.analytic.derived_scales``) are
 taken here from the functions' values on a grid of configurations (``GRID`` points over [−π, π)
@@ -79,6 +85,8 @@ FUNCTIONS: dict[str, tuple[str, str, str]] = {
     "D": ("", "nn", "damping_matrix"),
     "B": ("", "nu", "input_matrix"),
     "W": ("", "nw", "disturbance_matrix"),
+    "det_M": ("q", "", "det_mass_matrix"),
+    "qddot": ("qvuw", "n", "acceleration"),
 }
 #: the diagnosis's quantities this form names otherwise: the gravity vector is G (given, or h(q, 0))
 WRITTEN_NAMES = {"H": "G"}
@@ -314,7 +322,8 @@ def numpy_model(
     if "M" not in functions:
         fail(
             f"defines {', '.join(functions)} but no M(q, p): a model of NumPy functions gives M(q, p), "
-            "C(q, v, p) (or Cqdot(q, v, p) or h(q, v, p)) and G(q, p)"
+            "C(q, v, p) (or Cqdot(q, v, p) or h(q, v, p)) and G(q, p); a model of q̈ alone is DYNAMICS "
+            'with "dynamics": "qddot(q, v, u)" in its DECLARATION'
         )
     bias = [k for k in BIAS if k in functions]
     if len(bias) != 1:

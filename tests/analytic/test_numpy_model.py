@@ -153,6 +153,50 @@ def test_a_given_v_is_checked_by_energy(factor, status, tmp_path):
     assert [r.name for r in report.results if r.status == "fail"] == ([] if status == "pass" else ["energy"])
 
 
+#: det M and q̈ of the double pendulum as a file gives them: det M in closed form, q̈ solved with M
+DET_AND_QDDOT = """
+
+def det_M(q, p):
+    alpha = p.I1 + p.I2 + p.m1 * p.r1**2 + p.m2 * (p.l1**2 + p.r2**2)
+    beta, delta = p.m2 * p.l1 * p.r2, p.I2 + p.m2 * p.r2**2
+    c2 = np.cos(q[1])
+    return (alpha + 2 * beta * c2) * delta - (delta + beta * c2) ** 2
+
+
+def qddot(q, v, u, w, p):
+    return np.linalg.solve(M(q, p), B(p) @ u - D(p) @ v - C(q, v, p) @ v - G(q, p))
+
+
+DECLARATION ="""
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "failing"),
+    [
+        ("", "", []),
+        ("* delta - (delta", "* delta * 1.001 - (delta", ["det"]),
+        ("- G(q, p))", "- 1.001 * G(q, p))", ["aba"]),
+    ],
+    ids=["right", "det_M wrong", "qddot wrong"],
+)
+def test_a_given_det_m_and_qddot_are_checked(old, new, failing, tmp_path):
+    """det_M(q, p) and qddot(q, v, u, w, p) are the model's own: ``det`` and ``aba`` check them,
+    and an error planted in either fails its check alone."""
+    text = _changed(DOUBLE_PENDULUM, "\n\nDECLARATION =", DET_AND_QDDOT)
+    report = pendverify.check(
+        _file(tmp_path, _changed(text, old, new) if old else text), DP_URDF, DP_PARAMS, samples=60
+    )
+    assert {"det", "aba"} <= set(report.checks), report
+    assert [r.name for r in report.results if r.status == "fail"] == failing, report
+
+
+def test_qddot_alone_is_pointed_to_dynamics(tmp_path):
+    declaration = DOUBLE_PENDULUM[DOUBLE_PENDULUM.index("DECLARATION =") :]
+    text = f"import numpy as np\n\n\ndef qddot(q, v, u, w, p):\n    return -v\n\n\n{declaration}"
+    with pytest.raises(PendverifyError, match=r"no M\(q, p\).*q̈ alone is DYNAMICS"):
+        load_model_class(_file(tmp_path, text))
+
+
 def test_p_gives_the_parameters_by_attribute_and_by_key(tmp_path):
     text = _changed(DOUBLE_PENDULUM, "return p.g * np.array(", 'return p["g"] * np.array(')
     report = pendverify.check(_file(tmp_path, text), DP_URDF, DP_PARAMS, samples=60)
