@@ -936,30 +936,36 @@ def generate_keys(folder: str | Path, force: bool = False) -> tuple[Path, Path, 
 # --- worked examples -------------------------------------------------------------------------------
 def export(
     model: ModelLike,
-    lang: str,
+    lang: str | None,
     output: str | Path,
     urdf: UrdfLike | None = None,
     params: ParamsLike | None = None,
     *,
+    casadi: bool = False,
     force: bool = False,
 ):
-    """Write a model's closed forms as code, verified: ``pendverify export`` (docs/export.md).
+    """Write a model's closed forms as code, verified: ``pendverify export`` (docs/commands/export.md).
 
     ``lang`` is ``"c"`` (``NAME.h``, ``NAME.c``), ``"matlab"`` (one ``.m`` function per quantity
-    and their declaration) or ``"numpy"`` (a NumPy-functions model file); the files go into the
-    folder ``output`` (existing ones are replaced only with ``force``).  Before they are written
-    the code is read back as a model and checked against ``urdf`` with ``params``
-    (``pendverify.export.verification``); the result's ``verification`` says how, and its line
-    is in every file's banner.  Returns an ``ExportResult``.
+    and their declaration), ``"numpy"`` (a NumPy-functions model file) or None; ``casadi`` adds
+    ``NAME_casadi.py``, the quantities as CasADi ``Function`` objects (the ``casadi`` package must be
+    installed).  The files go into the folder ``output`` (existing ones are replaced only with
+    ``force``: otherwise nothing is written).  Before they are written each language's code is read
+    back as a model and checked against ``urdf`` with ``params``
+    (``pendverify.export.verification``); each result's ``verification`` says how, and its line is
+    in every file's banner.  Returns one ``ExportResult`` per language, ``lang``'s first.
     """
     # deferred on purpose: SymPy's code printers load only when code is exported
     from pendverify.export.files import export_model
 
+    langs = (*([] if lang is None else [lang]), *(["casadi"] if _flag("casadi", casadi) else []))
+    if not langs:
+        raise InputError(OPTIONS_SOURCE, "lang", lang, "a language (c, matlab, numpy), or casadi=True")
     model_cls = load_model(model)
     if urdf is not None:
         urdf = _urdf_arg(urdf)
     return export_model(
-        model_cls, lang, Path(output), check, urdf=urdf, params=params, force=_flag("force", force)
+        model_cls, langs, Path(output), check, urdf=urdf, params=params, force=_flag("force", force)
     )
 
 

@@ -5,6 +5,8 @@ that check, for every language; no compiler or no robot is one line, the files m
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from pendverify import api
@@ -13,7 +15,9 @@ from pendverify.export.verification import FAILED, UNVERIFIED, VERIFIED
 from pendverify.worked_examples import EXAMPLES
 from tests.cli_run import run_main
 
-LANGS = ("c", "matlab", "numpy")
+REPO = Path(__file__).resolve().parents[2]
+#: the languages, CasADi (``--casadi``) among them: its tests need the casadi package (the test extra)
+LANGS = ("c", "matlab", "numpy", "casadi")
 #: the worked examples whose model writes M (all of them); their Python model files
 CASES = [(example, lang) for example in EXAMPLES for lang in LANGS]
 #: a planted error in the written code of each language: the first entry of M times 11/10
@@ -21,7 +25,16 @@ PLANTS = {
     "c": ("out[0] = ", "out[0] = 1.1*"),
     "matlab": ("M = reshape([", "M = reshape([1.1*"),
     "numpy": ("return numpy.array([[", "return numpy.array([[1.1*"),
+    "casadi": ("out[0, 0] = ", "out[0, 0] = 1.1*"),
 }
+
+
+def _export(model, lang: str, output, *args):
+    """``api.export`` of one language (CasADi by ``casadi=True``): its one result."""
+    if lang == "casadi":
+        pytest.importorskip("casadi", reason="export --casadi needs the casadi package (pendverify[casadi])")
+    (result,) = api.export(model, None if lang == "casadi" else lang, output, *args, casadi=lang == "casadi")
+    return result
 
 
 def _example(name: str):
@@ -31,7 +44,7 @@ def _example(name: str):
 @pytest.mark.slow
 @pytest.mark.parametrize(("example", "lang"), CASES, ids=[f"{e.name}-{lang}" for e, lang in CASES])
 def test_every_worked_example_exports_verified(tmp_path, example, lang):
-    result = api.export(example.model.source, lang, tmp_path, example.urdf.source, example.params.source)
+    result = _export(example.model.source, lang, tmp_path, example.urdf.source, example.params.source)
     assert result.verification.status == VERIFIED, result.verification.line
     for path in result.files:
         assert "Verification: pendverify check of the written code: all checks pass" in path.read_text()
@@ -48,9 +61,10 @@ def test_a_planted_error_in_the_written_code_fails_its_check(tmp_path, monkeypat
 
     monkeypatch.setitem(export_files.WRITERS, lang, planted)
     example = _example("minimal_double_pendulum")
-    result = api.export(example.model.source, lang, tmp_path, example.urdf.source, example.params.source)
+    result = _export(example.model.source, lang, tmp_path, example.urdf.source, example.params.source)
     assert result.verification.status == FAILED, result.verification.line
-    assert "crba FAIL" in result.verification.line or "crba" in result.verification.line
+    failing = result.verification.line.split("written code: ")[1].split(" FAIL")[0].split(", ")
+    assert "crba" in failing, result.verification.line
     assert any(new in path.read_text() for path in result.files)  # written, and marked as failing
     assert all("FAIL" in path.read_text() for path in result.files)
 
@@ -68,38 +82,45 @@ def test_no_compiler_is_one_line_and_the_files_are_marked_unverified(tmp_path, m
 
 def test_without_a_robot_nothing_is_called_verified(tmp_path):
     example = _example("minimal_double_pendulum")
-    result = api.export(example.model.source, "numpy", tmp_path)
+    result = _export(example.model.source, "numpy", tmp_path)
     assert result.verification.status == UNVERIFIED and "--urdf" in result.verification.line
 
 
 def test_exported_files_are_not_replaced_without_force(tmp_path):
     example = _example("minimal_double_pendulum")
-    api.export(example.model.source, "numpy", tmp_path)
+    _export(example.model.source, "numpy", tmp_path)
     done = run_main(["export", str(example.model.source), "--lang", "numpy", "-o", str(tmp_path)])
     assert done.returncode == 2 and "give --force" in done.stderr
 
 
-def test_certify_export_signs_the_code_and_recheck_catches_an_edited_file(tmp_path):
-    """``certify --export c``: the verified C code in the bundle, its banner naming the certificate's
-    digest, covered by the signature; a hand-edited .c is refused by ``recheck``, naming it."""
+@pytest.mark.parametrize(
+    ("lang", "name"), [("c", "minimal_double_pendulum.c"), ("casadi", "minimal_double_pendulum_casadi.py")]
+)
+def test_certify_export_signs_the_code_and_recheck_catches_an_edited_file(tmp_path, lang, name):
+    """``certify --export c`` (``casadi``): the verified code in the bundle, its banner naming the
+    certificate's digest, covered by the signature; a hand-edited file is refused by ``recheck``,
+    naming it."""
+    if lang == "casadi":
+        pytest.importorskip("casadi", reason="export --casadi needs the casadi package (pendverify[casadi])")
     keys = tmp_path / "keys"
     assert run_main(["keygen", "-o", str(keys)]).returncode == 0
     example = _example("minimal_double_pendulum")
     out = tmp_path / "bundle"
     argv = ["certify", "--analytic", str(example.written_model.source), "--urdf", str(example.urdf.source)]
     argv += ["--params", str(example.params.source), "-o", str(out), "--samples", "30"]
-    done = run_main([*argv, "--key", str(keys / "pendverify-signing.key.pem"), "--export", "c"])
+    done = run_main([*argv, "--key", str(keys / "pendverify-signing.key.pem"), "--export", lang])
     assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
     cert = next(out.glob("*.cert.json"))
-    source = out / "minimal_double_pendulum.c"
+    source = out / name
     digest = __import__("json").loads(cert.read_text())["digest"]["value"]
     assert f"Certificate: sha256 {digest}" in source.read_text()
     assert "Verification: pendverify check of the written code: all checks pass" in source.read_text()
     trust = ["--trust", str(keys / "pendverify-signing.pub.pem")]
     assert run_main(["recheck", str(cert), *trust]).returncode == 0
-    source.write_text(source.read_text().replace("out[0] = ", "out[0] = 1.1*", 1))
+    old, new = PLANTS[lang]
+    source.write_text(source.read_text().replace(old, new, 1))
     done = run_main(["recheck", str(cert), *trust])
-    assert done.returncode == 2 and "minimal_double_pendulum.c" in done.stderr, done.stderr
+    assert done.returncode == 2 and name in done.stderr, done.stderr
 
 
 def test_certify_export_needs_a_key(tmp_path):
@@ -115,3 +136,146 @@ def test_the_file_names_a_bundle_allows_are_those_export_writes():
     from pendverify.export.names import METHODS
 
     assert METHODS == tuple(method for method, _, _ in QUANTITIES.values())
+
+
+#: where each language's function of a quantity starts: (language, key) → its first line's head
+FUNCTION_STARTS = {
+    ("c", "qddot"): "void double_pendulum_acceleration(",
+    ("c", "det_M"): "void double_pendulum_det_mass_matrix(",
+    ("matlab", "qddot"): "function qddot = double_pendulum_acceleration(",
+    ("matlab", "det_M"): "function det_M = double_pendulum_det_mass_matrix(",
+    ("numpy", "qddot"): "def qddot(",
+    ("numpy", "det_M"): "def det_M(",
+    ("casadi", "qddot"): "def _acceleration(",
+    ("casadi", "det_M"): "def _det_mass_matrix(",
+}
+#: the first value each language's function writes, and the same × 11/10
+FIRST_VALUE = {
+    "c": ("out[0] = ", "out[0] = 1.1*"),
+    "matlab": ("= reshape([", "= reshape([1.1*"),
+    "numpy": ("return ", "return 1.1*"),
+    "casadi": ("] = ", "] = 1.1*"),
+}
+
+
+def _planted_in(text: str, start: str, old: str, new: str) -> str:
+    """``text`` with the first ``old`` after ``start`` made ``new`` (unchanged where there is none:
+    another function's file, a C header)."""
+    at = text.find(start)
+    end = text.find(old, at) if at >= 0 else -1
+    return text if end < 0 else text[:end] + new + text[end + len(old) :]
+
+
+@pytest.mark.parametrize("lang", LANGS)
+@pytest.mark.parametrize(("key", "check"), [(None, None), ("qddot", "aba"), ("det_M", "det")])
+def test_the_models_own_qddot_and_det_m_are_written_and_checked(tmp_path, monkeypatch, lang, key, check):
+    """The reference double pendulum writes its own q̈ (f + g·u) and det M: both are exported, and
+    the check of the written code compares them with Pinocchio: an error planted in either fails
+    its check alone."""
+    writer = export_files.WRITERS[lang]
+    if key is not None:
+        old, new = FIRST_VALUE[lang]
+        start = FUNCTION_STARTS[lang, key]
+
+        def planted(forms, banner):
+            return {name: _planted_in(text, start, old, new) for name, text in writer(forms, banner).items()}
+
+        monkeypatch.setitem(export_files.WRITERS, lang, planted)
+    example = _example("double_pendulum")
+    result = _export(example.model.source, lang, tmp_path, example.urdf.source)
+    written = "".join(path.read_text() for path in result.files)
+    assert FUNCTION_STARTS[lang, "qddot"] in written and FUNCTION_STARTS[lang, "det_M"] in written
+    assert "Parameter set: the one the model reads off the robot description" in written
+    if key is None:
+        assert result.verification.status == VERIFIED, result.verification.line
+    else:
+        assert result.verification.status == FAILED, result.verification.line
+        assert f": {check} FAIL (" in result.verification.line, result.verification.line
+
+
+ACROBOT_QDDOT = (
+    "corpus_acrobot_gym_qddot.toml",
+    "corpus_acrobot_tedrake.urdf",
+    "corpus_acrobot_gym_qddot_params.toml",
+)
+
+
+@pytest.mark.parametrize("lang", LANGS)
+@pytest.mark.parametrize("plant", [False, True], ids=["as written", "planted"])
+def test_a_model_of_qddot_alone_exports_its_qddot_verified(tmp_path, monkeypatch, lang, plant):
+    """gymnasium's acrobot gives q̈ alone (one input, M not determined): its q̈, D and B are written
+    (NumPy as DYNAMICS code) and ``aba`` checks the written q̈; × 11/10 in it, that fails."""
+    if plant:
+        writer = export_files.WRITERS[lang]
+        old, new = FIRST_VALUE[lang]
+        start = {
+            "c": "void acrobot_gym_qddot_acceleration(",
+            "matlab": "function qddot",
+            "numpy": "def qddot(",
+            "casadi": "def _acceleration(",
+        }[lang]
+
+        def planted(forms, banner):
+            return {name: _planted_in(text, start, old, new) for name, text in writer(forms, banner).items()}
+
+        monkeypatch.setitem(export_files.WRITERS, lang, planted)
+    model, urdf, params = (REPO / "examples" / name for name in ACROBOT_QDDOT)
+    result = _export(model, lang, tmp_path, urdf, params)
+    names = {path.name for path in result.files}
+    assert "M" not in names and not any("mass_matrix" in n for n in names), names
+    if lang == "numpy":
+        assert "DYNAMICS = qddot" in (tmp_path / "acrobot_gym_qddot_numpy.py").read_text()
+    want = (FAILED, "aba FAIL") if plant else (VERIFIED, "all checks pass")
+    assert result.verification.status == want[0] and want[1] in result.verification.line, result.verification
+
+
+def test_a_robot_without_parameter_values_is_refused_before_anything_is_written(tmp_path):
+    """The cart reference system reads no parameters off its URDF and has none of its own: export
+    with --urdf needs --params, and says so before writing (not a 'failed' written code)."""
+    example = _example("cart_double_pendulum")
+    argv = ["export", str(example.model.source), "--lang", "numpy", "-o", str(tmp_path / "out")]
+    done = run_main([*argv, "--urdf", str(example.urdf.source)])
+    assert done.returncode == 2 and "give the parameter set (--params)" in done.stderr, done
+    assert not (tmp_path / "out").exists()
+
+
+def test_casadi_without_the_package_is_refused_in_one_line_before_any_work(tmp_path, monkeypatch):
+    import importlib.util
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(
+        importlib.util, "find_spec", lambda name, *a: None if name == "casadi" else real(name, *a)
+    )
+    example = _example("minimal_double_pendulum")
+    done = run_main(["export", str(example.model.source), "--casadi", "-o", str(tmp_path / "out")])
+    assert done.returncode == 2, done
+    assert (
+        "export --casadi: the casadi package is not installed (pip install 'pendverify[casadi]')"
+        in done.stderr
+    )
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_language_or_casadi_is_required(tmp_path):
+    example = _example("minimal_double_pendulum")
+    done = run_main(["export", str(example.model.source), "-o", str(tmp_path)])
+    assert done.returncode == 2 and "give --lang c|matlab|numpy, --casadi, or both" in done.stderr, done
+
+
+def test_lang_and_casadi_together_write_both_or_nothing(tmp_path):
+    """``--lang c --casadi`` writes both languages' files, each verified; when one of them exists,
+    neither language's files are written (without --force)."""
+    pytest.importorskip("casadi", reason="export --casadi needs the casadi package (pendverify[casadi])")
+    example = _example("minimal_double_pendulum")
+    argv = ["export", str(example.model.source), "--lang", "c", "--casadi", "-o", str(tmp_path)]
+    argv += ["--urdf", str(example.urdf.source), "--params", str(example.params.source)]
+    (tmp_path / "minimal_double_pendulum_casadi.py").write_text("# mine\n")
+    done = run_main(argv)
+    assert done.returncode == 2 and "give --force" in done.stderr, done
+    assert not (tmp_path / "minimal_double_pendulum.c").exists()
+    done = run_main([*argv, "--force"])
+    assert done.returncode == 0, done
+    assert done.stdout.count(f"{VERIFIED}: pendverify check of the written code: all checks pass") == 2, (
+        done.stdout
+    )
+    assert "export --casadi." in (tmp_path / "minimal_double_pendulum_casadi.py").read_text()

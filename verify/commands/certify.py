@@ -82,8 +82,9 @@ def register(sub) -> None:
     )
     p.add_argument(
         "--export",
-        choices=("c", "matlab", "numpy"),
-        help="add the model's code in this language to the bundle, verified against the URDF and signed "
+        choices=("c", "matlab", "numpy", "casadi"),
+        help="add the model's code in this language (casadi: CasADi Functions) to the bundle, verified "
+        "against the URDF and signed "
         "(needs --key; one set, not --sweep) (default: none)",
     )
     add_package_path_option(p)

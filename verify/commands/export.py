@@ -1,25 +1,33 @@
-"""``pendverify export``: a model's closed forms written as C, MATLAB or NumPy code, verified first."""
+"""``pendverify export``: a model's closed forms as C, MATLAB, NumPy or CasADi code, verified first."""
 
 from __future__ import annotations
 
 import argparse
 
 from pendverify.commands import add_command
+from pendverify.errors import PendverifyError
 
 
 def register(sub) -> None:
     p = add_command(
         sub,
         "export",
-        "write a model's M, C·q̇, G, D, B as C, MATLAB or NumPy code, checked against the robot first",
+        "write a model's M, C·q̇, G, D, B, det M, q̈ as C, MATLAB, NumPy or CasADi code, checked against "
+        "the robot first",
         [
             "pendverify export model.toml --lang c --urdf robot.urdf --params robot.toml -o exported",
             "pendverify export model.toml --lang matlab --urdf robot.urdf --params robot.toml -o exported",
+            "pendverify export model.toml --casadi --urdf robot.urdf --params robot.toml -o exported",
         ],
         quiet=False,
     )
     p.add_argument("model", metavar="MODEL", help="a model file (.py, .toml, or a declaration of .m files)")
-    p.add_argument("--lang", required=True, choices=("c", "matlab", "numpy"), help="the language to write")
+    p.add_argument("--lang", choices=("c", "matlab", "numpy"), help="the language to write")
+    p.add_argument(
+        "--casadi",
+        action="store_true",
+        help="write the quantities as CasADi Functions too (NAME_casadi.py; needs the casadi package)",
+    )
     p.add_argument("-o", "--output", required=True, metavar="DIR", help="the folder to write the files into")
     p.add_argument("--urdf", metavar="FILE", help="the robot description the written code is checked against")
     p.add_argument("--params", metavar="FILE", help="the parameter file the code is checked with")
@@ -30,8 +38,13 @@ def register(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     from pendverify import api  # deferred on purpose: building the command line imports no Pinocchio
 
-    result = api.export(args.model, args.lang, args.output, args.urdf, args.params, force=args.force)
-    for path in result.files:
-        print(f"wrote {path}")
-    print(f"{result.verification.status}: {result.verification.line}")
-    return 1 if result.failed else 0
+    if args.lang is None and not args.casadi:
+        raise PendverifyError("export: give --lang c|matlab|numpy, --casadi, or both")
+    results = api.export(
+        args.model, args.lang, args.output, args.urdf, args.params, casadi=args.casadi, force=args.force
+    )
+    for result in results:
+        for path in result.files:
+            print(f"wrote {path}")
+        print(f"{result.verification.status}: {result.verification.line}")
+    return 1 if any(result.failed for result in results) else 0

@@ -12,15 +12,19 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import importlib.metadata
+import importlib.util
 from dataclasses import dataclass
 from pathlib import Path
 
 from pendverify.atomic import check_output, write_atomic
 from pendverify.errors import PendverifyError
+from pendverify.export.casadi_code import NOT_INSTALLED, write_casadi
 from pendverify.export.closed_forms import ExportForms, export_forms
 from pendverify.export.verification import FAILED, Verification, verify
-from pendverify.export.writers import WRITERS
+from pendverify.export.writers import write_c, write_matlab, write_numpy
 
+#: language → its files' writer (``pendverify.export.writers``, ``pendverify.export.casadi_code``)
+WRITERS = {"c": write_c, "matlab": write_matlab, "numpy": write_numpy, "casadi": write_casadi}
 LANGUAGES = tuple(WRITERS)
 #: the verification line of the draft that is verified, replaced by the outcome's line
 PENDING = "(being verified)"
@@ -44,7 +48,12 @@ def _sha256(path: Path) -> str:
 
 
 def banner(
-    forms: ExportForms, lang: str, params: Path | None, certificate: str | None, verified: str
+    forms: ExportForms,
+    lang: str,
+    params: Path | None,
+    certificate: str | None,
+    verified: str,
+    read_from: str | None = None,
 ) -> list[str]:
     """The lines every exported file starts with (module docstring)."""
     version = importlib.metadata.version("pendverify")
@@ -53,7 +62,8 @@ def banner(
         if forms.source
         else f"the built-in model {forms.name}"
     )
-    lines = [f"The closed forms of model {forms.name}, written by pendverify {version} export --lang {lang}."]
+    option = "--casadi" if lang == "casadi" else f"--lang {lang}"
+    lines = [f"The closed forms of model {forms.name}, written by pendverify {version} export {option}."]
     lines.append(f"Model: {source}.")
     if forms.companions:
         read = ", ".join(f"{path.name} (sha256 {_sha256(path)})" for path in forms.companions)
@@ -64,6 +74,12 @@ def banner(
         )
     elif certificate:
         lines.append("Parameter set: the certificate's; the code takes the parameters as p.")
+    elif read_from:
+        lines.append(
+            f"Parameter set: the one the model reads off {read_from}; the code takes the parameters as p."
+        )
+    elif forms.default_params:
+        lines.append("Parameter set: the model's own defaults; the code takes the parameters as p.")
     else:
         lines.append("Parameter set: none; the code takes the parameters as p.")
     if certificate:
@@ -78,14 +94,50 @@ def exported_files(
     """The files of ``model_cls``'s quantities in ``lang`` (name → text), verified by ``check``
     (``pendverify.api.check``, given by the caller: the library does not import the API), the
     verification's line in their banner."""
-    if lang not in WRITERS:
-        raise PendverifyError(f"export: --lang {lang!r}: one of {', '.join(LANGUAGES)}")
-    forms = export_forms(model_cls)
-    if urdf is not None and model_cls.geometry_reader:
-        forms = dataclasses.replace(forms, urdf=_read_map(model_cls, urdf))
-    params_path = Path(params) if isinstance(params, str | Path) else None
-    draft = WRITERS[lang](forms, banner(forms, lang, params_path, certificate, PENDING))
-    verification = verify(lang, draft, forms, urdf, params, check)
+    return _exported(_ExportInput.of(model_cls, urdf, params, certificate, (lang,)), lang, check)
+
+
+@dataclass(frozen=True)
+class _ExportInput:
+    """What every language's files of one export are made from: the model's quantities, the robot
+    and the parameter set the written code is checked with, and what the banner says of them."""
+
+    forms: ExportForms
+    urdf: object
+    params: object  # what ``check`` takes: a file, a mapping, or None
+    params_path: Path | None
+    read_from: str | None
+    certificate: str | None
+
+    @classmethod
+    def of(cls, model_cls, urdf, params, certificate: str | None, langs: tuple[str, ...]) -> _ExportInput:
+        for lang in langs:
+            if lang not in WRITERS:
+                raise PendverifyError(f"export: --lang {lang!r}: one of {', '.join(LANGUAGES)}")
+            if lang == "casadi" and importlib.util.find_spec("casadi") is None:
+                raise PendverifyError(f"export --casadi: {NOT_INSTALLED}")
+        forms = export_forms(model_cls)
+        read_from = None
+        if urdf is not None and model_cls.geometry_reader:
+            joint_map, read = _read_geometry(model_cls, urdf)
+            forms = dataclasses.replace(forms, urdf=joint_map)
+            if params is None and certificate is None and read is not None:
+                params, read_from = read, _description_name(urdf)
+        if urdf is not None and params is None and not forms.default_params:
+            raise PendverifyError(
+                f"export: give the parameter set (--params) the written code is checked with: {forms.name} "
+                "has no parameter values of its own, and the robot description does not fix them"
+            )
+        params_path = Path(params) if isinstance(params, str | Path) else None
+        if params is None and forms.default_params:  # the written code has none: checked with the model's
+            params = dict(forms.default_params)
+        return cls(forms, urdf, params, params_path, read_from, certificate)
+
+
+def _exported(given: _ExportInput, lang: str, check) -> tuple[dict[str, str], Verification]:
+    head = banner(given.forms, lang, given.params_path, given.certificate, PENDING, given.read_from)
+    draft = WRITERS[lang](given.forms, head)
+    verification = verify(lang, draft, given.forms, given.urdf, given.params, check)
     # the code verified is the code written: only its banner's last line changes
     done = f"Verification: {verification.line}."
     return {
@@ -94,29 +146,46 @@ def exported_files(
 
 
 def export_model(
-    model_cls, lang: str, output: Path, check, *, urdf=None, params=None, force: bool = False
-) -> ExportResult:
-    """Write ``model_cls``'s quantities as ``lang`` code into ``output``, verified first
-    (``exported_files``)."""
+    model_cls, langs: tuple[str, ...], output: Path, check, *, urdf=None, params=None, force: bool = False
+) -> tuple[ExportResult, ...]:
+    """Write ``model_cls``'s quantities as code of each of ``langs`` into ``output``, each verified
+    first (``exported_files``); no file is written when one of them exists and not ``force``."""
     check_output(output, folder=True)
-    files, verification = exported_files(model_cls, lang, check, urdf=urdf, params=params)
-    existing = sorted(name for name in files if (output / name).exists())
+    given = _ExportInput.of(model_cls, urdf, params, None, langs)
+    made = [(lang, *_exported(given, lang, check)) for lang in langs]
+    existing = sorted(name for _, files, _ in made for name in files if (output / name).exists())
     if existing and not force:
         raise PendverifyError(f"{output / existing[0]}: exists; give --force to replace the exported files")
     output.mkdir(parents=True, exist_ok=True)
-    written = tuple(write_atomic(output / name, text) for name, text in files.items())
-    return ExportResult(lang, written, verification)
+    return tuple(
+        ExportResult(
+            lang, tuple(write_atomic(output / name, text) for name, text in files.items()), verification
+        )
+        for lang, files, verification in made
+    )
 
 
-def _read_map(model_cls, urdf) -> dict:
-    """The URDF table of a model that reads its coordinate map off the robot's geometry (a reference
-    system): the joints, T and θ0 it reads there, which the exported code's declaration states."""
+def _read_geometry(model_cls, urdf) -> tuple[dict, dict | None]:
+    """What a model that reads the robot's geometry (a reference system) reads off ``urdf``: the
+    URDF table (the joints, T and θ0, which the exported code's declaration states) and the
+    parameter values (None where the description does not fix them), which the written code,
+    having none of its own, is checked with."""
     from pendverify.robot.system import PinocchioSystem
 
     system = PinocchioSystem.for_model(model_cls, urdf)
     joints = [system.model.names[j] for j in range(1, system.model.njoints)]
+    read = system.geometry.params
     return {
         "joints": joints,
         "transform": [[float(x) for x in row] for row in system.cmap.T],
         "offset": [float(x) for x in system.cmap.theta0],
-    }
+    }, (None if read is None else read.as_dict())
+
+
+def _description_name(urdf) -> str:
+    """The robot description's file name for the banner, or what it is when it is not a file."""
+    return (
+        f"the robot description {urdf}"
+        if isinstance(urdf, str | Path) and Path(urdf).is_file()
+        else ("the robot description given")
+    )

@@ -6,7 +6,16 @@ import re
 
 #: the model methods exported, one file each in MATLAB (``NAME_<method>.m``): those of
 #: ``closed_forms.QUANTITIES`` (a test compares them; this module imports neither SymPy nor NumPy)
-METHODS = ("mass_matrix", "coriolis_force", "gravity", "damping_matrix", "input_matrix", "disturbance_matrix")
+METHODS = (
+    "mass_matrix",
+    "coriolis_force",
+    "gravity",
+    "damping_matrix",
+    "input_matrix",
+    "disturbance_matrix",
+    "det_mass_matrix",
+    "acceleration",
+)
 
 
 def c_name(name: str) -> str:
@@ -19,4 +28,5 @@ def export_file_names(model_name: str) -> frozenset[str]:
     """Every file ``export`` may write for model ``model_name``, in any language."""
     prefix = c_name(model_name)
     matlab = {f"{prefix}_{method}.m" for method in METHODS}
-    return frozenset({f"{prefix}.h", f"{prefix}.c", f"{prefix}_numpy.py", f"{prefix}_matlab.toml", *matlab})
+    code = {f"{prefix}{suffix}" for suffix in (".h", ".c", "_numpy.py", "_casadi.py", "_matlab.toml")}
+    return frozenset({*code, *matlab})

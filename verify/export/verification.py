@@ -4,12 +4,17 @@ The files of one language are written into a private temporary folder and read b
 file pendverify reads, which ``check`` then compares with the robot on its usual states and
 tolerances:
 
-* **NumPy**: the module is a NumPy-functions model file (``pendverify.analytic.numpy_model``);
+* **NumPy**: the module is a NumPy-functions model file (``pendverify.analytic.numpy_model``), or
+  ``DYNAMICS`` code for a model of q̈ alone;
 * **MATLAB**: the declaration reads the ``.m`` files through the MATLAB reader (docs/matlab.md);
 * **C**: the source is compiled by the system's C compiler (``$CC``, else ``cc``) into a shared
   library, and a NumPy-functions shim calls its functions through ``ctypes`` (a ``double`` array
   per argument, the parameters as the ``NAME_params`` structure).  No compiler is one line: the
-  files are written, marked unverified.
+  files are written, marked unverified;
+* **CasADi**: the module is imported and its ``casadi.Function`` objects are called on numbers by
+  a shim.
+
+Models of q̈ alone are read back as ``DYNAMICS`` code (``pendverify.analytic.python_dynamics``).
 
 ``Verification.status`` is ``verified`` (every check passes), ``failed`` (a check fails, or the
 code does not compile or load: the line says which) or ``unverified`` (nothing compared it with
@@ -60,12 +65,15 @@ def verify(lang: str, files: dict[str, str], forms: ExportForms, urdf, params, c
             model = folder / f"{prefix}_numpy.py"
         elif lang == "matlab":
             model = folder / f"{prefix}_matlab.toml"
+        elif lang == "casadi":
+            model = folder / f"{prefix}_casadi_shim.py"
+            model.write_text(_shim(forms, *_casadi_calls(folder / f"{prefix}_casadi.py")), encoding="utf-8")
         else:
             built = _compile(folder, prefix)
             if isinstance(built, Verification):
                 return built
             model = folder / f"{prefix}_c_shim.py"
-            model.write_text(_shim(forms, built), encoding="utf-8")
+            model.write_text(_shim(forms, *_c_calls(forms, built)), encoding="utf-8")
         return _checked(model, urdf, params, check)
 
 
@@ -81,7 +89,8 @@ def _checked(model: Path, urdf, params, check) -> Verification:
     errors = [r.largest_error for r in report.results if r.largest_error is not None]
     worst = max((e for e in errors if math.isfinite(e)), default=0.0)
     states = sum(report.states.values())
-    counted = f"{len(report.results)} checks on {states} states, largest relative error {worst:.2e}"
+    checks = f"{len(report.results)} check{'s' * (len(report.results) != 1)}"
+    counted = f"{checks} on {states} states, largest relative error {worst:.2e}"
     if report.passed:
         return Verification(VERIFIED, f"pendverify check of the written code: all checks pass ({counted})")
     failing = ", ".join(sorted({r.name for r in report.failures()}))
@@ -121,48 +130,86 @@ def _compile(folder: Path, prefix: str) -> Path | Verification:
     return library
 
 
-def _shim(forms: ExportForms, library: Path) -> str:
-    """A NumPy-functions model whose functions call the compiled C through ``ctypes``."""
+def _c_calls(forms: ExportForms, library: Path) -> tuple[list[str], object]:
+    """The shim's head and body (``_shim``) that call the compiled C through ``ctypes``: a ``double``
+    array per argument, the parameters as the ``NAME_params`` structure, the result into ``out``."""
     prefix = c_name(forms.name)
-    names = [p.name for p in forms.p]
-    n = len(forms.coordinates)
-    lines = [
-        '"""The exported C code as a NumPy-functions model (pendverify.export.verification)."""',
+    head = [
         "import ctypes",
-        "import numpy",
         "",
         f"_lib = ctypes.CDLL({str(library)!r})",
-        "",
-        "",
-        f"_NAMES = {names!r}",
+        f"_NAMES = {[p.name for p in forms.p]!r}",
         "",
         "",
         "class _Params(ctypes.Structure):",
         "    _fields_ = [(name, ctypes.c_double) for name in _NAMES]",
         "",
         "",
-        "def _params(p):",
-        "    return _Params(*[float(p[name]) for name in _NAMES])",
-        "",
-        "",
         "def _vector(x):",
-        f"    return (ctypes.c_double * {n})(*[float(e) for e in x])",
+        "    return (ctypes.c_double * len(x))(*[float(e) for e in x])",
+    ]
+
+    def body(key: str, arguments: list[str]) -> list[str]:
+        size = forms.quantities[key].rows * forms.quantities[key].cols
+        params = "ctypes.byref(_Params(*[float(p[name]) for name in _NAMES]))"
+        call = [*(f"_vector({a})" for a in arguments), params, "out"]
+        return [
+            f"    out = (ctypes.c_double * {size})()",
+            f"    _lib.{prefix}_{QUANTITIES[key][0]}({', '.join(call)})",
+            "    value = numpy.array(out[:], dtype=float)",
+        ]
+
+    return head, body
+
+
+def _casadi_calls(module: Path) -> tuple[list[str], object]:
+    """The shim's head and body (``_shim``) that call the CasADi module's functions on numbers."""
+    head = [
+        "import importlib.util",
+        "",
+        f"_spec = importlib.util.spec_from_file_location('exported_casadi', {str(module)!r})",
+        "_casadi = importlib.util.module_from_spec(_spec)",
+        "_spec.loader.exec_module(_casadi)",
+    ]
+
+    def body(key: str, arguments: list[str]) -> list[str]:
+        call = [*(f"numpy.asarray({a}, dtype=float)" for a in arguments), "_casadi.parameters(p)"]
+        return [f"    value = numpy.array(_casadi.{key}({', '.join(call)}), dtype=float).reshape(-1)"]
+
+    return head, body
+
+
+def _shim(forms: ExportForms, head: list[str], body) -> str:
+    """A model pendverify reads whose functions call the written code: NumPy functions
+    (``pendverify.analytic.numpy_model``), or ``DYNAMICS`` code for a model of q̈ alone.  ``body(key,
+    arguments)`` gives the lines that set ``value``, the quantity's entries row-major, from the
+    arrays named ``arguments`` and the parameters ``p``."""
+    lines = [
+        '"""The exported code as a model (pendverify.export.verification)."""',
+        "import numpy",
+        *head,
         "",
         "",
     ]
+    alone = "M" not in forms.quantities  # q̈ alone: DYNAMICS code, u the inputs then the disturbances
+    nu = len(forms.u)
     for key, matrix in forms.quantities.items():
-        method, args, _ = QUANTITIES[key]
-        parameters = [*(["q"] if "q" in args else []), *(["v"] if "v" in args else []), "p"]
-        call = [*(["_vector(q)"] if "q" in args else []), *(["_vector(v)"] if "v" in args else [])]
-        size = matrix.rows * matrix.cols
-        shape = f"({matrix.rows},)" if key in ("Cqdot", "G") else f"({matrix.rows}, {matrix.cols})"
+        if alone:
+            parameters = ["q", "v", "u", "**p"]
+            given = {"q": "q", "v": "v", "u": f"u[:{nu}]", "w": f"u[{nu}:]"}
+        else:
+            parameters = [*QUANTITIES[key][1], "p"]
+            given = {a: a for a in "qvuw"}
+        shape = {"matrix": f".reshape({matrix.rows}, {matrix.cols})", "vector": "", "number": "[0]"}
         lines += [
             f"def {key}({', '.join(parameters)}):",
-            f"    out = (ctypes.c_double * {size})()",
-            f"    _lib.{prefix}_{method}({', '.join([*call, 'ctypes.byref(_params(p))', 'out'])})",
-            f"    return numpy.array(out[:], dtype=float).reshape{shape}",
+            *body(key, [given[a] for a in forms.arguments(key)]),
+            f"    return value{shape[forms.shape(key)]}",
             "",
             "",
         ]
-    lines.append(f"DECLARATION = {forms.declaration()!r}")
+    if alone:
+        lines += ["DYNAMICS = qddot", f"DECLARATION = {forms.dynamics_declaration()!r}"]
+    else:
+        lines.append(f"DECLARATION = {forms.declaration()!r}")
     return "\n".join(lines) + "\n"

@@ -2,8 +2,9 @@
 
 Every file starts with ``banner`` lines (the model file and its SHA-256, the parameter set, the
 certificate's digest when ``certify`` exports, and how the code was verified).  In each language
-a quantity is one function of the coordinates ``q``, the rates ``v`` (C·q̇ only) and the
-parameters ``p``; its common subexpressions are computed once (``sympy.cse``) as temporaries
+a quantity is one function of the coordinates ``q``, the rates ``v`` (C·q̇ and q̈), the inputs
+``u`` and disturbances ``w`` (q̈; left out of C and MATLAB signatures where the model has none)
+and the parameters ``p``; its common subexpressions are computed once (``sympy.cse``) as temporaries
 ``t0, t1, …`` (``tmp_0, …`` where a model name is ``t<k>``):
 
 * **C99** (``NAME.h``, ``NAME.c``): ``typedef struct { double m1; … } NAME_params;`` and
@@ -13,8 +14,11 @@ parameters ``p``; its common subexpressions are computed once (``sympy.cse``) as
   a vector and ``p`` a structure (``p.m1``), and ``NAME_matlab.toml``, the declaration that reads
   them back (``docs/matlab.md``);
 * **NumPy** (``NAME_numpy.py``): the NumPy-functions model format (``M(q, p)``, ``Cqdot(q, v, p)``,
-  ``G(q, p)``, ``D(p)``, ``B(p)``, ``W(p)`` and ``DECLARATION``: ``pendverify.analytic.numpy_model``),
-  so that the module is itself a model pendverify reads.
+  ``G(q, p)``, ``D(p)``, ``B(p)``, ``W(p)``, ``det_M(q, p)``, ``qddot(q, v, u, w, p)`` and
+  ``DECLARATION``: ``pendverify.analytic.numpy_model``), so that the module is itself a model
+  pendverify reads; a model of q̈ alone is written as ``DYNAMICS`` code, ``qddot(q, v, u, **p)``
+  with u the inputs then the disturbances, B, D and W in its declaration
+  (``pendverify.analytic.python_dynamics``).
 """
 
 from __future__ import annotations
@@ -36,15 +40,17 @@ C_RESERVED = frozenset(
     """auto break case char const continue default do double else enum extern float for goto if inline
     int long register restrict return short signed sizeof static struct switch typedef union unsigned
     void volatile while _Bool _Complex _Imaginary sin cos tan exp log sqrt pow fabs atan2 asin acos atan
-    sinh cosh tanh y0 y1 yn j0 j1 jn gamma out p q v""".split()
+    sinh cosh tanh y0 y1 yn j0 j1 jn gamma out p q v u w""".split()
 )
 
 
 #: the names a MATLAB function's body may not take for a coordinate or parameter: its arguments,
 #: its output names and the functions the printed code calls
-MATLAB_RESERVED = frozenset("q v p M Cqdot G D B W pi sin cos tan exp log sqrt abs reshape".split())
+MATLAB_RESERVED = frozenset(
+    "q v u w p M Cqdot G D B W det_M qddot pi sin cos tan exp log sqrt abs reshape".split()
+)
 #: the same for a NumPy module's functions
-NUMPY_RESERVED = frozenset("q v p numpy".split())
+NUMPY_RESERVED = frozenset("q v u w p numpy".split())
 C_KEYWORDS = frozenset(
     """auto break case char const continue default do double else enum extern float for goto if inline
     int long register restrict return short signed sizeof static struct switch typedef union unsigned
@@ -53,46 +59,41 @@ C_KEYWORDS = frozenset(
 
 
 def renamed(forms: ExportForms, reserved: frozenset) -> ExportForms:
-    """``forms`` with each coordinate, rate and parameter whose name is ``reserved`` in the language
-    renamed ``name_`` in the expressions (its declared name stays: the struct's field, the
-    declaration's entry)."""
+    """``forms`` with each coordinate, rate, input, disturbance and parameter whose name is
+    ``reserved`` in the language renamed ``name_`` in the expressions (its declared name stays:
+    the struct's field, the declaration's entry)."""
+    symbols = (*forms.q, *forms.v, *forms.u, *forms.w, *forms.p)
     local: dict[str, str] = {}
-    for s in (*forms.q, *forms.v, *forms.p):
+    for s in symbols:
         name = s.name
         while name in reserved or name in local.values():
             name += "_"
         local[s.name] = name
     if all(k == v for k, v in local.items()):
         return forms
-    swap = {s: sp.Symbol(local[s.name], real=True) for s in (*forms.q, *forms.v, *forms.p)}
+    swap = {s: sp.Symbol(local[s.name], real=True) for s in symbols}
     return dataclasses.replace(
         forms,
         quantities={k: m.xreplace(swap) for k, m in forms.quantities.items()},
-        q=tuple(swap[s] for s in forms.q),
-        v=tuple(swap[s] for s in forms.v),
-        p=tuple(swap[s] for s in forms.p),
+        **{group: tuple(swap[s] for s in getattr(forms, group)) for group in "qvuwp"},
     )
 
 
 def _temporaries(forms: ExportForms):
-    taken = {s.name for s in (*forms.q, *forms.v, *forms.p)}
+    taken = {s.name for s in (*forms.q, *forms.v, *forms.u, *forms.w, *forms.p)}
     prefix = "t" if not any(re.fullmatch(r"t\d+", n) for n in taken) else "tmp_"
     return sp.numbered_symbols(prefix, real=True)
 
 
-def _reduced(forms: ExportForms, matrix: sp.Matrix):
+def reduced(forms: ExportForms, matrix: sp.Matrix):
     """(temporaries [(symbol, expression)], the entries row-major) of one quantity."""
     entries = [matrix[i, j] for i in range(matrix.rows) for j in range(matrix.cols)]
     return sp.cse(entries, symbols=_temporaries(forms), optimizations="basic")
 
 
-def _used(forms: ExportForms, shared, entries, group: tuple) -> list[sp.Symbol]:
+def used(forms: ExportForms, shared, entries, group: tuple) -> list[sp.Symbol]:
     found = set().union(*(e.free_symbols for _, e in shared), *(e.free_symbols for e in entries))
     return [s for s in group if s in found]
-
-
-def _arguments(key: str) -> str:
-    return QUANTITIES[key][1]
 
 
 # -------------------------------------------------------------------------------- C99
@@ -113,34 +114,29 @@ def write_c(forms: ExportForms, banner: list[str]) -> dict[str, str]:
     struct = ["typedef struct {", *(f"    double {name};" for name in fields), f"}} {prefix}_params;"]
     header = [*comment, f"#ifndef {prefix.upper()}_H", f"#define {prefix.upper()}_H", "", *struct, ""]
     source = [*comment, "#include <math.h>", f'#include "{prefix}.h"', ""]
-    n = len(forms.coordinates)
     for key, matrix in forms.quantities.items():
-        method, args, what = QUANTITIES[key]
+        method, _, what = QUANTITIES[key]
         signature = [
-            *([f"const double q[{n}]"] if "q" in args else []),
-            *([f"const double v[{n}]"] if "v" in args else []),
+            *(f"const double {a}[{len(getattr(forms, a))}]" for a in forms.arguments(key)),
             f"const {prefix}_params *p",
             f"double out[{matrix.rows * matrix.cols}]",
         ]
         declaration = f"void {prefix}_{method}({', '.join(signature)})"
-        layout = "row-major" if matrix.cols > 1 else "a vector"
+        layout = {"matrix": "row-major", "vector": "a vector", "number": "out[0]"}[forms.shape(key)]
         header += [f"/* {what}: out is {matrix.rows} × {matrix.cols}, {layout} */", f"{declaration};", ""]
-        shared, entries = _reduced(forms, matrix)
+        shared, entries = reduced(forms, matrix)
         body = [
-            f"    const double {s.name} = q[{forms.q.index(s)}];"
-            for s in _used(forms, shared, entries, forms.q)
-        ]
-        body += [
-            f"    const double {s.name} = v[{forms.v.index(s)}];"
-            for s in _used(forms, shared, entries, forms.v)
+            f"    const double {s.name} = {a}[{getattr(forms, a).index(s)}];"
+            for a in "qvuw"
+            for s in used(forms, shared, entries, getattr(forms, a))
         ]
         body += [
             f"    const double {s.name} = p->{fields[forms.p.index(s)]};"
-            for s in _used(forms, shared, entries, forms.p)
+            for s in used(forms, shared, entries, forms.p)
         ]
         body += [f"    const double {t.name} = {sp.ccode(e, standard='c99')};" for t, e in shared]
         body += [f"    out[{k}] = {sp.ccode(e, standard='c99')};" for k, e in enumerate(entries)]
-        if not _used(forms, shared, entries, forms.p):
+        if not used(forms, shared, entries, forms.p):
             body.insert(0, "    (void)p;")
         source += [f"{declaration}", "{", *body, "}", ""]
     header += [f"#endif /* {prefix.upper()}_H */", ""]
@@ -163,18 +159,21 @@ def write_matlab(forms: ExportForms, banner: list[str]) -> dict[str, str]:
     files: dict[str, str] = {}
     keys: dict[str, str] = {}
     for key, matrix in forms.quantities.items():
-        method, args, what = QUANTITIES[key]
+        method, _, what = QUANTITIES[key]
         output = _matlab_output(declared, key)
-        arguments = [*(["q"] if "q" in args else []), *(["v"] if "v" in args else []), "p"]
+        arguments = [*forms.arguments(key), "p"]
         lines = [
             f"function {output} = {prefix}_{method}({','.join(arguments)})",
             f"%{prefix.upper()}_{method.upper()}",
         ]
         lines += [f"%    {what}", *(f"%    {line}" for line in banner), ""]
-        shared, entries = _reduced(forms, matrix)
-        lines += [f"{s.name} = q({forms.q.index(s) + 1});" for s in _used(forms, shared, entries, forms.q)]
-        lines += [f"{s.name} = v({forms.v.index(s) + 1});" for s in _used(forms, shared, entries, forms.v)]
-        lines += [f"{s.name} = p.{fields[forms.p.index(s)]};" for s in _used(forms, shared, entries, forms.p)]
+        shared, entries = reduced(forms, matrix)
+        lines += [
+            f"{s.name} = {a}({getattr(forms, a).index(s) + 1});"
+            for a in "qvuw"
+            for s in used(forms, shared, entries, getattr(forms, a))
+        ]
+        lines += [f"{s.name} = p.{fields[forms.p.index(s)]};" for s in used(forms, shared, entries, forms.p)]
         lines += [f"{t.name} = {sp.octave_code(e)};" for t, e in shared]
         column_major = [entries[i * matrix.cols + j] for j in range(matrix.cols) for i in range(matrix.rows)]
         values = ",".join(sp.octave_code(e) for e in column_major)
@@ -198,11 +197,10 @@ def write_matlab(forms: ExportForms, banner: list[str]) -> dict[str, str]:
     if "urdf" in declaration:
         toml += ["", "[urdf]", *(f"{k} = {json.dumps(v)}" for k, v in declaration["urdf"].items())]
     toml += ["", "[matlab]", f"files = {json.dumps(list(files))}", "", "[matlab.arguments]"]
-    toml += [
-        f"q = {json.dumps(list(forms.coordinates))}",
-        f"v = {json.dumps(list(forms.rates))}",
-        'p = "struct"',
-    ]
+    vectors = {"q": forms.coordinates, "v": forms.rates, "u": forms.inputs, "w": forms.disturbances}
+    needed = {a for key in forms.quantities for a in forms.arguments(key)}
+    toml += [f"{a} = {json.dumps(list(names))}" for a, names in vectors.items() if a in needed]
+    toml += ['p = "struct"']
     files[f"{prefix}_matlab.toml"] = "\n".join(toml) + "\n"
     return files
 
@@ -210,39 +208,52 @@ def write_matlab(forms: ExportForms, banner: list[str]) -> dict[str, str]:
 # ----------------------------------------------------------------------------- NumPy
 
 
-_NUMPY_NAMES = {"M": "M", "Cqdot": "Cqdot", "G": "G", "D": "D", "B": "B", "W": "W"}
-
-
 def write_numpy(forms: ExportForms, banner: list[str]) -> dict[str, str]:
-    """``NAME_numpy.py``: a NumPy-functions model file (module docstring)."""
+    """``NAME_numpy.py``: a NumPy-functions model file, or ``DYNAMICS`` code for a model of q̈
+    alone (module docstring)."""
     prefix = c_name(forms.name)
-    fields = [p.name for p in forms.p]
-    forms = renamed(forms, NUMPY_RESERVED)
-    printer = numpy_printer()
+    declared, forms = forms, renamed(forms, NUMPY_RESERVED)
     lines = ['"""' + "\n".join(banner) + '\n"""', "", "import numpy", "", ""]
-    for key, matrix in forms.quantities.items():
-        args = _arguments(key)
-        parameters = [*(["q"] if "q" in args else []), *(["v"] if "v" in args else []), "p"]
-        lines.append(f"def {_NUMPY_NAMES[key]}({', '.join(parameters)}):")
-        lines.append(f'    """{QUANTITIES[key][2]}."""')
-        shared, entries = _reduced(forms, matrix)
-        if "q" in args:
-            lines.append(f"    {', '.join(s.name for s in forms.q)}, = q")
-        if "v" in args:
-            lines.append(f"    {', '.join(s.name for s in forms.v)}, = v")
-        lines += [
-            f"    {s.name} = p[{fields[forms.p.index(s)]!r}]" for s in _used(forms, shared, entries, forms.p)
-        ]
-        lines += [f"    {t.name} = {printer.doprint(e)}" for t, e in shared]
-        rows = [
-            "[" + ", ".join(printer.doprint(entries[i * matrix.cols + j]) for j in range(matrix.cols)) + "]"
-            for i in range(matrix.rows)
-        ]
-        shape = f"({matrix.rows},)" if key in ("Cqdot", "G") else f"({matrix.rows}, {matrix.cols})"
-        lines.append(f"    return numpy.array([{', '.join(rows)}], dtype=float).reshape{shape}")
-        lines += ["", ""]
+    if "M" not in forms.quantities:
+        return {f"{prefix}_numpy.py": "\n".join(lines + _numpy_dynamics(forms, declared)) + "\n"}
+    for key in forms.quantities:
+        arguments = [*QUANTITIES[key][1], "p"]
+        lines += _numpy_function(forms, key, key, arguments, {a: a for a in QUANTITIES[key][1]})
     lines.append(f"DECLARATION = {forms.declaration()!r}")
     return {f"{prefix}_numpy.py": "\n".join(lines) + "\n"}
 
 
-WRITERS = {"c": write_c, "matlab": write_matlab, "numpy": write_numpy}
+def _numpy_dynamics(forms: ExportForms, declared: ExportForms) -> list[str]:
+    """q̈ as ``DYNAMICS`` code, ``qddot(q, v, u, **p)``, u the inputs then the disturbances, and
+    its declaration with B, D and W written as a text model writes them."""
+    nu = len(forms.u)
+    unpack = {"q": "q", "v": "v", "u": f"u[:{nu}]", "w": f"u[{nu}:]"}
+    lines = _numpy_function(forms, "qddot", "qddot", ["q", "v", "u", "**p"], unpack)
+    return [*lines, "DYNAMICS = qddot", f"DECLARATION = {declared.dynamics_declaration()!r}"]
+
+
+def _numpy_function(forms: ExportForms, key: str, name: str, arguments: list[str], unpack: dict) -> list[str]:
+    """One function ``name(arguments)`` returning ``key``'s value; ``unpack`` says which array
+    each argument group (q, v, u, w) is read from."""
+    fields = {s: name for s, (name, _, _) in zip(forms.p, forms.parameters, strict=True)}
+    printer = numpy_printer()
+    matrix = forms.quantities[key]
+    shared, entries = reduced(forms, matrix)
+    lines = [f"def {name}({', '.join(arguments)}):", f'    """{QUANTITIES[key][2]}."""']
+    for group in QUANTITIES[key][1]:
+        symbols = getattr(forms, group)
+        if symbols:
+            lines.append(f"    {', '.join(s.name for s in symbols)}, = {unpack[group]}")
+    lines += [f"    {s.name} = p[{fields[s]!r}]" for s in used(forms, shared, entries, forms.p)]
+    lines += [f"    {t.name} = {printer.doprint(e)}" for t, e in shared]
+    shape = forms.shape(key)
+    if shape == "number":
+        lines.append(f"    return float({printer.doprint(entries[0])})")
+    else:
+        rows = [
+            "[" + ", ".join(printer.doprint(entries[i * matrix.cols + j]) for j in range(matrix.cols)) + "]"
+            for i in range(matrix.rows)
+        ]
+        size = f"({matrix.rows},)" if shape == "vector" else f"({matrix.rows}, {matrix.cols})"
+        lines.append(f"    return numpy.array([{', '.join(rows)}], dtype=float).reshape{size}")
+    return [*lines, "", ""]
