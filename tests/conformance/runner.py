@@ -10,6 +10,7 @@ and returns (exit status, stdout + stderr), an exception escaping ``main`` being
 
 from __future__ import annotations
 
+import importlib.util
 import traceback
 from pathlib import Path
 
@@ -31,10 +32,13 @@ class Files:
         self.params = write_parameters(model, folder)
         self.model = write_model(model, format_name, folder) if format_name != "-" else None
 
-    def export_language(self) -> str:
-        """The language ``export`` writes this cell's model in: c, matlab and numpy in turn over the
-        model files' names (stable: the same cell always exports the same language)."""
-        return ("c", "matlab", "numpy")[sum(map(ord, self.model.name)) % 3]
+    def export_language(self) -> list[str]:
+        """The language options ``export`` writes this cell's model with: c, matlab, numpy and casadi
+        (where the package is installed: the test extra has it) in turn over the model files' names
+        (stable: the same cell always exports the same language)."""
+        langs = [["--lang", "c"], ["--lang", "matlab"], ["--lang", "numpy"]]
+        langs += [["--casadi"]] if importlib.util.find_spec("casadi") is not None else []
+        return langs[sum(map(ord, self.model.name)) % len(langs)]
 
     def analytic(self) -> list[str]:
         return ["--analytic", str(self.model), "--urdf", str(self.robot), "--params", str(self.params)]
@@ -74,7 +78,7 @@ def _certify(files: Files, keys: Path) -> list[list[str]]:
 def _export(files: Files, out: Path) -> list[list[str]]:
     """``export`` of the cell's model: without a robot (the code written, unverified), then checked
     against the cell's description (replacing the files), in the cell's language."""
-    head = ["export", str(files.model), "--lang", files.export_language(), "-o", str(out)]
+    head = ["export", str(files.model), *files.export_language(), "-o", str(out)]
     return [head, [*head, "--force", "--urdf", str(files.robot), "--params", str(files.params)]]
 
 
