@@ -279,3 +279,38 @@ def test_lang_and_casadi_together_write_both_or_nothing(tmp_path):
         done.stdout
     )
     assert "export --casadi." in (tmp_path / "minimal_double_pendulum_casadi.py").read_text()
+
+
+#: the simple end: a free 1-DOF pendulum given by q̈ alone (no inputs, no B), the robot of
+#: tests/analytic/data/pendulum_functions.urdf (2 kg at 0.5 m, damping 0.1)
+FREE_PENDULUM = """name = "free_pendulum"
+inputs = []
+qddot = ["(-b*dtheta - m*g*l*sin(theta))/(m*l**2)"]
+D = [["b"]]
+
+[coordinates]
+theta = "angle"
+
+[parameters]
+m = { kind = "mass" }
+l = { kind = "length" }
+b = { kind = "damping" }
+g = { kind = "gravity" }
+
+[urdf]
+joints = ["hinge"]
+"""
+
+
+@pytest.mark.parametrize("lang", LANGS)
+def test_a_one_dof_model_of_qddot_alone_without_inputs_exports_verified(tmp_path, lang):
+    """No inputs: the C, MATLAB and CasADi q̈ take no u (an empty argument is left out), the NumPy
+    DYNAMICS code unpacks none; each is read back and ``aba`` passes."""
+    model, params = tmp_path / "free.toml", tmp_path / "params.toml"
+    model.write_text(FREE_PENDULUM)
+    params.write_text('model = "free_pendulum"\n[parameters]\nm = 2.0\nl = 0.5\nb = 0.1\ng = 9.81\n')
+    urdf = REPO / "tests" / "analytic" / "data" / "pendulum_functions.urdf"
+    result = _export(model, lang, tmp_path / "out", urdf, params)
+    assert result.verification.status == VERIFIED, result.verification.line
+    text = "".join(path.read_text() for path in result.files)
+    assert "const double u[" not in text and 'SX.sym("u"' not in text
