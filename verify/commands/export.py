@@ -12,8 +12,7 @@ def register(sub) -> None:
     p = add_command(
         sub,
         "export",
-        "write a model's M, C·q̇, G, D, B, det M, q̈ as C, MATLAB, NumPy or CasADi code, checked against "
-        "the robot first",
+        "write a model's closed forms as C, MATLAB, NumPy or CasADi code, checked against the robot first",
         [
             "pendverify export model.toml --lang c --urdf robot.urdf --params robot.toml -o exported",
             "pendverify export model.toml --lang matlab --urdf robot.urdf --params robot.toml -o exported",

@@ -117,20 +117,15 @@ class _ExportInput:
             if lang == "casadi" and importlib.util.find_spec("casadi") is None:
                 raise PendverifyError(f"export --casadi: {NOT_INSTALLED}")
         forms = export_forms(model_cls)
-        read_from = None
-        if urdf is not None and model_cls.geometry_reader:
-            joint_map, read = _read_geometry(model_cls, urdf)
-            forms = dataclasses.replace(forms, urdf=joint_map)
-            if params is None and certificate is None and read is not None:
-                params, read_from = read, _description_name(urdf)
-        if urdf is not None and params is None and not forms.default_params:
-            raise PendverifyError(
-                f"export: give the parameter set (--params) the written code is checked with: {forms.name} "
-                "has no parameter values of its own, and the robot description does not fix them"
-            )
         params_path = Path(params) if isinstance(params, str | Path) else None
-        if params is None and forms.default_params:  # the written code has none: checked with the model's
-            params = dict(forms.default_params)
+        read_from = None
+        if urdf is not None:  # the code is checked with the parameter set the model's check takes
+            target = _target(model_cls, urdf, params)
+            if model_cls.geometry_reader:
+                forms = dataclasses.replace(forms, urdf=_joint_map(target.system))
+            if params is None and model_cls.default_params is None:
+                read_from = _description_name(urdf)
+            params = target.model.params.as_dict()
         return cls(forms, urdf, params, params_path, read_from, certificate)
 
 
@@ -165,21 +160,23 @@ def export_model(
     )
 
 
-def _read_geometry(model_cls, urdf) -> tuple[dict, dict | None]:
-    """What a model that reads the robot's geometry (a reference system) reads off ``urdf``: the
-    URDF table (the joints, T and θ0, which the exported code's declaration states) and the
-    parameter values (None where the description does not fix them), which the written code,
-    having none of its own, is checked with."""
-    from pendverify.robot.system import PinocchioSystem
+def _target(model_cls, urdf, params):
+    """The model's target on ``urdf`` as ``check`` makes it: its parameter set is ``params`` (a
+    file or a mapping), else the model's ``PARAMS``, else what the model reads off the robot, else
+    refused naming what to give (``pendverify.targets.model_target``)."""
+    from pendverify.targets import model_target, parameter_values
 
-    system = PinocchioSystem.for_model(model_cls, urdf)
-    joints = [system.model.names[j] for j in range(1, system.model.njoints)]
-    read = system.geometry.params
+    return model_target(model_cls, urdf, None if params is None else parameter_values(model_cls, params))
+
+
+def _joint_map(system) -> dict:
+    """The URDF table of a model that reads its coordinate map off the robot's geometry (a reference
+    system): the joints, T and θ0 it reads there, which the exported code's declaration states."""
     return {
-        "joints": joints,
+        "joints": [system.model.names[j] for j in range(1, system.model.njoints)],
         "transform": [[float(x) for x in row] for row in system.cmap.T],
         "offset": [float(x) for x in system.cmap.theta0],
-    }, (None if read is None else read.as_dict())
+    }
 
 
 def _description_name(urdf) -> str:
