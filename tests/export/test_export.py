@@ -314,3 +314,42 @@ def test_a_one_dof_model_of_qddot_alone_without_inputs_exports_verified(tmp_path
     assert result.verification.status == VERIFIED, result.verification.line
     text = "".join(path.read_text() for path in result.files)
     assert "const double u[" not in text and 'SX.sym("u"' not in text
+
+
+def test_the_c_header_links_from_cpp(tmp_path):
+    """A C++ controller includes the header and links the C object: the declarations are
+    ``extern "C"``; its M at one state is the exported NumPy module's."""
+    import importlib.util
+    import shutil
+    import subprocess
+
+    import numpy as np
+
+    cxx, cc = shutil.which("c++"), shutil.which("cc")
+    if cxx is None or cc is None:
+        pytest.skip("needs a C and a C++ compiler")
+    example = _example("minimal_double_pendulum")
+    api.export(example.model.source, "c", tmp_path)
+    (numpy_code,) = api.export(example.model.source, "numpy", tmp_path)
+    spec = importlib.util.spec_from_file_location("exported", numpy_code.files[0])
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    params = api.load_params(example.model.source, example.params.source).as_dict()
+    fields = "".join(f"    p.{name} = {params[name]!r};\n" for name in module.DECLARATION["parameters"])
+    (tmp_path / "main.cpp").write_text(
+        '#include <cstdio>\n#include "minimal_double_pendulum.h"\n'
+        "int main() {\n    minimal_double_pendulum_params p;\n"
+        f"{fields}"
+        "    const double q[2] = {0.3, -0.2};\n    double M[4];\n"
+        "    minimal_double_pendulum_mass_matrix(q, &p, M);\n"
+        '    std::printf("%.17g %.17g %.17g %.17g\\n", M[0], M[1], M[2], M[3]);\n    return 0;\n}\n'
+    )
+    subprocess.run(
+        [cc, "-std=c99", "-c", "minimal_double_pendulum.c", "-o", "model.o"], cwd=tmp_path, check=True
+    )
+    subprocess.run([cxx, "main.cpp", "model.o", "-lm", "-o", "main"], cwd=tmp_path, check=True)
+    printed = subprocess.run([str(tmp_path / "main")], capture_output=True, text=True, check=True).stdout
+    expected = module.M(np.array([0.3, -0.2]), params).ravel()
+    # the same expressions, C's pow against NumPy's power: each entry (a sum of a few positive
+    # products of the parameters and cos θ2) rounds in under 16 operations, each within ε
+    assert np.allclose([float(x) for x in printed.split()], expected, rtol=32 * np.finfo(float).eps, atol=0)

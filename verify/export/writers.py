@@ -7,7 +7,8 @@ a quantity is one function of the coordinates ``q``, the rates ``v`` (C·q̇ and
 and the parameters ``p``; its common subexpressions are computed once (``sympy.cse``) as temporaries
 ``t0, t1, …`` (``tmp_0, …`` where a model name is ``t<k>``):
 
-* **C99** (``NAME.h``, ``NAME.c``): ``typedef struct { double m1; … } NAME_params;`` and
+* **C99** (``NAME.h``, ``NAME.c``; the header's declarations ``extern "C"`` in C++):
+  ``typedef struct { double m1; … } NAME_params;`` and
   ``void NAME_mass_matrix(const double q[n], const NAME_params *p, double out[n*n])``, and so on:
   no allocation, ``double`` arrays, matrices row-major (``out[i*cols + j]``);
 * **MATLAB/Octave** (``NAME_mass_matrix.m``, …): ``function M = NAME_mass_matrix(q, p)`` with ``q``
@@ -112,7 +113,9 @@ def write_c(forms: ExportForms, banner: list[str]) -> dict[str, str]:
     forms = renamed(forms, C_RESERVED)
     comment = ["/*", *(f" * {line}" for line in banner), " */"]
     struct = ["typedef struct {", *(f"    double {name};" for name in fields), f"}} {prefix}_params;"]
-    header = [*comment, f"#ifndef {prefix.upper()}_H", f"#define {prefix.upper()}_H", "", *struct, ""]
+    guard = f"{prefix.upper()}_H"
+    cplusplus = ["#ifdef __cplusplus", 'extern "C" {', "#endif", ""]
+    header = [*comment, f"#ifndef {guard}", f"#define {guard}", "", *cplusplus, *struct, ""]
     source = [*comment, "#include <math.h>", f'#include "{prefix}.h"', ""]
     for key, matrix in forms.quantities.items():
         method, _, what = QUANTITIES[key]
@@ -139,7 +142,7 @@ def write_c(forms: ExportForms, banner: list[str]) -> dict[str, str]:
         if not used(forms, shared, entries, forms.p):
             body.insert(0, "    (void)p;")
         source += [f"{declaration}", "{", *body, "}", ""]
-    header += [f"#endif /* {prefix.upper()}_H */", ""]
+    header += ["#ifdef __cplusplus", "}", "#endif", "", f"#endif /* {guard} */", ""]
     return {f"{prefix}.h": "\n".join(header), f"{prefix}.c": "\n".join(source)}
 
 
