@@ -31,6 +31,7 @@ model reads it: completed, checked and turned into a model class, so every comma
 from __future__ import annotations
 
 import difflib
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -64,6 +65,9 @@ class MatlabSource:
     whole: dict[str, str] = field(default_factory=dict)
     #: equation key → its value in the declaration (a string, or lists of them)
     written: dict[str, object] = field(default_factory=dict)
+    #: file → (its statements, the arguments it was evaluated with, its text): what a line edit
+    #: of a repair (``pendverify.analytic.matlab_edit``) evaluates again
+    functions: dict[Path, tuple[MatlabFunction, dict, str]] = field(default_factory=dict)
 
     def entry_text(self, key: str, position: tuple[int, ...]) -> str | None:
         """The declaration's text of the entry at ``position`` of ``key`` (``"-M12"``), if it has one."""
@@ -71,6 +75,19 @@ class MatlabSource:
         for i in position:
             item = item[i] if isinstance(item, list) and i < len(item) else None
         return item if isinstance(item, str) else None
+
+    @property
+    def used(self) -> set[str]:
+        """The outputs the declaration's equations read (a script's other names are temporaries)."""
+        texts, stack = [], list(self.written.values())
+        while stack:
+            item = stack.pop()
+            if isinstance(item, list):
+                stack += item
+            elif isinstance(item, str):
+                texts.append(item)
+        words = {w for text in texts for w in re.findall(r"[A-Za-z_]\w*", text)}
+        return (words & set(self.outputs)) | set(self.whole.values())
 
     def line_of(self, key: str, position: tuple[int, ...]) -> tuple[Path, int] | None:
         """(file, line) where the entry at ``position`` of equation ``key`` was written, if known:
@@ -119,6 +136,7 @@ def read_matlab(reader, spec, table) -> tuple[MatlabSource, dict[str, object]]:
         except SourceError as exc:
             _fail_at(path, text, exc)
         source.files += (path,)
+        source.functions[path] = (function, bindings, text)
         for name, output in outputs.items():
             if name in values:
                 reader.fail(

@@ -257,13 +257,39 @@ def _header(tree: Tree) -> tuple[str, tuple[str, ...], tuple[str, ...]]:
     return name, outputs, params
 
 
+@dataclass(frozen=True)
+class Assignment:
+    """A statement ``name = expression`` whose value is a scalar: the temporaries ``t2 = cos(q2);``
+    that ``matlabFunction`` writes, and a model's scalar outputs."""
+
+    index: int  # the statement's place in ``MatlabFunction.statements``
+    name: str
+    line: int
+    last_line: int  # the line of its last token (a statement continued with ``...`` spans several)
+    value: sp.Expr
+
+
 def evaluate(function: MatlabFunction, bindings: dict[str, object]) -> dict[str, Output]:
     """The function's outputs (a script's: every name it assigns), its arguments bound to
     ``bindings`` (SymPy symbols, ``VectorArgument``\\ s, ``StructArgument``\\ s); ``SourceError``
     at the first problem."""
-    run = _Evaluation(dict(bindings))
-    for statement, tree in function.statements:
+    return traced(function, bindings)[0]
+
+
+def traced(
+    function: MatlabFunction, bindings: dict[str, object], replaced: tuple[int, object] | None = None
+) -> tuple[dict[str, Output], list[Assignment]]:
+    """``evaluate``'s outputs and the scalar ``Assignment``\\ s made on the way; with ``replaced``
+    (a statement's index, a value), that statement's name takes the value instead of its
+    expression's (what the file would give were the statement's right-hand side that value)."""
+    run = _Evaluation(dict(bindings), replaced)
+    for index, (statement, tree) in enumerate(function.statements):
+        run.index = index
         run.statement(statement, tree)
+    return _outputs(function, run), run.scalars
+
+
+def _outputs(function: MatlabFunction, run) -> dict[str, Output]:
     if function.name is None:
         return run.assigned
     missing = [o for o in function.outputs if o not in run.assigned]
@@ -276,11 +302,14 @@ def evaluate(function: MatlabFunction, bindings: dict[str, object]) -> dict[str,
 
 
 class _Evaluation:
-    def __init__(self, bindings: dict[str, object]):
+    def __init__(self, bindings: dict[str, object], replaced: tuple[int, object] | None = None):
         self.values = bindings
         self.arguments = set(bindings)
         self.assigned: dict[str, Output] = {}
         self.sizes: dict = {}
+        self.replaced = replaced
+        self.index = -1
+        self.scalars: list[Assignment] = []
 
     # statements
     def statement(self, statement: Statement, tree: Tree) -> None:
@@ -303,10 +332,14 @@ class _Evaluation:
         target = tree.children[0]
         line = statement.line
         if kind == "assign_name":
-            value = self.value(tree.children[2])
+            replaced = self.replaced is not None and self.replaced[0] == self.index
+            value = self.replaced[1] if replaced else self.value(tree.children[2])
             self._refuse_argument(target)
             self.values[str(target)] = value
             self.assigned[str(target)] = Output(value, line)
+            if isinstance(value, sp.Expr) and not isinstance(value, sp.MatrixBase):
+                last = max(t.line for t in statement.tokens)
+                self.scalars.append(Assignment(self.index, str(target), line, last, value))
             return
         arguments, value = tree.children[1], self.value(tree.children[3])
         self._refuse_argument(target)

@@ -135,16 +135,25 @@ def test_the_published_shapes_verify(tmp_path, name):
 
 
 def test_a_planted_error_is_named_at_the_m_files_line_in_matlab_syntax(tmp_path):
+    """The error planted in M[1,2] (= M[2,1], one temporary of matlabFunction's layout) is repaired
+    as the line of that temporary, in MATLAB's operators and the file's names; the line edited as
+    printed, the model passes."""
     model, urdf, params = _write(tmp_path, "cart_double_pendulum", plant=True)
     done = run_main(["check", *_files(model, urdf, params), "--samples", "20"])
     assert done.returncode == 1, done.stdout[-3000:] + done.stderr[-2000:]
-    source = (tmp_path / "PendulumODEMatrices.m").read_text().splitlines()
-    line = next(k for k, text in enumerate(source, start=1) if text.strip().startswith("W = reshape"))
     repairs = [r for r in done.stdout.splitlines() if "M[1,2]: " in r and "makes every check pass" in r]
     assert repairs, done.stdout[-3000:]
-    assert f"PendulumODEMatrices.m, line {line}, entry M[1,2]" in repairs[0], repairs[0]
-    written = repairs[0].split("M[1,2]: ", 1)[1]
-    assert re.search(r"\.\*|\.\^", written) and "**" not in written, repairs[0]  # MATLAB's operators
+    found = re.search(r"PendulumODEMatrices\.m, line (\d+), which computes M\[1,2\], M\[2,1\]", repairs[0])
+    assert found, repairs[0]
+    written, suggested = re.search(r"M\[1,2\]: (.*?;) → (.*?;) makes", repairs[0]).groups()
+    assert re.fullmatch(r"t\d+ = .*", suggested) and "**" not in suggested, repairs[0]  # MATLAB, its names
+    path = tmp_path / "PendulumODEMatrices.m"
+    lines = path.read_text().split("\n")
+    assert lines[int(found.group(1)) - 1].strip() == written
+    lines[int(found.group(1)) - 1] = suggested
+    path.write_text("\n".join(lines))
+    done = run_main(["check", *_files(model, urdf, params), "--samples", "20"])
+    assert done.returncode == 0, done.stdout[-3000:]
 
 
 def test_an_error_in_balance_equations_fails(tmp_path):

@@ -102,6 +102,25 @@ class Notation:
         edited = minimal_edit(source, written, old, new, self.render)
         return written, edited if edited is not None else whole[1]
 
+    def line_edit(self, changes: dict):
+        """For a model of ``.m`` files, the one line of a file whose change is the confirmed repair
+        ``changes`` ({(method, flat index): (old, new)}) (``pendverify.analytic.matlab_edit``);
+        None for other models, or when no single line makes exactly those changes."""
+        if self.kind != "matlab":
+            return None
+        from pendverify.diagnosis.matlab_line_edit import line_edit  # deferred: a .m model's alone
+
+        entries = {}
+        for (method, index), pair in changes.items():
+            key = TEXT_KEYS.get(method, method)
+            value = self.spec.equations.get(key)
+            if key in self.derived or value is None or index is None:
+                return None
+            position = entry_position(method, value.shape, index) if isinstance(value, sp.MatrixBase) else ()
+            entries[key, position] = pair
+        angles = tuple(s for s, angle in zip(self.spec.symbols["q"], self.spec.angular, strict=True) if angle)
+        return line_edit(self.spec.matlab, entries, angles)
+
     def location(self, method: str, label: str, index: int | None = None) -> str:
         """Where the entry sits: the file, the key (or Class.method) and the entry; for an entry an
         ``.m`` file writes (flat ``index``), that file and its line."""

@@ -511,13 +511,18 @@ def _findings(
     """The ``repair`` findings of one edit that makes every check pass (one per entry it changes);
     ``verdict`` says whether it is confirmed (``_Confirmation.findings``)."""
     out = []
+    line = notation.line_edit(changes)  # a .m model's repair as the one line of its file to change
+    labels = [entry_label(method, forms[method], index) for method, index in changes]
     for (method, index), (old, new) in changes.items():
         label = entry_label(method, forms[method], index)
         written, suggested = notation.entry_edit(method, index, old, new)
         location = notation.location(method, label, index)
+        if line is not None:
+            written, suggested = line.written, line.suggested
+            location = f"{line.path}, line {line.line}, which computes {', '.join(labels)}"
         shown = (
             f"{written} → {suggested}"
-            if len(written) + len(suggested) <= 160
+            if len(written) + len(suggested) <= (320 if line is not None else 160)
             else f"{notation.render(edit.old)} → {notation.render(edit.new)} in {label}"
         )
         if edit.operator == "pair":
