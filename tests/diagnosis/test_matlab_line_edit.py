@@ -39,9 +39,9 @@ in1 = ["theta"]
 PARAMS = 'model = "pendulum_m"\n[parameters]\nm = 2.0\nl = 0.5\nb = 0.1\ng = 9.81\n'
 
 
-def _check(tmp_path: Path, body: str):
+def _check(tmp_path: Path, body: str, declaration: str = DECLARATION):
     (tmp_path / "pend.m").write_text(body)
-    (tmp_path / "pend.toml").write_text(DECLARATION)
+    (tmp_path / "pend.toml").write_text(declaration)
     (tmp_path / "params.toml").write_text(PARAMS)
     argv = ["check", "--analytic", str(tmp_path / "pend.toml"), "--urdf", str(URDF)]
     return run_main([*argv, "--params", str(tmp_path / "params.toml"), "--samples", "20"])
@@ -142,3 +142,22 @@ def test_an_entry_no_assignment_computes_alone_keeps_its_whole_repair(tmp_path):
     assert done.returncode == 1, done.stdout[-3000:] + done.stderr[-2000:]
     repair = _repair(done.stdout)
     assert "which computes" not in repair and "mass.m, line 5, entry M[1,1]" in repair, repair
+
+
+def test_an_entry_the_declaration_writes_negated_is_repaired_at_its_temporary(tmp_path):
+    """OptimTraj's layout: the file returns −M entry by entry (M = [["-M11"]]); the wrong temporary
+    t3 = 2 m l² is −M11's negative, and its line is the one printed."""
+    body = (
+        "function [M11,G1] = pend(in1,m,l,g)\n"
+        "theta = in1(1,:);\n"
+        "t2 = l.^2;\n"
+        "t3 = m.*t2.*2.0;\n"  # line 4
+        "M11 = -t3;\n"
+        "G1 = g.*l.*m.*sin(theta);\n"
+    )
+    declaration = DECLARATION.replace('M = "M"\nH = "G"', 'M = [["-M11"]]\nH = ["G1"]')
+    done = _check(tmp_path, body, declaration)
+    assert done.returncode == 1, done.stdout[-3000:] + done.stderr[-2000:]
+    repair = _repair(done.stdout)
+    assert "pend.m, line 4, which computes M[1,1]" in repair and "→ t3 = m.*t2;" in repair, repair
+    assert _check(tmp_path, _applied(tmp_path, repair), declaration).returncode == 0

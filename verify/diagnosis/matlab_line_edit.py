@@ -4,10 +4,11 @@
 ``W = reshape([…,t7,…],[3,3]);`` on another), and one temporary often serves several entries
 (M's symmetric pair).  The diagnosis confirms a repair entry by entry: each entry ``(key,
 position)`` written ``old`` should be ``new``.  Its line edit is a scalar assignment ``name =
-expression`` of a file whose value is one of those entries' ``old`` (up to the output's sign)
-such that, were its right-hand side that entry's ``new``, the file's outputs would change in
-exactly the repaired entries, each to its ``new``, and nowhere else (the file is evaluated again,
-``matlab_parse.traced``).  So the line edit is the confirmed repair itself, not a guess at it.
+expression`` of a file whose value is one of those entries' ``old``, or its negative (OptimTraj's
+acrobot returns −M entry by entry), such that, were its right-hand side that entry's ``new`` (or
+its negative), the file's outputs would change in exactly the repaired entries, each to its
+``new``, and nowhere else (the file is evaluated again, ``matlab_parse.traced``; the earliest such
+line is printed).  So the line edit is the confirmed repair itself, not a guess at it.
 
 The new right-hand side is written in the file's own names: the temporaries assigned before the
 line (and the names it gives its arguments' entries, ``q2 = in1(2,:)``) replace the sub-expressions
@@ -17,6 +18,7 @@ the repaired value exactly; otherwise there is no line edit (the entry's repair 
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -58,10 +60,10 @@ def line_edit(source, changes: dict, angles: tuple = ()) -> LineEdit | None:
     (path,) = files
     function, bindings, text = source.functions[path]
     before, scalars = traced(function, bindings)
-    for assignment in scalars:
-        for old, new in cells.values():
-            if _same(assignment.value, old, angles):
-                edit = _tried(source, path, assignment, new, before, cells, scalars, text, angles)
+    for assignment in scalars:  # in the file's order: the earliest line that is the repair
+        for (old, new), sign in itertools.product(cells.values(), (1, -1)):
+            if _same(assignment.value, sign * old, angles):
+                edit = _tried(source, path, assignment, sign * new, before, cells, scalars, text, angles)
                 if edit is not None:
                     return edit
     return None
