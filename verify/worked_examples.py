@@ -1,9 +1,9 @@
 """The worked examples installed with pendverify, and copying one into a folder ready to run.
 
-An example is a model written by hand (a Python model file, and a LaTeX or text model
-where one exists), the URDF it is checked against (with xacro and MJCF versions where
-they exist), its parameter file and a scene that simulates it.  The files come from the
-shipped folders (``pendverify.shipped``) and are listed in the shipped catalogue
+An example is a model written by hand (a Python model file, and a LaTeX or text model and a
+declaration of MATLAB ``.m`` files where they exist), the URDF it is checked against (with xacro
+and MJCF versions where they exist), its parameter file and a scene that simulates it.  The files
+come from the shipped folders (``pendverify.shipped``) and are listed in the shipped catalogue
 ``examples/catalogue.toml``.
 
 ``copy_example`` lays them out in the folder as the package and the repository do, each at
@@ -54,6 +54,9 @@ class WorkedExample:
     scene: ShippedFile
     #: the same model as LaTeX or text, where one is shipped
     written_model: ShippedFile | None = None
+    #: the same model derived in MATLAB: a declaration of ``.m`` files, and those files
+    matlab_model: ShippedFile | None = None
+    matlab_files: tuple[ShippedFile, ...] = ()
     #: the URDF's robot as xacro or MJCF, where those are shipped
     descriptions: tuple[ShippedFile, ...] = ()
     #: sweep files over the model's parameters (``certify --sweep``), where those are shipped
@@ -61,13 +64,14 @@ class WorkedExample:
 
     @property
     def files(self) -> tuple[ShippedFile, ...]:
-        written = (self.written_model,) if self.written_model else ()
-        return (self.model, *written, self.urdf, *self.descriptions, self.params, self.scene, *self.sweeps)
+        models = (*self.models, *self.matlab_files)
+        return (*models, self.urdf, *self.descriptions, self.params, self.scene, *self.sweeps)
 
     @property
     def models(self) -> tuple[ShippedFile, ...]:
-        """The model files ``check --analytic`` takes: Python first, then the LaTeX or text one."""
-        return (self.model, self.written_model) if self.written_model else (self.model,)
+        """The model files ``check --analytic`` takes: Python first, then the LaTeX or text one,
+        then the declaration of ``.m`` files."""
+        return tuple(f for f in (self.model, self.written_model, self.matlab_model) if f is not None)
 
     def __repr__(self) -> str:
         files = f"{len(self.files)} files: {', '.join(str(f.path) for f in self.files)}"
@@ -85,6 +89,8 @@ ROLES = {
     "model": "model (Python)",
     "latex": "model (LaTeX)",
     "text": "model (text)",
+    "matlab": "model (MATLAB: a declaration of .m files)",
+    "matlab_files": "MATLAB function (.m)",
     "urdf": "URDF",
     "params": "parameters",
     "scene": "scene",
@@ -108,6 +114,8 @@ def _entry(table: dict) -> WorkedExample:
         table["dof"],
         **{key: _file(table[key], ROLES[key]) for key in ("model", "urdf", "params", "scene")},
         written_model=_file(table[written[0]], ROLES[written[0]]) if written else None,
+        matlab_model=_file(table["matlab"], ROLES["matlab"]) if "matlab" in table else None,
+        matlab_files=tuple(_file(spec, ROLES["matlab_files"]) for spec in table.get("matlab_files", ())),
         descriptions=tuple(
             _file(spec, DESCRIPTION_ROLES[Path(spec).suffix]) for spec in table.get("descriptions", ())
         ),
