@@ -353,3 +353,12 @@ def test_the_c_header_links_from_cpp(tmp_path):
     # the same expressions, C's pow against NumPy's power: each entry (a sum of a few positive
     # products of the parameters and cos θ2) rounds in under 16 operations, each within ε
     assert np.allclose([float(x) for x in printed.split()], expected, rtol=32 * np.finfo(float).eps, atol=0)
+
+
+def test_a_robot_given_as_xml_text_is_named_so_in_the_banner(tmp_path):
+    """The API takes the URDF's text too: the parameters the reference system reads off it are
+    those the code is checked with, and the banner does not take the text for a file name."""
+    example = _example("double_pendulum")
+    result = _export(example.model.source, "numpy", tmp_path, example.urdf.source.read_text())
+    assert result.verification.status == VERIFIED, result.verification.line
+    assert "reads off the robot description given;" in result.files[0].read_text()

@@ -22,6 +22,7 @@ from pendverify.export.casadi_code import NOT_INSTALLED, write_casadi
 from pendverify.export.closed_forms import ExportForms, export_forms
 from pendverify.export.verification import FAILED, Verification, verify
 from pendverify.export.writers import write_c, write_matlab, write_numpy
+from pendverify.robot.description import is_description_text
 
 #: language → its files' writer (``pendverify.export.writers``, ``pendverify.export.casadi_code``)
 WRITERS = {"c": write_c, "matlab": write_matlab, "numpy": write_numpy, "casadi": write_casadi}
@@ -180,9 +181,8 @@ def _joint_map(system) -> dict:
 
 
 def _description_name(urdf) -> str:
-    """The robot description's file name for the banner, or what it is when it is not a file."""
-    return (
-        f"the robot description {urdf}"
-        if isinstance(urdf, str | Path) and Path(urdf).is_file()
-        else ("the robot description given")
-    )
+    """The robot description's file for the banner, or what it is when it is not a file (its XML
+    text, or a Pinocchio model read)."""
+    if isinstance(urdf, str | Path) and not is_description_text(str(urdf)):
+        return f"the robot description {urdf}"
+    return "the robot description given"
