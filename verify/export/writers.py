@@ -50,8 +50,8 @@ C_RESERVED = frozenset(
 MATLAB_RESERVED = frozenset(
     "q v u w p M Cqdot G D B W det_M qddot pi sin cos tan exp log sqrt abs reshape".split()
 )
-#: the same for a NumPy module's functions
-NUMPY_RESERVED = frozenset("q v u w p numpy".split())
+#: the same for a NumPy module's functions (float: det M is returned as float(...))
+NUMPY_RESERVED = frozenset("q v u w p numpy float".split())
 C_KEYWORDS = frozenset(
     """auto break case char const continue default do double else enum extern float for goto if inline
     int long register restrict return short signed sizeof static struct switch typedef union unsigned
