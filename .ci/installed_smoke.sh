@@ -92,5 +92,11 @@ step pendverify simulate cart_pole/scenes/cart_pole_lqr_push.toml
 mjcf=$(shipped examples double_pendulum.mjcf.xml)
 step pendverify show --robot "$mjcf"
 step pendverify check --model double_pendulum --urdf "$mjcf"
+# the MATLAB form of a worked example, and the verified model exported as C (compiled) and NumPy
+step pendverify example minimal_double_pendulum minimal
+step pendverify check --analytic minimal/examples/minimal_double_pendulum_matlab.toml --urdf minimal/urdf/double_pendulum.urdf --params minimal/examples/minimal_double_pendulum.toml
+step pendverify export minimal/examples/minimal_double_pendulum_matlab.toml --lang c -o exported --urdf minimal/urdf/double_pendulum.urdf --params minimal/examples/minimal_double_pendulum.toml
+grep -q "Verification: pendverify check of the written code: all checks pass" exported/minimal_double_pendulum.c || { echo "FAILED: the exported C code is not verified"; exit 1; }
+step pendverify export double_pendulum --lang numpy -o exported --urdf reference/urdf/double_pendulum.urdf
 step python -m pendverify --version
 echo "installed smoke test passed"
