@@ -34,7 +34,7 @@ MAX_OPS = 400
 
 @dataclass(frozen=True)
 class LineEdit:
-    """The line of a ``.m`` file to change, as written and as repaired, and the entries it fixes."""
+    """The line of a ``.m`` file to change: where it is, as the file writes it and as repaired."""
 
     path: Path
     line: int
