@@ -95,7 +95,7 @@ class Notation:
         if source is None:
             return whole
         value = self.spec.equations[key]
-        position = entry_position(method, value.shape, index) if isinstance(value, sp.MatrixBase) else ()
+        position = _position(method, value, index)
         written = source.entry_text(key, position, old)
         if written is None:
             return whole
@@ -104,7 +104,7 @@ class Notation:
 
     def line_edit(self, changes: dict):
         """For a model of ``.m`` files, the one line of a file whose change is the confirmed repair
-        ``changes`` ({(method, flat index): (old, new)}) (``pendverify.analytic.matlab_edit``);
+        ``changes`` ({(method, flat index): (old, new)}) (``pendverify.diagnosis.matlab_line_edit``);
         None for other models, or when no single line makes exactly those changes."""
         if self.kind != "matlab":
             return None
@@ -116,7 +116,7 @@ class Notation:
             value = self.spec.equations.get(key)
             if key in self.derived or value is None or index is None:
                 return None
-            position = entry_position(method, value.shape, index) if isinstance(value, sp.MatrixBase) else ()
+            position = _position(method, value, index)
             entries[key, position] = pair
         angles = tuple(s for s, angle in zip(self.spec.symbols["q"], self.spec.angular, strict=True) if angle)
         return line_edit(self.spec.matlab, entries, angles)
@@ -134,10 +134,16 @@ class Notation:
             and key not in self.derived
         ):
             value = self.spec.equations[key]
-            position = entry_position(method, value.shape, index) if isinstance(value, sp.MatrixBase) else ()
+            position = _position(method, value, index)
             found = self.spec.matlab.line_of(key, position)
             if found is not None:
                 path, line = found
                 return f"{path}, line {line}, entry {label} (key {key} of {self.source})"
         how = f" (derived: {self.derived[key]})" if key in self.derived else ""
         return f"{self.source}, key {key}{how}, entry {label}"
+
+
+def _position(method: str, value, index: int) -> tuple[int, ...]:
+    """Where the flat ``index`` of ``method``'s entries sits in the equation's ``value``: (row,
+    column) or (row,) of a matrix, () of a scalar (``forms.entry_position``)."""
+    return entry_position(method, value.shape, index) if isinstance(value, sp.MatrixBase) else ()

@@ -96,6 +96,12 @@ class ExportForms:
             out["urdf"] = self.urdf
         return out
 
+    def dynamics_arrays(self) -> dict[str, str]:
+        """Where ``DYNAMICS`` code ``qddot(q, v, u, **p)`` finds each argument group: u holds the
+        inputs, then the disturbances (``pendverify.analytic.python_dynamics``)."""
+        nu = len(self.u)
+        return {"q": "q", "v": "v", "u": f"u[:{nu}]", "w": f"u[{nu}:]"}
+
     def dynamics_declaration(self) -> dict:
         """The declaration of q̈ alone written as ``DYNAMICS`` code: ``declaration()``, the signature
         ``qddot(q, v, u)``, and B, D and W as a text model writes them

@@ -192,11 +192,10 @@ def _shim(forms: ExportForms, head: list[str], body) -> str:
         "",
     ]
     alone = "M" not in forms.quantities  # q̈ alone: DYNAMICS code, u the inputs then the disturbances
-    nu = len(forms.u)
     for key, matrix in forms.quantities.items():
         if alone:
             parameters = ["q", "v", "u", "**p"]
-            given = {"q": "q", "v": "v", "u": f"u[:{nu}]", "w": f"u[{nu}:]"}
+            given = forms.dynamics_arrays()
         else:
             parameters = [*QUANTITIES[key][1], "p"]
             given = {a: a for a in "qvuw"}

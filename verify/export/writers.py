@@ -221,7 +221,7 @@ def write_numpy(forms: ExportForms, banner: list[str]) -> dict[str, str]:
         return {f"{prefix}_numpy.py": "\n".join(lines + _numpy_dynamics(forms, declared)) + "\n"}
     for key in forms.quantities:
         arguments = [*QUANTITIES[key][1], "p"]
-        lines += _numpy_function(forms, key, key, arguments, {a: a for a in QUANTITIES[key][1]})
+        lines += _numpy_function(forms, key, arguments, {a: a for a in QUANTITIES[key][1]})
     lines.append(f"DECLARATION = {forms.declaration()!r}")
     return {f"{prefix}_numpy.py": "\n".join(lines) + "\n"}
 
@@ -229,20 +229,18 @@ def write_numpy(forms: ExportForms, banner: list[str]) -> dict[str, str]:
 def _numpy_dynamics(forms: ExportForms, declared: ExportForms) -> list[str]:
     """q̈ as ``DYNAMICS`` code, ``qddot(q, v, u, **p)``, u the inputs then the disturbances, and
     its declaration with B, D and W written as a text model writes them."""
-    nu = len(forms.u)
-    unpack = {"q": "q", "v": "v", "u": f"u[:{nu}]", "w": f"u[{nu}:]"}
-    lines = _numpy_function(forms, "qddot", "qddot", ["q", "v", "u", "**p"], unpack)
+    lines = _numpy_function(forms, "qddot", ["q", "v", "u", "**p"], forms.dynamics_arrays())
     return [*lines, "DYNAMICS = qddot", f"DECLARATION = {declared.dynamics_declaration()!r}"]
 
 
-def _numpy_function(forms: ExportForms, key: str, name: str, arguments: list[str], unpack: dict) -> list[str]:
-    """One function ``name(arguments)`` returning ``key``'s value; ``unpack`` says which array
-    each argument group (q, v, u, w) is read from."""
+def _numpy_function(forms: ExportForms, key: str, arguments: list[str], unpack: dict) -> list[str]:
+    """The function ``key(arguments)`` returning ``key``'s value; ``unpack`` says which array each
+    argument group (q, v, u, w) is read from."""
     fields = {s: name for s, (name, _, _) in zip(forms.p, forms.parameters, strict=True)}
     printer = numpy_printer()
     matrix = forms.quantities[key]
     shared, entries = reduced(forms, matrix)
-    lines = [f"def {name}({', '.join(arguments)}):", f'    """{QUANTITIES[key][2]}."""']
+    lines = [f"def {key}({', '.join(arguments)}):", f'    """{QUANTITIES[key][2]}."""']
     for group in QUANTITIES[key][1]:
         symbols = getattr(forms, group)
         if symbols:
