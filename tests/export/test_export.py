@@ -37,6 +37,16 @@ def _export(model, lang: str, output, *args):
     return result
 
 
+def _plant(monkeypatch, lang: str, edit) -> None:
+    """Make ``lang``'s writer plant an error: ``edit`` applied to the text of each file it writes."""
+    writer = export_files.WRITERS[lang]
+
+    def planted(forms, banner):
+        return {name: edit(text) for name, text in writer(forms, banner).items()}
+
+    monkeypatch.setitem(export_files.WRITERS, lang, planted)
+
+
 def _example(name: str):
     return next(e for e in EXAMPLES if e.name == name)
 
@@ -53,19 +63,13 @@ def test_every_worked_example_exports_verified(tmp_path, example, lang):
 @pytest.mark.parametrize("lang", LANGS)
 def test_a_planted_error_in_the_written_code_fails_its_check(tmp_path, monkeypatch, lang):
     """The check of the written code can fail: M[1,1] × 11/10 in the code (not in the model)."""
-    writer = export_files.WRITERS[lang]
-    old, new = PLANTS[lang]
-
-    def planted(forms, banner):
-        return {name: text.replace(old, new, 1) for name, text in writer(forms, banner).items()}
-
-    monkeypatch.setitem(export_files.WRITERS, lang, planted)
+    _plant(monkeypatch, lang, lambda text: text.replace(*PLANTS[lang], 1))
     example = _example("minimal_double_pendulum")
     result = _export(example.model.source, lang, tmp_path, example.urdf.source, example.params.source)
     assert result.verification.status == FAILED, result.verification.line
     failing = result.verification.line.split("written code: ")[1].split(" FAIL")[0].split(", ")
     assert "crba" in failing, result.verification.line
-    assert any(new in path.read_text() for path in result.files)  # written, and marked as failing
+    assert any(PLANTS[lang][1] in path.read_text() for path in result.files)  # written, and marked as failing
     assert all("FAIL" in path.read_text() for path in result.files)
 
 
@@ -172,15 +176,10 @@ def test_the_models_own_qddot_and_det_m_are_written_and_checked(tmp_path, monkey
     """The reference double pendulum writes its own q̈ (f + g·u) and det M: both are exported, and
     the check of the written code compares them with Pinocchio: an error planted in either fails
     its check alone."""
-    writer = export_files.WRITERS[lang]
     if key is not None:
-        old, new = FIRST_VALUE[lang]
-        start = FUNCTION_STARTS[lang, key]
-
-        def planted(forms, banner):
-            return {name: _planted_in(text, start, old, new) for name, text in writer(forms, banner).items()}
-
-        monkeypatch.setitem(export_files.WRITERS, lang, planted)
+        _plant(
+            monkeypatch, lang, lambda text: _planted_in(text, FUNCTION_STARTS[lang, key], *FIRST_VALUE[lang])
+        )
     example = _example("double_pendulum")
     result = _export(example.model.source, lang, tmp_path, example.urdf.source)
     written = "".join(path.read_text() for path in result.files)
@@ -206,19 +205,13 @@ def test_a_model_of_qddot_alone_exports_its_qddot_verified(tmp_path, monkeypatch
     """gymnasium's acrobot gives q̈ alone (one input, M not determined): its q̈, D and B are written
     (NumPy as DYNAMICS code) and ``aba`` checks the written q̈; × 11/10 in it, that fails."""
     if plant:
-        writer = export_files.WRITERS[lang]
-        old, new = FIRST_VALUE[lang]
         start = {
             "c": "void acrobot_gym_qddot_acceleration(",
             "matlab": "function qddot",
             "numpy": "def qddot(",
             "casadi": "def _acceleration(",
         }[lang]
-
-        def planted(forms, banner):
-            return {name: _planted_in(text, start, old, new) for name, text in writer(forms, banner).items()}
-
-        monkeypatch.setitem(export_files.WRITERS, lang, planted)
+        _plant(monkeypatch, lang, lambda text: _planted_in(text, start, *FIRST_VALUE[lang]))
     model, urdf, params = (REPO / "examples" / name for name in ACROBOT_QDDOT)
     result = _export(model, lang, tmp_path, urdf, params)
     names = {path.name for path in result.files}
