@@ -75,8 +75,9 @@ def _tried(
     """The edit ``assignment``'s right-hand side → ``new``, if it changes exactly ``cells``."""
     function, bindings, _ = source.functions[path]
     after, _ = traced(function, bindings, (assignment.index, new))
+    used = source.used  # read off the declaration's text: once, not per output
     for name, output in before.items():
-        if name not in source.used:
+        if name not in used:
             continue  # a script's temporary: every name a script assigns is an output
         value, changed = output.value, after[name].value
         for cell in _cells(value):
