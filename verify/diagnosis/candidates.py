@@ -43,7 +43,7 @@ from pendverify.analytic.symbolic_reading import SymbolicModel, entries
 from pendverify.diagnosis.clock import now
 from pendverify.diagnosis.patterns import basis_for, fit
 from pendverify.diagnosis.slots import QUANTITY, SCREEN_RTOL, Slot
-from pendverify.symbolic.edits import Edit, replace_at, structural_edits, sums, walk, with_term
+from pendverify.symbolic.edits import Edit, phrase, replace_at, structural_edits, sums, walk, with_term
 
 DEGREE = 3
 MAX_PAIRS = 40
@@ -102,7 +102,7 @@ def _coefficient_edits(slot: Slot, evaluate) -> list[Edit]:
             new = factor * term
             expr = new if whole else with_term(slot.expr, path, terms, i, new)
             operator = {0: "drop", -1: "sign"}.get(k, "scale")
-            out.append(Edit(operator, term, new, expr, f"{term} → {new}"))
+            out.append(Edit(operator, term, new, expr, phrase("{} → {}", term, new)))
     return out
 
 
@@ -138,7 +138,7 @@ def _number_edits(slot: Slot, evaluate) -> list[Edit]:
         new = sp.Rational(fraction.numerator, fraction.denominator)
         if new != number:
             expr = slot.expr.xreplace({number: new})
-            out.append(Edit("number", number, new, expr, f"{number} → {new}"))
+            out.append(Edit("number", number, new, expr, phrase("{} → {}", number, new)))
     return out
 
 
@@ -326,7 +326,9 @@ def _restored_term_edits(slot: Slot, pool) -> list[Edit]:
             else:
                 continue
             added = next(iter(missing))
-            out.append(Edit("drop", node, new, replace_at(slot.expr, path, new), f"add {added} to {node}"))
+            out.append(
+                Edit("drop", node, new, replace_at(slot.expr, path, new), phrase("add {} to {}", added, node))
+            )
     return out
 
 
@@ -433,7 +435,9 @@ def expression_edits(expr, sm) -> Iterator[Edit]:
         for i, term in enumerate(terms):
             for k in COEFFICIENTS[:4]:
                 new = sp.Rational(k.numerator, k.denominator) * term
-                yield Edit("scale", term, new, with_term(expr, path, terms, i, new), f"{term} → {new}")
+                yield Edit(
+                    "scale", term, new, with_term(expr, path, terms, i, new), phrase("{} → {}", term, new)
+                )
     yield from structural_edits(expr, sm.angles, sm.symbols["v"], sm.kinds)
 
 
@@ -464,7 +468,13 @@ def pairs_within(slot: Slot, sm, evaluate, pool, deadline: float) -> list[Edit]:
         for second, _, mismatch in _evaluated(inner, seconds, sm, evaluate, deadline):
             if mismatch <= SCREEN_RTOL and second.expr != slot.expr:
                 out.append(
-                    Edit("pair", slot.expr, second.expr, second.expr, f"{first.what}, then {second.what}")
+                    Edit(
+                        "pair",
+                        slot.expr,
+                        second.expr,
+                        second.expr,
+                        phrase("{}, then {}", first.words, second.words),
+                    )
                 )
     return out
 

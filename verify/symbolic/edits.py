@@ -22,8 +22,11 @@ pivot            a term ± m·r² added (an inertia about the   add a term (fitt
 
 The coefficient and added-term inverses are not enumerated but solved for from the
 numbers (``pendverify.diagnosis.repair``); the others are enumerated here (``structural_edits``).
-Every edit is ``Edit(operator, old, new, expr, what)``: the sub-expression replaced, its
-replacement, the whole new entry and the edit in words.
+Every edit is ``Edit(operator, old, new, expr, words)``: the sub-expression replaced, its
+replacement, the whole new entry and the edit in words (``what``).  The words are a ``Phrase``
+where they name SymPy expressions, formatted only when read: a repair search screens thousands
+of edits and shows a few, and printing an expression costs more than evaluating it (the repair
+search of gymnasium's acrobot spent 10 of its 23 s printing the words of edits it then dropped).
 """
 
 from __future__ import annotations
@@ -38,14 +41,36 @@ SHIFTS = (sp.pi / 2, -sp.pi / 2, sp.pi)
 
 
 @dataclass(frozen=True)
+class Phrase:
+    """Words with SymPy expressions in them, ``template.format(*args)`` when read (module docstring)."""
+
+    template: str
+    args: tuple
+
+    def __str__(self) -> str:
+        return self.template.format(*self.args)
+
+
+def phrase(template: str, *args) -> Phrase:
+    """``template.format(*args)``, put off until it is read."""
+    return Phrase(template, args)
+
+
+@dataclass(frozen=True)
 class Edit:
-    """One edit of one entry: ``old`` (a sub-expression) became ``new``; ``expr`` is the new entry."""
+    """One edit of one entry: ``old`` (a sub-expression) became ``new``; ``expr`` is the new entry;
+    ``words`` say it (``what``)."""
 
     operator: str
     old: sp.Expr
     new: sp.Expr
     expr: sp.Expr
-    what: str
+    words: str | Phrase
+
+    @property
+    def what(self) -> str:
+        """The edit in words."""
+        return str(self.words)
 
 
 def walk(node, path=()) -> Iterator[tuple[sp.Basic, tuple[int, ...]]]:
@@ -86,18 +111,26 @@ def term_edits(expr, rates, factors=()) -> Iterator[Edit]:
     inside one term."""
     for path, terms in sums(expr):
         for i, term in enumerate(terms):
-            yield Edit("sign", term, -term, with_term(expr, path, terms, i, -term), f"{term} → {-term}")
-            yield Edit("drop", term, sp.S.Zero, with_term(expr, path, terms, i, None), f"drop {term}")
+            yield Edit(
+                "sign", term, -term, with_term(expr, path, terms, i, -term), phrase("{} → {}", term, -term)
+            )
+            yield Edit(
+                "drop", term, sp.S.Zero, with_term(expr, path, terms, i, None), phrase("drop {}", term)
+            )
             for operator, factor, words in factors:
                 new = factor * term
                 yield Edit(
-                    operator, term, new, with_term(expr, path, terms, i, new), f"{term} → {words}·{term}"
+                    operator,
+                    term,
+                    new,
+                    with_term(expr, path, terms, i, new),
+                    phrase("{} → {}·{}", term, words, term),
                 )
             for a, b in combinations(rates, 2):
                 if term.has(a) or term.has(b):
                     swapped = term.xreplace({a: b, b: a})
                     new = with_term(expr, path, terms, i, swapped)
-                    yield Edit("swap θ̇", term, swapped, new, f"{a} ↔ {b} in {term}")
+                    yield Edit("swap θ̇", term, swapped, new, phrase("{} ↔ {} in {}", a, b, term))
 
 
 def trig_edits(expr, angles, offsets: bool = False) -> Iterator[Edit]:
@@ -106,16 +139,26 @@ def trig_edits(expr, angles, offsets: bool = False) -> Iterator[Edit]:
         if not isinstance(node, (sp.sin, sp.cos)):
             continue
         other = (sp.cos if isinstance(node, sp.sin) else sp.sin)(*node.args)
-        yield Edit("sin↔cos", node, other, replace_at(expr, path, other), f"{node} → {other}")
+        yield Edit("sin↔cos", node, other, replace_at(expr, path, other), phrase("{} → {}", node, other))
         arg = node.args[0]
         for a, b in combinations(angles, 2):
             if arg.has(a) or arg.has(b):
                 swapped = node.func(arg.xreplace({a: b, b: a}))
-                yield Edit("swap θ", node, swapped, replace_at(expr, path, swapped), f"{a} ↔ {b} in {node}")
+                yield Edit(
+                    "swap θ",
+                    node,
+                    swapped,
+                    replace_at(expr, path, swapped),
+                    phrase("{} ↔ {} in {}", a, b, node),
+                )
         for shift in SHIFTS if offsets else ():
             shifted = node.func(arg + shift)
             yield Edit(
-                "offset", node, shifted, replace_at(expr, path, shifted), f"{arg} → {arg + shift} in {node}"
+                "offset",
+                node,
+                shifted,
+                replace_at(expr, path, shifted),
+                phrase("{} → {} in {}", arg, arg + shift, node),
             )
 
 
@@ -131,7 +174,7 @@ def parameter_edits(expr, kinds: dict) -> Iterator[Edit]:
         for other in sorted(kinds, key=str):
             if other != p and kinds[other] == kinds[p]:
                 new = replaced(other)
-                yield Edit("parameter", node, new, replace_at(expr, path, new), f"{node} → {new}")
+                yield Edit("parameter", node, new, replace_at(expr, path, new), phrase("{} → {}", node, new))
 
 
 def folded_parameter_edits(expr, kinds: dict) -> Iterator[Edit]:
@@ -146,7 +189,7 @@ def folded_parameter_edits(expr, kinds: dict) -> Iterator[Edit]:
         for other in sorted(kinds, key=str):
             if other != p and kinds[other] == kinds[p]:
                 new = (k - 1) * p + other
-                yield Edit("parameter", node, new, replace_at(expr, path, new), f"{node} → {new}")
+                yield Edit("parameter", node, new, replace_at(expr, path, new), phrase("{} → {}", node, new))
 
 
 def structural_edits(expr, angles, rates, kinds: dict) -> Iterator[Edit]:
