@@ -89,23 +89,36 @@ class MatlabSource:
         words = {w for text in texts for w in re.findall(r"[A-Za-z_]\w*", text)}
         return (words & set(self.outputs)) | set(self.whole.values())
 
-    def line_of(self, key: str, position: tuple[int, ...]) -> tuple[Path, int] | None:
-        """(file, line) where the entry at ``position`` of equation ``key`` was written, if known:
-        the entry of a whole matrix output, or an entry the declaration writes as one scalar output."""
+    def output_cell(self, key: str, position: tuple[int, ...]) -> tuple[str, tuple[int, int], int] | None:
+        """(output name, its cell, the sign the declaration gives it) of the entry at ``position`` of
+        equation ``key``, if known: a cell of a whole matrix output (``M = "W"``, ``"-W"``), or an
+        entry the declaration writes as one output (``"-M12"``: cell (0, 0))."""
         if key in self.whole:
-            path, output = self.outputs[self.whole[key]]
+            name = self.whole[key]
+            sign = -1 if str(self.written.get(key, "")).strip().startswith("-") else 1
+            value = self.outputs[name][1].value
             cell = position if len(position) == 2 else (*position, 0)
-            value = output.value
             if isinstance(value, sp.MatrixBase) and value.shape[0] == 1 and len(position) == 1:
                 cell = (0, position[0])
-            return path, output.line_of(cell)
-        entry_text = self.entry_text(key, position)
-        if entry_text is not None:
-            name = entry_text.strip().lstrip("+-").strip()
-            if name in self.outputs:
-                path, output = self.outputs[name]
-                return path, output.line
-        return None
+            return name, cell, sign
+        text = self.entry_text(key, position)
+        if text is None:
+            return None
+        stripped = text.strip()
+        name = stripped.lstrip("+-").strip()
+        if name not in self.outputs:
+            return None
+        return name, (0, 0), -1 if stripped.startswith("-") else 1
+
+    def line_of(self, key: str, position: tuple[int, ...]) -> tuple[Path, int] | None:
+        """(file, line) where the entry at ``position`` of equation ``key`` was written, if known
+        (``output_cell``)."""
+        found = self.output_cell(key, position)
+        if found is None:
+            return None
+        name, cell, _ = found
+        path, output = self.outputs[name]
+        return path, output.line_of(cell) if key in self.whole else output.line
 
 
 def read_matlab(reader, spec, table) -> tuple[MatlabSource, dict[str, object]]:

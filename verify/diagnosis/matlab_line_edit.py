@@ -96,23 +96,12 @@ def _tried(
 
 
 def _cell(source, key: str, position: tuple[int, ...]):
-    """(output name, its cell, the sign the declaration gives it) of an equation entry, or None."""
-    if key in source.whole:
-        name = source.whole[key]
-        sign = -1 if str(source.written.get(key, "")).strip().startswith("-") else 1
-        value = source.outputs[name][1].value
-        cell = position if len(position) == 2 else (*position, 0)
-        if isinstance(value, sp.MatrixBase) and value.shape[0] == 1 and len(position) == 1:
-            cell = (0, position[0])
-        return name, cell, sign
-    text = source.entry_text(key, position)
-    if text is None:
-        return None
-    stripped = text.strip()
-    name = stripped.lstrip("+-").strip()
-    if name not in source.outputs or isinstance(source.outputs[name][1].value, sp.MatrixBase):
-        return None
-    return name, (0, 0), -1 if stripped.startswith("-") else 1
+    """(output name, its cell, its sign) of an equation entry (``MatlabSource.output_cell``), or
+    None; an entry written as a matrix output's name is not one scalar assignment's."""
+    found = source.output_cell(key, position)
+    if found is None or key in source.whole:
+        return found
+    return None if isinstance(source.outputs[found[0]][1].value, sp.MatrixBase) else found
 
 
 def _cells(value) -> list[tuple[int, int]]:
