@@ -133,13 +133,11 @@ def write_c(forms: ExportForms, banner: list[str]) -> dict[str, str]:
             for a in "qvuw"
             for s in used(forms, shared, entries, getattr(forms, a))
         ]
-        body += [
-            f"    const double {s.name} = p->{fields[forms.p.index(s)]};"
-            for s in used(forms, shared, entries, forms.p)
-        ]
+        params = used(forms, shared, entries, forms.p)
+        body += [f"    const double {s.name} = p->{fields[forms.p.index(s)]};" for s in params]
         body += [f"    const double {t.name} = {sp.ccode(e, standard='c99')};" for t, e in shared]
         body += [f"    out[{k}] = {sp.ccode(e, standard='c99')};" for k, e in enumerate(entries)]
-        if not used(forms, shared, entries, forms.p):
+        if not params:
             body.insert(0, "    (void)p;")
         source += [f"{declaration}", "{", *body, "}", ""]
     header += ["#ifdef __cplusplus", "}", "#endif", "", f"#endif /* {guard} */", ""]
