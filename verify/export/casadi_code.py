@@ -80,9 +80,9 @@ def write_casadi(forms: ExportForms, banner: list[str]) -> dict[str, str]:
         "",
     ]
     built = []
+    sizes = {a: len(getattr(forms, a)) for a in "qvuwp"}
     for key, matrix in forms.quantities.items():
         arguments = [*forms.arguments(key), "p"]
-        sizes = {a: len(getattr(forms, a)) for a in "qvuwp"}
         shared, entries = reduced(forms, matrix)
         body = [f'    {a} = casadi.SX.sym("{a}", {sizes[a]})' for a in arguments]
         body += [
