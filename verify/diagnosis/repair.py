@@ -513,13 +513,13 @@ def _findings(
     out = []
     line = notation.line_edit(changes)  # a .m model's repair as the one line of its file to change
     labels = [entry_label(method, forms[method], index) for method, index in changes]
-    for (method, index), (old, new) in changes.items():
-        label = entry_label(method, forms[method], index)
-        written, suggested = notation.entry_edit(method, index, old, new)
-        location = notation.location(method, label, index)
+    for ((method, index), (old, new)), label in zip(changes.items(), labels, strict=True):
         if line is not None:
             written, suggested = line.written, line.suggested
             location = f"{line.path}, line {line.line}, which computes {', '.join(labels)}"
+        else:
+            written, suggested = notation.entry_edit(method, index, old, new)
+            location = notation.location(method, label, index)
         shown = (
             f"{written} → {suggested}"
             if len(written) + len(suggested) <= (320 if line is not None else 160)
